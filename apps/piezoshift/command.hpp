@@ -1,0 +1,16 @@
+#pragma once
+// How a subcommand plugs into the piezoshift program: add_*_command() declares the subcommand and
+// its options on the CLI11 app; when CLI11 selects it, its callback stores the action to run.
+// main() runs that action once parsing is complete, inside the one place that maps errors to exit
+// statuses (bad input: 2).
+#include <functional>
+
+#include <CLI/CLI.hpp>
+
+namespace piezoshift::app {
+
+using Action = std::function<int()>;
+
+void add_design_command(CLI::App& app, Action& action);
+
+}  // namespace piezoshift::app

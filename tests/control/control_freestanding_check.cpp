@@ -1,0 +1,31 @@
+// Built with -fno-exceptions -fno-rtti: proves the controller core needs neither, and that a full
+// controller tick is usable in a constant expression (so it cannot allocate).
+#include "piezoshift/control/semi_closed_loop.hpp"
+
+namespace {
+
+using piezoshift::control::SemiClosedLoopController;
+using piezoshift::control::Vec3;
+
+constexpr double first_tick_dac_V() {
+  SemiClosedLoopController c;
+  const auto out = c.update(Vec3{5.0, 5.0, 5.0}, Vec3{0.0, 0.0, 0.0});
+  return out.dac_V[0];
+}
+
+// First tick from rest: u = (kp + ki + kd) e = 0.801 e, e = S_1 = (A p(5) 1)_1, then x 0.625 V/um.
+constexpr double kP5 = ((-0.0001009 * 5.0 + 0.000389) * 5.0 + 1.014) * 5.0 + 0.2914;
+constexpr double kExpected = 0.801 * kP5 * (-0.4218 + 0.6030 + 0.6547) * 0.625;
+static_assert(first_tick_dac_V() - kExpected < 1e-12 && kExpected - first_tick_dac_V() < 1e-12);
+static_assert(noexcept(SemiClosedLoopController{}.update(Vec3{}, Vec3{})));
+
+}  // namespace
+
+int main() {
+  SemiClosedLoopController c;
+  Vec3 sgs{0.0, 0.0, 0.0};
+  double last = 0.0;
+  for (int k = 0; k < 5; ++k)
+    last = c.update(Vec3{5.0, 5.0, 5.0}, sgs).dac_V[1];
+  return (last > 0.0 && last <= 10.0) ? 0 : 1;
+}
