@@ -2,7 +2,7 @@
 // How a subcommand plugs into the piezoshift program: add_*_command() declares the subcommand and
 // its options on the CLI11 app; when CLI11 selects it, its callback stores the action to run.
 // main() runs that action once parsing is complete, inside the one place that maps errors to exit
-// statuses (bad input: 2).
+// statuses (bad input: 2). One file per subcommand: <name>_command.cpp.
 #include <functional>
 
 #include <CLI/CLI.hpp>
@@ -11,6 +11,9 @@ namespace piezoshift::app {
 
 using Action = std::function<int()>;
 
-void add_design_command(CLI::App& app, Action& action);
+void add_design_command(CLI::App& app, Action& action);    // design_command.cpp
+void add_simulate_command(CLI::App& app, Action& action);  // simulate_command.cpp
+void add_fit_command(CLI::App& app, Action& action);       // fit_command.cpp
+void add_analyze_command(CLI::App& app, Action& action);   // analyze_command.cpp
 
 }  // namespace piezoshift::app

@@ -15,6 +15,9 @@ int main(int argc, char** argv) {
 
   piezoshift::app::Action action;
   piezoshift::app::add_design_command(app, action);
+  piezoshift::app::add_simulate_command(app, action);
+  piezoshift::app::add_fit_command(app, action);
+  piezoshift::app::add_analyze_command(app, action);
 
   try {
     app.parse(argc, argv);

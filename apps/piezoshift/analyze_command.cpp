@@ -1,0 +1,11 @@
+// `piezoshift analyze`: placeholder, being written.
+#include "command.hpp"
+
+namespace piezoshift::app {
+
+void add_analyze_command(CLI::App& app, Action& action) {
+  CLI::App* cmd = app.add_subcommand("analyze", "(not yet available)");
+  cmd->callback([&action] { action = [] { return 1; }; });
+}
+
+}  // namespace piezoshift::app

@@ -1,0 +1,11 @@
+// `piezoshift simulate`: placeholder, being written.
+#include "command.hpp"
+
+namespace piezoshift::app {
+
+void add_simulate_command(CLI::App& app, Action& action) {
+  CLI::App* cmd = app.add_subcommand("simulate", "(not yet available)");
+  cmd->callback([&action] { action = [] { return 1; }; });
+}
+
+}  // namespace piezoshift::app

@@ -1,0 +1,88 @@
+#pragma once
+// Reading TOML configuration files (toml++) into the project's parameter structs.
+//
+//   io::ConfigFile cfg = io::ConfigFile::load("my.toml");
+//   io::ConfigSection a = cfg.section("actuator");
+//   a.read("stiffness_N_per_um", params.stiffness_N_per_um, io::Bounds::positive());
+//   cfg.reject_unknown();   // every key in the file must have been read by someone
+//
+// A key that is absent leaves the struct's default (the paper's value) untouched. A wrong type, a
+// value out of bounds, NaN or infinity, a syntax error, and (through reject_unknown) a key or
+// section nobody asked for each throw io::InputError naming the file, the key and the reason.
+#include <array>
+#include <cstdint>
+#include <memory>
+#include <string>
+#include <string_view>
+
+namespace piezoshift::io {
+
+//! Allowed range for a number; the bound is open (excluded) where the flag says so.
+struct Bounds {
+  double lo = -1e308;
+  double hi = 1e308;
+  bool lo_open = false;
+  bool hi_open = false;
+
+  static constexpr Bounds any() { return {}; }
+  static constexpr Bounds positive() { return {0.0, 1e308, true, false}; }
+  static constexpr Bounds non_negative() { return {0.0, 1e308, false, false}; }
+  static constexpr Bounds closed(double lo, double hi) { return {lo, hi, false, false}; }
+  static constexpr Bounds open(double lo, double hi) { return {lo, hi, true, true}; }
+
+  bool contains(double v) const;
+  std::string describe() const;  //!< e.g. "> 0" or "in [0, 1]"
+};
+
+class ConfigFile;
+
+//! One [section] (or [a.b] nested table) of a configuration file. Absent sections read as empty.
+class ConfigSection {
+ public:
+  //! Each read() leaves value untouched when the key is absent; returns whether it was present.
+  bool read(std::string_view key, double& value, Bounds bounds = Bounds::any()) const;
+  bool read(std::string_view key, std::int64_t& value, Bounds bounds = Bounds::any()) const;
+  bool read(std::string_view key, bool& value) const;
+  bool read(std::string_view key, std::string& value) const;
+  bool read(std::string_view key, std::array<double, 3>& value,
+            Bounds bounds = Bounds::any()) const;
+  //! A 3x3 matrix as a list of three rows.
+  bool read(std::string_view key, std::array<std::array<double, 3>, 3>& value,
+            Bounds bounds = Bounds::any()) const;
+
+  bool has(std::string_view key) const;
+  const std::string& name() const { return name_; }
+
+ private:
+  friend class ConfigFile;
+  ConfigSection(const ConfigFile* file, std::string name) : file_(file), name_(std::move(name)) {}
+  const ConfigFile* file_;
+  std::string name_;
+};
+
+class ConfigFile {
+ public:
+  //! Parses a file; a missing file or a syntax error throws InputError with file, line, column.
+  static ConfigFile load(const std::string& path);
+  //! Parses text (tests, built-in defaults); source_name stands in for the file name in messages.
+  static ConfigFile parse(std::string_view text, const std::string& source_name);
+
+  ConfigFile(ConfigFile&&) noexcept;
+  ConfigFile& operator=(ConfigFile&&) noexcept;
+  ~ConfigFile();
+
+  //! A dotted name reaches nested tables: section("twin.amplifier").
+  ConfigSection section(std::string_view dotted_name) const;
+  //! Throws InputError naming the first key (in file order) that no read() asked for.
+  void reject_unknown() const;
+
+  const std::string& source() const;
+
+ private:
+  friend class ConfigSection;
+  struct Impl;
+  explicit ConfigFile(std::unique_ptr<Impl> impl);
+  std::unique_ptr<Impl> impl_;
+};
+
+}  // namespace piezoshift::io

@@ -1,0 +1,246 @@
+#include "piezoshift/io/config_file.hpp"
+
+#include <cmath>
+#include <set>
+#include <sstream>
+
+#include <fmt/core.h>
+#include <toml++/toml.h>
+
+#include "piezoshift/io/input_error.hpp"
+
+namespace piezoshift::io {
+
+bool Bounds::contains(double v) const {
+  if (!std::isfinite(v))
+    return false;
+  const bool above = lo_open ? v > lo : v >= lo;
+  const bool below = hi_open ? v < hi : v <= hi;
+  return above && below;
+}
+
+std::string Bounds::describe() const {
+  const bool no_lo = lo <= -1e308, no_hi = hi >= 1e308;
+  if (no_lo && no_hi)
+    return "a finite number";
+  if (no_hi)
+    return fmt::format("{} {}", lo_open ? ">" : ">=", lo);
+  if (no_lo)
+    return fmt::format("{} {}", hi_open ? "<" : "<=", hi);
+  return fmt::format("in {}{}, {}{}", lo_open ? "(" : "[", lo, hi, hi_open ? ")" : "]");
+}
+
+struct ConfigFile::Impl {
+  std::string source;
+  toml::table root;
+  mutable std::set<std::string> used;  // dotted paths read so far
+
+  [[noreturn]] void fail(const std::string& path, const toml::source_region& where,
+                         const std::string& reason) const {
+    if (where.begin.line > 0) {
+      throw InputError(fmt::format("{}:{}:{}: {}: {}", source, where.begin.line, where.begin.column,
+                                   path, reason));
+    }
+    throw InputError(fmt::format("{}: {}: {}", source, path, reason));
+  }
+
+  const toml::node* find(const std::string& section, std::string_view key) const {
+    const toml::node* table = section.empty() ? &root : root.at_path(section).node();
+    if (table == nullptr || !table->is_table())
+      return nullptr;
+    return table->as_table()->get(key);
+  }
+
+  double number(const std::string& path, const toml::node& n, Bounds b) const {
+    double v = 0.0;
+    if (const auto* f = n.as_floating_point()) {
+      v = f->get();
+    } else if (const auto* i = n.as_integer()) {
+      v = static_cast<double>(i->get());
+    } else {
+      fail(path, n.source(),
+           fmt::format("expected a number, found {}",
+                       toml::impl::node_type_friendly_names[static_cast<int>(n.type())]));
+    }
+    if (!b.contains(v)) {
+      fail(path, n.source(), fmt::format("value {} is not allowed: must be {}", v, b.describe()));
+    }
+    return v;
+  }
+
+  void collect_unknown(const toml::table& t, const std::string& prefix) const {
+    for (const auto& [k, node] : t) {
+      const std::string path =
+          prefix.empty() ? std::string(k.str()) : prefix + "." + std::string(k.str());
+      if (node.is_table() && !used.count(path)) {
+        collect_unknown(*node.as_table(), path);
+      } else if (!used.count(path)) {
+        fail(path, node.source(),
+             node.is_table() ? "unknown section" : "unknown key (check its spelling and section)");
+      }
+    }
+  }
+};
+
+ConfigFile::ConfigFile(std::unique_ptr<Impl> impl) : impl_(std::move(impl)) {}
+ConfigFile::ConfigFile(ConfigFile&&) noexcept = default;
+ConfigFile& ConfigFile::operator=(ConfigFile&&) noexcept = default;
+ConfigFile::~ConfigFile() = default;
+
+ConfigFile ConfigFile::load(const std::string& path) {
+  auto impl = std::make_unique<Impl>();
+  impl->source = path;
+  try {
+    impl->root = toml::parse_file(path);
+  } catch (const toml::parse_error& e) {
+    const auto& b = e.source().begin;
+    if (b.line == 0)
+      throw InputError(fmt::format("{}: cannot read: {}", path, e.description()));
+    throw InputError(
+        fmt::format("{}:{}:{}: syntax error: {}", path, b.line, b.column, e.description()));
+  }
+  return ConfigFile(std::move(impl));
+}
+
+ConfigFile ConfigFile::parse(std::string_view text, const std::string& source_name) {
+  auto impl = std::make_unique<Impl>();
+  impl->source = source_name;
+  try {
+    impl->root = toml::parse(text, source_name);
+  } catch (const toml::parse_error& e) {
+    const auto& b = e.source().begin;
+    throw InputError(
+        fmt::format("{}:{}:{}: syntax error: {}", source_name, b.line, b.column, e.description()));
+  }
+  return ConfigFile(std::move(impl));
+}
+
+const std::string& ConfigFile::source() const {
+  return impl_->source;
+}
+
+ConfigSection ConfigFile::section(std::string_view dotted_name) const {
+  const std::string name(dotted_name);
+  if (const toml::node* n = impl_->root.at_path(name).node(); n != nullptr && !n->is_table()) {
+    impl_->fail(name, n->source(), "expected a section (table)");
+  }
+  return ConfigSection(this, name);
+}
+
+void ConfigFile::reject_unknown() const {
+  impl_->collect_unknown(impl_->root, "");
+}
+
+namespace {
+std::string join(const std::string& section, std::string_view key) {
+  return section.empty() ? std::string(key) : section + "." + std::string(key);
+}
+}  // namespace
+
+bool ConfigSection::has(std::string_view key) const {
+  return file_->impl_->find(name_, key) != nullptr;
+}
+
+bool ConfigSection::read(std::string_view key, double& value, Bounds bounds) const {
+  const auto& impl = *file_->impl_;
+  const toml::node* n = impl.find(name_, key);
+  if (n == nullptr)
+    return false;
+  const std::string path = join(name_, key);
+  impl.used.insert(path);
+  value = impl.number(path, *n, bounds);
+  return true;
+}
+
+bool ConfigSection::read(std::string_view key, std::int64_t& value, Bounds bounds) const {
+  const auto& impl = *file_->impl_;
+  const toml::node* n = impl.find(name_, key);
+  if (n == nullptr)
+    return false;
+  const std::string path = join(name_, key);
+  impl.used.insert(path);
+  const auto* i = n->as_integer();
+  if (i == nullptr)
+    impl.fail(path, n->source(), "expected an integer");
+  if (!bounds.contains(static_cast<double>(i->get()))) {
+    impl.fail(path, n->source(),
+              fmt::format("value {} is not allowed: must be {}", i->get(), bounds.describe()));
+  }
+  value = i->get();
+  return true;
+}
+
+bool ConfigSection::read(std::string_view key, bool& value) const {
+  const auto& impl = *file_->impl_;
+  const toml::node* n = impl.find(name_, key);
+  if (n == nullptr)
+    return false;
+  const std::string path = join(name_, key);
+  impl.used.insert(path);
+  const auto* b = n->as_boolean();
+  if (b == nullptr)
+    impl.fail(path, n->source(), "expected true or false");
+  value = b->get();
+  return true;
+}
+
+bool ConfigSection::read(std::string_view key, std::string& value) const {
+  const auto& impl = *file_->impl_;
+  const toml::node* n = impl.find(name_, key);
+  if (n == nullptr)
+    return false;
+  const std::string path = join(name_, key);
+  impl.used.insert(path);
+  const auto* s = n->as_string();
+  if (s == nullptr)
+    impl.fail(path, n->source(), "expected a string");
+  value = s->get();
+  return true;
+}
+
+bool ConfigSection::read(std::string_view key, std::array<double, 3>& value, Bounds bounds) const {
+  const auto& impl = *file_->impl_;
+  const toml::node* n = impl.find(name_, key);
+  if (n == nullptr)
+    return false;
+  const std::string path = join(name_, key);
+  impl.used.insert(path);
+  const auto* a = n->as_array();
+  if (a == nullptr || a->size() != 3) {
+    impl.fail(path, n->source(), "expected a list of three numbers");
+  }
+  std::array<double, 3> v{};
+  for (std::size_t i = 0; i < 3; ++i) {
+    v[i] = impl.number(fmt::format("{}[{}]", path, i), *a->get(i), bounds);
+  }
+  value = v;
+  return true;
+}
+
+bool ConfigSection::read(std::string_view key, std::array<std::array<double, 3>, 3>& value,
+                         Bounds bounds) const {
+  const auto& impl = *file_->impl_;
+  const toml::node* n = impl.find(name_, key);
+  if (n == nullptr)
+    return false;
+  const std::string path = join(name_, key);
+  impl.used.insert(path);
+  const auto* rows = n->as_array();
+  if (rows == nullptr || rows->size() != 3) {
+    impl.fail(path, n->source(), "expected three rows of three numbers");
+  }
+  std::array<std::array<double, 3>, 3> m{};
+  for (std::size_t r = 0; r < 3; ++r) {
+    const auto* row = rows->get(r)->as_array();
+    if (row == nullptr || row->size() != 3) {
+      impl.fail(path, rows->get(r)->source(), fmt::format("row {} is not three numbers", r + 1));
+    }
+    for (std::size_t c = 0; c < 3; ++c) {
+      m[r][c] = impl.number(fmt::format("{}[{}][{}]", path, r, c), *row->get(c), bounds);
+    }
+  }
+  value = m;
+  return true;
+}
+
+}  // namespace piezoshift::io
