@@ -18,6 +18,7 @@ int main(int argc, char** argv) {
   piezoshift::app::add_simulate_command(app, action);
   piezoshift::app::add_fit_command(app, action);
   piezoshift::app::add_analyze_command(app, action);
+  piezoshift::app::add_run_command(app, action);
 
   try {
     app.parse(argc, argv);

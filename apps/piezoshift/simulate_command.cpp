@@ -1,11 +1,277 @@
-// `piezoshift simulate`: placeholder, being written.
+// `piezoshift simulate`: runs the digital twin (docs/twin.md) open loop or with the paper's
+// semi-closed-loop controller, one control tick at a time, and reports where the plate ended up.
+//
+//   piezoshift simulate --open-loop-volts 10,10,10 --duration-s 2
+//   piezoshift simulate --step-um 11 --duration-s 1 --log step.csv --json
+//   piezoshift simulate --profile staircase.csv --duration-s 120 --seed 7 --config my.toml
+//
+// Per tick: Z_d from the mode, controller (if any) on the last AI sample, twin.step(AO). The
+// profile is a staircase: from each row's t_s on, Z_d = zd_um (0 before the first row). The log
+// has one row per control tick, taken at the end of the tick (the AO held during it, the AI
+// sampled at its end, the truth and the interferometer's dynamic reading at its end).
+#include <cmath>
+#include <cstdint>
+#include <initializer_list>
+#include <memory>
+#include <optional>
+#include <string>
+#include <vector>
+
+#include <fmt/core.h>
+#include <nlohmann/json.hpp>
+
 #include "command.hpp"
+#include "piezoshift/control/semi_closed_loop.hpp"
+#include "piezoshift/io/csv_table.hpp"
+#include "piezoshift/io/csv_writer.hpp"
+#include "piezoshift/io/input_error.hpp"
+#include "piezoshift/io/project_config.hpp"
+#include "piezoshift/plant/twin.hpp"
 
 namespace piezoshift::app {
+namespace {
+
+using Json = nlohmann::ordered_json;
+using control::Vec3;
+
+struct SimulateOptions {
+  std::string config_path;  // empty: the built-in twin (configs/paper.toml's values)
+  std::uint64_t seed = 1;
+  double duration_s = 1.0;
+  std::vector<double> open_loop_volts;
+  std::optional<double> step_um;
+  double step_at_s = 0.0;
+  std::string profile_path;
+  std::string log_path;
+  bool json = false;
+};
+
+// A staircase Z_d(t): the last row with t_s <= t, 0 before the first row.
+struct Profile {
+  std::vector<double> t_s, zd_um;
+  std::size_t next = 0;
+  double current = 0.0;
+
+  double at(double t) {
+    while (next < t_s.size() && t_s[next] <= t)
+      current = zd_um[next++];
+    return current;
+  }
+};
+
+Profile load_profile(const std::string& path) {
+  const io::CsvTable table = io::CsvTable::load(path);
+  table.require_columns({"t_s", "zd_um"});
+  Profile p{table.column("t_s"), table.column("zd_um")};
+  if (p.t_s.empty())
+    throw io::InputError(fmt::format("{}: the profile has no rows", path));
+  for (std::size_t r = 0; r < p.t_s.size(); ++r) {
+    if (p.t_s[r] < 0.0 || (r > 0 && p.t_s[r] < p.t_s[r - 1])) {
+      throw io::InputError(
+          fmt::format("{}:{}: t_s = {} must be >= 0 and not less than the row before", path,
+                      table.line_of_row(r), p.t_s[r]));
+    }
+  }
+  return p;
+}
+
+std::vector<std::string> log_columns(bool closed_loop) {
+  std::vector<std::string> c{"t_s"};
+  if (closed_loop) {
+    c.push_back("zd_um");
+    for (const char* n : {"s1_um", "s2_um", "s3_um", "u1_um", "u2_um", "u3_um"})
+      c.emplace_back(n);
+  }
+  for (const char* n :
+       {"ao1_V",   "ao2_V",   "ao3_V",   "amp1_V",     "amp2_V",       "amp3_V",
+        "ai1_V",   "ai2_V",   "ai3_V",   "stack1_um",  "stack2_um",    "stack3_um",
+        "leg1_um", "leg2_um", "leg3_um", "plate_z_um", "theta_x_urad", "theta_y_urad",
+        "p1_um",   "p2_um",   "p3_um",   "ifm1_um",    "ifm2_um",      "ifm3_um"})
+    c.emplace_back(n);
+  if (closed_loop)
+    c.emplace_back("saturated_mask_bits");
+  return c;
+}
+
+Json vec_json(const Vec3& v) {
+  return Json::array({v[0], v[1], v[2]});
+}
+
+int run_simulate(const SimulateOptions& opt) {
+  const int modes = (opt.open_loop_volts.empty() ? 0 : 1) + (opt.step_um ? 1 : 0) +
+                    (opt.profile_path.empty() ? 0 : 1);
+  if (modes != 1) {
+    throw io::InputError("simulate: give exactly one of --open-loop-volts, --step-um, --profile");
+  }
+  if (!std::isfinite(opt.duration_s) || !(opt.duration_s > 0.0))
+    throw io::InputError(fmt::format("--duration-s = {} must be positive", opt.duration_s));
+  if (!std::isfinite(opt.step_at_s) || opt.step_at_s < 0.0)
+    throw io::InputError(fmt::format("--step-at-s = {} must be >= 0", opt.step_at_s));
+
+  io::ProjectConfig config;
+  if (!opt.config_path.empty())
+    config = io::load_project_config(opt.config_path);
+  plant::Twin twin(config.design, config.twin, opt.seed);
+  const double range_V = config.twin.daq.range_V;
+  const double period_s = twin.model().control_period_s;
+
+  const bool closed_loop = opt.open_loop_volts.empty();
+  Vec3 open_loop{};
+  if (!closed_loop) {
+    for (std::size_t i = 0; i < 3; ++i) {
+      const double v = opt.open_loop_volts[i];
+      if (!std::isfinite(v) || v < -range_V || v > range_V) {
+        throw io::InputError(fmt::format("--open-loop-volts: V{} = {} is outside the DAQ's +-{} V",
+                                         i + 1, v, range_V));
+      }
+      open_loop[i] = v;
+    }
+  }
+  if (opt.step_um && !std::isfinite(*opt.step_um))
+    throw io::InputError("--step-um must be a finite number");
+  Profile profile;
+  if (!opt.profile_path.empty())
+    profile = load_profile(opt.profile_path);
+
+  control::SemiClosedLoopParams cp;
+  cp.sample_time_s = period_s;  // the paper's gains, re-expressed at the twin's DAQ period
+  control::SemiClosedLoopController controller(cp);
+
+  const auto ticks = static_cast<std::uint64_t>(std::llround(opt.duration_s / period_s));
+  if (ticks < 1)
+    throw io::InputError(fmt::format("--duration-s = {} is shorter than one control period ({} s)",
+                                     opt.duration_s, period_s));
+
+  std::unique_ptr<io::CsvWriter> log;
+  if (!opt.log_path.empty()) {
+    log = std::make_unique<io::CsvWriter>(opt.log_path, log_columns(closed_loop), 9);
+    log->comment(fmt::format("piezoshift simulate: seed {}, config {}, {} s at {} s per tick",
+                             opt.seed, opt.config_path.empty() ? "built-in" : opt.config_path,
+                             opt.duration_s, period_s));
+  }
+
+  Vec3 ai = twin.read_ai();
+  std::uint64_t saturated_ticks = 0;
+  std::vector<double> row;
+  for (std::uint64_t k = 0; k < ticks; ++k) {
+    const double t = static_cast<double>(k) * period_s;
+    control::ControllerOutput out{};
+    double zd = 0.0;
+    Vec3 ao = open_loop;
+    if (closed_loop) {
+      if (opt.step_um)
+        zd = t >= opt.step_at_s ? *opt.step_um : 0.0;
+      else
+        zd = profile.at(t);
+      out = controller.update(Vec3{zd, zd, zd}, ai);
+      ao = out.dac_V;
+      saturated_ticks += out.saturated_mask != 0 ? 1 : 0;
+    }
+    ai = twin.step(ao);
+    if (log) {
+      const plant::TwinTruth& s = twin.truth();
+      const plant::InterferometerReading& r = twin.interferometer();
+      row.clear();
+      row.push_back(s.time_s);
+      if (closed_loop) {
+        row.push_back(zd);
+        row.insert(row.end(), out.target_um.begin(), out.target_um.end());
+        row.insert(row.end(), out.command_um.begin(), out.command_um.end());
+      }
+      for (const Vec3* v : std::initializer_list<const Vec3*>{&s.ao_V, &s.amplifier_V, &ai,
+                                                              &s.stack_elongation_um, &s.leg_um})
+        row.insert(row.end(), v->begin(), v->end());
+      row.push_back(s.plate_z_um);
+      row.push_back(s.theta_x_urad);
+      row.push_back(s.theta_y_urad);
+      row.insert(row.end(), s.points_um.begin(), s.points_um.end());
+      row.insert(row.end(), r.dynamic_um.begin(), r.dynamic_um.end());
+      if (closed_loop)
+        row.push_back(static_cast<double>(out.saturated_mask));
+      log->row(row);
+    }
+  }
+  if (log)
+    log->close();
+
+  const plant::TwinTruth& s = twin.truth();
+  const plant::InterferometerReading& r = twin.interferometer();
+  const plant::TwinModel& m = twin.model();
+  const char* mode = !closed_loop ? "open_loop" : (opt.step_um ? "step" : "profile");
+  if (opt.json) {
+    Json j{{"mode", mode},
+           {"config_file", opt.config_path.empty() ? Json(nullptr) : Json(opt.config_path)},
+           {"seed", opt.seed},
+           {"duration_s", static_cast<double>(ticks) * period_s},
+           {"ticks", ticks},
+           {"control_period_s", period_s},
+           {"physics_rate_Hz", config.twin.physics_rate_Hz},
+           {"final_plate_z_um", s.plate_z_um},
+           {"final_theta_x_urad", s.theta_x_urad},
+           {"final_theta_y_urad", s.theta_y_urad},
+           {"final_points_um", vec_json(r.dynamic_um)},
+           {"final_points_static_um", vec_json(r.static_um)},
+           {"final_true_points_um", vec_json(s.points_um)},
+           {"final_ao_V", vec_json(s.ao_V)},
+           {"final_ai_V", vec_json(ai)},
+           {"final_amplifier_V", vec_json(s.amplifier_V)},
+           {"saturated_ticks", saturated_ticks},
+           {"model",
+            {{"contact_stiffness_N_per_um", m.contact_stiffness_N_per_um},
+             {"contact_identified", m.contact_identified},
+             {"mechanism_stiffness_N_per_um", m.mechanism_stiffness_N_per_um},
+             {"loaded_modes_Hz",
+              Json::array({m.loaded_modes_Hz[0], m.loaded_modes_Hz[1], m.loaded_modes_Hz[2]})},
+             {"unloaded_mechanism_Hz", m.unloaded_mechanism_Hz},
+             {"sgs_gain", vec_json(m.geometry.sgs_gain)}}}};
+    if (opt.step_um) {
+      j["step_um"] = *opt.step_um;
+      j["step_at_s"] = opt.step_at_s;
+    }
+    if (!opt.log_path.empty())
+      j["log_file"] = opt.log_path;
+    fmt::print("{}\n", j.dump(2));
+    return 0;
+  }
+  fmt::print("piezoshift simulate ({}), seed {}, {} ticks of {} s\n", mode, opt.seed, ticks,
+             period_s);
+  fmt::print("  plate Z at O          {:10.4f} um\n", s.plate_z_um);
+  fmt::print("  tilt theta_x, theta_y {:10.3f} {:10.3f} urad\n", s.theta_x_urad, s.theta_y_urad);
+  fmt::print("  points P1..P3 (true)  {:10.4f} {:10.4f} {:10.4f} um\n", s.points_um[0],
+             s.points_um[1], s.points_um[2]);
+  fmt::print("  interferometer        {:10.4f} {:10.4f} {:10.4f} um\n", r.dynamic_um[0],
+             r.dynamic_um[1], r.dynamic_um[2]);
+  fmt::print("  stack voltages        {:10.3f} {:10.3f} {:10.3f} V\n", s.amplifier_V[0],
+             s.amplifier_V[1], s.amplifier_V[2]);
+  if (closed_loop)
+    fmt::print("  saturated ticks       {:10d}\n", saturated_ticks);
+  if (!opt.log_path.empty())
+    fmt::print("  log                   {}\n", opt.log_path);
+  return 0;
+}
+
+}  // namespace
 
 void add_simulate_command(CLI::App& app, Action& action) {
-  CLI::App* cmd = app.add_subcommand("simulate", "(not yet available)");
-  cmd->callback([&action] { action = [] { return 1; }; });
+  CLI::App* cmd = app.add_subcommand(
+      "simulate", "Run the digital twin open loop or with the paper's controller (docs/twin.md)");
+  auto opt = std::make_shared<SimulateOptions>();
+  cmd->add_option("--config", opt->config_path,
+                  "TOML file (configs/paper.toml's sections; absent keys keep the paper's values)");
+  cmd->add_option("--seed", opt->seed, "seed of the twin's random numbers (default 1)");
+  cmd->add_option("--duration-s", opt->duration_s, "simulated time [s] (default 1)");
+  cmd->add_option("--open-loop-volts", opt->open_loop_volts,
+                  "open loop: the three DAQ output volts V1,V2,V3 (x15 at the stacks)")
+      ->expected(3)
+      ->delimiter(',');
+  cmd->add_option("--step-um", opt->step_um,
+                  "closed loop: step of the three points' desired displacement Z_d [um]");
+  cmd->add_option("--step-at-s", opt->step_at_s, "when the step is applied [s] (default 0)");
+  cmd->add_option("--profile", opt->profile_path,
+                  "closed loop: CSV with columns t_s,zd_um (a staircase of Z_d)");
+  cmd->add_option("--log", opt->log_path, "CSV log, one row per control tick");
+  cmd->add_flag("--json", opt->json, "print a JSON summary instead of the text one");
+  cmd->callback([&action, opt] { action = [opt] { return run_simulate(*opt); }; });
 }
 
 }  // namespace piezoshift::app

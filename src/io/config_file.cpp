@@ -1,8 +1,11 @@
 #include "piezoshift/io/config_file.hpp"
 
+#include <algorithm>
 #include <cmath>
 #include <set>
 #include <sstream>
+#include <tuple>
+#include <vector>
 
 #include <fmt/core.h>
 #include <toml++/toml.h>
@@ -30,10 +33,11 @@ std::string Bounds::describe() const {
   return fmt::format("in {}{}, {}{}", lo_open ? "(" : "[", lo, hi, hi_open ? ")" : "]");
 }
 
-struct ConfigFile::Impl {
+struct ConfigFileImpl {
   std::string source;
   toml::table root;
-  mutable std::set<std::string> used;  // dotted paths read so far
+  mutable std::set<std::string> used;      // dotted paths read so far
+  mutable std::set<std::string> sections;  // sections asked for, with their parent tables
 
   [[noreturn]] void fail(const std::string& path, const toml::source_region& where,
                          const std::string& reason) const {
@@ -62,33 +66,50 @@ struct ConfigFile::Impl {
            fmt::format("expected a number, found {}",
                        toml::impl::node_type_friendly_names[static_cast<int>(n.type())]));
     }
+    if (!std::isfinite(v)) {
+      fail(path, n.source(),
+           fmt::format("value {} is not allowed: not a finite number (must be {})", v,
+                       b.describe()));
+    }
     if (!b.contains(v)) {
       fail(path, n.source(), fmt::format("value {} is not allowed: must be {}", v, b.describe()));
     }
     return v;
   }
 
-  void collect_unknown(const toml::table& t, const std::string& prefix) const {
+  struct Unknown {
+    std::string path;
+    toml::source_region where;
+    const char* reason;
+  };
+
+  // A table nobody asked for is one unknown section (its keys are not listed one by one); inside
+  // a section asked for, every key not read is unknown. Empty unknown tables count too.
+  void collect_unknown(const toml::table& t, const std::string& prefix,
+                       std::vector<Unknown>& out) const {
     for (const auto& [k, node] : t) {
       const std::string path =
           prefix.empty() ? std::string(k.str()) : prefix + "." + std::string(k.str());
-      if (node.is_table() && !used.count(path)) {
-        collect_unknown(*node.as_table(), path);
-      } else if (!used.count(path)) {
-        fail(path, node.source(),
-             node.is_table() ? "unknown section" : "unknown key (check its spelling and section)");
+      if (used.count(path))
+        continue;
+      if (node.is_table() && sections.count(path)) {
+        collect_unknown(*node.as_table(), path, out);
+      } else if (node.is_table()) {
+        out.push_back({path, node.source(), "unknown section"});
+      } else {
+        out.push_back({path, node.source(), "unknown key (check its spelling and section)"});
       }
     }
   }
 };
 
-ConfigFile::ConfigFile(std::unique_ptr<Impl> impl) : impl_(std::move(impl)) {}
+ConfigFile::ConfigFile(std::unique_ptr<ConfigFileImpl> impl) : impl_(std::move(impl)) {}
 ConfigFile::ConfigFile(ConfigFile&&) noexcept = default;
 ConfigFile& ConfigFile::operator=(ConfigFile&&) noexcept = default;
 ConfigFile::~ConfigFile() = default;
 
 ConfigFile ConfigFile::load(const std::string& path) {
-  auto impl = std::make_unique<Impl>();
+  auto impl = std::make_unique<ConfigFileImpl>();
   impl->source = path;
   try {
     impl->root = toml::parse_file(path);
@@ -103,7 +124,7 @@ ConfigFile ConfigFile::load(const std::string& path) {
 }
 
 ConfigFile ConfigFile::parse(std::string_view text, const std::string& source_name) {
-  auto impl = std::make_unique<Impl>();
+  auto impl = std::make_unique<ConfigFileImpl>();
   impl->source = source_name;
   try {
     impl->root = toml::parse(text, source_name);
@@ -124,11 +145,27 @@ ConfigSection ConfigFile::section(std::string_view dotted_name) const {
   if (const toml::node* n = impl_->root.at_path(name).node(); n != nullptr && !n->is_table()) {
     impl_->fail(name, n->source(), "expected a section (table)");
   }
-  return ConfigSection(this, name);
+  // Asking for "a.b.c" makes "a", "a.b" and "a.b.c" known sections for reject_unknown().
+  for (std::size_t dot = name.find('.'); dot != std::string::npos; dot = name.find('.', dot + 1))
+    impl_->sections.insert(name.substr(0, dot));
+  impl_->sections.insert(name);
+  return ConfigSection(impl_.get(), name);
 }
 
 void ConfigFile::reject_unknown() const {
-  impl_->collect_unknown(impl_->root, "");
+  std::vector<ConfigFileImpl::Unknown> unknown;
+  impl_->collect_unknown(impl_->root, "", unknown);
+  if (unknown.empty())
+    return;
+  // toml++ tables iterate in key order, not file order: report the one that comes first in the
+  // file, so that fixing errors from the top down works.
+  const auto first =
+      std::min_element(unknown.begin(), unknown.end(),
+                       [](const ConfigFileImpl::Unknown& a, const ConfigFileImpl::Unknown& b) {
+                         return std::tuple(a.where.begin.line, a.where.begin.column, a.path) <
+                                std::tuple(b.where.begin.line, b.where.begin.column, b.path);
+                       });
+  impl_->fail(first->path, first->where, first->reason);
 }
 
 namespace {
@@ -138,11 +175,11 @@ std::string join(const std::string& section, std::string_view key) {
 }  // namespace
 
 bool ConfigSection::has(std::string_view key) const {
-  return file_->impl_->find(name_, key) != nullptr;
+  return file_->find(name_, key) != nullptr;
 }
 
 bool ConfigSection::read(std::string_view key, double& value, Bounds bounds) const {
-  const auto& impl = *file_->impl_;
+  const auto& impl = *file_;
   const toml::node* n = impl.find(name_, key);
   if (n == nullptr)
     return false;
@@ -153,7 +190,7 @@ bool ConfigSection::read(std::string_view key, double& value, Bounds bounds) con
 }
 
 bool ConfigSection::read(std::string_view key, std::int64_t& value, Bounds bounds) const {
-  const auto& impl = *file_->impl_;
+  const auto& impl = *file_;
   const toml::node* n = impl.find(name_, key);
   if (n == nullptr)
     return false;
@@ -171,7 +208,7 @@ bool ConfigSection::read(std::string_view key, std::int64_t& value, Bounds bound
 }
 
 bool ConfigSection::read(std::string_view key, bool& value) const {
-  const auto& impl = *file_->impl_;
+  const auto& impl = *file_;
   const toml::node* n = impl.find(name_, key);
   if (n == nullptr)
     return false;
@@ -185,7 +222,7 @@ bool ConfigSection::read(std::string_view key, bool& value) const {
 }
 
 bool ConfigSection::read(std::string_view key, std::string& value) const {
-  const auto& impl = *file_->impl_;
+  const auto& impl = *file_;
   const toml::node* n = impl.find(name_, key);
   if (n == nullptr)
     return false;
@@ -199,7 +236,7 @@ bool ConfigSection::read(std::string_view key, std::string& value) const {
 }
 
 bool ConfigSection::read(std::string_view key, std::array<double, 3>& value, Bounds bounds) const {
-  const auto& impl = *file_->impl_;
+  const auto& impl = *file_;
   const toml::node* n = impl.find(name_, key);
   if (n == nullptr)
     return false;
@@ -217,9 +254,28 @@ bool ConfigSection::read(std::string_view key, std::array<double, 3>& value, Bou
   return true;
 }
 
+bool ConfigSection::read(std::string_view key, std::array<double, 4>& value, Bounds bounds) const {
+  const auto& impl = *file_;
+  const toml::node* n = impl.find(name_, key);
+  if (n == nullptr)
+    return false;
+  const std::string path = join(name_, key);
+  impl.used.insert(path);
+  const auto* a = n->as_array();
+  if (a == nullptr || a->size() != 4) {
+    impl.fail(path, n->source(), "expected a list of four numbers");
+  }
+  std::array<double, 4> v{};
+  for (std::size_t i = 0; i < 4; ++i) {
+    v[i] = impl.number(fmt::format("{}[{}]", path, i), *a->get(i), bounds);
+  }
+  value = v;
+  return true;
+}
+
 bool ConfigSection::read(std::string_view key, std::array<std::array<double, 3>, 3>& value,
                          Bounds bounds) const {
-  const auto& impl = *file_->impl_;
+  const auto& impl = *file_;
   const toml::node* n = impl.find(name_, key);
   if (n == nullptr)
     return false;

@@ -35,6 +35,7 @@ struct Bounds {
 };
 
 class ConfigFile;
+struct ConfigFileImpl;  // the parsed document; lives on the heap, so sections survive a move
 
 //! One [section] (or [a.b] nested table) of a configuration file. Absent sections read as empty.
 class ConfigSection {
@@ -46,6 +47,9 @@ class ConfigSection {
   bool read(std::string_view key, std::string& value) const;
   bool read(std::string_view key, std::array<double, 3>& value,
             Bounds bounds = Bounds::any()) const;
+  //! A list of four numbers (e.g. the cubic's p = [p3, p2, p1, p0]).
+  bool read(std::string_view key, std::array<double, 4>& value,
+            Bounds bounds = Bounds::any()) const;
   //! A 3x3 matrix as a list of three rows.
   bool read(std::string_view key, std::array<std::array<double, 3>, 3>& value,
             Bounds bounds = Bounds::any()) const;
@@ -55,8 +59,9 @@ class ConfigSection {
 
  private:
   friend class ConfigFile;
-  ConfigSection(const ConfigFile* file, std::string name) : file_(file), name_(std::move(name)) {}
-  const ConfigFile* file_;
+  ConfigSection(const ConfigFileImpl* file, std::string name)
+      : file_(file), name_(std::move(name)) {}
+  const ConfigFileImpl* file_;  // valid while the ConfigFile (moved or not) lives
   std::string name_;
 };
 
@@ -79,10 +84,8 @@ class ConfigFile {
   const std::string& source() const;
 
  private:
-  friend class ConfigSection;
-  struct Impl;
-  explicit ConfigFile(std::unique_ptr<Impl> impl);
-  std::unique_ptr<Impl> impl_;
+  explicit ConfigFile(std::unique_ptr<ConfigFileImpl> impl);
+  std::unique_ptr<ConfigFileImpl> impl_;
 };
 
 }  // namespace piezoshift::io

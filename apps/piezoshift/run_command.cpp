@@ -1,0 +1,335 @@
+// `piezoshift run`: the real-time loop (docs/runtime.md) against the twin or a Comedi board, with
+// the safety supervisor between controller and DAQ (docs/safety.md) and optional fault injection.
+//
+// Exit status: 0 the run completed (duration, SIGINT or SIGTERM) without a fault; 3 the safety
+// supervisor latched a fault (the outputs were ramped to 0 V); 2 bad input, including a DAQ
+// device that cannot be opened; 1 internal error.
+#include <algorithm>
+#include <csignal>
+#include <cstdint>
+#include <limits>
+#include <memory>
+#include <optional>
+#include <string>
+#include <vector>
+
+#include <fmt/core.h>
+#include <nlohmann/json.hpp>
+
+#include "command.hpp"
+#include "piezoshift/io/input_error.hpp"
+#include "piezoshift/runtime/comedi_backend.hpp"
+#include "piezoshift/runtime/control_loop.hpp"
+#include "piezoshift/runtime/controller_config.hpp"
+#include "piezoshift/runtime/csv_logger.hpp"
+#include "piezoshift/runtime/fault_injection.hpp"
+#include "piezoshift/runtime/loop_clock.hpp"
+#include "piezoshift/runtime/realtime.hpp"
+#include "piezoshift/runtime/sim_backend.hpp"
+
+namespace piezoshift::app {
+
+namespace {
+
+using namespace piezoshift::runtime;
+
+constexpr int kExitFault = 3;
+
+struct RunOptions {
+  std::string daq = "sim";
+  double rate_Hz = 1000.0;
+  std::string calibration;
+  std::optional<double> step_um;
+  std::string profile;
+  double duration_s = 0.0;
+  std::string log;
+  bool json = false;
+  std::vector<std::string> faults;
+  std::uint64_t seed = 1;
+  bool free_run = false;
+  int cpu = -1;
+  std::int64_t max_overruns = 3;
+};
+
+std::atomic<int> g_stop_signal{0};
+
+extern "C" void on_stop_signal(int signo) {
+  g_stop_signal.store(signo, std::memory_order_relaxed);
+}
+
+// Installs the SIGINT/SIGTERM handlers for the run's lifetime and restores the old ones.
+class StopSignals {
+ public:
+  StopSignals() {
+    struct sigaction sa {};
+    sa.sa_handler = on_stop_signal;
+    sigemptyset(&sa.sa_mask);
+    sigaction(SIGINT, &sa, &old_int_);
+    sigaction(SIGTERM, &sa, &old_term_);
+  }
+  ~StopSignals() {
+    sigaction(SIGINT, &old_int_, nullptr);
+    sigaction(SIGTERM, &old_term_, nullptr);
+  }
+  StopSignals(const StopSignals&) = delete;
+  StopSignals& operator=(const StopSignals&) = delete;
+
+ private:
+  struct sigaction old_int_ {};
+  struct sigaction old_term_ {};
+};
+
+const char* signal_name(int signo) {
+  switch (signo) {
+    case SIGINT:
+      return "SIGINT";
+    case SIGTERM:
+      return "SIGTERM";
+    default:
+      return "signal";
+  }
+}
+
+double us(std::int64_t ns) {
+  return static_cast<double>(ns) * 1e-3;
+}
+
+int run(const RunOptions& o) {
+  if (!(o.rate_Hz >= 1000.0 && o.rate_Hz <= 10000.0)) {
+    throw io::InputError(
+        fmt::format("--rate-hz {}: supported rates are 1000 to 10000 Hz", o.rate_Hz));
+  }
+  if (!(o.duration_s > 0.0) || o.duration_s > 1e6)
+    throw io::InputError(fmt::format("--duration-s {}: must be > 0 s", o.duration_s));
+
+  control::SemiClosedLoopParams params;
+  if (!o.calibration.empty())
+    params = load_controller_config(o.calibration);
+  SetpointProfile profile = !o.profile.empty() ? SetpointProfile::load_csv(o.profile)
+                                               : SetpointProfile::step(o.step_um.value_or(0.0));
+  std::vector<FaultSpec> faults;
+  for (const std::string& f : o.faults)
+    faults.push_back(parse_fault_spec(f));
+
+  // The backend.
+  std::unique_ptr<DaqBackend> hardware;
+  SimBackend* sim = nullptr;
+  if (o.daq == "sim") {
+    SimOptions so;
+    so.seed = o.seed;
+    so.rate_Hz = o.rate_Hz;
+    auto s = std::make_unique<SimBackend>(so);
+    sim = s.get();
+    hardware = std::move(s);
+  } else if (o.daq == "comedi" || o.daq.rfind("comedi:", 0) == 0) {
+    ComediOptions co;
+    if (o.daq.size() > 7)
+      co.device = o.daq.substr(7);
+    if (!faults.empty())
+      throw io::InputError("--fault needs --daq sim (faults are injected into the twin)");
+    if (o.free_run)
+      throw io::InputError("--free-run needs --daq sim (hardware runs in real time)");
+    hardware = std::make_unique<ComediBackend>(co);
+  } else {
+    throw io::InputError(fmt::format("--daq '{}': expected sim or comedi:/dev/comediN", o.daq));
+  }
+  hardware->configure();  // comedi: names the device it cannot open (exit 2)
+
+  std::unique_ptr<LoopClock> clock;
+  if (o.free_run)
+    clock = std::make_unique<SimulatedClock>();
+  else
+    clock = std::make_unique<MonotonicClock>();
+  const std::int64_t period_ns = std::llround(1e9 / o.rate_Hz);
+
+  std::unique_ptr<FaultInjectingBackend> injector;
+  DaqBackend* daq = hardware.get();
+  if (!faults.empty()) {
+    injector = std::make_unique<FaultInjectingBackend>(*hardware, *clock, period_ns, faults,
+                                                       FaultInjectionParams{}, sim);
+    daq = injector.get();
+  }
+
+  std::unique_ptr<CsvLogger> logger;
+  if (!o.log.empty()) {
+    CsvLoggerOptions lo;
+    lo.path = o.log;
+    lo.with_truth = sim != nullptr;
+    logger = std::make_unique<CsvLogger>(lo);
+  }
+
+  LoopConfig config;
+  config.rate_Hz = o.rate_Hz;
+  config.duration_s = o.duration_s;
+  config.stop_signal = &g_stop_signal;
+  if (o.max_overruns < 1)
+    throw io::InputError(fmt::format("--max-overruns {}: must be >= 1", o.max_overruns));
+  SafetyLimits limits;
+  limits.max_consecutive_overruns = static_cast<std::uint32_t>(
+      std::min<std::int64_t>(o.max_overruns, std::numeric_limits<std::uint32_t>::max()));
+  ControlLoop loop(config, params, limits, *daq, *clock, std::move(profile),
+                   logger ? &logger->ring() : nullptr);
+
+  g_stop_signal.store(0);
+  StopSignals signals;
+  if (logger)
+    logger->start();  // before the real-time request: the logging thread stays a normal thread
+  RealtimeReport rt;
+  if (clock->real_time()) {
+    RealtimeRequest req;
+    req.cpu = o.cpu;
+    rt = request_realtime(req);
+    if (!rt.refusals.empty()) {
+      std::string why;
+      for (const std::string& r : rt.refusals)
+        why += (why.empty() ? "" : "; ") + r;
+      fmt::print(stderr,
+                 "piezoshift: warning: real-time request partly refused ({}); running on with "
+                 "what was granted, the timing figures will show it\n",
+                 why);
+    }
+  }
+
+  daq->activate();
+  const LoopResult r = loop.run();
+  daq->deactivate();
+  if (logger)
+    logger->stop();
+
+  // Summary.
+  const LoopStats& st = loop.stats();
+  const std::uint64_t injected =
+      injector ? injector->first_injected_tick() : FaultInjectingBackend::kNotYet;
+  const bool has_latency =
+      r.fault_detected && injected != FaultInjectingBackend::kNotYet && r.fault.tick >= injected;
+  std::string stop_reason = to_string(r.stop_reason);
+  if (r.stop_reason == StopReason::kSignal)
+    stop_reason = signal_name(r.signal);
+
+  nlohmann::json j;
+  j["daq"] = hardware->name();
+  j["rate_Hz"] = o.rate_Hz;
+  j["sample_time_s"] = static_cast<double>(period_ns) * 1e-9;
+  j["clock"] = o.free_run ? "free-run" : "realtime";
+  j["duration_s"] = o.duration_s;
+  j["ticks"] = r.ticks;
+  j["stop_reason"] = stop_reason;
+  j["period_error_p50_us"] = us(st.period_error.percentile_ns(0.5));
+  j["period_error_p99_us"] = us(st.period_error.percentile_ns(0.99));
+  j["period_error_p999_us"] = us(st.period_error.percentile_ns(0.999));
+  j["period_error_max_us"] = us(st.period_error.max_ns());
+  j["wake_latency_p50_us"] = us(st.wake_latency.percentile_ns(0.5));
+  j["wake_latency_p99_us"] = us(st.wake_latency.percentile_ns(0.99));
+  j["wake_latency_p999_us"] = us(st.wake_latency.percentile_ns(0.999));
+  j["wake_latency_max_us"] = us(st.wake_latency.max_ns());
+  j["compute_time_p50_us"] = us(st.compute.percentile_ns(0.5));
+  j["compute_time_p99_us"] = us(st.compute.percentile_ns(0.99));
+  j["compute_time_max_us"] = us(st.compute.max_ns());
+  j["overruns"] = st.overruns;
+  j["max_consecutive_overruns"] = st.max_consecutive_overruns;
+  j["skipped_slots"] = st.skipped_slots;
+  j["realtime"] = {{"sched_fifo", rt.fifo},
+                   {"mlockall", rt.memory_locked},
+                   {"cpu", rt.cpu >= 0 ? nlohmann::json(rt.cpu) : nlohmann::json(nullptr)},
+                   {"refused", rt.refusals}};
+  j["fault_detected"] = r.fault_detected;
+  j["fault_reason"] = r.fault_detected ? nlohmann::json(to_string(r.fault.reason)) : nullptr;
+  j["fault_tick"] = r.fault_detected ? nlohmann::json(r.fault.tick) : nullptr;
+  j["fault_channel"] = r.fault_detected && r.fault.channel >= 0
+                           ? nlohmann::json(r.fault.channel + 1)
+                           : nlohmann::json(nullptr);
+  j["fault_value"] = r.fault_detected ? nlohmann::json(r.fault.value) : nullptr;
+  j["fault_limit"] = r.fault_detected ? nlohmann::json(r.fault.limit) : nullptr;
+  nlohmann::json injected_list = nlohmann::json::array();
+  for (std::size_t i = 0; injector && i < injector->faults().size(); ++i) {
+    const FaultSpec& f = injector->faults()[i];
+    const std::uint64_t t = injector->injected_tick(i);
+    injected_list.push_back(
+        {{"kind", to_string(f.kind)},
+         {"time_s", f.time_s},
+         {"channel", f.channel >= 0 ? nlohmann::json(f.channel + 1) : nlohmann::json(nullptr)},
+         {"injected_tick",
+          t != FaultInjectingBackend::kNotYet ? nlohmann::json(t) : nlohmann::json(nullptr)}});
+  }
+  j["faults_injected"] = injected_list;
+  j["detect_latency_ticks"] =
+      has_latency ? nlohmann::json(r.fault.tick - injected) : nlohmann::json(nullptr);
+  j["max_output_V"] = r.max_output_V;
+  j["min_output_V"] = r.min_output_V;
+  j["max_output_slew_V_per_ms"] = r.max_output_slew_V_per_ms;
+  j["log"] = {{"path", o.log.empty() ? nlohmann::json(nullptr) : nlohmann::json(o.log)},
+              {"records_written", logger ? logger->records_written() : 0},
+              {"records_dropped", r.telemetry_dropped},
+              {"error", logger && !logger->error().empty() ? nlohmann::json(logger->error())
+                                                           : nlohmann::json(nullptr)}};
+
+  if (o.json) {
+    fmt::print("{}\n", j.dump(2));
+  } else {
+    fmt::print("run: {} at {} Hz ({} clock), {} ticks, stopped by {}\n", hardware->name(),
+               o.rate_Hz, o.free_run ? "free-running" : "real-time", r.ticks, stop_reason);
+    fmt::print("period error   p50 {:.1f} us  p99 {:.1f} us  p99.9 {:.1f} us  max {:.1f} us\n",
+               us(st.period_error.percentile_ns(0.5)), us(st.period_error.percentile_ns(0.99)),
+               us(st.period_error.percentile_ns(0.999)), us(st.period_error.max_ns()));
+    fmt::print("compute time   p50 {:.1f} us  p99 {:.1f} us  max {:.1f} us\n",
+               us(st.compute.percentile_ns(0.5)), us(st.compute.percentile_ns(0.99)),
+               us(st.compute.max_ns()));
+    fmt::print("overruns       {} (longest run {})\n", st.overruns, st.max_consecutive_overruns);
+    fmt::print("outputs        max {:.3f} V, max slew {:.3f} V/ms\n", r.max_output_V,
+               r.max_output_slew_V_per_ms);
+    if (r.fault_detected) {
+      fmt::print(
+          "FAULT          {} at tick {}{} (value {:.4g}, limit {:.4g}){}\n",
+          to_string(r.fault.reason), r.fault.tick,
+          r.fault.channel >= 0 ? fmt::format(" on channel {}", r.fault.channel + 1) : "",
+          r.fault.value, r.fault.limit,
+          has_latency ? fmt::format(", {} ticks after injection", r.fault.tick - injected) : "");
+    } else {
+      fmt::print("faults         none\n");
+    }
+    if (logger) {
+      fmt::print("log            {} ({} records{})\n", o.log, logger->records_written(),
+                 r.telemetry_dropped ? fmt::format(", {} DROPPED", r.telemetry_dropped) : "");
+    }
+  }
+  if (logger && !logger->error().empty())
+    fmt::print(stderr, "piezoshift: error: log {}: {}\n", o.log, logger->error());
+  return r.fault_detected ? kExitFault : 0;
+}
+
+}  // namespace
+
+void add_run_command(CLI::App& app, Action& action) {
+  auto o = std::make_shared<RunOptions>();
+  CLI::App* cmd = app.add_subcommand(
+      "run", "Run the real-time loop against the twin or a Comedi DAQ board (docs/runtime.md)");
+  cmd->add_option("--daq", o->daq, "sim, or comedi:/dev/comediN (the NI PCI-6229 via Comedi)")
+      ->capture_default_str();
+  cmd->add_option("--rate-hz", o->rate_Hz, "loop rate, 1000 (the paper) to 10000 Hz")
+      ->capture_default_str();
+  cmd->add_option("--calibration", o->calibration,
+                  "TOML with [controller] kp, ki, kd, gains_sample_time_s, p, A");
+  auto* step = cmd->add_option("--step-um", o->step_um, "step Z_d1 = Z_d2 = Z_d3 to Z (um)");
+  auto* prof = cmd->add_option("--profile", o->profile,
+                               "CSV with t_s and z_um (or z1_um, z2_um, z3_um), piecewise linear");
+  step->excludes(prof);
+  prof->excludes(step);
+  cmd->add_option("--duration-s", o->duration_s, "controlled time (s); a ramp to 0 V follows")
+      ->required();
+  cmd->add_option("--log", o->log, "CSV log of every tick (flushed every 0.25 s)");
+  cmd->add_flag("--json", o->json, "print the summary as JSON");
+  cmd->add_option("--fault", o->faults,
+                  "inject KIND@T_S[:CHANNEL] into the twin (sgs-open, sgs-stuck, adc-nan, "
+                  "adc-spike, amplifier-fail, actuator-crack, overrun-burst); repeatable");
+  cmd->add_option("--seed", o->seed, "twin noise seed")->capture_default_str();
+  cmd->add_flag("--free-run", o->free_run,
+                "sim only: simulated clock, as fast as possible (tests, benches)");
+  cmd->add_option("--max-overruns", o->max_overruns,
+                  "consecutive deadline overruns that trip the supervisor")
+      ->capture_default_str();
+  cmd->add_option("--cpu", o->cpu, "CPU to pin the loop to (-1: the last one, -2: none)")
+      ->capture_default_str();
+  cmd->callback([&action, o] { action = [o] { return run(*o); }; });
+}
+
+}  // namespace piezoshift::app

@@ -1,0 +1,70 @@
+#pragma once
+// The `sim` backend: the digital twin (plant::Twin) behind the DAQ interface, advanced in step
+// with the loop's clock. Per tick, keeping the board's timing contract (daq_backend.hpp):
+//
+//   read(t):   n = period_ns / T (1, or more after skipped slots)
+//              n x twin.advance()      physics over the elapsed periods with the AO held that
+//                                      went out at the previous tick; ends with the AI sample
+//              ai = twin.read_ai()
+//              twin.write_ao(staged)   the outputs of the last write() go out now
+//   write(t):  staged = ao
+//
+// so the twin sees the same one-transaction-per-tick timing as the Comedi backend. The twin runs
+// at the loop's rate: its DAQ period is the loop period and its physics rate the smallest whole
+// multiple of the loop rate at or above the twin's physics_rate_Hz (20 kHz by default).
+//
+// Faults (PlantFaultHooks): every channel fault kind is shown by the twin itself (its
+// ChannelFault): sgs-open, sgs-stuck, adc-nan, adc-spike, amplifier-fail, actuator-crack. A
+// stiffness change re-discretizes the twin's mechanics: inject() is then not real-time safe,
+// which only fault-injection runs ever do.
+//
+// read()/write()/truth() are real-time safe; configure() builds the twin (allocates, throws
+// io::InputError for parameters that cannot make one).
+#include <cstdint>
+#include <memory>
+
+#include "piezoshift/design/design_inputs.hpp"
+#include "piezoshift/plant/twin.hpp"
+#include "piezoshift/plant/twin_params.hpp"
+#include "piezoshift/runtime/daq_backend.hpp"
+#include "piezoshift/runtime/fault_injection.hpp"
+
+namespace piezoshift::runtime {
+
+struct SimOptions {
+  design::DesignInputs design{};
+  plant::TwinParams twin{};
+  std::uint64_t seed = 1;
+  double rate_Hz = 1000.0;  //!< the loop's rate; the twin's DAQ period is 1 / rate_Hz
+};
+
+class SimBackend final : public DaqBackend, public PlantFaultHooks {
+ public:
+  explicit SimBackend(SimOptions options);
+  ~SimBackend() override;
+
+  void configure() override;
+  void activate() override;
+  void deactivate() noexcept override;
+  DaqStatus read(const CycleTime& t, Vec3& ai_V) noexcept override;
+  DaqStatus write(const CycleTime& t, const Vec3& ao_V) noexcept override;
+  std::string name() const override { return "sim"; }
+  bool truth(Vec3& z_um, Vec3& interferometer_um) const noexcept override;
+
+  bool inject(FaultKind kind, std::size_t channel,
+              const FaultInjectionParams& params) noexcept override;
+
+  //! The twin (after configure()).
+  const plant::Twin& twin() const { return *twin_; }
+  std::int64_t period_ns() const noexcept { return period_ns_; }
+
+ private:
+  SimOptions options_;
+  std::int64_t period_ns_ = 0;
+  std::unique_ptr<plant::Twin> twin_;
+  Vec3 staged_{};
+  Vec3 last_ai_{};
+  bool active_ = false;
+};
+
+}  // namespace piezoshift::runtime

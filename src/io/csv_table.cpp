@@ -1,0 +1,193 @@
+#include "piezoshift/io/csv_table.hpp"
+
+#include <cerrno>
+#include <charconv>
+#include <cmath>
+#include <cstring>
+#include <fstream>
+#include <sstream>
+
+#include <fmt/core.h>
+
+#include "piezoshift/io/input_error.hpp"
+
+namespace piezoshift::io {
+namespace {
+
+std::string_view trim(std::string_view s) {
+  const auto first = s.find_first_not_of(" \t");
+  if (first == std::string_view::npos)
+    return {};
+  const auto last = s.find_last_not_of(" \t");
+  return s.substr(first, last - first + 1);
+}
+
+std::vector<std::string> split_fields(std::string_view line) {
+  std::vector<std::string> out;
+  std::size_t start = 0;
+  while (true) {
+    const auto comma = line.find(',', start);
+    out.emplace_back(
+        trim(line.substr(start, comma == std::string_view::npos ? line.npos : comma - start)));
+    if (comma == std::string_view::npos)
+      break;
+    start = comma + 1;
+  }
+  return out;
+}
+
+std::string join(const std::vector<std::string>& names) {
+  std::string s;
+  for (const auto& n : names) {
+    if (!s.empty())
+      s += ',';
+    s += n;
+  }
+  return s;
+}
+
+// Shortens a cell for a message so a binary file does not flood the terminal.
+std::string shown(std::string_view cell) {
+  constexpr std::size_t kMax = 40;
+  return cell.size() <= kMax ? std::string(cell) : std::string(cell.substr(0, kMax)) + "...";
+}
+
+}  // namespace
+
+bool parse_finite_double(std::string_view cell, double& value) {
+  cell = trim(cell);
+  // from_chars takes no leading '+'; accept one in front of a digit or point.
+  if (cell.size() > 1 && cell.front() == '+' && cell[1] != '-' && cell[1] != '+')
+    cell.remove_prefix(1);
+  if (cell.empty())
+    return false;
+  double v = 0.0;
+  const auto [end, ec] = std::from_chars(cell.data(), cell.data() + cell.size(), v);
+  if (ec != std::errc() || end != cell.data() + cell.size() || !std::isfinite(v))
+    return false;
+  value = v;
+  return true;
+}
+
+CsvTable CsvTable::load(const std::string& path) {
+  std::ifstream in(path, std::ios::binary);
+  if (!in) {
+    throw InputError(fmt::format("{}: cannot open: {}", path, std::strerror(errno)));
+  }
+  std::ostringstream text;
+  text << in.rdbuf();
+  if (in.bad()) {
+    throw InputError(fmt::format("{}: cannot read: {}", path, std::strerror(errno)));
+  }
+  return parse(text.str(), path);
+}
+
+CsvTable CsvTable::parse(std::string_view text, const std::string& source_name) {
+  CsvTable t;
+  t.source_ = source_name;
+  if (text.substr(0, 3) == "\xEF\xBB\xBF")
+    text.remove_prefix(3);
+  std::size_t line_no = 0;
+  std::size_t pos = 0;
+  while (pos < text.size()) {
+    const auto nl = text.find('\n', pos);
+    std::string_view line = text.substr(pos, nl == std::string_view::npos ? text.npos : nl - pos);
+    pos = (nl == std::string_view::npos) ? text.size() : nl + 1;
+    ++line_no;
+    if (!line.empty() && line.back() == '\r')
+      line.remove_suffix(1);
+    const std::string_view content = trim(line);
+    if (content.empty() || content.front() == '#')
+      continue;
+    std::vector<std::string> fields = split_fields(line);
+    if (t.header_.empty()) {
+      for (std::size_t i = 0; i < fields.size(); ++i) {
+        std::string& name = fields[i];
+        if (name.size() >= 2 && name.front() == '"' && name.back() == '"')
+          name = std::string(trim(std::string_view(name).substr(1, name.size() - 2)));
+        if (name.empty()) {
+          throw InputError(fmt::format(
+              "{}:{}: header field {} is empty (a trailing comma?); the header names the "
+              "columns, e.g. s1_um,s2_um,s3_um",
+              source_name, line_no, i + 1));
+        }
+      }
+      t.header_ = std::move(fields);
+      t.header_line_ = line_no;
+      continue;
+    }
+    if (fields.size() != t.header_.size()) {
+      throw InputError(fmt::format("{}:{}: {} fields, but the header (line {}) has {}", source_name,
+                                   line_no, fields.size(), t.header_line_, t.header_.size()));
+    }
+    t.cells_.push_back(std::move(fields));
+    t.lines_.push_back(line_no);
+  }
+  if (t.header_.empty()) {
+    throw InputError(
+        fmt::format("{}: no header row: the file is empty or has only comments", source_name));
+  }
+  return t;
+}
+
+bool CsvTable::has_column(std::string_view name) const {
+  for (const auto& h : header_) {
+    if (h == name)
+      return true;
+  }
+  return false;
+}
+
+void CsvTable::require_columns(std::initializer_list<std::string_view> names) const {
+  std::string missing;
+  std::size_t count = 0;
+  for (const auto name : names) {
+    if (!has_column(name)) {
+      missing += (missing.empty() ? "'" : ", '") + std::string(name) + "'";
+      ++count;
+    }
+  }
+  if (count > 0) {
+    throw InputError(fmt::format("{}:{}: missing column{} {} (the header has: {})", source_,
+                                 header_line_, count > 1 ? "s" : "", missing, join(header_)));
+  }
+}
+
+std::size_t CsvTable::index_of(std::string_view name) const {
+  std::size_t found = header_.size();
+  for (std::size_t i = 0; i < header_.size(); ++i) {
+    if (header_[i] != name)
+      continue;
+    if (found != header_.size()) {
+      throw InputError(fmt::format("{}:{}: column '{}' appears twice (fields {} and {})", source_,
+                                   header_line_, name, found + 1, i + 1));
+    }
+    found = i;
+  }
+  if (found == header_.size()) {
+    throw InputError(fmt::format("{}:{}: missing column '{}' (the header has: {})", source_,
+                                 header_line_, name, join(header_)));
+  }
+  return found;
+}
+
+std::vector<double> CsvTable::column(std::string_view name) const {
+  const std::size_t c = index_of(name);
+  std::vector<double> values(cells_.size());
+  for (std::size_t r = 0; r < cells_.size(); ++r) {
+    const std::string& cell = cells_[r][c];
+    if (parse_finite_double(cell, values[r]))
+      continue;
+    double any = 0.0;
+    const auto [end, ec] = std::from_chars(cell.data(), cell.data() + cell.size(), any);
+    const bool non_finite = ec == std::errc() && end == cell.data() + cell.size();
+    throw InputError(
+        fmt::format("{}:{}: column '{}' (field {}): {}", source_, lines_[r], name, c + 1,
+                    cell.empty() ? std::string("empty cell, expected a number")
+                    : non_finite ? fmt::format("'{}' is not a finite number", shown(cell))
+                                 : fmt::format("'{}' is not a number", shown(cell))));
+  }
+  return values;
+}
+
+}  // namespace piezoshift::io

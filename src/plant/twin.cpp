@@ -1,0 +1,282 @@
+#include "piezoshift/plant/twin.hpp"
+
+#include <cmath>
+#include <limits>
+#include <numbers>
+#include <stdexcept>
+
+#include <Eigen/LU>
+
+#include "piezoshift/plant/daq.hpp"
+#include "piezoshift/plant/sgs.hpp"
+
+namespace piezoshift::plant {
+
+Twin::Twin(const design::DesignInputs& design, const TwinParams& params, std::uint64_t seed)
+    : model_(make_twin_model(design, params)), seed_(seed), rng_(seed) {
+  const TwinParams& p = model_.params;
+  // The run's draws at construction, in this order: the lab cycle's phase, the interferometer's
+  // scale error.
+  lab_ = LabEnvironment(p.lab, 2.0 * std::numbers::pi * rng_.uniform());
+  ifm_scale_ = 1.0 + p.interferometer.accuracy_ppm * 1e-6 * (2.0 * rng_.uniform() - 1.0);
+
+  for (std::size_t i = 0; i < 3; ++i) {
+    ks_[i] = model_.series_stiffness_N_per_um;
+    ks_over_ka_[i] = ks_[i] / model_.actuator_stiffness_N_per_um;
+    sgs_gain_[i] = model_.sgs_gain_per_elongation[i];
+  }
+  sgs_beta_ = 1.0 - std::exp(-2.0 * std::numbers::pi * p.sgs.bandwidth_Hz * model_.physics_step_s);
+  ai_noise_V_ =
+      std::hypot(p.sgs.noise_nm_rms * 1e-3 / model_.sgs_nominal_um_per_V, p.daq.ai_noise_V_rms);
+  lsb_V_ = daq_lsb_V(p.daq);
+  inv_lsb_V_ = 1.0 / lsb_V_;  // cheaper than dividing; can differ only at an exact midpoint
+  code_max_ = std::ldexp(1.0, static_cast<int>(p.daq.resolution_bits) - 1) - 1.0;
+  code_min_ = -code_max_ - 1.0;
+  lab_sin_ = std::sin(lab_.phase_at(0.0));
+  lab_cos_ = std::cos(lab_.phase_at(0.0));
+  const double step_rad = lab_.angular_rate_rad_per_s() * model_.control_period_s;
+  lab_rot_sin_ = std::sin(step_rad);
+  lab_rot_cos_ = std::cos(step_rad);
+  mechanics_ = model_.mechanics;
+  ifm_countdown_ = model_.interferometer_every;
+  for (std::size_t i = 0; i < 3; ++i)
+    sgs_last_V_[i] = p.sgs.offset_V[i];
+  update_truth(Vec3{0.0, 0.0, 0.0}, lab_.air_C(0.0), lab_.structure_C(0.0));
+}
+
+// daq_quantize_V with the constants kept (same result).
+double Twin::quantize_V(double v) const noexcept {
+  double c = std::nearbyint(v * inv_lsb_V_);
+  if (!(c == c))
+    c = 0.0;
+  c = c < code_min_ ? code_min_ : (c > code_max_ ? code_max_ : c);
+  return c * lsb_V_;
+}
+
+AoStatus Twin::write_ao(const Vec3& ao_V) noexcept {
+  const double range = model_.params.daq.range_V;
+  AoStatus status = AoStatus::kOk;
+  for (std::size_t i = 0; i < 3; ++i) {
+    const double v = ao_V[i];
+    if (!std::isfinite(v)) {
+      status = AoStatus::kInvalid;
+      continue;
+    }
+    if ((v > range || v < -range) && status == AoStatus::kOk)
+      status = AoStatus::kClamped;
+    ao_V_[i] = quantize_V(v);
+  }
+  return status;
+}
+
+void Twin::advance() noexcept {
+  const TwinModel& m = model_;
+  const std::size_t n = m.substeps;
+  // Local copies of the small models and of the states the loop updates: the compiler can then
+  // keep them in registers instead of reloading them after every store to a member.
+  const Amplifier amp = m.amplifier;
+  const LinearMechanics mech = mechanics_;
+  MechanicsState ms = mech_;
+  double fm0 = filtered_modes_[0], fm1 = filtered_modes_[2], fm2 = filtered_modes_[4];
+  std::size_t countdown = ifm_countdown_;
+  const double gain_V = m.params.amplifier.gain;
+  Vec3 amp_in = ao_V_;
+  for (std::size_t i = 0; i < 3; ++i)
+    if (faults_[i].amplifier_failed)
+      amp_in[i] = 0.0;
+  // The amplifier's output runs monotonically toward its held target within the period, so each
+  // stack's hysteresis is evaluated along a monotone sweep (hysteresis.hpp, PlaySweep).
+  PlaySweep sweep0(m.hysteresis, play_[0], gain_V * amp_in[0] > amp_V_[0]);
+  PlaySweep sweep1(m.hysteresis, play_[1], gain_V * amp_in[1] > amp_V_[1]);
+  PlaySweep sweep2(m.hysteresis, play_[2], gain_V * amp_in[2] > amp_V_[2]);
+
+  double v0 = amp_V_[0], v1 = amp_V_[1], v2 = amp_V_[2];
+  double ys0 = 0.0, ys1 = 0.0, ys2 = 0.0;
+  const double g0 = m.stroke_gain_um[0], g1 = m.stroke_gain_um[1], g2 = m.stroke_gain_um[2];
+  const double c0 = creep_out_[0], c1 = creep_out_[1], c2 = creep_out_[2];
+  const double k0 = ks_[0], k1 = ks_[1], k2 = ks_[2];
+  const double beta = sgs_beta_;
+  double f0 = filtered_free_um_[0], f1 = filtered_free_um_[1], f2 = filtered_free_um_[2];
+  double x0 = 0.0, x1 = 0.0, x2 = 0.0;
+  bool pending_end_sample = false;
+  const double t0 = static_cast<double>(tick_) * m.control_period_s;
+  for (std::size_t s = 0; s < n; ++s) {
+    v0 = amp.step(v0, amp_in[0]);
+    v1 = amp.step(v1, amp_in[1]);
+    v2 = amp.step(v2, amp_in[2]);
+    const double y0 = sweep0.at(v0), y1 = sweep1.at(v1), y2 = sweep2.at(v2);
+    ys0 += y0;
+    ys1 += y1;
+    ys2 += y2;
+    x0 = g0 * (y0 + c0);
+    x1 = g1 * (y1 + c1);
+    x2 = g2 * (y2 + c2);
+    mech.step(ms, {k0 * x0, k1 * x1, k2 * x2});
+    f0 += beta * (x0 - f0);
+    f1 += beta * (x1 - f1);
+    f2 += beta * (x2 - f2);
+    fm0 += beta * (ms[0] - fm0);
+    fm1 += beta * (ms[2] - fm1);
+    fm2 += beta * (ms[4] - fm2);
+    if (--countdown == 0) {
+      countdown = m.interferometer_every;
+      if (s + 1 == n) {
+        pending_end_sample = true;  // at the period's end: sampled below, temperatures shared
+      } else {
+        const double t = t0 + static_cast<double>(s + 1) * m.physics_step_s;
+        sample_interferometer(mech.displacement_um(ms), t, lab_.interferometer_drift_um(t));
+      }
+    }
+  }
+  mech_ = ms;
+  filtered_modes_[0] = fm0;
+  filtered_modes_[2] = fm1;
+  filtered_modes_[4] = fm2;
+  ifm_countdown_ = countdown;
+  sweep0.commit(play_[0]);
+  sweep1.commit(play_[1]);
+  sweep2.commit(play_[2]);
+  amp_V_ = {v0, v1, v2};
+  free_um_ = {x0, x1, x2};
+  filtered_free_um_ = {f0, f1, f2};
+  const Vec3 x = mechanics_.displacement_um(mech_);
+  for (std::size_t i = 0; i < 3; ++i)
+    elongation_um_[i] = free_um_[i] - ks_over_ka_[i] * (free_um_[i] - x[i]);
+  ++tick_;
+  const double inv_n = 1.0 / static_cast<double>(n);
+  const double y_mean[3] = {ys0 * inv_n, ys1 * inv_n, ys2 * inv_n};
+  for (std::size_t i = 0; i < 3; ++i) {
+    creep_out_[i] = m.creep.update(creep_[i], y_mean[i]);
+    if (m.params.sgs.gauge_creep_per_decade != 0.0)
+      gauge_out_[i] = m.gauge_creep.update(gauge_creep_[i], elongation_um_[i]);
+  }
+  const double t = static_cast<double>(tick_) * m.control_period_s;
+  if (tick_ % kLabResync == 0) {
+    lab_sin_ = std::sin(lab_.phase_at(t));
+    lab_cos_ = std::cos(lab_.phase_at(t));
+  } else {
+    const double s_new = lab_sin_ * lab_rot_cos_ + lab_cos_ * lab_rot_sin_;
+    lab_cos_ = lab_cos_ * lab_rot_cos_ - lab_sin_ * lab_rot_sin_;
+    lab_sin_ = s_new;
+  }
+  double air = 0.0, structure = 0.0;
+  lab_.temperatures_C(lab_sin_, lab_cos_, air, structure);
+  if (pending_end_sample)
+    sample_interferometer(x, t, lab_.drift_um(air, structure));
+  sample_ai(structure - lab_.structure_at_start_C());
+  update_truth(x, air, structure);
+}
+
+void Twin::sample_ai(double structure_change_K) noexcept {
+  const TwinParams& p = model_.params;
+  const SgsParams& sgs = p.sgs;
+  const double drift_um = sgs.zero_drift_nm_per_K * 1e-3 * structure_change_K;
+  const double nl_V = sgs.nonlinearity_fraction * sgs.full_scale_V;
+  const double inv_scale = 1.0 / model_.sgs_nominal_um_per_V;
+  const Vec3 fx = mechanics_.displacement_um(filtered_modes_);  // the filtered x
+  for (std::size_t i = 0; i < 3; ++i) {
+    const double filtered_e =
+        filtered_free_um_[i] - ks_over_ka_[i] * (filtered_free_um_[i] - fx[i]);
+    const double r_um = sgs_gain_[i] * (filtered_e - gauge_out_[i]) + drift_um;
+    const double v_lin = r_um * inv_scale;
+    double v = sgs.offset_V[i] + v_lin +
+               nl_V * sgs_nonlinearity_shape(sgs.nonlinearity_shape, v_lin / sgs.full_scale_V);
+    // One deviate per channel and sample carries the conditioner's and the ADC's noise (both
+    // white at the sample rate, so their sum is one normal of the combined variance).
+    const double noise = ai_noise_V_ * rng_.normal();
+    const ChannelFault& f = faults_[i];
+    if (f.sgs_open)
+      v = 1.2 * sgs.full_scale_V;
+    else if (f.sgs_stuck)
+      v = sgs_last_V_[i];
+    sgs_last_V_[i] = v;
+    double ai = quantize_V(v + noise + f.adc_spike_V);
+    faults_[i].adc_spike_V = 0.0;
+    if (f.adc_nan)
+      ai = std::numeric_limits<double>::quiet_NaN();
+    ai_V_[i] = ai;
+    truth_.sgs_V[i] = v + noise;
+  }
+}
+
+void Twin::sample_interferometer(const Vec3& x_um, double t_s, double drift_um) noexcept {
+  const InterferometerParams& p = model_.params.interferometer;
+  const control::Mat3& w = model_.geometry.barycentric;
+  const double res_um = p.resolution_nm * 1e-3;
+  const double cyclic_um = p.cyclic_error_nm * 1e-3;
+  const double k_cyclic = 4.0 * std::numbers::pi / (p.wavelength_nm * 1e-3);
+  for (std::size_t j = 0; j < 3; ++j) {
+    const double z = w[j][0] * x_um[0] + w[j][1] * x_um[1] + w[j][2] * x_um[2];
+    double m = ifm_scale_ * z + drift_um + p.noise_nm_rms * 1e-3 * rng_.normal();
+    if (cyclic_um != 0.0)
+      m += cyclic_um * std::sin(k_cyclic * z);
+    ifm_.dynamic_um[j] = std::nearbyint(m / res_um) * res_um;
+    static_sum_[j] += m;
+  }
+  ifm_.dynamic_time_s = t_s;
+  if (++static_n_ == model_.interferometer_static_samples) {
+    for (std::size_t j = 0; j < 3; ++j) {
+      ifm_.static_um[j] =
+          std::nearbyint(static_sum_[j] / static_cast<double>(static_n_) / res_um) * res_um;
+      static_sum_[j] = 0.0;
+    }
+    static_n_ = 0;
+    ifm_.static_time_s = t_s;
+    ++ifm_.static_count;
+  }
+}
+
+void Twin::update_truth(const Vec3& x_um, double air_C, double structure_C) noexcept {
+  const TwinModel& m = model_;
+  TwinTruth& t = truth_;
+  t.time_s = static_cast<double>(tick_) * m.control_period_s;
+  t.ao_V = ao_V_;
+  t.amplifier_V = amp_V_;
+  t.free_elongation_um = free_um_;
+  t.stack_elongation_um = elongation_um_;
+  t.leg_um = x_um;
+  const Vec3 pose = control::multiply(m.legs_to_pose, x_um);
+  t.plate_z_um = pose[0];
+  t.theta_x_urad = pose[1];
+  t.theta_y_urad = pose[2];
+  t.points_um = control::multiply(m.geometry.barycentric, x_um);
+  t.air_temperature_C = air_C;
+  t.structure_temperature_C = structure_C;
+}
+
+void Twin::set_fault(std::size_t channel, const ChannelFault& fault) {
+  if (channel >= 3)
+    throw std::invalid_argument("twin: fault channel must be 0, 1 or 2");
+  if (!(fault.stack_stiffness_scale > 0.0) || !std::isfinite(fault.stack_stiffness_scale))
+    throw std::invalid_argument("twin: stack_stiffness_scale must be positive");
+  const bool restiffen = fault.stack_stiffness_scale != faults_[channel].stack_stiffness_scale;
+  faults_[channel] = fault;
+  if (!restiffen)
+    return;
+  std::array<double, 3> k{};
+  for (std::size_t i = 0; i < 3; ++i) {
+    const double ka = model_.actuator_stiffness_N_per_um * faults_[i].stack_stiffness_scale;
+    ks_[i] = series_stiffness_N_per_um(ka, model_.contact_stiffness_N_per_um);
+    ks_over_ka_[i] = ks_[i] / ka;
+    k[i] = model_.mechanism_stiffness_N_per_um + ks_[i];
+  }
+  // The modal coordinates change with the modes: carry the physical displacements, velocities
+  // and filtered displacements over (x = Phi eta, so eta = Phi^-1 x).
+  const Vec3 x = mechanics_.displacement_um(mech_);
+  const Vec3 v = mechanics_.velocity_um_per_s(mech_);
+  const Vec3 fx = mechanics_.displacement_um(filtered_modes_);
+  mechanics_ = make_leg_plate_mechanics(model_, k);
+  const Eigen::Matrix3d phi_inv = mechanics_.mode_shapes().inverse();
+  const Eigen::Vector3d eta = phi_inv * Eigen::Vector3d(x[0], x[1], x[2]);
+  const Eigen::Vector3d eta_dot = phi_inv * Eigen::Vector3d(v[0], v[1], v[2]);
+  const Eigen::Vector3d eta_f = phi_inv * Eigen::Vector3d(fx[0], fx[1], fx[2]);
+  for (Eigen::Index r = 0; r < 3; ++r) {
+    const auto i = static_cast<std::size_t>(2 * r);
+    mech_[i] = eta(r);
+    mech_[i + 1] = eta_dot(r);
+    filtered_modes_[i] = eta_f(r);
+    filtered_modes_[i + 1] = 0.0;
+  }
+}
+
+}  // namespace piezoshift::plant

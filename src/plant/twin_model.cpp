@@ -1,0 +1,253 @@
+#include "piezoshift/plant/twin_model.hpp"
+
+#include <cmath>
+#include <numbers>
+#include <stdexcept>
+#include <string>
+
+#include <fmt/core.h>
+#include <Eigen/LU>
+
+#include "piezoshift/design/flexure.hpp"
+#include "piezoshift/design/natural_frequency.hpp"
+#include "piezoshift/kinematics/tripod.hpp"
+#include "piezoshift/plant/contact.hpp"
+
+namespace piezoshift::plant {
+namespace {
+
+[[noreturn]] void fail(const std::string& message) {
+  throw std::invalid_argument(message);
+}
+
+void require(bool ok, const std::string& message) {
+  if (!ok)
+    fail(message);
+}
+
+bool positive(double v) {
+  return std::isfinite(v) && v > 0.0;
+}
+
+// n = value when value is (to rounding) a whole number >= 1.
+std::size_t whole_number(double value, const std::string& what) {
+  const double n = std::round(value);
+  require(std::isfinite(value) && n >= 1.0 && std::fabs(value - n) <= 1e-9 * std::fmax(1.0, n),
+          fmt::format("{} is {}, which must be a whole number >= 1", what, value));
+  return static_cast<std::size_t>(n);
+}
+
+// Component constructors throw with their own wording; prefix the TOML section.
+template <typename Make>
+auto built(const char* section, Make make) {
+  try {
+    return make();
+  } catch (const std::invalid_argument& e) {
+    fail(fmt::format("{}: {}", section, e.what()));
+  }
+}
+
+}  // namespace
+
+LinearMechanics make_leg_plate_mechanics(const TwinModel& m,
+                                         const std::array<double, 3>& leg_stiffness_N_per_um) {
+  // x = T q with T rows [1, y_i, -x_i] (metres, radians): the plate's kinetic energy in leg
+  // coordinates is 1/2 x'^T T^-T M_p T^-1 x'.
+  Eigen::Matrix3d t;
+  for (Eigen::Index i = 0; i < 3; ++i) {
+    const auto& a = m.geometry.actuators[static_cast<std::size_t>(i)];
+    t.row(i) << 1.0, a.y_m, -a.x_m;
+  }
+  const Eigen::Matrix3d t_inv = t.inverse();
+  const Eigen::Vector3d mp(m.plate.mass_kg, m.plate.inertia_x_kg_m2, m.plate.inertia_y_kg_m2);
+  Eigen::Matrix3d mass = t_inv.transpose() * mp.asDiagonal() * t_inv;
+  mass.diagonal().array() += m.leg_mass_kg;
+  mass = 0.5 * (mass + mass.transpose());
+  Eigen::Matrix3d k = Eigen::Matrix3d::Zero();
+  for (Eigen::Index i = 0; i < 3; ++i)
+    k(i, i) = 1e6 * leg_stiffness_N_per_um[static_cast<std::size_t>(i)];
+  return LinearMechanics(mass, k, m.params.mechanics.modal_damping_ratio, m.physics_step_s);
+}
+
+TwinModel make_twin_model(const design::DesignInputs& d, const TwinParams& p) {
+  if (const std::string problem = design::design_inputs_problem(d); !problem.empty())
+    fail(problem);
+  TwinModel m;
+  m.design = d;
+  m.params = p;
+
+  // Timing
+  require(positive(p.physics_rate_Hz), "twin.physics_rate_Hz must be positive");
+  require(positive(p.daq.sample_time_s), "twin.daq.sample_time_s must be positive");
+  m.control_period_s = p.daq.sample_time_s;
+  m.substeps = whole_number(p.physics_rate_Hz * p.daq.sample_time_s,
+                            "twin.physics_rate_Hz * twin.daq.sample_time_s (physics steps per "
+                            "control period)");
+  m.physics_step_s = p.daq.sample_time_s / static_cast<double>(m.substeps);
+  require(positive(p.interferometer.dynamic_sample_rate_Hz),
+          "twin.interferometer.dynamic_sample_rate_Hz must be positive");
+  m.interferometer_every = whole_number(
+      p.physics_rate_Hz / p.interferometer.dynamic_sample_rate_Hz,
+      "twin.physics_rate_Hz / twin.interferometer.dynamic_sample_rate_Hz (physics steps per "
+      "interferometer sample)");
+  m.interferometer_static_samples = whole_number(
+      p.interferometer.static_average_s * p.interferometer.dynamic_sample_rate_Hz,
+      "twin.interferometer.static_average_s * twin.interferometer.dynamic_sample_rate_Hz "
+      "(samples per static reading)");
+
+  // DAQ, amplifier
+  require(p.daq.resolution_bits >= 2 && p.daq.resolution_bits <= 32,
+          "twin.daq.resolution_bits must be in [2, 32]");
+  require(positive(p.daq.range_V), "twin.daq.range_V must be positive");
+  require(std::isfinite(p.daq.ai_noise_V_rms) && p.daq.ai_noise_V_rms >= 0.0,
+          "twin.daq.ai_noise_V_rms must be >= 0");
+  const AmplifierParams& amp = p.amplifier;
+  require(positive(amp.gain), "twin.amplifier.gain must be positive");
+  require(std::isfinite(amp.output_min_V) && positive(amp.output_max_V) &&
+              amp.output_min_V < amp.output_max_V,
+          "twin.amplifier.output_min_V must be below twin.amplifier.output_max_V (> 0)");
+  require(positive(amp.average_power_W), "twin.amplifier.average_power_W must be positive");
+  require(positive(amp.small_signal_bandwidth_Hz),
+          "twin.amplifier.small_signal_bandwidth_Hz must be positive");
+  m.amplifier = Amplifier(amp, d.actuator.capacitance_F, m.physics_step_s);
+  m.amplifier_current_limit_A = amplifier_current_limit_A(amp);
+  m.amplifier_slew_V_per_s = amplifier_slew_rate_V_per_s(amp, d.actuator.capacitance_F);
+
+  // Stack: hysteresis over the amplifier's full output, creep at the control period
+  m.hysteresis =
+      built("twin.piezo", [&] { return PrandtlIshlinskii(p.piezo.hysteresis, amp.output_max_V); });
+  m.creep = built("twin.piezo", [&] { return CreepChain(p.piezo.creep, m.control_period_s); });
+  require(positive(p.piezo.creep_reference_time_s),
+          "twin.piezo.creep_reference_time_s must be positive");
+  const double f_ref = 1.0 + m.creep.step_response(p.piezo.creep_reference_time_s);
+  double scale_sum = 0.0;
+  for (std::size_t i = 0; i < 3; ++i) {
+    const double s = p.piezo.free_stroke_scale[i];
+    require(positive(s), fmt::format("twin.piezo.free_stroke_scale[{}] must be positive", i));
+    m.free_stroke_um[i] = d.actuator.nominal_stroke_um * s;
+    m.stroke_gain_um[i] = m.free_stroke_um[i] / f_ref;
+    scale_sum += s;
+  }
+
+  // Stiffness: mechanism from the design's Eqs. 2-3, actuator from Table 1, contact identified
+  m.mechanism_stiffness_N_per_um = design::mechanism_stiffness_N_per_um(d.material, d.hinge);
+  m.actuator_stiffness_N_per_um = d.actuator.stiffness_N_per_um;
+  const double km = m.mechanism_stiffness_N_per_um, ka = m.actuator_stiffness_N_per_um;
+  require(positive(p.contact.open_loop_time_s), "twin.contact.open_loop_time_s must be positive");
+  m.open_loop_creep_factor = (1.0 + m.creep.step_response(p.contact.open_loop_time_s)) / f_ref;
+  if (p.contact.stiffness_N_per_um.has_value()) {
+    const double kc = *p.contact.stiffness_N_per_um;
+    require(kc > 0.0 && !std::isnan(kc), "twin.contact.stiffness_N_per_um must be positive");
+    m.contact_stiffness_N_per_um = kc;
+  } else {
+    require(positive(p.contact.open_loop_travel_um),
+            "twin.contact.open_loop_travel_um must be positive");
+    const double free_at_measurement =
+        d.actuator.nominal_stroke_um * scale_sum / 3.0 * m.open_loop_creep_factor;
+    m.contact_stiffness_N_per_um = built("twin.contact", [&] {
+      return identify_contact_stiffness_N_per_um(p.contact.open_loop_travel_um, free_at_measurement,
+                                                 ka, km);
+    });
+    m.contact_identified = true;
+  }
+  m.series_stiffness_N_per_um = series_stiffness_N_per_um(ka, m.contact_stiffness_N_per_um);
+  const double ks = m.series_stiffness_N_per_um;
+  m.equation1_um = design::available_displacement_um(d.actuator, km);
+  for (std::size_t i = 0; i < 3; ++i)
+    m.leg_static_um[i] = m.free_stroke_um[i] * ks / (ks + km);
+
+  // Masses
+  m.mechanism_mass_kg = d.mechanism.moving_mass_kg;
+  const double w_a = 2.0 * std::numbers::pi * d.actuator.resonance_frequency_Hz;
+  m.stack_mass_kg = ka * 1e6 / (w_a * w_a);
+  m.leg_mass_kg = m.mechanism_mass_kg + m.stack_mass_kg;
+  require(positive(p.plate.radius_m), "twin.plate.radius_m must be positive");
+  require(positive(p.plate.thickness_m), "twin.plate.thickness_m must be positive");
+  require(std::isfinite(p.plate.payload_mass_kg) && p.plate.payload_mass_kg >= 0.0,
+          "twin.plate.payload_mass_kg must be >= 0");
+  m.plate = plate_inertia(p.plate, d.material.density_kg_per_m3);
+
+  // Geometry and sensors
+  m.geometry = built("twin.geometry", [&] { return make_twin_geometry(p.geometry); });
+  for (std::size_t j = 0; j < 3; ++j) {
+    const double r = std::hypot(m.geometry.points[j].x_m, m.geometry.points[j].y_m);
+    require(r <= p.plate.radius_m,
+            fmt::format("twin.plate.radius_m = {} m does not reach measurement point P{}, {:.4f} m "
+                        "from the centre (twin.geometry.actuator_radius_m = {} m)",
+                        p.plate.radius_m, j + 1, r, p.geometry.actuator_radius_m));
+  }
+  const kinematics::TripodGeometry legs(m.geometry.actuators);
+  for (std::size_t i = 0; i < 3; ++i) {
+    std::array<double, 3> unit{0.0, 0.0, 0.0};
+    unit[i] = 1.0;
+    const kinematics::PlatePose pose = legs.forward(unit);
+    m.legs_to_pose[0][i] = pose.z_um;
+    m.legs_to_pose[1][i] = pose.theta_x_urad;
+    m.legs_to_pose[2][i] = pose.theta_y_urad;
+  }
+  const SgsParams& sgs = p.sgs;
+  require(positive(sgs.full_scale_V), "twin.sgs.full_scale_V must be positive");
+  require(std::isfinite(sgs.nonlinearity_fraction) && sgs.nonlinearity_fraction >= 0.0,
+          "twin.sgs.nonlinearity_fraction must be >= 0");
+  require(std::isfinite(sgs.noise_nm_rms) && sgs.noise_nm_rms >= 0.0,
+          "twin.sgs.noise_nm_rms must be >= 0");
+  require(positive(sgs.bandwidth_Hz), "twin.sgs.bandwidth_Hz must be positive");
+  require(std::isfinite(sgs.zero_drift_nm_per_K), "twin.sgs.zero_drift_nm_per_K must be finite");
+  for (std::size_t i = 0; i < 3; ++i) {
+    require(std::isfinite(sgs.offset_V[i]), fmt::format("twin.sgs.offset_V[{}] must be finite", i));
+    m.sgs_gain_per_elongation[i] =
+        m.geometry.sgs_gain[i] / (1.0 + km / m.contact_stiffness_N_per_um);
+  }
+  m.sgs_nominal_um_per_V = d.actuator.nominal_stroke_um / sgs.full_scale_V;
+  CreepParams gauge = p.piezo.creep;
+  gauge.per_decade_fraction = sgs.gauge_creep_per_decade;
+  m.gauge_creep = built("twin.sgs", [&] { return CreepChain(gauge, m.control_period_s); });
+
+  // Interferometer and lab
+  const InterferometerParams& ifm = p.interferometer;
+  require(positive(ifm.wavelength_nm), "twin.interferometer.wavelength_nm must be positive");
+  require(positive(ifm.resolution_nm), "twin.interferometer.resolution_nm must be positive");
+  require(std::isfinite(ifm.accuracy_ppm) && ifm.accuracy_ppm >= 0.0,
+          "twin.interferometer.accuracy_ppm must be >= 0");
+  require(std::isfinite(ifm.noise_nm_rms) && ifm.noise_nm_rms >= 0.0,
+          "twin.interferometer.noise_nm_rms must be >= 0");
+  require(std::isfinite(ifm.cyclic_error_nm) && ifm.cyclic_error_nm >= 0.0,
+          "twin.interferometer.cyclic_error_nm must be >= 0");
+  const LabParams& lab = p.lab;
+  require(std::isfinite(lab.temperature_C), "twin.lab.temperature_C must be finite");
+  require(std::isfinite(lab.temperature_amplitude_K) && lab.temperature_amplitude_K >= 0.0,
+          "twin.lab.temperature_amplitude_K must be >= 0");
+  require(positive(lab.temperature_period_s), "twin.lab.temperature_period_s must be positive");
+  require(positive(lab.structure_time_constant_s),
+          "twin.lab.structure_time_constant_s must be positive");
+  require(std::isfinite(lab.metrology_loop_length_m) && lab.metrology_loop_length_m >= 0.0,
+          "twin.lab.metrology_loop_length_m must be >= 0");
+  require(std::isfinite(lab.metrology_loop_cte_per_K),
+          "twin.lab.metrology_loop_cte_per_K must be finite");
+  require(std::isfinite(lab.uncompensated_air_path_m) && lab.uncompensated_air_path_m >= 0.0,
+          "twin.lab.uncompensated_air_path_m must be >= 0");
+  require(std::isfinite(lab.air_index_per_K), "twin.lab.air_index_per_K must be finite");
+
+  // Dynamics
+  const MechanicsParams& mech = p.mechanics;
+  require(mech.modal_damping_ratio >= 0.0 && mech.modal_damping_ratio < 1.0,
+          "twin.mechanics.modal_damping_ratio must be in [0, 1)");
+  require(mech.mechanism_damping_ratio >= 0.0 && mech.mechanism_damping_ratio < 1.0,
+          "twin.mechanics.mechanism_damping_ratio must be in [0, 1)");
+  m.mechanics = make_leg_plate_mechanics(m, {km + ks, km + ks, km + ks});
+  m.loaded_modes_Hz = m.mechanics.natural_frequencies_Hz();
+  m.unloaded_mechanism_Hz = design::natural_frequency_Hz(km, m.mechanism_mass_kg);
+  m.leg_with_stack_Hz = design::natural_frequency_Hz(km + ks, m.leg_mass_kg);
+  return m;
+}
+
+std::string twin_params_problem(const design::DesignInputs& design, const TwinParams& twin) {
+  try {
+    (void)make_twin_model(design, twin);
+  } catch (const std::invalid_argument& e) {
+    return e.what();
+  }
+  return {};
+}
+
+}  // namespace piezoshift::plant

@@ -1,0 +1,181 @@
+#include "piezoshift/runtime/control_loop.hpp"
+
+#include <cmath>
+#include <limits>
+#include <stdexcept>
+
+namespace piezoshift::runtime {
+
+const char* to_string(StopReason reason) noexcept {
+  switch (reason) {
+    case StopReason::kDuration:
+      return "duration";
+    case StopReason::kSignal:
+      return "signal";
+    case StopReason::kFault:
+      return "fault";
+  }
+  return "unknown";
+}
+
+ControlLoop::ControlLoop(const LoopConfig& config, const control::SemiClosedLoopParams& params,
+                         const SafetyLimits& limits, DaqBackend& daq, LoopClock& clock,
+                         SetpointProfile profile, SpscRing<TelemetryRecord>* telemetry)
+    : config_(config),
+      params_(params),
+      period_ns_(0),
+      duration_ticks_(0),
+      daq_(daq),
+      clock_(clock),
+      profile_(std::move(profile)),
+      telemetry_(telemetry) {
+  if (!(config.rate_Hz > 0.0) || !std::isfinite(config.rate_Hz))
+    throw std::invalid_argument("ControlLoop: rate_Hz must be > 0");
+  if (!(config.duration_s >= 0.0) || !std::isfinite(config.duration_s))
+    throw std::invalid_argument("ControlLoop: duration_s must be >= 0");
+  period_ns_ = std::llround(1e9 / config.rate_Hz);
+  duration_ticks_ = static_cast<std::uint64_t>(std::llround(config.duration_s * config.rate_Hz));
+  // The controller gets the real sample time; its gains are rescaled from gains_sample_time_s.
+  params_.sample_time_s = static_cast<double>(period_ns_) * 1e-9;
+  controller_.configure(params_);
+  supervisor_.configure(limits, params_.sample_time_s, params_.scaling);
+}
+
+LoopResult ControlLoop::run() noexcept {
+  LoopResult result{};
+  controller_.configure(params_);
+  supervisor_.reset();
+  profile_.rewind();
+  stats_.clear();
+  const double period_s = params_.sample_time_s;
+  const double period_ms = period_s * 1e3;
+  result.min_output_V = std::numeric_limits<double>::infinity();
+  result.max_output_V = -std::numeric_limits<double>::infinity();
+
+  const std::int64_t start = clock_.now_ns();
+  std::int64_t deadline = start;
+  std::int64_t previous_deadline = start - period_ns_;
+  std::int64_t previous_wake = start;
+  DaqStatus previous_write = DaqStatus::kOk;
+  bool previous_overran = false;
+  bool stop_requested = false;
+  Vec3 previous_ao{};
+
+  for (std::uint64_t tick = 0;; ++tick) {
+    clock_.sleep_until_ns(deadline);
+    const std::int64_t wake = clock_.now_ns();
+    const CycleTime ct{tick, deadline - start, deadline - previous_deadline};
+
+    if (!stop_requested) {
+      if (tick >= duration_ticks_) {
+        stop_requested = true;
+        result.stop_reason = StopReason::kDuration;
+      } else if (config_.stop_signal != nullptr &&
+                 config_.stop_signal->load(std::memory_order_relaxed) != 0) {
+        stop_requested = true;
+        result.stop_reason = StopReason::kSignal;
+        result.signal = config_.stop_signal->load(std::memory_order_relaxed);
+      }
+      if (stop_requested)
+        supervisor_.request_stop();
+    }
+    if (clear_requested_.exchange(false, std::memory_order_acq_rel)) {
+      if (supervisor_.clear_fault()) {
+        controller_.reset();
+        controller_.hold_integrators(false);
+        if (stop_requested)
+          supervisor_.request_stop();
+      }
+    }
+
+    Vec3 ai{};
+    const DaqStatus read_status = daq_.read(ct, ai);
+    const Vec3 zd = profile_.at(static_cast<double>(ct.since_start_ns) * 1e-9);
+    const control::ControllerOutput c = controller_.update(zd, ai);
+    SupervisorInput in{};
+    in.tick = tick;
+    in.period_s = static_cast<double>(ct.period_ns) * 1e-9;
+    in.sgs_V = ai;
+    in.request_V = c.dac_V;
+    in.target_um = c.target_um;
+    in.feedback_um = c.feedback_um;
+    in.read_status = read_status;
+    in.previous_write_status = previous_write;
+    in.previous_tick_overran = previous_overran;
+    const SupervisorOutput s = supervisor_.update(in);
+    controller_.hold_integrators(s.hold_integrators);
+    const DaqStatus write_status = daq_.write(ct, s.ao_V);
+    previous_write = write_status;
+    if (supervisor_.faulted() && !result.fault_detected) {
+      result.fault_detected = true;
+      result.fault = supervisor_.fault();
+    }
+
+    for (std::size_t i = 0; i < s.ao_V.size(); ++i) {
+      const double v = s.ao_V[i];
+      if (v > result.max_output_V)
+        result.max_output_V = v;
+      if (v < result.min_output_V)
+        result.min_output_V = v;
+      const double slew = std::fabs(v - previous_ao[i]) / period_ms;
+      if (slew > result.max_output_slew_V_per_ms)
+        result.max_output_slew_V_per_ms = slew;
+    }
+    previous_ao = s.ao_V;
+    result.last_sgs_V = ai;
+
+    const std::int64_t end = clock_.now_ns();
+    previous_overran = stats_.record(deadline, wake, end, previous_wake, period_ns_);
+
+    if (telemetry_ != nullptr) {
+      TelemetryRecord r{};
+      r.tick = tick;
+      r.t_s = static_cast<double>(ct.since_start_ns) * 1e-9;
+      r.zd_um = zd;
+      r.target_um = c.target_um;
+      r.sgs_V = ai;
+      r.request_V = c.dac_V;
+      r.ao_V = s.ao_V;
+      if (!daq_.truth(r.truth_um, r.interferometer_um)) {
+        const double nan = std::numeric_limits<double>::quiet_NaN();
+        r.truth_um = Vec3{nan, nan, nan};
+        r.interferometer_um = r.truth_um;
+      }
+      r.wake_latency_us = static_cast<double>(wake - deadline) * 1e-3;
+      r.compute_us = static_cast<double>(end - wake) * 1e-3;
+      r.overrun = previous_overran ? 1 : 0;
+      r.limited = s.limited ? 1 : 0;
+      r.held = s.hold_integrators ? 1 : 0;
+      r.state = static_cast<std::uint8_t>(s.state);
+      r.fault_reason = static_cast<std::uint8_t>(supervisor_.fault().reason);
+      r.fault_channel = static_cast<std::int8_t>(supervisor_.fault().channel);
+      r.read_status = static_cast<std::uint8_t>(read_status);
+      r.write_status = static_cast<std::uint8_t>(write_status);
+      if (!telemetry_->try_push(r))
+        ++result.telemetry_dropped;
+    }
+
+    const bool safe_after_fault = supervisor_.faulted() && supervisor_.outputs_at_zero();
+    if (s.state == SupervisorState::kStopped ||
+        (safe_after_fault && (config_.stop_when_safe_after_fault || stop_requested))) {
+      result.ticks = tick + 1;
+      if (safe_after_fault)
+        result.stop_reason = StopReason::kFault;
+      break;
+    }
+
+    previous_wake = wake;
+    previous_deadline = deadline;
+    deadline += period_ns_;
+    if (end > deadline) {  // missed the next deadline: re-phase to the first slot after `end`
+      const std::int64_t skip = (end - deadline + period_ns_ - 1) / period_ns_;
+      deadline += skip * period_ns_;
+      stats_.skipped_slots += static_cast<std::uint64_t>(skip);
+    }
+  }
+  if (supervisor_.faulted())
+    result.fault = supervisor_.fault();
+  return result;
+}
+
+}  // namespace piezoshift::runtime

@@ -1,0 +1,61 @@
+#include "piezoshift/runtime/realtime.hpp"
+
+#include <pthread.h>
+#include <sched.h>
+#include <sys/mman.h>
+#include <unistd.h>
+
+#include <cerrno>
+#include <cstring>
+
+#include <fmt/core.h>
+
+namespace piezoshift::runtime {
+
+namespace {
+// Touches the stack below the caller so its pages are mapped (and locked) before the loop runs.
+__attribute__((noinline)) void prefault_stack(std::size_t bytes) {
+  constexpr std::size_t kChunk = 4096;
+  volatile unsigned char* probe = static_cast<volatile unsigned char*>(__builtin_alloca(bytes));
+  for (std::size_t i = 0; i < bytes; i += kChunk)
+    probe[i] = 0;
+}
+}  // namespace
+
+RealtimeReport request_realtime(const RealtimeRequest& request) {
+  RealtimeReport report;
+  if (request.lock_memory) {
+    if (::mlockall(MCL_CURRENT | MCL_FUTURE) == 0) {
+      report.memory_locked = true;
+      prefault_stack(request.stack_prefault_bytes);
+    } else {
+      report.refusals.push_back(fmt::format("mlockall refused: {}", std::strerror(errno)));
+    }
+  }
+  if (request.cpu != -2) {
+    int cpu = request.cpu;
+    if (cpu == -1) {
+      const long n = ::sysconf(_SC_NPROCESSORS_ONLN);
+      cpu = n > 0 ? static_cast<int>(n - 1) : 0;
+    }
+    cpu_set_t set;
+    CPU_ZERO(&set);
+    CPU_SET(cpu, &set);
+    if (::pthread_setaffinity_np(::pthread_self(), sizeof(set), &set) == 0) {
+      report.cpu = cpu;
+    } else {
+      report.refusals.push_back(fmt::format("pinning to CPU {} refused", cpu));
+    }
+  }
+  sched_param param{};
+  param.sched_priority = request.priority;
+  if (const int err = ::pthread_setschedparam(::pthread_self(), SCHED_FIFO, &param); err == 0) {
+    report.fifo = true;
+  } else {
+    report.refusals.push_back(
+        fmt::format("SCHED_FIFO priority {} refused: {}", request.priority, std::strerror(err)));
+  }
+  return report;
+}
+
+}  // namespace piezoshift::runtime

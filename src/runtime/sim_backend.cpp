@@ -1,0 +1,117 @@
+#include "piezoshift/runtime/sim_backend.hpp"
+
+#include <cmath>
+#include <stdexcept>
+
+#include <fmt/core.h>
+
+#include "piezoshift/io/input_error.hpp"
+
+namespace piezoshift::runtime {
+
+SimBackend::SimBackend(SimOptions options) : options_(std::move(options)) {}
+SimBackend::~SimBackend() = default;
+
+void SimBackend::configure() {
+  if (!(options_.rate_Hz > 0.0) || !std::isfinite(options_.rate_Hz))
+    throw io::InputError(fmt::format("sim: rate {} Hz is not > 0", options_.rate_Hz));
+  period_ns_ = std::llround(1e9 / options_.rate_Hz);
+  plant::TwinParams p = options_.twin;
+  p.daq.sample_time_s = static_cast<double>(period_ns_) * 1e-9;
+  const double control_rate_Hz = 1.0 / p.daq.sample_time_s;
+  const double substeps = std::ceil(p.physics_rate_Hz / control_rate_Hz - 1e-9);
+  p.physics_rate_Hz = control_rate_Hz * (substeps < 1.0 ? 1.0 : substeps);
+  if (const std::string problem = plant::twin_params_problem(options_.design, p); !problem.empty())
+    throw io::InputError(fmt::format("sim: the twin cannot be built: {}", problem));
+  try {
+    twin_ = std::make_unique<plant::Twin>(options_.design, p, options_.seed);
+  } catch (const std::invalid_argument& e) {
+    throw io::InputError(fmt::format("sim: the twin cannot be built: {}", e.what()));
+  }
+}
+
+void SimBackend::activate() {
+  if (!twin_)
+    throw io::InputError("sim: activate() before configure()");
+  staged_ = Vec3{};
+  twin_->write_ao(staged_);
+  active_ = true;
+}
+
+void SimBackend::deactivate() noexcept {
+  if (!twin_)
+    return;
+  staged_ = Vec3{};
+  twin_->write_ao(staged_);
+  active_ = false;
+}
+
+DaqStatus SimBackend::read(const CycleTime& t, Vec3& ai_V) noexcept {
+  if (!active_)
+    return DaqStatus::kInactive;
+  std::int64_t n = (t.period_ns + period_ns_ / 2) / period_ns_;
+  if (n < 1)
+    n = 1;
+  for (std::int64_t i = 0; i < n; ++i)
+    twin_->advance();
+  ai_V = twin_->read_ai();
+  last_ai_ = ai_V;
+  twin_->write_ao(staged_);
+  return DaqStatus::kOk;
+}
+
+DaqStatus SimBackend::write(const CycleTime&, const Vec3& ao_V) noexcept {
+  if (!active_)
+    return DaqStatus::kInactive;
+  staged_ = ao_V;
+  for (double v : ao_V)
+    if (!(v >= -10.0 && v <= 10.0))
+      return DaqStatus::kClamped;  // the twin's converter saturates (or keeps a NaN channel)
+  return DaqStatus::kOk;
+}
+
+bool SimBackend::truth(Vec3& z_um, Vec3& interferometer_um) const noexcept {
+  if (!twin_)
+    return false;
+  z_um = twin_->truth().points_um;
+  interferometer_um = twin_->interferometer().dynamic_um;
+  return true;
+}
+
+bool SimBackend::inject(FaultKind kind, std::size_t channel,
+                        const FaultInjectionParams& params) noexcept {
+  if (!twin_ || channel >= 3)
+    return false;
+  plant::ChannelFault f = twin_->fault(channel);
+  switch (kind) {
+    case FaultKind::kSgsOpen:
+      f.sgs_open = true;
+      break;
+    case FaultKind::kSgsStuck:
+      f.sgs_stuck = true;
+      break;
+    case FaultKind::kAdcNan:
+      f.adc_nan = true;
+      break;
+    case FaultKind::kAdcSpike:
+      // towards the far end of the range, as the emulation does; the ADC clips it
+      f.adc_spike_V = last_ai_[channel] < 5.0 ? params.spike_V : -params.spike_V;
+      break;
+    case FaultKind::kAmplifierFail:
+      f.amplifier_failed = true;
+      break;
+    case FaultKind::kActuatorCrack:
+      f.stack_stiffness_scale = params.crack_stiffness_factor;
+      break;
+    case FaultKind::kOverrunBurst:
+      return false;
+  }
+  try {
+    twin_->set_fault(channel, f);
+  } catch (...) {
+    return false;
+  }
+  return true;
+}
+
+}  // namespace piezoshift::runtime

@@ -1,0 +1,145 @@
+#include "piezoshift/io/project_config.hpp"
+
+#include <filesystem>
+#include <fstream>
+#include <string>
+
+#include <gtest/gtest.h>
+#include <unistd.h>
+
+#include "piezoshift/io/input_error.hpp"
+
+namespace piezoshift::io {
+namespace {
+
+class ProjectConfigTest : public ::testing::Test {
+ protected:
+  void SetUp() override {
+    const auto* info = ::testing::UnitTest::GetInstance()->current_test_info();
+    dir_ = std::filesystem::temp_directory_path() /
+           ("piezoshift_" + std::string(info->name()) + "_" + std::to_string(::getpid()));
+    std::filesystem::create_directories(dir_);
+  }
+  void TearDown() override { std::filesystem::remove_all(dir_); }
+
+  std::string write(const std::string& text) {
+    const std::filesystem::path p = dir_ / "config.toml";
+    std::ofstream(p) << text;
+    return p.string();
+  }
+  // Loads text that must fail; returns the message, which must name the file.
+  std::string error_for(const std::string& text) {
+    const std::string path = write(text);
+    try {
+      load_project_config(path);
+    } catch (const InputError& e) {
+      const std::string m = e.what();
+      EXPECT_NE(m.find(path), std::string::npos) << m;
+      return m;
+    }
+    ADD_FAILURE() << "no InputError for:\n" << text;
+    return "";
+  }
+  std::filesystem::path dir_;
+};
+
+bool contains(const std::string& text, const std::string& part) {
+  return text.find(part) != std::string::npos;
+}
+
+TEST_F(ProjectConfigTest, PaperTomlGivesExactlyTheDefaults) {
+  const ProjectConfig c = load_project_config(PIEZOSHIFT_SOURCE_DIR "/configs/paper.toml");
+  EXPECT_TRUE(c.design == design::DesignInputs{});
+  // Spot checks, in case operator== were ever wrong.
+  EXPECT_EQ(c.design.actuator.stiffness_N_per_um, 70.0);
+  EXPECT_EQ(c.design.material.allowable_stress_Pa, 355e6);
+  EXPECT_EQ(c.design.hinge.link_length_m, 18e-3);
+  EXPECT_EQ(c.design.mechanism.moving_mass_kg, 0.05075);
+}
+
+TEST_F(ProjectConfigTest, EmptyFileGivesTheDefaults) {
+  EXPECT_TRUE(load_project_config(write("")).design == design::DesignInputs{});
+}
+
+TEST_F(ProjectConfigTest, MissingKeysKeepTheirDefaults) {
+  const ProjectConfig c = load_project_config(
+      write("[hinge]\nthickness_m = 1.5e-3\n[material]\nelastic_modulus_Pa = 70e9\n"
+            "[actuator]\nnominal_stroke_um = 20\n[mechanism]\nmoving_mass_kg = 0.02\n"));
+  design::DesignInputs expected;
+  expected.hinge.thickness_m = 1.5e-3;
+  expected.material.elastic_modulus_Pa = 70e9;
+  expected.actuator.nominal_stroke_um = 20.0;
+  expected.mechanism.moving_mass_kg = 0.02;
+  EXPECT_TRUE(c.design == expected);
+}
+
+TEST_F(ProjectConfigTest, UnknownKeyOrSection) {
+  std::string m = error_for("[hinge]\nthicknes_m = 2e-3\n");
+  EXPECT_TRUE(contains(m, "hinge.thicknes_m: unknown key")) << m;
+  m = error_for("[hinges]\nthickness_m = 2e-3\n");
+  EXPECT_TRUE(contains(m, "hinges: unknown section")) << m;
+  m = error_for("stiffness_N_per_um = 70\n");  // outside any section
+  EXPECT_TRUE(contains(m, "stiffness_N_per_um: unknown key")) << m;
+}
+
+TEST_F(ProjectConfigTest, WrongTypeNegativeZeroNan) {
+  std::string m = error_for("[actuator]\nstiffness_N_per_um = \"70\"\n");
+  EXPECT_TRUE(contains(m, "actuator.stiffness_N_per_um: expected a number")) << m;
+  m = error_for("[material]\nelastic_modulus_Pa = -2.1e11\n");
+  EXPECT_TRUE(
+      contains(m, "material.elastic_modulus_Pa: value -210000000000 is not allowed: must be > 0"))
+      << m;
+  m = error_for("[hinge]\nwidth_m = 0\n");
+  EXPECT_TRUE(contains(m, "hinge.width_m: value 0 is not allowed: must be > 0")) << m;
+  m = error_for("[mechanism]\nmoving_mass_kg = nan\n");
+  EXPECT_TRUE(contains(m, "mechanism.moving_mass_kg: value nan")) << m;
+  m = error_for("[actuator]\nnominal_stroke_um = inf\n");
+  EXPECT_TRUE(contains(m, "actuator.nominal_stroke_um")) << m;
+}
+
+TEST_F(ProjectConfigTest, PoissonRatioMustBeBetweenZeroAndOneHalf) {
+  for (const char* v : {"0.5", "0", "-0.1", "0.7"}) {
+    const std::string m = error_for(std::string("[material]\npoisson_ratio = ") + v + "\n");
+    EXPECT_TRUE(contains(m, "material.poisson_ratio")) << m;
+    EXPECT_TRUE(contains(m, "in (0, 0.5)")) << m;
+  }
+  EXPECT_EQ(load_project_config(write("[material]\npoisson_ratio = 0.33\n"))
+                .design.material.poisson_ratio,
+            0.33);
+}
+
+TEST_F(ProjectConfigTest, HingeGeometryIsChecked) {
+  // t = 13 mm against the default R = 6 mm: the neck would be thicker than the notch diameter.
+  std::string m = error_for("[hinge]\nthickness_m = 13e-3\n");
+  EXPECT_TRUE(contains(m, "hinge.thickness_m")) << m;
+  EXPECT_TRUE(contains(m, "hinge.radius_m")) << m;
+  // L = 10 mm with R = 6 mm: the notches at the two ends of a link overlap.
+  m = error_for("[hinge]\nlink_length_m = 10e-3\n");
+  EXPECT_TRUE(contains(m, "hinge.link_length_m")) << m;
+  EXPECT_TRUE(contains(m, "hinge.radius_m")) << m;
+}
+
+TEST_F(ProjectConfigTest, SyntaxErrorAndMissingFile) {
+  std::string m = error_for("[hinge]\nwidth_m = 8e-3\nthickness_m 2e-3\n");
+  EXPECT_TRUE(contains(m, ":3:")) << m;
+  EXPECT_TRUE(contains(m, "syntax error")) << m;
+  const std::string missing = (dir_ / "absent.toml").string();
+  try {
+    load_project_config(missing);
+    ADD_FAILURE() << "no error for a missing file";
+  } catch (const InputError& e) {
+    EXPECT_TRUE(contains(e.what(), missing)) << e.what();
+  }
+}
+
+TEST_F(ProjectConfigTest, ReadDesignSectionsLeavesUnknownKeysToTheCaller) {
+  // The helper another section's reader mirrors: it reads, it does not reject.
+  const ConfigFile f = ConfigFile::parse("[hinge]\nwidth_m = 9e-3\n[twin]\nseed = 1\n", "mem");
+  design::DesignInputs d;
+  read_design_sections(f, d);
+  EXPECT_EQ(d.hinge.width_m, 9e-3);
+  EXPECT_THROW(f.reject_unknown(), InputError);  // [twin] was nobody's
+}
+
+}  // namespace
+}  // namespace piezoshift::io

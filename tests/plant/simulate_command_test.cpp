@@ -1,0 +1,146 @@
+// Runs `piezoshift simulate` and checks its output, its log and its exit status.
+#include <sys/wait.h>
+#include <unistd.h>
+
+#include <cstdio>
+#include <filesystem>
+#include <fstream>
+#include <sstream>
+#include <string>
+
+#include <gtest/gtest.h>
+#include <nlohmann/json.hpp>
+
+namespace {
+
+struct RunResult {
+  int status = -1;
+  std::string out;
+  std::string err;
+};
+
+class SimulateCommand : public ::testing::Test {
+ protected:
+  void SetUp() override {
+    const auto* info = ::testing::UnitTest::GetInstance()->current_test_info();
+    dir_ = std::filesystem::temp_directory_path() /
+           ("piezoshift_sim_" + std::string(info->name()) + "_" + std::to_string(::getpid()));
+    std::filesystem::create_directories(dir_);
+  }
+  void TearDown() override { std::filesystem::remove_all(dir_); }
+
+  std::string path(const std::string& name) const { return (dir_ / name).string(); }
+  std::string write(const std::string& name, const std::string& text) {
+    std::ofstream(path(name)) << text;
+    return path(name);
+  }
+  static std::string read(const std::string& p) {
+    std::ifstream in(p);
+    std::stringstream s;
+    s << in.rdbuf();
+    return s.str();
+  }
+
+  RunResult run(const std::string& args) {
+    const std::string err_path = path("stderr.txt");
+    const std::string cmd =
+        std::string("'") + PIEZOSHIFT_CLI + "' simulate " + args + " 2>'" + err_path + "'";
+    RunResult r;
+    FILE* pipe = ::popen(cmd.c_str(), "r");
+    if (pipe == nullptr) {
+      ADD_FAILURE() << "popen failed: " << cmd;
+      return r;
+    }
+    char buf[4096];
+    for (std::size_t n; (n = std::fread(buf, 1, sizeof buf, pipe)) > 0;)
+      r.out.append(buf, n);
+    const int status = ::pclose(pipe);
+    r.status = WIFEXITED(status) ? WEXITSTATUS(status) : -1;
+    r.err = read(err_path);
+    return r;
+  }
+
+  std::filesystem::path dir_;
+};
+
+TEST_F(SimulateCommand, OpenLoopAtTenVoltsReachesThePapersTravel) {
+  const RunResult r = run("--open-loop-volts 10,10,10 --duration-s 1.5 --json");
+  ASSERT_EQ(r.status, 0) << r.err;
+  const auto j = nlohmann::json::parse(r.out);
+  EXPECT_EQ(j["mode"], "open_loop");
+  EXPECT_NEAR(j["final_plate_z_um"].get<double>(), 12.93, 0.05);
+  ASSERT_EQ(j["final_points_um"].size(), 3u);
+  for (const auto& p : j["final_points_um"])
+    EXPECT_NEAR(p.get<double>(), 12.93, 0.05);
+}
+
+TEST_F(SimulateCommand, StepWithThePapersControllerLogsEveryTickWithUnits) {
+  const std::string log = path("step.csv");
+  const RunResult r = run("--step-um 5 --duration-s 0.5 --seed 3 --json --log '" + log + "'");
+  ASSERT_EQ(r.status, 0) << r.err;
+  const auto j = nlohmann::json::parse(r.out);
+  EXPECT_EQ(j["mode"], "step");
+  EXPECT_EQ(j["ticks"], 500);
+  // the paper's feedforward: the points go to p(5) = 5.3585 um (less the gauge's bow)
+  for (const auto& p : j["final_true_points_um"])
+    EXPECT_NEAR(p.get<double>(), 5.3585, 0.03);
+  std::ifstream in(log);
+  std::string line, header;
+  int rows = 0;
+  while (std::getline(in, line)) {
+    if (line.empty() || line[0] == '#')
+      continue;
+    if (header.empty())
+      header = line;
+    else
+      ++rows;
+  }
+  EXPECT_EQ(rows, 500);
+  EXPECT_EQ(header.rfind("t_s,zd_um,s1_um", 0), 0u) << header;
+  EXPECT_NE(header.find("plate_z_um"), std::string::npos);
+  EXPECT_NE(header.find("ifm3_um"), std::string::npos);
+}
+
+TEST_F(SimulateCommand, SameSeedGivesTheSameLogAndAnotherSeedDoesNot) {
+  const std::string a = path("a.csv"), b = path("b.csv"), c = path("c.csv");
+  ASSERT_EQ(run("--step-um 8 --duration-s 0.3 --seed 9 --log '" + a + "'").status, 0);
+  ASSERT_EQ(run("--step-um 8 --duration-s 0.3 --seed 9 --log '" + b + "'").status, 0);
+  ASSERT_EQ(run("--step-um 8 --duration-s 0.3 --seed 10 --log '" + c + "'").status, 0);
+  EXPECT_EQ(read(a), read(b));
+  EXPECT_NE(read(a), read(c));
+}
+
+TEST_F(SimulateCommand, ProfileIsFollowedAsAStaircase) {
+  const std::string profile = write("p.csv", "t_s,zd_um\n0.0,2.0\n0.3,6.0\n");
+  const RunResult r = run("--profile '" + profile + "' --duration-s 0.6 --json");
+  ASSERT_EQ(r.status, 0) << r.err;
+  const auto j = nlohmann::json::parse(r.out);
+  EXPECT_EQ(j["mode"], "profile");
+  // p(6) = 6.3676 um; the gauge's 0.1 % bow reads ~9 mV high there, so the points sit ~16 nm low
+  for (const auto& p : j["final_true_points_um"])
+    EXPECT_NEAR(p.get<double>(), 6.3676, 0.03);
+}
+
+TEST_F(SimulateCommand, BadInputExitsTwoWithAClearMessage) {
+  RunResult r = run("--open-loop-volts 10,12,10 --duration-s 0.1");
+  EXPECT_EQ(r.status, 2);
+  EXPECT_NE(r.err.find("--open-loop-volts"), std::string::npos) << r.err;
+  r = run("--step-um 5 --duration-s -1");
+  EXPECT_EQ(r.status, 2);
+  EXPECT_NE(r.err.find("--duration-s"), std::string::npos) << r.err;
+  r = run("--step-um 5 --open-loop-volts 1,1,1");
+  EXPECT_EQ(r.status, 2);
+  r = run("--duration-s 1");
+  EXPECT_EQ(r.status, 2);
+  const std::string bad = write("bad.toml", "[twin.amplifier]\naverage_power_W = 0\n");
+  r = run("--step-um 5 --config '" + bad + "'");
+  EXPECT_EQ(r.status, 2);
+  EXPECT_NE(r.err.find("twin.amplifier.average_power_W"), std::string::npos) << r.err;
+  EXPECT_NE(r.err.find(bad), std::string::npos) << r.err;
+  const std::string profile = write("p.csv", "t_s,zd_um\n0.5,2.0\n0.2,6.0\n");
+  r = run("--profile '" + profile + "' --duration-s 0.1");
+  EXPECT_EQ(r.status, 2);
+  EXPECT_NE(r.err.find("p.csv:3"), std::string::npos) << r.err;
+}
+
+}  // namespace

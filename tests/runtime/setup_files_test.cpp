@@ -1,0 +1,140 @@
+// Set-up inputs of a run: setpoint profiles, the controller's TOML, atomic file replacement.
+#include <unistd.h>
+
+#include <filesystem>
+#include <fstream>
+#include <sstream>
+
+#include <gtest/gtest.h>
+
+#include "piezoshift/io/input_error.hpp"
+#include "piezoshift/runtime/atomic_file.hpp"
+#include "piezoshift/runtime/controller_config.hpp"
+#include "piezoshift/runtime/setpoint_profile.hpp"
+
+namespace piezoshift::runtime {
+namespace {
+
+namespace fs = std::filesystem;
+
+class TempDir : public ::testing::Test {
+ protected:
+  void SetUp() override {
+    dir_ = fs::temp_directory_path() /
+           ("piezoshift_runtime_" + std::to_string(::getpid()) + "_" +
+            ::testing::UnitTest::GetInstance()->current_test_info()->name());
+    fs::create_directories(dir_);
+  }
+  void TearDown() override { fs::remove_all(dir_); }
+  std::string write(const std::string& name, const std::string& text) {
+    const fs::path p = dir_ / name;
+    std::ofstream(p) << text;
+    return p.string();
+  }
+  static std::string read(const std::string& path) {
+    std::ifstream in(path);
+    std::stringstream s;
+    s << in.rdbuf();
+    return s.str();
+  }
+  fs::path dir_;
+};
+
+using SetpointProfileTest = TempDir;
+using ControllerConfigTest = TempDir;
+using AtomicFileTest = TempDir;
+
+TEST_F(SetpointProfileTest, PiecewiseLinearBetweenRowsHeldOutside) {
+  SetpointProfile p = SetpointProfile::load_csv(write("p.csv", "t_s,z_um\n0.1,0\n0.2,10\n0.4,4\n"));
+  EXPECT_EQ(p.at(0.0)[0], 0.0);
+  EXPECT_NEAR(p.at(0.15)[1], 5.0, 1e-12);
+  EXPECT_NEAR(p.at(0.3)[2], 7.0, 1e-12);
+  EXPECT_EQ(p.at(9.0)[0], 4.0);
+  EXPECT_NEAR(p.at(0.125)[0], 2.5, 1e-12) << "time going back re-searches";
+}
+
+TEST_F(SetpointProfileTest, ThreePointColumns) {
+  SetpointProfile p =
+      SetpointProfile::load_csv(write("p.csv", "t_s,z1_um,z2_um,z3_um\n0,1,2,3\n1,3,2,1\n"));
+  const Vec3 z = p.at(0.5);
+  EXPECT_NEAR(z[0], 2.0, 1e-12);
+  EXPECT_NEAR(z[1], 2.0, 1e-12);
+  EXPECT_NEAR(z[2], 2.0, 1e-12);
+}
+
+TEST_F(SetpointProfileTest, RefusesOutOfStrokeAndNonIncreasingTimesWithLine) {
+  const std::string a = write("a.csv", "t_s,z_um\n0,1\n0.1,17\n");
+  EXPECT_THROW(
+      {
+        try {
+          SetpointProfile::load_csv(a);
+        } catch (const io::InputError& e) {
+          EXPECT_NE(std::string(e.what()).find("a.csv:3"), std::string::npos) << e.what();
+          throw;
+        }
+      },
+      io::InputError);
+  const std::string b = write("b.csv", "t_s,z_um\n0,1\n0,2\n");
+  EXPECT_THROW(SetpointProfile::load_csv(b), io::InputError);
+  EXPECT_THROW(SetpointProfile::step(-0.1), io::InputError);
+  EXPECT_THROW(SetpointProfile::step(16.5), io::InputError);
+}
+
+TEST_F(ControllerConfigTest, ReadsGainsPolynomialAndMatrix) {
+  const control::SemiClosedLoopParams p = load_controller_config(write("c.toml", R"(
+[controller]
+kp = 0.5
+ki = 0.25
+kd = 0.0
+gains_sample_time_s = 2e-3
+p = [0.0, 0.0, 1.0, 0.1]
+A = [[1, 0, 0], [0, 2, 0], [0, 0, 3]]
+)"));
+  EXPECT_EQ(p.gains.kp, 0.5);
+  EXPECT_EQ(p.gains.ki, 0.25);
+  EXPECT_EQ(p.gains_sample_time_s, 2e-3);
+  EXPECT_EQ(p.polynomial.p1, 1.0);
+  EXPECT_EQ(p.polynomial.p0, 0.1);
+  EXPECT_EQ(p.matrix.a[1][1], 2.0);
+}
+
+TEST_F(ControllerConfigTest, AbsentKeysKeepThePapersValues) {
+  const control::SemiClosedLoopParams p =
+      load_controller_config(write("c.toml", "[controller]\nkp = 0.7\n"));
+  EXPECT_EQ(p.gains.kp, 0.7);
+  EXPECT_EQ(p.gains.ki, 0.2);
+  EXPECT_EQ(p.polynomial.p3, -0.0001009);
+  EXPECT_EQ(p.matrix.a[2][2], -0.2980);
+}
+
+TEST_F(ControllerConfigTest, RejectsUnknownKeyAndShortPolynomial) {
+  EXPECT_THROW(load_controller_config(write("a.toml", "[controller]\nkq = 1\n")), io::InputError);
+  try {
+    load_controller_config(write("b.toml", "[controller]\np = [1, 2, 3]\n"));
+    FAIL();
+  } catch (const io::InputError& e) {
+    EXPECT_NE(std::string(e.what()).find("controller.p"), std::string::npos) << e.what();
+  }
+}
+
+TEST_F(AtomicFileTest, ReplacesContentAndLeavesNoTemporary) {
+  const std::string path = write("cal.toml", "old\n");
+  write_file_atomically(path, "new content\n");
+  EXPECT_EQ(read(path), "new content\n");
+  int files = 0;
+  for (const auto& e : fs::directory_iterator(dir_)) {
+    (void)e;
+    ++files;
+  }
+  EXPECT_EQ(files, 1);
+}
+
+TEST_F(AtomicFileTest, FailureLeavesTheOldFileIntact) {
+  const std::string path = write("cal.toml", "old\n");
+  EXPECT_THROW(write_file_atomically((dir_ / "missing" / "cal.toml").string(), "x"),
+               io::InputError);
+  EXPECT_EQ(read(path), "old\n");
+}
+
+}  // namespace
+}  // namespace piezoshift::runtime
