@@ -23,7 +23,7 @@ test: build
 	@ctest --preset $(PRESET) -j $(JOBS)
 
 demo: build
-	@$(PIEZOSHIFT) design
+	@$(PIEZOSHIFT) reproduce --out $(DEMO_OUT)
 
 sanitize:
 	@$(MAKE) --no-print-directory test PRESET=sanitize

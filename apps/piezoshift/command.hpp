@@ -11,10 +11,12 @@ namespace piezoshift::app {
 
 using Action = std::function<int()>;
 
-void add_design_command(CLI::App& app, Action& action);    // design_command.cpp
-void add_simulate_command(CLI::App& app, Action& action);  // simulate_command.cpp
-void add_fit_command(CLI::App& app, Action& action);       // fit_command.cpp
-void add_analyze_command(CLI::App& app, Action& action);   // analyze_command.cpp
-void add_run_command(CLI::App& app, Action& action);       // run_command.cpp
+void add_design_command(CLI::App& app, Action& action);     // design_command.cpp
+void add_simulate_command(CLI::App& app, Action& action);   // simulate_command.cpp
+void add_fit_command(CLI::App& app, Action& action);        // fit_command.cpp
+void add_analyze_command(CLI::App& app, Action& action);    // analyze_command.cpp
+void add_run_command(CLI::App& app, Action& action);        // run_command.cpp
+void add_reproduce_command(CLI::App& app, Action& action);  // reproduce_command.cpp
+void add_calibrate_command(CLI::App& app, Action& action);  // calibrate_command.cpp
 
 }  // namespace piezoshift::app

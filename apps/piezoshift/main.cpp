@@ -19,6 +19,8 @@ int main(int argc, char** argv) {
   piezoshift::app::add_fit_command(app, action);
   piezoshift::app::add_analyze_command(app, action);
   piezoshift::app::add_run_command(app, action);
+  piezoshift::app::add_calibrate_command(app, action);
+  piezoshift::app::add_reproduce_command(app, action);
 
   try {
     app.parse(argc, argv);

@@ -17,10 +17,10 @@
 #include <nlohmann/json.hpp>
 
 #include "command.hpp"
+#include "piezoshift/calibration/calibration_file.hpp"
 #include "piezoshift/io/input_error.hpp"
 #include "piezoshift/runtime/comedi_backend.hpp"
 #include "piezoshift/runtime/control_loop.hpp"
-#include "piezoshift/runtime/controller_config.hpp"
 #include "piezoshift/runtime/csv_logger.hpp"
 #include "piezoshift/runtime/fault_injection.hpp"
 #include "piezoshift/runtime/loop_clock.hpp"
@@ -104,7 +104,7 @@ int run(const RunOptions& o) {
 
   control::SemiClosedLoopParams params;
   if (!o.calibration.empty())
-    params = load_controller_config(o.calibration);
+    params = calibration::load_calibration_file(o.calibration);
   SetpointProfile profile = !o.profile.empty() ? SetpointProfile::load_csv(o.profile)
                                                : SetpointProfile::step(o.step_um.value_or(0.0));
   std::vector<FaultSpec> faults;

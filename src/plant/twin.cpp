@@ -38,13 +38,15 @@ Twin::Twin(const design::DesignInputs& design, const TwinParams& params, std::ui
   lab_rot_sin_ = std::sin(step_rad);
   lab_rot_cos_ = std::cos(step_rad);
   mechanics_ = model_.mechanics;
+  force_N_.assign(model_.substeps, {0.0, 0.0, 0.0});  // the one allocation, at set-up
   ifm_countdown_ = model_.interferometer_every;
   for (std::size_t i = 0; i < 3; ++i)
     sgs_last_V_[i] = p.sgs.offset_V[i];
   update_truth(Vec3{0.0, 0.0, 0.0}, lab_.air_C(0.0), lab_.structure_C(0.0));
 }
 
-// daq_quantize_V with the constants kept (same result).
+// daq_quantize_V with the constants kept (a product for the quotient: the same code except, at
+// most, exactly at a rounding midpoint).
 double Twin::quantize_V(double v) const noexcept {
   double c = std::nearbyint(v * inv_lsb_V_);
   if (!(c == c))
@@ -72,49 +74,46 @@ AoStatus Twin::write_ao(const Vec3& ao_V) noexcept {
 void Twin::advance() noexcept {
   const TwinModel& m = model_;
   const std::size_t n = m.substeps;
-  // Local copies of the small models and of the states the loop updates: the compiler can then
-  // keep them in registers instead of reloading them after every store to a member.
+  const double beta = sgs_beta_;
+  const double gain_V = m.params.amplifier.gain;
+  const double inv_n = 1.0 / static_cast<double>(n);
+
+  // Pass 1, one stack at a time (few live values, so they stay in registers): amplifier,
+  // hysteresis, free elongation and its conditioner-filtered copy, and the stack force for every
+  // physics step of the period. The amplifier's output runs monotonically toward its held
+  // target, so the hysteresis is evaluated along a monotone sweep (hysteresis.hpp, PlaySweep).
   const Amplifier amp = m.amplifier;
+  double y_mean[3];
+  for (std::size_t c = 0; c < 3; ++c) {
+    const double in = faults_[c].amplifier_failed ? 0.0 : ao_V_[c];
+    double v = amp_V_[c];
+    PlaySweep sweep(m.hysteresis, play_[c], gain_V * in > v);
+    const double g = m.stroke_gain_um[c], creep = creep_out_[c], k = ks_[c];
+    double y_sum = 0.0, xf = free_um_[c], f = filtered_free_um_[c];
+    for (std::size_t s = 0; s < n; ++s) {
+      v = amp.step(v, in);
+      const double y = sweep.at(v);
+      y_sum += y;
+      xf = g * (y + creep);
+      f += beta * (xf - f);
+      force_N_[s][c] = k * xf;
+    }
+    sweep.commit(play_[c]);
+    amp_V_[c] = v;
+    free_um_[c] = xf;
+    filtered_free_um_[c] = f;
+    y_mean[c] = y_sum * inv_n;
+  }
+
+  // Pass 2: the legs and plate, the filtered modal coordinates, the interferometer's samples.
   const LinearMechanics mech = mechanics_;
   MechanicsState ms = mech_;
   double fm0 = filtered_modes_[0], fm1 = filtered_modes_[2], fm2 = filtered_modes_[4];
   std::size_t countdown = ifm_countdown_;
-  const double gain_V = m.params.amplifier.gain;
-  Vec3 amp_in = ao_V_;
-  for (std::size_t i = 0; i < 3; ++i)
-    if (faults_[i].amplifier_failed)
-      amp_in[i] = 0.0;
-  // The amplifier's output runs monotonically toward its held target within the period, so each
-  // stack's hysteresis is evaluated along a monotone sweep (hysteresis.hpp, PlaySweep).
-  PlaySweep sweep0(m.hysteresis, play_[0], gain_V * amp_in[0] > amp_V_[0]);
-  PlaySweep sweep1(m.hysteresis, play_[1], gain_V * amp_in[1] > amp_V_[1]);
-  PlaySweep sweep2(m.hysteresis, play_[2], gain_V * amp_in[2] > amp_V_[2]);
-
-  double v0 = amp_V_[0], v1 = amp_V_[1], v2 = amp_V_[2];
-  double ys0 = 0.0, ys1 = 0.0, ys2 = 0.0;
-  const double g0 = m.stroke_gain_um[0], g1 = m.stroke_gain_um[1], g2 = m.stroke_gain_um[2];
-  const double c0 = creep_out_[0], c1 = creep_out_[1], c2 = creep_out_[2];
-  const double k0 = ks_[0], k1 = ks_[1], k2 = ks_[2];
-  const double beta = sgs_beta_;
-  double f0 = filtered_free_um_[0], f1 = filtered_free_um_[1], f2 = filtered_free_um_[2];
-  double x0 = 0.0, x1 = 0.0, x2 = 0.0;
   bool pending_end_sample = false;
   const double t0 = static_cast<double>(tick_) * m.control_period_s;
   for (std::size_t s = 0; s < n; ++s) {
-    v0 = amp.step(v0, amp_in[0]);
-    v1 = amp.step(v1, amp_in[1]);
-    v2 = amp.step(v2, amp_in[2]);
-    const double y0 = sweep0.at(v0), y1 = sweep1.at(v1), y2 = sweep2.at(v2);
-    ys0 += y0;
-    ys1 += y1;
-    ys2 += y2;
-    x0 = g0 * (y0 + c0);
-    x1 = g1 * (y1 + c1);
-    x2 = g2 * (y2 + c2);
-    mech.step(ms, {k0 * x0, k1 * x1, k2 * x2});
-    f0 += beta * (x0 - f0);
-    f1 += beta * (x1 - f1);
-    f2 += beta * (x2 - f2);
+    mech.step(ms, force_N_[s]);
     fm0 += beta * (ms[0] - fm0);
     fm1 += beta * (ms[2] - fm1);
     fm2 += beta * (ms[4] - fm2);
@@ -133,18 +132,10 @@ void Twin::advance() noexcept {
   filtered_modes_[2] = fm1;
   filtered_modes_[4] = fm2;
   ifm_countdown_ = countdown;
-  sweep0.commit(play_[0]);
-  sweep1.commit(play_[1]);
-  sweep2.commit(play_[2]);
-  amp_V_ = {v0, v1, v2};
-  free_um_ = {x0, x1, x2};
-  filtered_free_um_ = {f0, f1, f2};
   const Vec3 x = mechanics_.displacement_um(mech_);
   for (std::size_t i = 0; i < 3; ++i)
     elongation_um_[i] = free_um_[i] - ks_over_ka_[i] * (free_um_[i] - x[i]);
   ++tick_;
-  const double inv_n = 1.0 / static_cast<double>(n);
-  const double y_mean[3] = {ys0 * inv_n, ys1 * inv_n, ys2 * inv_n};
   for (std::size_t i = 0; i < 3; ++i) {
     creep_out_[i] = m.creep.update(creep_[i], y_mean[i]);
     if (m.params.sgs.gauge_creep_per_decade != 0.0)

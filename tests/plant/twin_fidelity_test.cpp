@@ -31,17 +31,20 @@ TEST(Fidelity1, OpenLoopTravelAtTenVoltsIsThePapers12Point9Microns) {
   EXPECT_NEAR(twin.truth().plate_z_um, 12.9, 0.3);
   EXPECT_NEAR(twin.truth().plate_z_um, 12.931, 0.01);  // the identification's own target
   hold(twin, 10.0, 0.5);
-  // the interferometer's static reading over 1 s..2 s, at each point
+  // the interferometer's static reading over 1 s..2 s: with the identified per-leg stroke spread
+  // the plate tilts, but the mean of P1..P3 stays at the identified travel (docs/twin.md)
   const InterferometerReading& r = twin.interferometer();
   ASSERT_EQ(r.static_count, 2u);
-  for (std::size_t j = 0; j < 3; ++j)
-    EXPECT_NEAR(r.static_um[j], 12.9, 0.3) << "P" << j + 1;
+  EXPECT_NEAR((r.static_um[0] + r.static_um[1] + r.static_um[2]) / 3.0, 12.9, 0.3);
+  // and each leg gives its own stack's share: the short stack (s = 0.875) about 11.1 um
+  EXPECT_NEAR(twin.truth().leg_um[1] / twin.truth().leg_um[0], 0.875 / 1.011, 0.01);
 }
 
 // Fidelity target 2, Eq. 1: 16 um free, about 14.6 um on the mechanism, 0.1 s after 150 V.
 TEST(Fidelity2, FreeStackGivesItsNominalStrokeAndOneLegOnItsMechanismFollowsEquation1) {
   TwinParams rigid;
   rigid.contact.stiffness_N_per_um = std::numeric_limits<double>::infinity();
+  rigid.piezo.free_stroke_scale = {1.0, 1.0, 1.0};  // the nominal stack of Table 1
   Twin twin({}, rigid, 1);
   // the amplifier slews 150 V in 5.8 ms; read 0.1 s after the voltage change is complete
   hold(twin, 10.0, 0.106);
@@ -56,7 +59,9 @@ TEST(Fidelity2, FreeStackGivesItsNominalStrokeAndOneLegOnItsMechanismFollowsEqua
 }
 
 TEST(Fidelity2, WithTheIdentifiedContactALegDeliversLessThanEquation1) {
-  Twin twin({}, {}, 1);
+  TwinParams nominal;
+  nominal.piezo.free_stroke_scale = {1.0, 1.0, 1.0};  // the nominal stack of Table 1
+  Twin twin({}, nominal, 1);
   hold(twin, 10.0, 0.106);
   const TwinModel& m = twin.model();
   EXPECT_NEAR(m.contact_stiffness_N_per_um, 41.86, 0.01);

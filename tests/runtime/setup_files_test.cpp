@@ -7,9 +7,9 @@
 
 #include <gtest/gtest.h>
 
+#include "piezoshift/calibration/calibration_file.hpp"
+#include "piezoshift/io/atomic_file.hpp"
 #include "piezoshift/io/input_error.hpp"
-#include "piezoshift/runtime/atomic_file.hpp"
-#include "piezoshift/runtime/controller_config.hpp"
 #include "piezoshift/runtime/setpoint_profile.hpp"
 
 namespace piezoshift::runtime {
@@ -81,7 +81,7 @@ TEST_F(SetpointProfileTest, RefusesOutOfStrokeAndNonIncreasingTimesWithLine) {
 }
 
 TEST_F(ControllerConfigTest, ReadsGainsPolynomialAndMatrix) {
-  const control::SemiClosedLoopParams p = load_controller_config(write("c.toml", R"(
+  const control::SemiClosedLoopParams p = calibration::load_calibration_file(write("c.toml", R"(
 [controller]
 kp = 0.5
 ki = 0.25
@@ -100,7 +100,7 @@ A = [[1, 0, 0], [0, 2, 0], [0, 0, 3]]
 
 TEST_F(ControllerConfigTest, AbsentKeysKeepThePapersValues) {
   const control::SemiClosedLoopParams p =
-      load_controller_config(write("c.toml", "[controller]\nkp = 0.7\n"));
+      calibration::load_calibration_file(write("c.toml", "[controller]\nkp = 0.7\n"));
   EXPECT_EQ(p.gains.kp, 0.7);
   EXPECT_EQ(p.gains.ki, 0.2);
   EXPECT_EQ(p.polynomial.p3, -0.0001009);
@@ -108,9 +108,10 @@ TEST_F(ControllerConfigTest, AbsentKeysKeepThePapersValues) {
 }
 
 TEST_F(ControllerConfigTest, RejectsUnknownKeyAndShortPolynomial) {
-  EXPECT_THROW(load_controller_config(write("a.toml", "[controller]\nkq = 1\n")), io::InputError);
+  EXPECT_THROW(calibration::load_calibration_file(write("a.toml", "[controller]\nkq = 1\n")),
+               io::InputError);
   try {
-    load_controller_config(write("b.toml", "[controller]\np = [1, 2, 3]\n"));
+    calibration::load_calibration_file(write("b.toml", "[controller]\np = [1, 2, 3]\n"));
     FAIL();
   } catch (const io::InputError& e) {
     EXPECT_NE(std::string(e.what()).find("controller.p"), std::string::npos) << e.what();
@@ -119,7 +120,7 @@ TEST_F(ControllerConfigTest, RejectsUnknownKeyAndShortPolynomial) {
 
 TEST_F(AtomicFileTest, ReplacesContentAndLeavesNoTemporary) {
   const std::string path = write("cal.toml", "old\n");
-  write_file_atomically(path, "new content\n");
+  io::write_file_atomically(path, "new content\n");
   EXPECT_EQ(read(path), "new content\n");
   int files = 0;
   for (const auto& e : fs::directory_iterator(dir_)) {
@@ -131,7 +132,7 @@ TEST_F(AtomicFileTest, ReplacesContentAndLeavesNoTemporary) {
 
 TEST_F(AtomicFileTest, FailureLeavesTheOldFileIntact) {
   const std::string path = write("cal.toml", "old\n");
-  EXPECT_THROW(write_file_atomically((dir_ / "missing" / "cal.toml").string(), "x"),
+  EXPECT_THROW(io::write_file_atomically((dir_ / "missing" / "cal.toml").string(), "x"),
                io::InputError);
   EXPECT_EQ(read(path), "old\n");
 }

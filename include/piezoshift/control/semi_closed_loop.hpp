@@ -95,6 +95,12 @@ class SemiClosedLoopController {
     for (auto& c : pid_)
       c.reset(params_.output_min_um);
   }
+  //! Clears the history and starts each channel from a given command (bumpless hand-over, e.g.
+  //! from open loop to closed loop at the voltage already applied).
+  constexpr void reset_to(const Vec3& command_um) noexcept {
+    for (std::size_t i = 0; i < kChannels; ++i)
+      pid_[i].reset(command_um[i]);
+  }
   constexpr void set_enabled(bool enabled) noexcept {
     for (auto& c : pid_)
       c.set_enabled(enabled);

@@ -58,12 +58,14 @@ class LinearMechanics {
     const double u[3] = {in_[0][0] * f0 + in_[0][1] * f1 + in_[0][2] * f2,
                          in_[1][0] * f0 + in_[1][1] * f1 + in_[1][2] * f2,
                          in_[2][0] * f0 + in_[2][1] * f1 + in_[2][2] * f2};
-    for (std::size_t r = 0; r < 3; ++r) {
-      const double q = s[2 * r], v = s[2 * r + 1];
-      const Mode& m = mode_[r];
-      s[2 * r] = m.by_q[0] * q + m.by_v[0] * v + m.by_u[0] * u[r];
-      s[2 * r + 1] = m.by_q[1] * q + m.by_v[1] * v + m.by_u[1] * u[r];
-    }
+    const double q0 = s[0], v0 = s[1], q1 = s[2], v1 = s[3], q2 = s[4], v2 = s[5];
+    const Mode &m0 = mode_[0], &m1 = mode_[1], &m2 = mode_[2];
+    s[0] = m0.by_q[0] * q0 + m0.by_v[0] * v0 + m0.by_u[0] * u[0];
+    s[1] = m0.by_q[1] * q0 + m0.by_v[1] * v0 + m0.by_u[1] * u[0];
+    s[2] = m1.by_q[0] * q1 + m1.by_v[0] * v1 + m1.by_u[0] * u[1];
+    s[3] = m1.by_q[1] * q1 + m1.by_v[1] * v1 + m1.by_u[1] * u[1];
+    s[4] = m2.by_q[0] * q2 + m2.by_v[0] * v2 + m2.by_u[0] * u[2];
+    s[5] = m2.by_q[1] * q2 + m2.by_v[1] * v2 + m2.by_u[1] * u[2];
   }
 
   //! x = Phi eta [um].

@@ -22,9 +22,11 @@ struct PiezoParams {
   //! t_ref: the nominal stroke is the free elongation this long after a 0 -> 150 V step
   //! (PI tutorial: creep is referred to the displacement 0.1 s after the voltage change)
   double creep_reference_time_s = 0.1;
-  //! s_i: each stack's free stroke over the nominal one. Stacks are sold with a stroke tolerance;
-  //! the paper gives no per-stack data, so the default is the nominal stack for all three.
-  std::array<double, 3> free_stroke_scale{1.0, 1.0, 1.0};
+  //! s_i: each stack's free stroke over the nominal one (stacks are sold with a stroke
+  //! tolerance). Identified from Section 4.1 (docs/twin.md, "Per-leg stroke"): the semi-closed
+  //! travel of 11.5 um is the weakest leg's, while the open-loop 12.9 um fixes the mean; the
+  //! spread keeps both the plate's Z at O and the mean of P1..P3 at the nominal stack's value.
+  std::array<double, 3> free_stroke_scale{1.011, 0.875, 1.114};
 
   bool operator==(const PiezoParams&) const = default;
 };

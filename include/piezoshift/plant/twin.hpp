@@ -24,6 +24,7 @@
 // exceptions, no I/O). Construction and set_fault are not.
 #include <array>
 #include <cstdint>
+#include <vector>
 
 #include "piezoshift/control/vec3.hpp"
 #include "piezoshift/design/design_inputs.hpp"
@@ -138,6 +139,7 @@ class Twin {
   double lsb_V_ = 0.0, inv_lsb_V_ = 0.0;  // DAQ
   double code_min_ = 0.0, code_max_ = 0.0;
   LinearMechanics mechanics_;
+  std::vector<std::array<double, 3>> force_N_;  // stack forces of one period, per physics step
 
   // State
   std::uint64_t tick_ = 0;

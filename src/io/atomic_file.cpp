@@ -1,4 +1,4 @@
-#include "piezoshift/runtime/atomic_file.hpp"
+#include "piezoshift/io/atomic_file.hpp"
 
 #include <fcntl.h>
 #include <unistd.h>
@@ -11,7 +11,7 @@
 
 #include "piezoshift/io/input_error.hpp"
 
-namespace piezoshift::runtime {
+namespace piezoshift::io {
 
 namespace {
 [[noreturn]] void fail(const std::string& path, const char* what, int err) {
@@ -68,4 +68,4 @@ void write_file_atomically(const std::string& path, std::string_view contents) {
   }
 }
 
-}  // namespace piezoshift::runtime
+}  // namespace piezoshift::io

@@ -8,8 +8,8 @@
 #include <string>
 #include <string_view>
 
-namespace piezoshift::runtime {
+namespace piezoshift::io {
 
 void write_file_atomically(const std::string& path, std::string_view contents);
 
-}  // namespace piezoshift::runtime
+}  // namespace piezoshift::io

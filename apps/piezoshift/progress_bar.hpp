@@ -1,0 +1,24 @@
+#pragma once
+// A progress bar on stderr for long jobs, drawn only when stderr is a terminal (so logs and CI
+// output stay clean): "  [3/8] linearity        [#########           ]  45 %".
+#include <string>
+#include <string_view>
+
+namespace piezoshift::app {
+
+class ProgressBar {
+ public:
+  explicit ProgressBar(int stages);
+  ~ProgressBar();
+  //! done/total of the stage called label; a new label starts the next stage.
+  void update(double done, double total, std::string_view label);
+
+ private:
+  bool enabled_;
+  int stages_;
+  int stage_ = 0;
+  std::string label_;
+  int last_percent_ = -1;
+};
+
+}  // namespace piezoshift::app

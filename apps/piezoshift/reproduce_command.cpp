@@ -1,0 +1,86 @@
+// `piezoshift reproduce`: calibrate the twin, run the paper's four experiments, write the report.
+#include <unistd.h>
+
+#include <cstdio>
+#include <memory>
+#include <string>
+
+#include <fmt/core.h>
+
+#include "command.hpp"
+#include "piezoshift/io/input_error.hpp"
+#include "piezoshift/io/project_config.hpp"
+#include "piezoshift/reproduction/report.hpp"
+#include "piezoshift/reproduction/reproduction.hpp"
+#include "piezoshift/reproduction/summary.hpp"
+#include "progress_bar.hpp"
+
+namespace piezoshift::app {
+namespace {
+
+struct Options {
+  std::string out = "out/reproduce";
+  std::uint64_t seed = 1;
+  std::string config;
+  std::string pid = "paper";
+  bool quick = false;
+  bool json = false;
+};
+
+int run(const Options& o) {
+  const io::ProjectConfig config =
+      o.config.empty() ? io::ProjectConfig{} : io::load_project_config(o.config);
+  reproduction::ReproduceOptions ro;
+  ro.seed = o.seed;
+  ro.quick = o.quick;
+  ro.pid = o.pid == "search" ? calibration::PidChoice::kSearch : calibration::PidChoice::kPaper;
+  reproduction::ReproductionResult result;
+  {
+    // PID gains, matrix A, polynomial p, travel range, step, linearity, repeatability x 2
+    ProgressBar bar(8);
+    result = reproduction::reproduce(config, ro,
+                                     [&bar](double done, double total, std::string_view label) {
+                                       bar.update(done, total, label);
+                                     });
+  }
+  const std::string label = o.config.empty() ? "built-in defaults (configs/paper.toml)" : o.config;
+  const reproduction::ReportFiles files = reproduction::write_report(result, o.out, label);
+  if (o.json) {
+    fmt::print("{}\n", reproduction::summary_json(result).dump(2));
+    return 0;
+  }
+  const auto& t = result;
+  fmt::print("piezoshift reproduce: {:.0f} s simulated in {:.2f} s\n", t.simulated_time_s,
+             t.wall_time_s);
+  fmt::print(
+      "  travel range     {:.2f} um open loop, {:.1f} um semi-closed loop   (paper: 12.9, 11.5)\n",
+      t.travel.open_loop_um, t.travel.semi_closed_um);
+  fmt::print(
+      "  step response    settles (+-2 %) in {:.3f} s at {:g} um            (paper: < 0.3 s)\n",
+      t.step.metrics.settling_time_pct_s, t.step.desired_um.back());
+  fmt::print("  linearity        {:.3f} % zero-end, {:.3f} % best fit         (paper: 0.21 %)\n",
+             t.linearity.metrics.linearity_zero_end_pct,
+             t.linearity.metrics.linearity_best_fit_pct);
+  fmt::print("  repeatability    {:.2f} nm at 5 um, {:.2f} nm at 10 um          (paper: 2, 3 nm)\n",
+             t.repeat_5um.metrics.repeatability_nm, t.repeat_10um.metrics.repeatability_nm);
+  fmt::print("report: {}\n        {}\n", files.markdown.string(), files.html.string());
+  return 0;
+}
+
+}  // namespace
+
+void add_reproduce_command(CLI::App& app, Action& action) {
+  auto o = std::make_shared<Options>();
+  CLI::App* cmd = app.add_subcommand(
+      "reproduce", "Calibrate the twin, run the paper's four experiments, write the report");
+  cmd->add_option("--out", o->out, "output folder for report.md, report.html, figures, CSVs");
+  cmd->add_option("--seed", o->seed, "seed of the twin's random numbers");
+  cmd->add_option("--config", o->config, "TOML configuration (configs/paper.toml's sections)");
+  cmd->add_option("--pid", o->pid, "paper: the paper's gains; search: the stage-1 search's")
+      ->check(CLI::IsMember({"paper", "search"}));
+  cmd->add_flag("--quick", o->quick, "shortened schedule (tests, a first look)");
+  cmd->add_flag("--json", o->json, "print the JSON summary");
+  cmd->callback([o, &action] { action = [o] { return run(*o); }; });
+}
+
+}  // namespace piezoshift::app

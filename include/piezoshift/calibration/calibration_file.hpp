@@ -1,0 +1,43 @@
+#pragma once
+// The calibration file: what the three calibration stages found, in the form the controller
+// loads (`piezoshift calibrate` writes it; `piezoshift run --calibration FILE` and
+// `piezoshift reproduce` read it). TOML:
+//
+//   [controller]
+//   kp = 0.6                   # per-sample gains (Eq. 7), Section 4
+//   ki = 0.2
+//   kd = 0.001
+//   gains_sample_time_s = 1e-3 # the T_s the gains were tuned at (Section 4: 1 ms)
+//   p = [-0.0001009, 0.000389, 1.014, 0.2914]          # [p3, p2, p1, p0], Eq. 8 (first)
+//   A = [[-0.4218, 0.6030, 0.6547],                     # Eq. 8 (second)
+//        [0.3482, -0.1491, 0.6962],
+//        [0.6321, 0.4397, -0.2980]]
+//
+// Every key is optional (absent: the paper's value, Section 4); an unknown key or section, a
+// wrong type or a bad value throws io::InputError naming file, key and reason. The run's own
+// sample time is set by the loop, not here. Files are written whole to a temporary file and
+// renamed over the old one (io/atomic_file.hpp), with 17 significant digits so that reading
+// back gives the same doubles.
+#include <string>
+
+#include "piezoshift/control/semi_closed_loop.hpp"
+
+namespace piezoshift::io {
+class ConfigFile;
+}
+
+namespace piezoshift::calibration {
+
+//! Reads [controller] from an already parsed file into params (does not reject unknown keys).
+void read_controller_section(const io::ConfigFile& file, control::SemiClosedLoopParams& params);
+//! Loads a file holding only [controller]; rejects anything else.
+control::SemiClosedLoopParams load_calibration_file(const std::string& path);
+
+//! The file's text; header lines (each prefixed with "# ") describe where it came from.
+std::string format_calibration(const control::SemiClosedLoopParams& params,
+                               const std::string& header);
+//! Writes format_calibration() atomically; throws io::InputError when the path is not writable.
+void write_calibration_file(const std::string& path, const control::SemiClosedLoopParams& params,
+                            const std::string& header);
+
+}  // namespace piezoshift::calibration

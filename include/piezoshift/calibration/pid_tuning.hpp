@@ -1,0 +1,78 @@
+#pragma once
+// Calibration stage 1 (paper, Section 3, first step): the PID gains, by the paper's trial and
+// error made systematic. For every candidate (kp, ki, kd) on a grid, on a fresh twin:
+//   for each actuator i alone (inner loop only, the other two held at their zero target):
+//     step its SGS target from 0 to its maximum nominal displacement S_max,i, hold step_duration_s
+//     score from its SGS feedback y(t) (experiments/metrics_step_response.hpp, y_inf = target):
+//       overshoot_pct         100 max(0, max y - S) / S
+//       settling_time_s       to +- settle_band_pct of the step
+//       steady_state_error_nm |mean(y) - S| over the last steady_window_s
+// A candidate is acceptable when, on all three actuators, overshoot <= max_overshoot_pct
+// ("little or even no overshoot"), it settled within the record and the steady-state error is
+// <= max_steady_state_error_nm. Among acceptable candidates the one with the shortest worst
+// settling time wins, ties going to the smaller error; if none is acceptable, the smallest
+// worst-case overshoot wins and `acceptable` says so.
+//
+// S_max,i is what actuator i's SGS reads at the full 10 V open loop (measured first, on the
+// same twin), times step_fraction (< 1, so that the step scores the loop and not the amplifier's
+// rail).
+#include <cstdint>
+#include <vector>
+
+#include "piezoshift/control/semi_closed_loop.hpp"
+#include "piezoshift/experiments/progress.hpp"
+#include "piezoshift/io/project_config.hpp"
+
+namespace piezoshift::calibration {
+
+struct PidScore {
+  double overshoot_pct = 0.0;
+  double settling_time_s = 0.0;  //!< +inf when not settled within the record
+  double steady_state_error_nm = 0.0;
+};
+
+struct PidTrial {
+  control::PidGains gains{};
+  std::array<PidScore, 3> per_actuator{};
+  PidScore worst{};  //!< element-wise worst over the three actuators
+  bool acceptable = false;
+  double simulated_time_s = 0.0;
+};
+
+struct PidTuningOptions {
+  std::vector<double> kp_values{0.1, 0.2, 0.3, 0.4, 0.5, 0.6, 0.7, 0.8, 0.9, 1.0};
+  std::vector<double> ki_values{0.02, 0.05, 0.1, 0.15, 0.2, 0.3, 0.4, 0.5};
+  std::vector<double> kd_values{0.0, 0.001, 0.01};
+  double step_fraction = 0.95;  //!< of the SGS reading at 10 V open loop
+  double step_duration_s = 0.5;
+  double settle_band_pct = 2.0;
+  double steady_window_s = 0.1;
+  double max_overshoot_pct = 1.0;
+  double max_steady_state_error_nm = 5.0;
+};
+
+struct PidTuningResult {
+  control::Vec3 step_target_um{};  //!< S_max,i per actuator, SGS um
+  PidTrial best{};                 //!< the winner (see header)
+  PidTrial paper{};                //!< the paper's gains, scored the same way
+  std::vector<PidTrial> trials;    //!< every candidate, in grid order (kp outer, kd inner)
+  double simulated_time_s = 0.0;   //!< all trials together
+};
+
+//! Scores one candidate on a fresh twin built from config and seed. base supplies everything but
+//! the gains (sample time, limits, scaling).
+PidTrial score_pid_gains(const io::ProjectConfig& config, const control::SemiClosedLoopParams& base,
+                         const control::PidGains& gains, const control::Vec3& step_target_um,
+                         std::uint64_t seed, const PidTuningOptions& options = {});
+
+//! S_max,i: the SGS readings at 10 V open loop (settled for 1 s), times step_fraction.
+control::Vec3 maximum_step_targets(const io::ProjectConfig& config,
+                                   const control::SemiClosedLoopParams& base, std::uint64_t seed,
+                                   double step_fraction);
+
+//! The full grid search; throws std::invalid_argument for an empty grid or a bad option.
+PidTuningResult tune_pid(const io::ProjectConfig& config, const control::SemiClosedLoopParams& base,
+                         std::uint64_t seed, const PidTuningOptions& options = {},
+                         const experiments::Progress& progress = {});
+
+}  // namespace piezoshift::calibration

@@ -1,0 +1,116 @@
+#pragma once
+// The paper's four experiments (Section 4), each on a fresh bench (the twin at rest, the
+// controller given), so each is reproducible on its own from its seed. The unit is the same in
+// every one (its parameters come from the configuration); the seed changes only the session:
+// noise, the phase of the lab's temperature cycle, the interferometer's scale error.
+//
+// Travel range (4.1)   open loop: all AO at 10 V (150 V) for open_loop_settle_s, then one static
+//                      reading; travel = mean of P1..P3.
+//                      semi-closed loop: Z_d from start_um upwards in increment_um, hold_s each,
+//                      one static reading; a level is tracked when no PID is at its output limit
+//                      and |mean(P) - Z_d| <= tolerance_um; travel = the last level tracked
+//                      before the first that is not.
+// Step response (4.1)  Z_d = 0 for pre_s, then a step to step_um, record_s recorded with the
+//                      interferometer's dynamic mode (1 kHz); metrics_step_response.hpp on the
+//                      mean of P1..P3.
+// Linearity (4.2)      Z_d = 0, 1, ..., 11 um, step_hold_s each, one static (1 s) sample per
+//                      second; the displacement of a level is the mean of its samples after the
+//                      first skip_samples; metrics_linearity.hpp.
+// Repeatability (4.3)  moves times: Z_d = 0 for rest_s, Z_d = target for settle_s, one static
+//                      reading; z_i = mean of P1..P3; metrics_repeatability.hpp (Eq. 9).
+#include <cstdint>
+#include <vector>
+
+#include "piezoshift/control/semi_closed_loop.hpp"
+#include "piezoshift/experiments/metrics_linearity.hpp"
+#include "piezoshift/experiments/metrics_repeatability.hpp"
+#include "piezoshift/experiments/metrics_step_response.hpp"
+#include "piezoshift/experiments/progress.hpp"
+#include "piezoshift/io/project_config.hpp"
+
+namespace piezoshift::experiments {
+
+struct TravelRangeOptions {
+  double open_loop_settle_s = 5.0;
+  double start_um = 10.0;
+  double increment_um = 0.1;
+  double max_um = 16.0;  //!< give up above this (the nominal stroke)
+  double hold_s = 1.0;
+  double tolerance_um = 0.05;
+};
+
+struct TravelRangeResult {
+  double open_loop_um = 0.0;
+  control::Vec3 open_loop_points_um{};
+  double semi_closed_um = 0.0;      //!< 0 when even start_um was not tracked
+  std::vector<double> desired_um;   //!< every level tried
+  std::vector<double> measured_um;  //!< mean of P1..P3
+  std::vector<int> saturated_mask;  //!< controller saturation at the end of each level
+  double simulated_time_s = 0.0;
+};
+
+struct StepExperimentOptions {
+  double step_um = 11.0;
+  double pre_s = 0.5;
+  double record_s = 1.0;
+  double band_pct = 2.0;
+  double band_nm = 10.0;
+};
+
+struct StepExperimentResult {
+  std::vector<double> time_s;       //!< from the step instant
+  std::vector<double> measured_um;  //!< interferometer, dynamic mode, mean of P1..P3
+  std::vector<double> desired_um;
+  StepResponseMetrics metrics;
+  double simulated_time_s = 0.0;
+};
+
+struct LinearityOptions {
+  double max_um = 11.0;
+  double increment_um = 1.0;
+  double step_hold_s = 10.0;
+  std::size_t skip_samples = 2;  //!< static samples left out at the start of each level
+};
+
+struct LinearityResult {
+  std::vector<double> desired_um;     //!< per level
+  std::vector<double> measured_um;    //!< per level: mean of its samples
+  std::vector<double> sample_time_s;  //!< every static sample
+  std::vector<double> sample_desired_um;
+  std::vector<double> sample_measured_um;
+  LinearityMetrics metrics;
+  double simulated_time_s = 0.0;
+};
+
+struct RepeatabilityOptions {
+  double target_um = 5.0;
+  int moves = 230;  //!< the paper's count
+  double rest_s = 0.5;
+  double settle_s = 0.5;
+};
+
+struct RepeatabilityResult {
+  double target_um = 0.0;
+  std::vector<double> measured_um;  //!< z_i
+  RepeatabilityMetrics metrics;
+  double simulated_time_s = 0.0;
+};
+
+TravelRangeResult run_travel_range(const io::ProjectConfig& config,
+                                   const control::SemiClosedLoopParams& controller,
+                                   std::uint64_t seed, const TravelRangeOptions& options = {},
+                                   const Progress& progress = {});
+StepExperimentResult run_step_response(const io::ProjectConfig& config,
+                                       const control::SemiClosedLoopParams& controller,
+                                       std::uint64_t seed,
+                                       const StepExperimentOptions& options = {},
+                                       const Progress& progress = {});
+LinearityResult run_linearity(const io::ProjectConfig& config,
+                              const control::SemiClosedLoopParams& controller, std::uint64_t seed,
+                              const LinearityOptions& options = {}, const Progress& progress = {});
+RepeatabilityResult run_repeatability(const io::ProjectConfig& config,
+                                      const control::SemiClosedLoopParams& controller,
+                                      std::uint64_t seed, const RepeatabilityOptions& options = {},
+                                      const Progress& progress = {});
+
+}  // namespace piezoshift::experiments

@@ -1,0 +1,381 @@
+#include "piezoshift/reproduction/report.hpp"
+
+#include <cmath>
+#include <fstream>
+#include <system_error>
+
+#include <fmt/core.h>
+
+#include "piezoshift/calibration/calibration_file.hpp"
+#include "piezoshift/experiments/metrics_figures.hpp"
+#include "piezoshift/io/atomic_file.hpp"
+#include "piezoshift/io/csv_writer.hpp"
+#include "piezoshift/io/input_error.hpp"
+#include "piezoshift/io/plot.hpp"
+#include "piezoshift/reproduction/summary.hpp"
+
+namespace piezoshift::reproduction {
+namespace {
+
+namespace fs = std::filesystem;
+
+// The report is a list of blocks rendered twice, as Markdown and as HTML, so both say the same.
+struct Block {
+  enum Kind { kHeading, kParagraph, kTable, kImage, kCode } kind;
+  int level = 0;
+  std::string text;                            // heading, paragraph, code, image caption
+  std::vector<std::vector<std::string>> rows;  // table: first row is the header
+  std::string path;                            // image
+};
+
+std::string html_escape(const std::string& s) {
+  std::string out;
+  for (char c : s) {
+    switch (c) {
+      case '&':
+        out += "&amp;";
+        break;
+      case '<':
+        out += "&lt;";
+        break;
+      case '>':
+        out += "&gt;";
+        break;
+      case '"':
+        out += "&quot;";
+        break;
+      default:
+        out += c;
+    }
+  }
+  return out;
+}
+
+std::string to_markdown(const std::vector<Block>& blocks) {
+  std::string out;
+  for (const Block& b : blocks) {
+    switch (b.kind) {
+      case Block::kHeading:
+        out += std::string(b.level, '#') + " " + b.text + "\n\n";
+        break;
+      case Block::kParagraph:
+        out += b.text + "\n\n";
+        break;
+      case Block::kCode:
+        out += "```\n" + b.text + "\n```\n\n";
+        break;
+      case Block::kImage:
+        out += "![" + b.text + "](" + b.path + ")\n\n";
+        break;
+      case Block::kTable:
+        for (std::size_t r = 0; r < b.rows.size(); ++r) {
+          out += "|";
+          for (const auto& cell : b.rows[r])
+            out += " " + cell + " |";
+          out += "\n";
+          if (r == 0) {
+            out += "|";
+            for (std::size_t c = 0; c < b.rows[r].size(); ++c)
+              out += "---|";
+            out += "\n";
+          }
+        }
+        out += "\n";
+        break;
+    }
+  }
+  return out;
+}
+
+std::string to_html(const std::vector<Block>& blocks, const std::string& title) {
+  std::string out = "<!DOCTYPE html>\n<html lang=\"en\"><head><meta charset=\"utf-8\">\n<title>" +
+                    html_escape(title) +
+                    "</title>\n<style>body{font-family:sans-serif;max-width:60em;margin:2em auto;"
+                    "line-height:1.4}table{border-collapse:collapse;margin:1em 0}td,th{border:1px "
+                    "solid #999;padding:.3em .6em;text-align:left}img{max-width:100%}"
+                    "pre{background:#f4f4f4;padding:.5em}</style>\n</head><body>\n";
+  for (const Block& b : blocks) {
+    switch (b.kind) {
+      case Block::kHeading:
+        out += fmt::format("<h{0}>{1}</h{0}>\n", b.level, html_escape(b.text));
+        break;
+      case Block::kParagraph:
+        out += "<p>" + html_escape(b.text) + "</p>\n";
+        break;
+      case Block::kCode:
+        out += "<pre>" + html_escape(b.text) + "</pre>\n";
+        break;
+      case Block::kImage:
+        out += "<figure><img src=\"" + html_escape(b.path) + "\" alt=\"" + html_escape(b.text) +
+               "\"><figcaption>" + html_escape(b.text) + "</figcaption></figure>\n";
+        break;
+      case Block::kTable:
+        out += "<table>\n";
+        for (std::size_t r = 0; r < b.rows.size(); ++r) {
+          out += "<tr>";
+          for (const auto& cell : b.rows[r]) {
+            out += (r == 0 ? "<th>" : "<td>") + html_escape(cell) + (r == 0 ? "</th>" : "</td>");
+          }
+          out += "</tr>\n";
+        }
+        out += "</table>\n";
+        break;
+    }
+  }
+  return out + "</body></html>\n";
+}
+
+void write_text(const fs::path& path, const std::string& text) {
+  std::ofstream f(path);
+  f << text;
+  f.close();
+  if (!f)
+    throw io::InputError(fmt::format("{}: cannot write", path.string()));
+}
+
+std::string seconds(double t) {
+  return std::isfinite(t) ? fmt::format("{:.3f} s", t) : "not settled";
+}
+
+std::string matrix_text(const control::Mat3& a) {
+  std::string s;
+  for (const auto& row : a)
+    s += fmt::format("[{:8.4f} {:8.4f} {:8.4f}]\n", row[0], row[1], row[2]);
+  s.pop_back();
+  return s;
+}
+
+std::string poly_text(const control::CubicPolynomial& p) {
+  return fmt::format("p3 = {:.4e}, p2 = {:.4e}, p1 = {:.4f}, p0 = {:.4f} um", p.p3, p.p2, p.p1,
+                     p.p0);
+}
+
+std::vector<std::string> trial_row(const std::string& label, const calibration::PidTrial& t) {
+  return {label,
+          fmt::format("{:g} / {:g} / {:g}", t.gains.kp, t.gains.ki, t.gains.kd),
+          fmt::format("{:.2f} %", t.worst.overshoot_pct),
+          seconds(t.worst.settling_time_s),
+          fmt::format("{:.1f} nm", t.worst.steady_state_error_nm),
+          t.acceptable ? "yes" : "no"};
+}
+
+void write_data(const ReproductionResult& r, const fs::path& dir, ReportFiles& files) {
+  auto csv = [&](const std::string& name, std::vector<std::string> columns, int decimals) {
+    files.data.push_back(dir / name);
+    return std::make_unique<io::CsvWriter>((dir / name).string(), std::move(columns), decimals);
+  };
+  {
+    auto w = csv("step_response.csv", {"time_s", "desired_um", "measured_um"}, 6);
+    for (std::size_t k = 0; k < r.step.time_s.size(); ++k) {
+      w->row({r.step.time_s[k], r.step.desired_um[k], r.step.measured_um[k]});
+    }
+    w->close();
+  }
+  {
+    auto w = csv("linearity.csv", {"desired_um", "measured_um"}, 6);
+    for (std::size_t k = 0; k < r.linearity.desired_um.size(); ++k) {
+      w->row({r.linearity.desired_um[k], r.linearity.measured_um[k]});
+    }
+    w->close();
+    auto s = csv("linearity_samples.csv", {"time_s", "desired_um", "measured_um"}, 6);
+    for (std::size_t k = 0; k < r.linearity.sample_time_s.size(); ++k) {
+      s->row({r.linearity.sample_time_s[k], r.linearity.sample_desired_um[k],
+              r.linearity.sample_measured_um[k]});
+    }
+    s->close();
+  }
+  for (const auto* rep : {&r.repeat_5um, &r.repeat_10um}) {
+    auto w =
+        csv(fmt::format("repeatability_{:g}um.csv", rep->target_um), {"move", "measured_um"}, 6);
+    for (std::size_t k = 0; k < rep->measured_um.size(); ++k) {
+      w->row({static_cast<double>(k + 1), rep->measured_um[k]});
+    }
+    w->close();
+  }
+  {
+    auto w = csv("travel_range.csv", {"desired_um", "measured_um", "saturated_mask"}, 6);
+    for (std::size_t k = 0; k < r.travel.desired_um.size(); ++k) {
+      w->row({r.travel.desired_um[k], r.travel.measured_um[k],
+              static_cast<double>(r.travel.saturated_mask[k])});
+    }
+    w->close();
+  }
+  {
+    const auto& m = r.calibration.matrix;
+    auto w = csv("matrix_poses.csv", {"s1_um", "s2_um", "s3_um", "z1_um", "z2_um", "z3_um"}, 6);
+    for (std::size_t k = 0; k < m.ds_um.size(); ++k) {
+      w->row({m.ds_um[k][0], m.ds_um[k][1], m.ds_um[k][2], m.dz_um[k][0], m.dz_um[k][1],
+              m.dz_um[k][2]});
+    }
+    w->close();
+  }
+  {
+    const auto& p = r.calibration.polynomial;
+    auto w = csv("polynomial_points.csv", {"command_um", "measured_um"}, 6);
+    for (std::size_t k = 0; k < p.command_um.size(); ++k)
+      w->row({p.command_um[k], p.measured_um[k]});
+    w->close();
+  }
+  {
+    auto w = csv("pid_trials.csv",
+                 {"kp", "ki", "kd", "worst_overshoot_pct", "worst_settling_time_s",
+                  "worst_steady_state_error_nm", "acceptable"},
+                 6);
+    for (const auto& t : r.calibration.pid.trials) {
+      w->row({t.gains.kp, t.gains.ki, t.gains.kd, t.worst.overshoot_pct, t.worst.settling_time_s,
+              t.worst.steady_state_error_nm, t.acceptable ? 1.0 : 0.0});
+    }
+    w->close();
+  }
+  write_text(dir / "summary.json", summary_json(r).dump(2) + "\n");
+  files.data.push_back(dir / "summary.json");
+  calibration::write_calibration_file(
+      (dir / "calibration.toml").string(), r.calibration.controller,
+      fmt::format(
+          "piezoshift calibration, identified on the digital twin by `piezoshift reproduce`\n"
+          "seed {}, {} schedule, PID gains: {}",
+          r.options.seed, r.options.quick ? "quick" : "paper",
+          r.options.pid == calibration::PidChoice::kPaper ? "the paper's" : "searched"));
+  files.data.push_back(dir / "calibration.toml");
+}
+
+}  // namespace
+
+ReportFiles write_report(const ReproductionResult& r, const fs::path& dir,
+                         const std::string& config_label) {
+  std::error_code ec;
+  fs::create_directories(dir, ec);
+  if (ec)
+    throw io::InputError(
+        fmt::format("{}: cannot create the folder: {}", dir.string(), ec.message()));
+  ReportFiles files;
+  write_data(r, dir, files);
+
+  // Figures 10 to 12.
+  experiments::StepResponseOptions so;
+  so.band_pct = r.step.metrics.band_pct;
+  so.band_nm = r.step.metrics.band_nm;
+  io::Figure f10 = experiments::step_response_figure(
+      r.step.time_s, r.step.measured_um, r.step.metrics, so,
+      fmt::format("Step response to {:g} um (twin, interferometer dynamic mode, 1 kHz)",
+                  r.step.desired_um.back()));
+  io::Figure f11 = experiments::linearity_figure(r.linearity.desired_um, r.linearity.measured_um,
+                                                 r.linearity.metrics, "Linearity (twin)");
+  const std::vector<experiments::RepeatabilitySet> sets{{"5 um", r.repeat_5um.measured_um},
+                                                        {"10 um", r.repeat_10um.measured_um}};
+  io::Figure f12 = experiments::repeatability_figure(sets, 1.0, "Repeatability (twin)");
+  for (const auto& [fig, stem] :
+       {std::pair{&f10, "fig10_step_response"}, std::pair{&f11, "fig11_linearity"},
+        std::pair{&f12, "fig12_repeatability"}}) {
+    const io::PlotFiles pf = io::render(*fig, dir / stem);
+    files.figures.push_back(*pf.png);
+  }
+
+  const auto& cal = r.calibration;
+  const auto& step = r.step.metrics;
+  const auto& lin = r.linearity.metrics;
+  const control::SemiClosedLoopParams paper{};
+  std::vector<Block> doc;
+  auto h = [&](int level, std::string t) {
+    doc.push_back({Block::kHeading, level, std::move(t), {}, {}});
+  };
+  auto p = [&](std::string t) { doc.push_back({Block::kParagraph, 0, std::move(t), {}, {}}); };
+  auto code = [&](std::string t) { doc.push_back({Block::kCode, 0, std::move(t), {}, {}}); };
+  auto table = [&](std::vector<std::vector<std::string>> rows) {
+    doc.push_back({Block::kTable, 0, {}, std::move(rows), {}});
+  };
+  auto image = [&](std::string caption, std::string path) {
+    doc.push_back({Block::kImage, 0, std::move(caption), {}, std::move(path)});
+  };
+
+  h(1, "Reproduction of Li et al. (2017) on the piezoshift digital twin");
+  p(fmt::format(
+      "The paper's calibration and its four experiments (Sections 3 and 4), run on the digital "
+      "twin of the paper's hardware through the same controller code that runs on a real bench. "
+      "Seed {}, {} schedule, PID gains: {}, configuration: {}. {:.0f} s of simulated time in "
+      "{:.2f} s of wall time.",
+      r.options.seed, r.options.quick ? "quick (shortened)" : "the paper's full",
+      r.options.pid == calibration::PidChoice::kPaper ? "the paper's (kp 0.6, ki 0.2, kd 0.001)"
+                                                      : "the stage-1 search's",
+      config_label, r.simulated_time_s, r.wall_time_s));
+
+  h(2, "Table 4: results");
+  table({{"", "Travel range", "Step response", "Linearity", "Repeatability (1 sigma)"},
+         {"This paper", "12.9 um @open loop; 11.5 um @semi-closed loop", "<0.3 s @11 um", "0.21 %",
+          "2 nm @5 um; 3 nm @10 um"},
+         {"Twin (this run)",
+          fmt::format("{:.2f} um @open loop; {:.1f} um @semi-closed loop", r.travel.open_loop_um,
+                      r.travel.semi_closed_um),
+          fmt::format("{} @{:g} um (+-2 %); {} to +-10 nm", seconds(step.settling_time_pct_s),
+                      r.step.desired_um.back(), seconds(step.settling_time_abs_s)),
+          fmt::format("{:.3f} % (zero-end); {:.3f} % (best fit)", lin.linearity_zero_end_pct,
+                      lin.linearity_best_fit_pct),
+          fmt::format("{:.2f} nm @5 um (n = {}); {:.2f} nm @10 um (n = {})",
+                      r.repeat_5um.metrics.repeatability_nm, r.repeat_5um.metrics.n,
+                      r.repeat_10um.metrics.repeatability_nm, r.repeat_10um.metrics.n)},
+         {"S315.10 (PI)", "12 um @open loop", "-", "2 % - 4 %", "-"},
+         {"NPS-Z-15H (Queensgate)", "15 um @closed loop", "-", "0.02 %", "-"}});
+  p(fmt::format(
+      "Step response details: rise time (10-90 %) {}, overshoot {:.2f} %, step {:.3f} um.",
+      seconds(step.rise_time_s), step.overshoot_pct, step.step_um));
+
+  h(2, "Calibration");
+  h(3, "Stage 1: PID gains");
+  p(
+      fmt::format("Each actuator stepped alone (inner loop) to 95 % of what its SGS reads at 10 V "
+                  "open loop: {:.3f}, {:.3f}, {:.3f} um. Scores are the worst of the three "
+                  "actuators; a candidate is acceptable with overshoot <= 1 %, settled to +-2 % "
+                  "within the record and a steady-state error <= 5 nm. {} candidates searched.",
+                  cal.pid.step_target_um[0], cal.pid.step_target_um[1], cal.pid.step_target_um[2],
+                  cal.pid.trials.size()));
+  table(
+      {{"gains", "kp / ki / kd", "overshoot", "settling (2 %)", "steady-state error", "acceptable"},
+       trial_row("paper", cal.pid.paper),
+       trial_row("search best", cal.pid.best),
+       trial_row("used", cal.pid.paper.gains.kp == cal.controller.gains.kp &&
+                                 cal.pid.paper.gains.ki == cal.controller.gains.ki &&
+                                 cal.pid.paper.gains.kd == cal.controller.gains.kd
+                             ? cal.pid.paper
+                             : cal.pid.best)});
+  h(3, "Stage 2: transmission matrix A");
+  p(
+      fmt::format("{} poses (each actuator moved alone by {:g} um from {:g} um, in closed loop), "
+                  "least squares: rms residual {:.4f} um, cond(A) = {:.3f}.",
+                  cal.matrix.fit.poses, r.schedule.calibration.matrix.move_um,
+                  r.schedule.calibration.matrix.base_um, cal.matrix.fit.rms_residual_um,
+                  cal.matrix.fit.condition_number));
+  code("identified A:\n" + matrix_text(cal.controller.matrix.a) + "\n\npaper's A:\n" +
+       matrix_text(paper.matrix.a));
+  h(3, "Stage 3: cubic polynomial p");
+  p(fmt::format(
+      "{} equally spaced commands over 0 to {:g} um, {} of them left out with a PID at "
+      "its limit; rms residual {:.4f} um.",
+      r.schedule.calibration.polynomial.points, r.schedule.calibration.polynomial.max_um,
+      cal.polynomial.saturated_points, cal.polynomial.fit.rms_residual_um));
+  code("fitted: " + poly_text(cal.controller.polynomial) +
+       "\npaper:  " + poly_text(paper.polynomial));
+  p("The paper's A and p describe its own stage; the twin's are identified from the twin by the "
+    "same procedure, so they agree where the twin's geometry and sensors follow the paper's and "
+    "differ where the paper's stage had effects the twin does not model (docs/twin.md).");
+
+  h(2, "Figures");
+  image("Figure 10: step response", "fig10_step_response.png");
+  image("Figure 11: linearity, (a) displacement, (b) error", "fig11_linearity.png");
+  image("Figure 12: repeatability at 5 and 10 um", "fig12_repeatability.png");
+
+  h(2, "Files");
+  std::string list;
+  for (const auto& f : files.data)
+    list += f.filename().string() + "  ";
+  p("Data beside this report (CSV columns carry their units; `piezoshift fit` and `piezoshift "
+    "analyze` read them): " +
+    list);
+
+  files.markdown = dir / "report.md";
+  files.html = dir / "report.html";
+  write_text(files.markdown, to_markdown(doc));
+  write_text(files.html, to_html(doc, "piezoshift reproduction"));
+  return files;
+}
+
+}  // namespace piezoshift::reproduction

@@ -1,0 +1,83 @@
+#include "piezoshift/reproduction/summary.hpp"
+
+#include <cmath>
+
+namespace piezoshift::reproduction {
+namespace {
+
+nlohmann::json matrix_json(const control::Mat3& a) {
+  nlohmann::json rows = nlohmann::json::array();
+  for (const auto& row : a)
+    rows.push_back({row[0], row[1], row[2]});
+  return rows;
+}
+
+nlohmann::json poly_json(const control::CubicPolynomial& p) {
+  return {p.p3, p.p2, p.p1, p.p0};
+}
+
+// JSON has no infinity: a time that never came (not settled) is null.
+nlohmann::json time_or_null(double t) {
+  return std::isfinite(t) ? nlohmann::json(t) : nlohmann::json();
+}
+
+nlohmann::json trial_json(const calibration::PidTrial& t) {
+  nlohmann::json per = nlohmann::json::array();
+  for (const auto& s : t.per_actuator) {
+    per.push_back({{"overshoot_pct", s.overshoot_pct},
+                   {"settling_time_s", time_or_null(s.settling_time_s)},
+                   {"steady_state_error_nm", s.steady_state_error_nm}});
+  }
+  return {{"kp", t.gains.kp},
+          {"ki", t.gains.ki},
+          {"kd", t.gains.kd},
+          {"acceptable", t.acceptable},
+          {"worst_overshoot_pct", t.worst.overshoot_pct},
+          {"worst_settling_time_s", time_or_null(t.worst.settling_time_s)},
+          {"worst_steady_state_error_nm", t.worst.steady_state_error_nm},
+          {"per_actuator", per}};
+}
+
+}  // namespace
+
+nlohmann::json summary_json(const ReproductionResult& r) {
+  const auto& cal = r.calibration;
+  const auto& step = r.step.metrics;
+  nlohmann::json j;
+  j["seed"] = r.options.seed;
+  j["schedule"] = r.options.quick ? "quick" : "paper";
+  j["pid"] = r.options.pid == calibration::PidChoice::kPaper ? "paper" : "search";
+  j["travel_open_loop_um"] = r.travel.open_loop_um;
+  j["travel_semi_closed_um"] = r.travel.semi_closed_um;
+  j["step_um"] = step.step_um;
+  j["step_rise_time_s"] = time_or_null(step.rise_time_s);
+  j["step_overshoot_pct"] = step.overshoot_pct;
+  j["step_settling_time_s"] = time_or_null(step.settling_time_pct_s);
+  j["step_settling_time_10nm_s"] = time_or_null(step.settling_time_abs_s);
+  j["linearity_zero_end_pct"] = r.linearity.metrics.linearity_zero_end_pct;
+  j["linearity_best_fit_pct"] = r.linearity.metrics.linearity_best_fit_pct;
+  j["repeatability_5um_nm"] = r.repeat_5um.metrics.repeatability_nm;
+  j["repeatability_10um_nm"] = r.repeat_10um.metrics.repeatability_nm;
+  j["repeatability_5um_n"] = r.repeat_5um.metrics.n;
+  j["repeatability_10um_n"] = r.repeat_10um.metrics.n;
+  j["identified_A"] = matrix_json(cal.controller.matrix.a);
+  j["identified_A_condition_number"] = cal.matrix.fit.condition_number;
+  j["identified_A_rms_residual_um"] = cal.matrix.fit.rms_residual_um;
+  j["fitted_p"] = poly_json(cal.controller.polynomial);
+  j["fitted_p_rms_residual_um"] = cal.polynomial.fit.rms_residual_um;
+  j["fitted_p_saturated_points"] = cal.polynomial.saturated_points;
+  j["pid_gains"] = {{"kp", cal.controller.gains.kp},
+                    {"ki", cal.controller.gains.ki},
+                    {"kd", cal.controller.gains.kd},
+                    {"sample_time_s", cal.controller.gains_sample_time_s}};
+  j["pid_step_target_um"] = {cal.pid.step_target_um[0], cal.pid.step_target_um[1],
+                             cal.pid.step_target_um[2]};
+  j["pid_paper_score"] = trial_json(cal.pid.paper);
+  j["pid_search_best"] = trial_json(cal.pid.best);
+  j["pid_search_trials"] = cal.pid.trials.size();
+  j["simulated_time_s"] = r.simulated_time_s;
+  j["wall_time_s"] = r.wall_time_s;
+  return j;
+}
+
+}  // namespace piezoshift::reproduction

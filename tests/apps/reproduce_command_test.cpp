@@ -1,0 +1,57 @@
+// `piezoshift calibrate` and `piezoshift reproduce` as a user runs them.
+#include <nlohmann/json.hpp>
+
+#include "../support/cli_test.hpp"
+
+namespace piezoshift {
+namespace {
+
+using ReproduceCommand = testing::CliTest;
+
+TEST_F(ReproduceCommand, QuickRunWritesTheReportAndPrintsTheSummary) {
+  const std::string out = path("report");
+  const testing::CliResult r = run("reproduce --quick --seed 2 --json --out '" + out + "'");
+  ASSERT_EQ(r.status, 0) << r.err;
+  const auto j = nlohmann::json::parse(r.out);
+  EXPECT_NEAR(j["travel_open_loop_um"].get<double>(), 12.9, 0.3);
+  EXPECT_LT(j["step_settling_time_s"].get<double>(), 0.3);
+  EXPECT_EQ(j["seed"], 2);
+  EXPECT_EQ(j["schedule"], "quick");
+  EXPECT_TRUE(std::filesystem::exists(out + "/report.md"));
+  EXPECT_TRUE(std::filesystem::exists(out + "/summary.json"));
+  // The CSVs are what `analyze` reads: the same metric comes back from the recorded data.
+  const testing::CliResult a =
+      run("analyze repeatability --json --data '" + out + "/repeatability_5um.csv'");
+  ASSERT_EQ(a.status, 0) << a.err;
+  EXPECT_NEAR(nlohmann::json::parse(a.out)["repeatability_nm"].get<double>(),
+              j["repeatability_5um_nm"].get<double>(), 1e-3);
+}
+
+TEST_F(ReproduceCommand, CalibrateWritesAFileThatRunLoads) {
+  const std::string cal = path("cal.toml");
+  const testing::CliResult c = run("calibrate --pid paper --json --out '" + cal + "'");
+  ASSERT_EQ(c.status, 0) << c.err;
+  const auto j = nlohmann::json::parse(c.out);
+  EXPECT_DOUBLE_EQ(j["pid_gains"]["kp"].get<double>(), 0.6);
+  EXPECT_NEAR(j["A"][0][0].get<double>(), -0.4218, 0.05);  // the twin is built on the paper's A
+  EXPECT_EQ(j["p"].size(), 4U);
+  const testing::CliResult r =
+      run("run --daq sim --calibration '" + cal + "' --step-um 5 --duration-s 0.2 --json");
+  EXPECT_EQ(r.status, 0) << r.err;
+}
+
+TEST_F(ReproduceCommand, BadInputExitsWithStatusTwo) {
+  const std::string bad = write("bad.toml", "[twin.piezo]\nfree_stroke_scale = [1, -1, 1]\n");
+  testing::CliResult r = run("reproduce --quick --config '" + bad + "' --out '" + path("o") + "'");
+  EXPECT_EQ(r.status, 2);
+  EXPECT_NE(r.err.find("bad.toml"), std::string::npos) << r.err;
+  EXPECT_NE(r.err.find("free_stroke_scale"), std::string::npos) << r.err;
+  r = run("reproduce --pid sometimes");
+  EXPECT_EQ(r.status, 2);
+  r = run("calibrate --out '" + path("no/such/dir/cal.toml") + "' --pid paper");
+  EXPECT_EQ(r.status, 2);
+  EXPECT_NE(r.err.find("cal.toml"), std::string::npos) << r.err;
+}
+
+}  // namespace
+}  // namespace piezoshift
