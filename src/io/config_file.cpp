@@ -235,41 +235,43 @@ bool ConfigSection::read(std::string_view key, std::string& value) const {
   return true;
 }
 
+namespace {
+
+// A list of exactly N numbers, each within bounds; path names the key for messages.
+template <std::size_t N>
+std::array<double, N> number_list(const ConfigFileImpl& impl, const std::string& path,
+                                  const toml::node& n, Bounds bounds) {
+  static constexpr const char* kCount[] = {"zero", "one", "two", "three", "four"};
+  const auto* a = n.as_array();
+  if (a == nullptr || a->size() != N) {
+    impl.fail(path, n.source(), fmt::format("expected a list of {} numbers", kCount[N]));
+  }
+  std::array<double, N> v{};
+  for (std::size_t i = 0; i < N; ++i) {
+    v[i] = impl.number(fmt::format("{}[{}]", path, i), *a->get(i), bounds);
+  }
+  return v;
+}
+
+}  // namespace
+
 bool ConfigSection::read(std::string_view key, std::array<double, 3>& value, Bounds bounds) const {
-  const auto& impl = *file_;
-  const toml::node* n = impl.find(name_, key);
+  const toml::node* n = file_->find(name_, key);
   if (n == nullptr)
     return false;
   const std::string path = join(name_, key);
-  impl.used.insert(path);
-  const auto* a = n->as_array();
-  if (a == nullptr || a->size() != 3) {
-    impl.fail(path, n->source(), "expected a list of three numbers");
-  }
-  std::array<double, 3> v{};
-  for (std::size_t i = 0; i < 3; ++i) {
-    v[i] = impl.number(fmt::format("{}[{}]", path, i), *a->get(i), bounds);
-  }
-  value = v;
+  file_->used.insert(path);
+  value = number_list<3>(*file_, path, *n, bounds);
   return true;
 }
 
 bool ConfigSection::read(std::string_view key, std::array<double, 4>& value, Bounds bounds) const {
-  const auto& impl = *file_;
-  const toml::node* n = impl.find(name_, key);
+  const toml::node* n = file_->find(name_, key);
   if (n == nullptr)
     return false;
   const std::string path = join(name_, key);
-  impl.used.insert(path);
-  const auto* a = n->as_array();
-  if (a == nullptr || a->size() != 4) {
-    impl.fail(path, n->source(), "expected a list of four numbers");
-  }
-  std::array<double, 4> v{};
-  for (std::size_t i = 0; i < 4; ++i) {
-    v[i] = impl.number(fmt::format("{}[{}]", path, i), *a->get(i), bounds);
-  }
-  value = v;
+  file_->used.insert(path);
+  value = number_list<4>(*file_, path, *n, bounds);
   return true;
 }
 

@@ -11,54 +11,14 @@
 #include <gtest/gtest.h>
 #include <nlohmann/json.hpp>
 
+#include "../support/cli_test.hpp"
+
 namespace {
 
-struct RunResult {
-  int status = -1;
-  std::string out;
-  std::string err;
-};
-
-class DesignCommand : public ::testing::Test {
+using RunResult = piezoshift::testing::CliResult;
+class DesignCommand : public piezoshift::testing::CliTest {
  protected:
-  void SetUp() override {
-    const auto* info = ::testing::UnitTest::GetInstance()->current_test_info();
-    dir_ = std::filesystem::temp_directory_path() /
-           ("piezoshift_cli_" + std::string(info->name()) + "_" + std::to_string(::getpid()));
-    std::filesystem::create_directories(dir_);
-  }
-  void TearDown() override { std::filesystem::remove_all(dir_); }
-
-  std::string write(const std::string& name, const std::string& text) {
-    const std::filesystem::path p = dir_ / name;
-    std::ofstream(p) << text;
-    return p.string();
-  }
-
-  // Runs `piezoshift <args>`; stdout through the pipe, stderr through a file.
-  RunResult run(const std::string& args) {
-    const std::string err_path = (dir_ / "stderr.txt").string();
-    const std::string cmd =
-        std::string("'") + PIEZOSHIFT_CLI + "' " + args + " 2>'" + err_path + "'";
-    RunResult r;
-    FILE* pipe = ::popen(cmd.c_str(), "r");
-    if (pipe == nullptr) {
-      ADD_FAILURE() << "popen failed: " << cmd;
-      return r;
-    }
-    char buf[4096];
-    for (std::size_t n; (n = std::fread(buf, 1, sizeof buf, pipe)) > 0;)
-      r.out.append(buf, n);
-    const int w = ::pclose(pipe);
-    r.status = WIFEXITED(w) ? WEXITSTATUS(w) : -1;
-    std::ifstream e(err_path);
-    std::stringstream ss;
-    ss << e.rdbuf();
-    r.err = ss.str();
-    return r;
-  }
-
-  // A configuration file that must be refused: exit status 2, the file and key in the message.
+  // A configuration that `design` must refuse: exit 2, the file and the key named, no stdout.
   void expect_refused(const std::string& text, const std::string& key) {
     const std::string path = write("bad.toml", text);
     const RunResult r = run("design --config '" + path + "'");
@@ -67,8 +27,6 @@ class DesignCommand : public ::testing::Test {
     EXPECT_NE(r.err.find(key), std::string::npos) << r.err;
     EXPECT_EQ(r.out, "") << "nothing on stdout for bad input";
   }
-
-  std::filesystem::path dir_;
 };
 
 TEST_F(DesignCommand, JsonHasThePaperNumbers) {

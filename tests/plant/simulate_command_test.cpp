@@ -11,56 +11,14 @@
 #include <gtest/gtest.h>
 #include <nlohmann/json.hpp>
 
+#include "../support/cli_test.hpp"
+
 namespace {
 
-struct RunResult {
-  int status = -1;
-  std::string out;
-  std::string err;
-};
-
-class SimulateCommand : public ::testing::Test {
+using RunResult = piezoshift::testing::CliResult;
+class SimulateCommand : public piezoshift::testing::CliTest {
  protected:
-  void SetUp() override {
-    const auto* info = ::testing::UnitTest::GetInstance()->current_test_info();
-    dir_ = std::filesystem::temp_directory_path() /
-           ("piezoshift_sim_" + std::string(info->name()) + "_" + std::to_string(::getpid()));
-    std::filesystem::create_directories(dir_);
-  }
-  void TearDown() override { std::filesystem::remove_all(dir_); }
-
-  std::string path(const std::string& name) const { return (dir_ / name).string(); }
-  std::string write(const std::string& name, const std::string& text) {
-    std::ofstream(path(name)) << text;
-    return path(name);
-  }
-  static std::string read(const std::string& p) {
-    std::ifstream in(p);
-    std::stringstream s;
-    s << in.rdbuf();
-    return s.str();
-  }
-
-  RunResult run(const std::string& args) {
-    const std::string err_path = path("stderr.txt");
-    const std::string cmd =
-        std::string("'") + PIEZOSHIFT_CLI + "' simulate " + args + " 2>'" + err_path + "'";
-    RunResult r;
-    FILE* pipe = ::popen(cmd.c_str(), "r");
-    if (pipe == nullptr) {
-      ADD_FAILURE() << "popen failed: " << cmd;
-      return r;
-    }
-    char buf[4096];
-    for (std::size_t n; (n = std::fread(buf, 1, sizeof buf, pipe)) > 0;)
-      r.out.append(buf, n);
-    const int status = ::pclose(pipe);
-    r.status = WIFEXITED(status) ? WEXITSTATUS(status) : -1;
-    r.err = read(err_path);
-    return r;
-  }
-
-  std::filesystem::path dir_;
+  RunResult run(const std::string& args) const { return CliTest::run("simulate " + args); }
 };
 
 TEST_F(SimulateCommand, OpenLoopAtTenVoltsReachesThePapersTravel) {
@@ -108,8 +66,8 @@ TEST_F(SimulateCommand, SameSeedGivesTheSameLogAndAnotherSeedDoesNot) {
   ASSERT_EQ(run("--step-um 8 --duration-s 0.3 --seed 9 --log '" + a + "'").status, 0);
   ASSERT_EQ(run("--step-um 8 --duration-s 0.3 --seed 9 --log '" + b + "'").status, 0);
   ASSERT_EQ(run("--step-um 8 --duration-s 0.3 --seed 10 --log '" + c + "'").status, 0);
-  EXPECT_EQ(read(a), read(b));
-  EXPECT_NE(read(a), read(c));
+  EXPECT_EQ(read_text(a), read_text(b));
+  EXPECT_NE(read_text(a), read_text(c));
 }
 
 TEST_F(SimulateCommand, ProfileIsFollowedAsAStaircase) {

@@ -38,6 +38,14 @@ class CliTest : public ::testing::Test {
     return path(name);
   }
 
+  //! The whole content of a file (empty if it cannot be read).
+  static std::string read_text(const std::string& file) {
+    std::ifstream in(file);
+    std::stringstream ss;
+    ss << in.rdbuf();
+    return ss.str();
+  }
+
   CliResult run(const std::string& args) const {
     const std::string err_path = path("stderr.txt");
     const std::string cmd =
