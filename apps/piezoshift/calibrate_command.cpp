@@ -39,10 +39,9 @@ int run(const Options& o) {
   calibration::CalibrationOutcome c;
   {
     ProgressBar bar(3);
-    c = calibration::calibrate(config, control::SemiClosedLoopParams{}, o.seed, co,
-                               [&bar](double done, double total, std::string_view label) {
-                                 bar.update(done, total, label);
-                               });
+    control::SemiClosedLoopParams base;
+    base.sample_time_s = config.twin.daq.sample_time_s;  // the controller runs at the DAQ's rate
+    c = calibration::calibrate(config, base, o.seed, co, bar.callback());
   }
   calibration::write_calibration_file(
       o.out, c.controller,

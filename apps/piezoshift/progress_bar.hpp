@@ -4,6 +4,8 @@
 #include <string>
 #include <string_view>
 
+#include "piezoshift/experiments/progress.hpp"
+
 namespace piezoshift::app {
 
 class ProgressBar {
@@ -12,6 +14,11 @@ class ProgressBar {
   ~ProgressBar();
   //! done/total of the stage called label; a new label starts the next stage.
   void update(double done, double total, std::string_view label);
+  //! update() as the Progress callback that long jobs take.
+  experiments::Progress callback() {
+    return
+        [this](double done, double total, std::string_view label) { update(done, total, label); };
+  }
 
  private:
   bool enabled_;

@@ -38,10 +38,7 @@ int run(const Options& o) {
   {
     // PID gains, matrix A, polynomial p, travel range, step, linearity, repeatability x 2
     ProgressBar bar(8);
-    result = reproduction::reproduce(config, ro,
-                                     [&bar](double done, double total, std::string_view label) {
-                                       bar.update(done, total, label);
-                                     });
+    result = reproduction::reproduce(config, ro, bar.callback());
   }
   const std::string label = o.config.empty() ? "built-in defaults (configs/paper.toml)" : o.config;
   const reproduction::ReportFiles files = reproduction::write_report(result, o.out, label);

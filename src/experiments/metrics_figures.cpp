@@ -1,5 +1,6 @@
 #include "piezoshift/experiments/metrics_figures.hpp"
 
+#include <algorithm>
 #include <cmath>
 
 #include <fmt/core.h>
@@ -110,6 +111,10 @@ io::Figure repeatability_figure(std::span<const RepeatabilitySet> sets, double b
         make_panel(fmt::format("{}: e_R = {:.2f} nm (n = {})", s.label, r.repeatability_nm, r.n),
                    fmt::format("z - mean ({:.4f} um) [nm]", r.mean_um), "count", "off");
     p.series.push_back(io::histogram_series("", dev_nm, bin_nm));
+    // Counts start at zero, or the bars' heights mislead.
+    const auto& counts = p.series.back().y;
+    const double top = counts.empty() ? 1.0 : *std::max_element(counts.begin(), counts.end());
+    p.y_range = std::pair{0.0, 1.1 * top};
     f.panels.push_back(std::move(p));
   }
   return f;

@@ -2,6 +2,9 @@
 
 #include <cmath>
 #include <stdexcept>
+#include <string>
+
+#include <fmt/core.h>
 
 #include "piezoshift/experiments/bench.hpp"
 
@@ -144,6 +147,7 @@ RepeatabilityResult run_repeatability(const io::ProjectConfig& config,
   Bench bench(config, controller, seed);
   RepeatabilityResult r;
   r.target_um = o.target_um;
+  const std::string label = fmt::format("repeat. {:g} um", o.target_um);
   for (int i = 0; i < o.moves; ++i) {
     bench.drive_points(all(0.0));
     bench.run(o.rest_s);
@@ -151,7 +155,7 @@ RepeatabilityResult run_repeatability(const io::ProjectConfig& config,
     bench.run(o.settle_s);
     r.measured_um.push_back(mean3(bench.measure_static().points_um));
     if (progress)
-      progress(i + 1, o.moves, "repeatability");
+      progress(i + 1, o.moves, label);
   }
   r.metrics = repeatability_metrics(r.measured_um);
   r.simulated_time_s = bench.time_s();

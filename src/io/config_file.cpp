@@ -48,6 +48,18 @@ struct ConfigFileImpl {
     throw InputError(fmt::format("{}: {}: {}", source, path, reason));
   }
 
+  // The node of section.key, marked as read (so reject_unknown() passes it); nullptr when absent.
+  // path receives the dotted name for messages.
+  const toml::node* take(const std::string& section, std::string_view key,
+                         std::string& path) const {
+    const toml::node* n = find(section, key);
+    if (n != nullptr) {
+      path = section.empty() ? std::string(key) : section + "." + std::string(key);
+      used.insert(path);
+    }
+    return n;
+  }
+
   const toml::node* find(const std::string& section, std::string_view key) const {
     const toml::node* table = section.empty() ? &root : root.at_path(section).node();
     if (table == nullptr || !table->is_table())
@@ -168,34 +180,26 @@ void ConfigFile::reject_unknown() const {
   impl_->fail(first->path, first->where, first->reason);
 }
 
-namespace {
-std::string join(const std::string& section, std::string_view key) {
-  return section.empty() ? std::string(key) : section + "." + std::string(key);
-}
-}  // namespace
-
 bool ConfigSection::has(std::string_view key) const {
   return file_->find(name_, key) != nullptr;
 }
 
 bool ConfigSection::read(std::string_view key, double& value, Bounds bounds) const {
   const auto& impl = *file_;
-  const toml::node* n = impl.find(name_, key);
+  std::string path;
+  const toml::node* n = impl.take(name_, key, path);
   if (n == nullptr)
     return false;
-  const std::string path = join(name_, key);
-  impl.used.insert(path);
   value = impl.number(path, *n, bounds);
   return true;
 }
 
 bool ConfigSection::read(std::string_view key, std::int64_t& value, Bounds bounds) const {
   const auto& impl = *file_;
-  const toml::node* n = impl.find(name_, key);
+  std::string path;
+  const toml::node* n = impl.take(name_, key, path);
   if (n == nullptr)
     return false;
-  const std::string path = join(name_, key);
-  impl.used.insert(path);
   const auto* i = n->as_integer();
   if (i == nullptr)
     impl.fail(path, n->source(), "expected an integer");
@@ -209,11 +213,10 @@ bool ConfigSection::read(std::string_view key, std::int64_t& value, Bounds bound
 
 bool ConfigSection::read(std::string_view key, bool& value) const {
   const auto& impl = *file_;
-  const toml::node* n = impl.find(name_, key);
+  std::string path;
+  const toml::node* n = impl.take(name_, key, path);
   if (n == nullptr)
     return false;
-  const std::string path = join(name_, key);
-  impl.used.insert(path);
   const auto* b = n->as_boolean();
   if (b == nullptr)
     impl.fail(path, n->source(), "expected true or false");
@@ -223,11 +226,10 @@ bool ConfigSection::read(std::string_view key, bool& value) const {
 
 bool ConfigSection::read(std::string_view key, std::string& value) const {
   const auto& impl = *file_;
-  const toml::node* n = impl.find(name_, key);
+  std::string path;
+  const toml::node* n = impl.take(name_, key, path);
   if (n == nullptr)
     return false;
-  const std::string path = join(name_, key);
-  impl.used.insert(path);
   const auto* s = n->as_string();
   if (s == nullptr)
     impl.fail(path, n->source(), "expected a string");
@@ -256,21 +258,19 @@ std::array<double, N> number_list(const ConfigFileImpl& impl, const std::string&
 }  // namespace
 
 bool ConfigSection::read(std::string_view key, std::array<double, 3>& value, Bounds bounds) const {
-  const toml::node* n = file_->find(name_, key);
+  std::string path;
+  const toml::node* n = file_->take(name_, key, path);
   if (n == nullptr)
     return false;
-  const std::string path = join(name_, key);
-  file_->used.insert(path);
   value = number_list<3>(*file_, path, *n, bounds);
   return true;
 }
 
 bool ConfigSection::read(std::string_view key, std::array<double, 4>& value, Bounds bounds) const {
-  const toml::node* n = file_->find(name_, key);
+  std::string path;
+  const toml::node* n = file_->take(name_, key, path);
   if (n == nullptr)
     return false;
-  const std::string path = join(name_, key);
-  file_->used.insert(path);
   value = number_list<4>(*file_, path, *n, bounds);
   return true;
 }
@@ -278,11 +278,10 @@ bool ConfigSection::read(std::string_view key, std::array<double, 4>& value, Bou
 bool ConfigSection::read(std::string_view key, std::array<std::array<double, 3>, 3>& value,
                          Bounds bounds) const {
   const auto& impl = *file_;
-  const toml::node* n = impl.find(name_, key);
+  std::string path;
+  const toml::node* n = impl.take(name_, key, path);
   if (n == nullptr)
     return false;
-  const std::string path = join(name_, key);
-  impl.used.insert(path);
   const auto* rows = n->as_array();
   if (rows == nullptr || rows->size() != 3) {
     impl.fail(path, n->source(), "expected three rows of three numbers");

@@ -39,7 +39,8 @@ ReproductionResult reproduce(const io::ProjectConfig& config, const ReproduceOpt
   ReproductionResult r;
   r.options = options;
   r.schedule = s;
-  const control::SemiClosedLoopParams base{};
+  control::SemiClosedLoopParams base{};
+  base.sample_time_s = config.twin.daq.sample_time_s;  // the controller runs at the DAQ's rate
   r.calibration = calibration::calibrate(config, base, seed, s.calibration, progress);
   const auto& c = r.calibration.controller;
   r.travel = experiments::run_travel_range(config, c, seed + 10, s.travel, progress);
