@@ -6,7 +6,7 @@ BUILD_DIR = build/$(PRESET)
 PIEZOSHIFT = $(BUILD_DIR)/apps/piezoshift/piezoshift
 DEMO_OUT ?= out/demo
 
-.PHONY: all deps configure build test demo sanitize bench format format-check clean
+.PHONY: all deps configure build test demo python python-install sanitize bench format format-check clean
 
 all: build
 
@@ -24,6 +24,15 @@ test: build
 
 demo: build
 	@$(PIEZOSHIFT) reproduce --out $(DEMO_OUT)
+
+# The Python package (docs/python.md): built into $(BUILD_DIR)/python/piezoshift.
+python: configure
+	@cmake --build --preset $(PRESET) -j $(JOBS) --target _piezoshift
+	@echo "python: PYTHONPATH=$(CURDIR)/$(BUILD_DIR)/python /usr/bin/python3 -c 'import piezoshift'"
+
+# Installs it into the user's site-packages (~/.local), importable without PYTHONPATH.
+python-install: python
+	@cmake --install $(BUILD_DIR) --component python --prefix $(HOME)/.local
 
 sanitize:
 	@$(MAKE) --no-print-directory test PRESET=sanitize
