@@ -73,7 +73,8 @@ TEST(CsvTable, StructuralErrorsNameTheLine) {
             "columns, e.g. s1_um,s2_um,s3_um");
   EXPECT_EQ(error_of("y,x,y\n1,2,3\n", "y"),
             "data.csv:1: column 'y' appears twice (fields 1 and 3)");
-  EXPECT_EQ(error_of("# c\nx,y\n1,2\n", "z"), "data.csv:2: missing column 'z' (the header has: x,y)");
+  EXPECT_EQ(error_of("# c\nx,y\n1,2\n", "z"),
+            "data.csv:2: missing column 'z' (the header has: x,y)");
 }
 
 TEST(CsvTable, RequireColumnsListsEveryMissingName) {

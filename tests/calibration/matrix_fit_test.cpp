@@ -61,7 +61,7 @@ TEST(MatrixFit, RecoversPaperMatrixFromExactData) {
 }
 
 TEST(MatrixFit, RecoversPaperMatrixFromNoisyDataWithinFiveStandardErrors) {
-  Poses p = individual_moves(kPaperA, 3);  // 90 poses
+  Poses p = individual_moves(kPaperA, 3);         // 90 poses
   const double sigma_s = 0.002, sigma_z = 0.002;  // 2 nm on the SGS reading and on the XL-80
   test::GaussianNoise ns(42, sigma_s), nz(4242, sigma_z);
   Eigen::MatrixXd z(static_cast<Eigen::Index>(p.z.size()), 3);
@@ -124,7 +124,8 @@ TEST(MatrixFit, RejectsTooFewPosesAndNonFiniteValues) {
   } catch (const FitError& e) {
     EXPECT_NE(std::string(e.what()).find("2 poses; at least 3"), std::string::npos) << e.what();
   }
-  const std::vector<Vec3> s3{{1, 0, 0}, {0, 1, 0}, {0, 0, NAN}}, z3{{1, 0, 0}, {0, 1, 0}, {0, 0, 1}};
+  const std::vector<Vec3> s3{{1, 0, 0}, {0, 1, 0}, {0, 0, NAN}},
+      z3{{1, 0, 0}, {0, 1, 0}, {0, 0, 1}};
   EXPECT_THROW(fit_transmission_matrix(s3, z3), FitError);
   EXPECT_THROW(fit_transmission_matrix(s3, std::span(z3).first(2)), FitError);
 }

@@ -11,10 +11,10 @@
 namespace piezoshift::experiments {
 namespace {
 
-constexpr double kTau = 0.01;    // [s]
-constexpr double kStep = 11.0;   // [um], the paper's Figure 10 step
-constexpr double kDt = 1e-4;     // [s]
-constexpr double kT0 = 0.005;    // step instant [s]
+constexpr double kTau = 0.01;   // [s]
+constexpr double kStep = 11.0;  // [um], the paper's Figure 10 step
+constexpr double kDt = 1e-4;    // [s]
+constexpr double kT0 = 0.005;   // step instant [s]
 
 struct Record {
   std::vector<double> t, y;
@@ -62,12 +62,12 @@ TEST(StepResponse, SecondOrderOvershootMatchesClosedForm) {
     const double tk = k * 1e-4;
     t.push_back(tk);
     y.push_back(kStep * (1 - std::exp(-zeta * wn * tk) *
-                                 (std::cos(wd * tk) + zeta / std::sqrt(1 - zeta * zeta) *
-                                                          std::sin(wd * tk))));
+                                 (std::cos(wd * tk) +
+                                  zeta / std::sqrt(1 - zeta * zeta) * std::sin(wd * tk))));
   }
   const StepResponseMetrics m = step_response_metrics(t, y);
-  EXPECT_NEAR(m.overshoot_pct, 100 * std::exp(-zeta * std::numbers::pi / std::sqrt(1 - zeta * zeta)),
-              0.01);
+  EXPECT_NEAR(m.overshoot_pct,
+              100 * std::exp(-zeta * std::numbers::pi / std::sqrt(1 - zeta * zeta)), 0.01);
   EXPECT_NEAR(m.overshoot_pct, 16.303, 0.01);
   EXPECT_NEAR(m.peak_time_s, std::numbers::pi / wd, 1e-4);
   EXPECT_GT(m.settling_time_pct_s, m.peak_time_s);

@@ -33,7 +33,8 @@ std::pair<std::uint32_t, std::uint32_t> png_size(const fs::path& p) {
   if (b.size() < 24 || b.compare(0, 8, "\x89PNG\r\n\x1a\n") != 0)
     return {0, 0};
   auto be32 = [&](std::size_t i) {
-    return (std::uint32_t(std::uint8_t(b[i])) << 24) | (std::uint32_t(std::uint8_t(b[i + 1])) << 16) |
+    return (std::uint32_t(std::uint8_t(b[i])) << 24) |
+           (std::uint32_t(std::uint8_t(b[i + 1])) << 16) |
            (std::uint32_t(std::uint8_t(b[i + 2])) << 8) | std::uint32_t(std::uint8_t(b[i + 3]));
   };
   return {be32(16), be32(20)};
