@@ -2,6 +2,7 @@
 // calibration file that `piezoshift run --calibration` loads.
 #include <algorithm>
 #include <memory>
+#include <stdexcept>
 #include <string>
 
 #include <fmt/core.h>
@@ -10,6 +11,7 @@
 #include "command.hpp"
 #include "piezoshift/calibration/calibration_file.hpp"
 #include "piezoshift/calibration/calibration_procedure.hpp"
+#include "piezoshift/experiments/paper_experiments.hpp"
 #include "piezoshift/io/project_config.hpp"
 #include "progress_bar.hpp"
 
@@ -43,12 +45,18 @@ int run(const Options& o) {
     base.sample_time_s = config.twin.daq.sample_time_s;  // the controller runs at the DAQ's rate
     c = calibration::calibrate(config, base, o.seed, co, bar.callback());
   }
+  // The travel this controller reaches (Section 4.1), on a fourth session: `serve`'s Z limit.
+  const experiments::TravelRangeResult travel =
+      experiments::run_travel_range(config, c.controller, o.seed + 3);
+  if (!(travel.semi_closed_um > 0.0))
+    throw std::runtime_error("calibrate: the calibrated loop did not track the first travel level");
   calibration::write_calibration_file(
       o.out, c.controller,
       fmt::format("piezoshift calibration, identified on the digital twin by `piezoshift "
                   "calibrate`\nseed {}, configuration: {}, PID gains: {}",
                   o.seed, o.config.empty() ? "built-in defaults" : o.config,
-                  o.pid == "paper" ? "the paper's" : "searched"));
+                  o.pid == "paper" ? "the paper's" : "searched"),
+      travel.semi_closed_um);
   const auto& g = c.controller.gains;
   const auto& p = c.controller.polynomial;
   if (o.json) {
@@ -62,6 +70,7 @@ int run(const Options& o) {
     j["A_rms_residual_um"] = c.matrix.fit.rms_residual_um;
     j["condition_number"] = c.matrix.fit.condition_number;
     j["p_rms_residual_um"] = c.polynomial.fit.rms_residual_um;
+    j["travel_z_max_um"] = travel.semi_closed_um;
     fmt::print("{}\n", j.dump(2));
     return 0;
   }
@@ -77,6 +86,7 @@ int run(const Options& o) {
   }
   fmt::print("stage 3  cubic p    p3 {:.4e}, p2 {:.4e}, p1 {:.5f}, p0 {:.4f} um (rms {:.4f} um)\n",
              p.p3, p.p2, p.p1, p.p0, c.polynomial.fit.rms_residual_um);
+  fmt::print("travel   semi-closed loop {:.2f} um (Section 4.1)\n", travel.semi_closed_um);
   fmt::print("written: {}\n", o.out);
   return 0;
 }

@@ -20,6 +20,8 @@ int main(int argc, char** argv) {
   piezoshift::app::add_analyze_command(app, action);
   piezoshift::app::add_run_command(app, action);
   piezoshift::app::add_calibrate_command(app, action);
+  piezoshift::app::add_serve_command(app, action);
+  piezoshift::app::add_gcs_command(app, action);
   piezoshift::app::add_reproduce_command(app, action);
 
   try {

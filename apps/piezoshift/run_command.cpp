@@ -5,7 +5,6 @@
 // supervisor latched a fault (the outputs were ramped to 0 V); 2 bad input, including a DAQ
 // device that cannot be opened; 1 internal error.
 #include <algorithm>
-#include <csignal>
 #include <cstdint>
 #include <limits>
 #include <memory>
@@ -17,14 +16,13 @@
 #include <nlohmann/json.hpp>
 
 #include "command.hpp"
+#include "loop_setup.hpp"
 #include "piezoshift/calibration/calibration_file.hpp"
 #include "piezoshift/io/input_error.hpp"
-#include "piezoshift/runtime/comedi_backend.hpp"
 #include "piezoshift/runtime/control_loop.hpp"
 #include "piezoshift/runtime/csv_logger.hpp"
 #include "piezoshift/runtime/fault_injection.hpp"
 #include "piezoshift/runtime/loop_clock.hpp"
-#include "piezoshift/runtime/realtime.hpp"
 #include "piezoshift/runtime/sim_backend.hpp"
 
 namespace piezoshift::app {
@@ -51,45 +49,6 @@ struct RunOptions {
   std::int64_t max_overruns = 3;
 };
 
-std::atomic<int> g_stop_signal{0};
-
-extern "C" void on_stop_signal(int signo) {
-  g_stop_signal.store(signo, std::memory_order_relaxed);
-}
-
-// Installs the SIGINT/SIGTERM handlers for the run's lifetime and restores the old ones.
-class StopSignals {
- public:
-  StopSignals() {
-    struct sigaction sa {};
-    sa.sa_handler = on_stop_signal;
-    sigemptyset(&sa.sa_mask);
-    sigaction(SIGINT, &sa, &old_int_);
-    sigaction(SIGTERM, &sa, &old_term_);
-  }
-  ~StopSignals() {
-    sigaction(SIGINT, &old_int_, nullptr);
-    sigaction(SIGTERM, &old_term_, nullptr);
-  }
-  StopSignals(const StopSignals&) = delete;
-  StopSignals& operator=(const StopSignals&) = delete;
-
- private:
-  struct sigaction old_int_ {};
-  struct sigaction old_term_ {};
-};
-
-const char* signal_name(int signo) {
-  switch (signo) {
-    case SIGINT:
-      return "SIGINT";
-    case SIGTERM:
-      return "SIGTERM";
-    default:
-      return "signal";
-  }
-}
-
 double us(std::int64_t ns) {
   return static_cast<double>(ns) * 1e-3;
 }
@@ -112,27 +71,14 @@ int run(const RunOptions& o) {
     faults.push_back(parse_fault_spec(f));
 
   // The backend.
-  std::unique_ptr<DaqBackend> hardware;
-  SimBackend* sim = nullptr;
-  if (o.daq == "sim") {
-    SimOptions so;
-    so.seed = o.seed;
-    so.rate_Hz = o.rate_Hz;
-    auto s = std::make_unique<SimBackend>(so);
-    sim = s.get();
-    hardware = std::move(s);
-  } else if (o.daq == "comedi" || o.daq.rfind("comedi:", 0) == 0) {
-    ComediOptions co;
-    if (o.daq.size() > 7)
-      co.device = o.daq.substr(7);
-    if (!faults.empty())
-      throw io::InputError("--fault needs --daq sim (faults are injected into the twin)");
-    if (o.free_run)
-      throw io::InputError("--free-run needs --daq sim (hardware runs in real time)");
-    hardware = std::make_unique<ComediBackend>(co);
-  } else {
-    throw io::InputError(fmt::format("--daq '{}': expected sim or comedi:/dev/comediN", o.daq));
-  }
+  const bool comedi = o.daq.rfind("comedi", 0) == 0;
+  if (comedi && !faults.empty())
+    throw io::InputError("--fault needs --daq sim (faults are injected into the twin)");
+  if (comedi && o.free_run)
+    throw io::InputError("--free-run needs --daq sim (hardware runs in real time)");
+  ChosenBackend chosen = make_backend(o.daq, io::ProjectConfig{}, o.seed, o.rate_Hz);
+  std::unique_ptr<DaqBackend> hardware = std::move(chosen.backend);
+  SimBackend* sim = chosen.sim;
   hardware->configure();  // comedi: names the device it cannot open (exit 2)
 
   std::unique_ptr<LoopClock> clock;
@@ -170,25 +116,12 @@ int run(const RunOptions& o) {
   ControlLoop loop(config, params, limits, *daq, *clock, std::move(profile),
                    logger ? &logger->ring() : nullptr);
 
-  g_stop_signal.store(0);
   StopSignals signals;
   if (logger)
     logger->start();  // before the real-time request: the logging thread stays a normal thread
   RealtimeReport rt;
-  if (clock->real_time()) {
-    RealtimeRequest req;
-    req.cpu = o.cpu;
-    rt = request_realtime(req);
-    if (!rt.refusals.empty()) {
-      std::string why;
-      for (const std::string& r : rt.refusals)
-        why += (why.empty() ? "" : "; ") + r;
-      fmt::print(stderr,
-                 "piezoshift: warning: real-time request partly refused ({}); running on with "
-                 "what was granted, the timing figures will show it\n",
-                 why);
-    }
-  }
+  if (clock->real_time())
+    rt = request_realtime_or_warn(o.cpu);
 
   daq->activate();
   const LoopResult r = loop.run();

@@ -23,16 +23,21 @@ void read_controller_section(const io::ConfigFile& file, control::SemiClosedLoop
   c.read("A", params.matrix.a);
 }
 
-control::SemiClosedLoopParams load_calibration_file(const std::string& path) {
+control::SemiClosedLoopParams load_calibration_file(const std::string& path,
+                                                    std::optional<double>* travel_z_max_um) {
   const io::ConfigFile file = io::ConfigFile::load(path);
   control::SemiClosedLoopParams params;
   read_controller_section(file, params);
+  double z_max_um = 0.0;
+  const bool has_travel = file.section("travel").read("z_max_um", z_max_um, io::Bounds::positive());
   file.reject_unknown();
+  if (travel_z_max_um != nullptr)
+    *travel_z_max_um = has_travel ? std::optional<double>(z_max_um) : std::nullopt;
   return params;
 }
 
 std::string format_calibration(const control::SemiClosedLoopParams& params,
-                               const std::string& header) {
+                               const std::string& header, std::optional<double> travel_z_max_um) {
   std::string out;
   std::istringstream lines(header);
   for (std::string line; std::getline(lines, line);)
@@ -52,12 +57,17 @@ std::string format_calibration(const control::SemiClosedLoopParams& params,
     out += fmt::format("{}[{:.17g}, {:.17g}, {:.17g}]{}", r == 0 ? "" : "     ", a[r][0], a[r][1],
                        a[r][2], r == 2 ? "]  # S = A Z_S, Eq. 8\n" : ",\n");
   }
+  if (travel_z_max_um) {
+    out += "\n[travel]\n";
+    out += fmt::format("z_max_um = {:.17g}  # semi-closed-loop travel, Section 4.1\n",
+                       *travel_z_max_um);
+  }
   return out;
 }
 
 void write_calibration_file(const std::string& path, const control::SemiClosedLoopParams& params,
-                            const std::string& header) {
-  io::write_file_atomically(path, format_calibration(params, header));
+                            const std::string& header, std::optional<double> travel_z_max_um) {
+  io::write_file_atomically(path, format_calibration(params, header, travel_z_max_um));
 }
 
 }  // namespace piezoshift::calibration

@@ -31,10 +31,12 @@ ControlLoop::ControlLoop(const LoopConfig& config, const control::SemiClosedLoop
       telemetry_(telemetry) {
   if (!(config.rate_Hz > 0.0) || !std::isfinite(config.rate_Hz))
     throw std::invalid_argument("ControlLoop: rate_Hz must be > 0");
-  if (!(config.duration_s >= 0.0) || !std::isfinite(config.duration_s))
+  if (!(config.duration_s >= 0.0) || std::isnan(config.duration_s))
     throw std::invalid_argument("ControlLoop: duration_s must be >= 0");
   period_ns_ = std::llround(1e9 / config.rate_Hz);
-  duration_ticks_ = static_cast<std::uint64_t>(std::llround(config.duration_s * config.rate_Hz));
+  const double ticks = config.duration_s * config.rate_Hz;
+  duration_ticks_ = ticks >= 1.8e19 ? std::numeric_limits<std::uint64_t>::max()
+                                    : static_cast<std::uint64_t>(std::llround(ticks));
   // The controller gets the real sample time; its gains are rescaled from gains_sample_time_s.
   params_.sample_time_s = static_cast<double>(period_ns_) * 1e-9;
   controller_.configure(params_);
@@ -61,6 +63,21 @@ LoopResult ControlLoop::run() noexcept {
   bool stop_requested = false;
   Vec3 previous_ao{};
 
+  // Host mode state: servo off at 0 V until the host says otherwise.
+  HostLink* const host = config_.host;
+  bool closed_loop = host == nullptr;
+  Vec3 host_zd{};
+  Vec3 open_loop_V{};
+  std::uint64_t applied_sequence = 0;
+  const auto clear_latched_fault = [&]() noexcept {
+    if (supervisor_.clear_fault()) {
+      controller_.reset();
+      controller_.hold_integrators(false);
+      if (stop_requested)
+        supervisor_.request_stop();
+    }
+  };
+
   for (std::uint64_t tick = 0;; ++tick) {
     clock_.sleep_until_ns(deadline);
     const std::int64_t wake = clock_.now_ns();
@@ -79,20 +96,61 @@ LoopResult ControlLoop::run() noexcept {
       if (stop_requested)
         supervisor_.request_stop();
     }
-    if (clear_requested_.exchange(false, std::memory_order_acq_rel)) {
-      if (supervisor_.clear_fault()) {
-        controller_.reset();
-        controller_.hold_integrators(false);
-        if (stop_requested)
-          supervisor_.request_stop();
+    if (clear_requested_.exchange(false, std::memory_order_acq_rel))
+      clear_latched_fault();
+
+    HostCommand cmd{};
+    for (int n = 0;
+         host != nullptr && n < HostLink::kMaxCommandsPerTick && host->commands.try_pop(cmd); ++n) {
+      applied_sequence = cmd.sequence;
+      ++result.host_commands_applied;
+      switch (cmd.kind) {
+        case HostCommand::Kind::kMoveTo:
+          if (closed_loop)
+            host_zd = cmd.zd_um;
+          break;
+        case HostCommand::Kind::kServoOn: {
+          clear_latched_fault();
+          // Bumpless: each PID resumes from the command the output already holds.
+          const Vec3& ao = supervisor_.last_output_V();
+          Vec3 command_um{};
+          for (std::size_t i = 0; i < command_um.size(); ++i) {
+            const control::SignalScaling& sc = params_.scaling[i];
+            command_um[i] = (ao[i] - sc.drive_offset_V) / sc.drive_V_per_um;
+          }
+          controller_.reset_to(command_um);
+          controller_.hold_integrators(false);
+          host_zd = cmd.zd_um;
+          closed_loop = true;
+          break;
+        }
+        case HostCommand::Kind::kServoOff:
+          clear_latched_fault();
+          open_loop_V = supervisor_.last_output_V();
+          closed_loop = false;
+          break;
+        case HostCommand::Kind::kOpenLoop:
+          if (!closed_loop)
+            open_loop_V = cmd.ao_V;
+          break;
       }
     }
 
     Vec3 ai{};
     const DaqStatus read_status = daq_.read(ct, ai);
-    const Vec3 zd = profile_.at(static_cast<double>(ct.since_start_ns) * 1e-9);
-    const control::ControllerOutput c = controller_.update(zd, ai);
+    const Vec3 zd =
+        host != nullptr ? host_zd : profile_.at(static_cast<double>(ct.since_start_ns) * 1e-9);
+    control::ControllerOutput c{};
+    if (closed_loop) {
+      c = controller_.update(zd, ai);
+    } else {
+      c.dac_V = open_loop_V;
+      for (std::size_t i = 0; i < ai.size(); ++i)
+        c.feedback_um[i] = params_.scaling[i].sgs_to_um(ai[i]);
+      c.target_um = c.feedback_um;
+    }
     SupervisorInput in{};
+    in.closed_loop = closed_loop;
     in.tick = tick;
     in.period_s = static_cast<double>(ct.period_ns) * 1e-9;
     in.sgs_V = ai;
@@ -153,6 +211,25 @@ LoopResult ControlLoop::run() noexcept {
       r.write_status = static_cast<std::uint8_t>(write_status);
       if (!telemetry_->try_push(r))
         ++result.telemetry_dropped;
+    }
+
+    if (host != nullptr) {
+      HostSample h{};
+      h.tick = tick;
+      h.t_s = static_cast<double>(ct.since_start_ns) * 1e-9;
+      h.applied_sequence = applied_sequence;
+      h.zd_um = zd;
+      h.target_um = c.target_um;
+      h.sgs_V = ai;
+      h.ao_V = s.ao_V;
+      Vec3 truth{};
+      h.has_truth = daq_.truth(truth, h.interferometer_um) ? 1 : 0;
+      h.closed_loop = closed_loop && !supervisor_.faulted() ? 1 : 0;
+      h.state = static_cast<std::uint8_t>(s.state);
+      h.fault_reason = static_cast<std::uint8_t>(supervisor_.fault().reason);
+      h.fault_channel = static_cast<std::int8_t>(supervisor_.fault().channel);
+      if (!host->samples.try_push(h))
+        ++result.host_samples_dropped;
     }
 
     const bool safe_after_fault = supervisor_.faulted() && supervisor_.outputs_at_zero();

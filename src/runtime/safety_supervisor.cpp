@@ -168,7 +168,8 @@ void SafetySupervisor::check(const SupervisorInput& in) noexcept {
   for (std::size_t i = 0; i < control::kChannels; ++i) {
     const int ch = static_cast<int>(i);
     const double error = in.target_um[i] - in.feedback_um[i];
-    tracking_count_[i] = std::fabs(error) > limits_.tracking_error_um ? tracking_count_[i] + 1 : 0;
+    tracking_count_[i] =
+        in.closed_loop && std::fabs(error) > limits_.tracking_error_um ? tracking_count_[i] + 1 : 0;
     if (tracking_count_[i] >= tracking_ticks_) {
       latch(FaultReason::kTracking, k, ch, error, limits_.tracking_error_um);
       return;
@@ -184,7 +185,8 @@ void SafetySupervisor::check(const SupervisorInput& in) noexcept {
       latch(FaultReason::kResponse, k, ch, y, y < lo ? lo : hi);
       return;
     }
-    saturation_count_[i] = last_ao_V_[i] >= limits_.output_max_V ? saturation_count_[i] + 1 : 0;
+    saturation_count_[i] =
+        in.closed_loop && last_ao_V_[i] >= limits_.output_max_V ? saturation_count_[i] + 1 : 0;
     if (saturation_count_[i] >= saturation_ticks_) {
       latch(FaultReason::kSaturation, k, ch, last_ao_V_[i], limits_.output_max_V);
       return;

@@ -1,11 +1,8 @@
 // `piezoshift run` end to end: the program is spawned, as an operator would run it. The signal
 // tests run on the real clock (the point is a live process); they lift the overrun rule so a
 // loaded test machine cannot turn them into a fault run: timing is not what they test.
-#include <fcntl.h>
 #include <signal.h>
-#include <spawn.h>
 #include <sys/stat.h>
-#include <sys/wait.h>
 #include <unistd.h>
 
 #include <algorithm>
@@ -21,53 +18,15 @@
 #include <gtest/gtest.h>
 #include <nlohmann/json.hpp>
 
-extern char** environ;
+#include "../support/spawned_process.hpp"
 
 namespace {
 
 namespace fs = std::filesystem;
-
-struct Spawned {
-  pid_t pid = -1;
-};
-
-// Starts the program with stdout and stderr to files.
-Spawned spawn(const std::vector<std::string>& args, const std::string& out,
-              const std::string& err) {
-  std::vector<char*> argv;
-  std::string prog = PIEZOSHIFT_CLI;
-  argv.push_back(prog.data());
-  std::vector<std::string> copy = args;
-  for (auto& a : copy)
-    argv.push_back(a.data());
-  argv.push_back(nullptr);
-  posix_spawn_file_actions_t fa;
-  posix_spawn_file_actions_init(&fa);
-  posix_spawn_file_actions_addopen(&fa, 1, out.c_str(), O_WRONLY | O_CREAT | O_TRUNC, 0644);
-  posix_spawn_file_actions_addopen(&fa, 2, err.c_str(), O_WRONLY | O_CREAT | O_TRUNC, 0644);
-  Spawned s;
-  const int rc = posix_spawn(&s.pid, prog.c_str(), &fa, nullptr, argv.data(), environ);
-  posix_spawn_file_actions_destroy(&fa);
-  EXPECT_EQ(rc, 0);
-  return s;
-}
-
-int wait_exit(const Spawned& s, bool* signaled = nullptr, int* signo = nullptr) {
-  int status = 0;
-  waitpid(s.pid, &status, 0);
-  if (signaled)
-    *signaled = WIFSIGNALED(status);
-  if (signo && WIFSIGNALED(status))
-    *signo = WTERMSIG(status);
-  return WIFEXITED(status) ? WEXITSTATUS(status) : -1;
-}
-
-std::string slurp(const std::string& path) {
-  std::ifstream in(path);
-  std::stringstream s;
-  s << in.rdbuf();
-  return s.str();
-}
+using piezoshift::testing::slurp;
+using piezoshift::testing::spawn;
+using piezoshift::testing::Spawned;
+using piezoshift::testing::wait_exit;
 
 // Complete lines only: a trailing fragment without its newline is dropped and reported.
 std::vector<std::string> lines(const std::string& text, bool* partial_tail = nullptr) {

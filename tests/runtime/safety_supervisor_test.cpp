@@ -327,5 +327,34 @@ TEST(SafetySupervisor, RejectsInconsistentLimits) {
   EXPECT_THROW(s.configure(no_zero, kT, {}), std::invalid_argument);
 }
 
+TEST(SafetySupervisor, OpenLoopHasNoTrackingOrSaturationRule) {
+  // The saturation case above, and a tracking error of 4 um, with the servo off (`serve`'s SVA):
+  // 10 V held for 100 ticks is an operator's choice, not lost authority; there is no target.
+  SafetySupervisor s = make();
+  for (std::uint64_t k = 0; k < 150; ++k) {
+    SupervisorInput in = steady(k, 10.0);
+    in.closed_loop = false;
+    in.target_um = control::filled(14.0);
+    const double u = s.last_output_V()[0] / 0.625;
+    in.feedback_um = control::filled(0.9117 * u);
+    in.sgs_V = control::filled(0.9117 * u / 1.6);
+    s.update(in);
+  }
+  EXPECT_FALSE(s.faulted()) << to_string(s.fault().reason);
+  EXPECT_EQ(s.last_output_V()[0], 10.0);
+  // The response rule still holds in open loop: a dead amplifier trips it at the same tick as in
+  // StackNotAnsweringItsDriveMustPersist20Ticks.
+  SafetySupervisor dead = make();
+  SupervisorInput in = steady(0, 0.0);
+  in.closed_loop = false;
+  in.request_V = control::filled(5.0);
+  for (std::uint64_t k = 0; k <= 20; ++k) {
+    in.tick = k;
+    dead.update(in);
+    ASSERT_EQ(dead.faulted(), k == 20) << "tick " << k;
+  }
+  EXPECT_EQ(dead.fault().reason, FaultReason::kResponse);
+}
+
 }  // namespace
 }  // namespace piezoshift::runtime

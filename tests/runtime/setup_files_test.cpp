@@ -3,7 +3,9 @@
 
 #include <filesystem>
 #include <fstream>
+#include <optional>
 #include <sstream>
+#include <string>
 
 #include <gtest/gtest.h>
 
@@ -115,6 +117,23 @@ TEST_F(ControllerConfigTest, RejectsUnknownKeyAndShortPolynomial) {
     FAIL();
   } catch (const io::InputError& e) {
     EXPECT_NE(std::string(e.what()).find("controller.p"), std::string::npos) << e.what();
+  }
+}
+
+TEST_F(ControllerConfigTest, TravelSectionIsOptionalAndRoundTrips) {
+  std::optional<double> travel = 1.0;
+  calibration::load_calibration_file(write("none.toml", "[controller]\nkp = 0.7\n"), &travel);
+  EXPECT_FALSE(travel.has_value());
+  const std::string path = write("t.toml", "");
+  calibration::write_calibration_file(path, control::SemiClosedLoopParams{}, "travel", 11.0 / 3.0);
+  calibration::load_calibration_file(path, &travel);
+  ASSERT_TRUE(travel.has_value());
+  EXPECT_EQ(*travel, 11.0 / 3.0);
+  try {
+    calibration::load_calibration_file(write("bad.toml", "[travel]\nz_max_um = -1\n"));
+    FAIL();
+  } catch (const io::InputError& e) {
+    EXPECT_NE(std::string(e.what()).find("travel.z_max_um"), std::string::npos) << e.what();
   }
 }
 

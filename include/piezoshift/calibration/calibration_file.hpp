@@ -13,11 +13,16 @@
 //        [0.3482, -0.1491, 0.6962],
 //        [0.6321, 0.4397, -0.2980]]
 //
+//   [travel]                   # optional
+//   z_max_um = 11.5            # semi-closed-loop travel with this controller (Section 4.1);
+//                              # `piezoshift serve` takes its Z travel limit from it
+//
 // Every key is optional (absent: the paper's value, Section 4); an unknown key or section, a
 // wrong type or a bad value throws io::InputError naming file, key and reason. The run's own
 // sample time is set by the loop, not here. Files are written whole to a temporary file and
 // renamed over the old one (io/atomic_file.hpp), with 17 significant digits so that reading
 // back gives the same doubles.
+#include <optional>
 #include <string>
 
 #include "piezoshift/control/semi_closed_loop.hpp"
@@ -30,14 +35,18 @@ namespace piezoshift::calibration {
 
 //! Reads [controller] from an already parsed file into params (does not reject unknown keys).
 void read_controller_section(const io::ConfigFile& file, control::SemiClosedLoopParams& params);
-//! Loads a file holding only [controller]; rejects anything else.
-control::SemiClosedLoopParams load_calibration_file(const std::string& path);
+//! Loads a file holding [controller] and optionally [travel]; rejects anything else. The travel
+//! (empty when the file has none) goes to travel_z_max_um when given.
+control::SemiClosedLoopParams load_calibration_file(
+    const std::string& path, std::optional<double>* travel_z_max_um = nullptr);
 
 //! The file's text; header lines (each prefixed with "# ") describe where it came from.
 std::string format_calibration(const control::SemiClosedLoopParams& params,
-                               const std::string& header);
+                               const std::string& header,
+                               std::optional<double> travel_z_max_um = std::nullopt);
 //! Writes format_calibration() atomically; throws io::InputError when the path is not writable.
 void write_calibration_file(const std::string& path, const control::SemiClosedLoopParams& params,
-                            const std::string& header);
+                            const std::string& header,
+                            std::optional<double> travel_z_max_um = std::nullopt);
 
 }  // namespace piezoshift::calibration

@@ -6,23 +6,30 @@
 //     stop requested (duration reached, SIGINT/SIGTERM)  -> supervisor.request_stop()
 //     clear requested (request_clear())                  -> supervisor.clear_fault(),
 //                                                           controller reset (bumpless from 0 V)
+//     host mode: apply the host's commands (host_link.hpp)
 //     ai  = daq.read(k)                                  (applies the outputs staged at k-1)
-//     Z_d = profile(k T)
+//     Z_d = profile(k T), or the host's last move
 //     c   = controller.update(Z_d, ai)                   Eqs. 6-8, sample time T
+//           (host mode with the servo off: c = the host's open-loop volts)
 //     s   = supervisor.update(ai, c, statuses, overrun(k-1))
 //     controller.hold_integrators(s.hold_integrators)
 //     daq.write(k, s.ao_V)                               E_k = end of work
-//     stats (period error, wake latency, compute, overrun = E_k - D_k > T), telemetry push
+//     stats (period error, wake latency, compute, overrun = E_k - D_k > T), telemetry push,
+//     host sample push
 //     done when the supervisor has stopped, or has faulted and the outputs are at 0 V
 //     D_{k+1} = D_k + T; if E_k > D_{k+1}: skip to the first slot after E_k (counted)
 //
+// Host mode (LoopConfig::host set, `piezoshift serve`): the loop starts with the servo off and the
+// outputs at 0 V, and takes its set-points from the host's commands instead of the profile.
+//
 // run() is real-time safe: everything it touches is allocated by the constructor; the telemetry
-// push is a lock-free ring write that drops (and counts) on a full ring.
+// and host pushes are lock-free ring writes that drop (and count) on a full ring.
 #include <atomic>
 #include <cstdint>
 
 #include "piezoshift/control/semi_closed_loop.hpp"
 #include "piezoshift/runtime/daq_backend.hpp"
+#include "piezoshift/runtime/host_link.hpp"
 #include "piezoshift/runtime/loop_clock.hpp"
 #include "piezoshift/runtime/period_stats.hpp"
 #include "piezoshift/runtime/safety_supervisor.hpp"
@@ -34,11 +41,13 @@ namespace piezoshift::runtime {
 
 struct LoopConfig {
   double rate_Hz = 1000.0;  //!< 1 kHz (the paper's T_s = 1 ms) to 10 kHz
-  double duration_s = 1.0;  //!< controlled part; the ramp to 0 V follows
+  double duration_s = 1.0;  //!< controlled part; the ramp to 0 V follows (infinity: until stopped)
   //! Polled each tick; nonzero stops the run through the safe ramp (set by a signal handler).
   const std::atomic<int>* stop_signal = nullptr;
   //! End the run once a fault has ramped the outputs to 0 V (no operator to clear it).
   bool stop_when_safe_after_fault = true;
+  //! Host mode: set-points and servo state from this link (host_link.hpp), samples back to it.
+  HostLink* host = nullptr;
 };
 
 enum class StopReason : std::uint8_t { kDuration, kSignal, kFault };
@@ -54,6 +63,8 @@ struct LoopResult {
   double min_output_V = 0.0;
   double max_output_slew_V_per_ms = 0.0;  //!< max |ao(k) - ao(k-1)| / T over ticks and channels
   std::uint64_t telemetry_dropped = 0;
+  std::uint64_t host_samples_dropped = 0;
+  std::uint64_t host_commands_applied = 0;
   Vec3 last_sgs_V{};
 };
 

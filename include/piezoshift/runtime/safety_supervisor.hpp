@@ -17,11 +17,13 @@
 //                                                                        follow its slew-limited
 //                                                                        drive)
 //     only while running (not while ramping down on a stop):
+//       closed loop only (in.closed_loop; open loop has no target to track and may sit at 10 V):
 //       |target_um - feedback_um| > tracking_error_um for tracking_time_s      -> tracking
 //       feedback_um outside [g_min u_um - b, g_max u_um + b] for response_time_s -> response
 //         (u_um: the output applied in the previous tick, in um of command; b response_band_um.
 //          The stack must answer its drive: a dead amplifier, a split stack or a frozen sensor
 //          leave the SGS where it was while the drive moves.)
+//       closed loop only:
 //       output at output_max_V for saturation_time_s                           -> saturation
 //         (the loop has lost authority: the target is out of reach)
 //   outputs:
@@ -128,6 +130,9 @@ struct SupervisorInput {
   DaqStatus read_status = DaqStatus::kOk;
   DaqStatus previous_write_status = DaqStatus::kOk;
   bool previous_tick_overran = false;
+  //! The controller is closing the loop (false: open-loop outputs, `piezoshift serve` with the
+  //! servo off); the tracking and saturation rules apply only when true.
+  bool closed_loop = true;
 };
 
 struct SupervisorOutput {

@@ -1,0 +1,89 @@
+#include "loop_setup.hpp"
+
+#include <csignal>
+
+#include <fmt/core.h>
+
+#include "piezoshift/io/input_error.hpp"
+#include "piezoshift/runtime/comedi_backend.hpp"
+
+namespace piezoshift::app {
+
+std::atomic<int> g_stop_signal{0};
+
+namespace {
+extern "C" void on_stop_signal(int signo) {
+  g_stop_signal.store(signo, std::memory_order_relaxed);
+}
+}  // namespace
+
+ChosenBackend make_backend(const std::string& daq, const io::ProjectConfig& config,
+                           std::uint64_t seed, double rate_Hz) {
+  ChosenBackend chosen;
+  if (daq == "sim") {
+    runtime::SimOptions so;
+    so.design = config.design;
+    so.twin = config.twin;
+    so.seed = seed;
+    so.rate_Hz = rate_Hz;
+    auto s = std::make_unique<runtime::SimBackend>(so);
+    chosen.sim = s.get();
+    chosen.backend = std::move(s);
+  } else if (daq == "comedi" || daq.rfind("comedi:", 0) == 0) {
+    runtime::ComediOptions co;
+    if (daq.size() > 7)
+      co.device = daq.substr(7);
+    chosen.backend = std::make_unique<runtime::ComediBackend>(co);
+  } else {
+    throw io::InputError(fmt::format("--daq '{}': expected sim or comedi:/dev/comediN", daq));
+  }
+  return chosen;
+}
+
+struct StopSignals::Saved {
+  struct sigaction old_int {};
+  struct sigaction old_term {};
+};
+
+StopSignals::StopSignals() : saved_(std::make_unique<Saved>()) {
+  g_stop_signal.store(0);
+  struct sigaction sa {};
+  sa.sa_handler = on_stop_signal;
+  sigemptyset(&sa.sa_mask);
+  sigaction(SIGINT, &sa, &saved_->old_int);
+  sigaction(SIGTERM, &sa, &saved_->old_term);
+}
+
+StopSignals::~StopSignals() {
+  sigaction(SIGINT, &saved_->old_int, nullptr);
+  sigaction(SIGTERM, &saved_->old_term, nullptr);
+}
+
+const char* signal_name(int signo) {
+  switch (signo) {
+    case SIGINT:
+      return "SIGINT";
+    case SIGTERM:
+      return "SIGTERM";
+    default:
+      return "signal";
+  }
+}
+
+runtime::RealtimeReport request_realtime_or_warn(int cpu) {
+  runtime::RealtimeRequest req;
+  req.cpu = cpu;
+  runtime::RealtimeReport rt = runtime::request_realtime(req);
+  if (!rt.refusals.empty()) {
+    std::string why;
+    for (const std::string& r : rt.refusals)
+      why += (why.empty() ? "" : "; ") + r;
+    fmt::print(stderr,
+               "piezoshift: warning: real-time request partly refused ({}); running on with "
+               "what was granted, the timing figures will show it\n",
+               why);
+  }
+  return rt;
+}
+
+}  // namespace piezoshift::app

@@ -1,0 +1,51 @@
+#pragma once
+// Set-up shared by the commands that run the real-time loop (`run`, `serve`): the DAQ backend
+// chosen by --daq, the SIGINT/SIGTERM handlers that stop the loop through its safe ramp, and the
+// real-time request with its one warning.
+#include <atomic>
+#include <cstdint>
+#include <memory>
+#include <string>
+
+#include "piezoshift/io/project_config.hpp"
+#include "piezoshift/runtime/daq_backend.hpp"
+#include "piezoshift/runtime/realtime.hpp"
+#include "piezoshift/runtime/sim_backend.hpp"
+
+namespace piezoshift::app {
+
+struct ChosenBackend {
+  std::unique_ptr<runtime::DaqBackend> backend;
+  runtime::SimBackend* sim = nullptr;  //!< the same object when it is the twin, else null
+};
+
+//! "sim" (the twin of config, at rate_Hz, with seed) or "comedi[:DEVICE]". Throws io::InputError
+//! for anything else. Not configured yet.
+ChosenBackend make_backend(const std::string& daq, const io::ProjectConfig& config,
+                           std::uint64_t seed, double rate_Hz);
+
+//! Set by the handlers StopSignals installs: the signal number, 0 until one arrives.
+extern std::atomic<int> g_stop_signal;
+
+//! Installs SIGINT/SIGTERM handlers (setting g_stop_signal, cleared here) for its lifetime and
+//! restores the old ones.
+class StopSignals {
+ public:
+  StopSignals();
+  ~StopSignals();
+  StopSignals(const StopSignals&) = delete;
+  StopSignals& operator=(const StopSignals&) = delete;
+
+ private:
+  struct Saved;
+  std::unique_ptr<Saved> saved_;
+};
+
+//! "SIGINT", "SIGTERM" or "signal".
+const char* signal_name(int signo);
+
+//! Asks for real-time treatment of the calling thread (runtime/realtime.hpp) and prints one
+//! warning naming what was refused.
+runtime::RealtimeReport request_realtime_or_warn(int cpu);
+
+}  // namespace piezoshift::app

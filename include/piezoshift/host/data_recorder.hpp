@@ -1,0 +1,83 @@
+#pragma once
+// The GCS data recorder of `piezoshift serve` (DRC, DRC?, RTR, RTR?, DRL?, DRR?, TNR?):
+// kTables record tables of up to kPoints points each, one point every `rate` servo cycles.
+//
+//   DRC t s o   table t (1..kTables) records option o of source s:
+//                 0  nothing (the table is off)
+//                 1  target position of axis s (Z, U, V)          MOV? value, um or urad
+//                 2  current position of axis s                   POS? value, um or urad
+//                 3  position error of axis s                     target - position
+//                 7  voltage of output channel s (1, 2, 3)         amplifier output, V
+//                 17 sensor of input channel s (1, 2, 3)           SGS, um of actuator stroke
+//                 90 interferometer position of axis s (piezoshift: the twin's XL-80; NaN on
+//                    hardware, which has no interferometer on line)
+//               Options 1, 2, 3, 7 and 17 are PI's numbers for these signals.
+//   trigger     recording restarts from point 1 on every motion command (MOV, MVR, SVA, SVO,
+//               STP) and whenever DRC or RTR changes the set-up; it stops when kPoints are held.
+//   DRR?        GCS's data form: "# KEY = value" header lines ending with "# END_HEADER", then one
+//               line per point, columns separated by a space (SEPARATOR = 32).
+// Not thread-safe: the server's one network thread owns it.
+#include <array>
+#include <cstddef>
+#include <cstdint>
+#include <string>
+#include <string_view>
+#include <vector>
+
+#include "piezoshift/host/gcs_error.hpp"
+#include "piezoshift/host/stage_model.hpp"
+
+namespace piezoshift::host {
+
+//! What one servo cycle offers the recorder.
+struct RecorderInput {
+  AxisValues target{};          //!< MOV? values
+  AxisValues position{};        //!< POS? values
+  AxisValues interferometer{};  //!< NaN when there is none
+  Vec3 channel_V{};             //!< amplifier outputs
+  Vec3 sensor_um{};             //!< SGS in um
+};
+
+class DataRecorder {
+ public:
+  static constexpr int kTables = 8;
+  static constexpr std::size_t kPoints = 8192;
+  static constexpr int kMaxRate = 1000000;
+
+  DataRecorder();
+
+  //! DRC. kNone on success.
+  GcsError configure(int table, std::string_view source, int option);
+  //! DRC? answer body for one table, "Z 2" (or "0 0" when off). table must be valid.
+  std::string describe_table(int table) const;
+  bool table_exists(int table) const noexcept { return table >= 1 && table <= kTables; }
+
+  GcsError set_rate(long long cycles);
+  int rate() const noexcept { return rate_; }
+
+  //! Recording from point 1 again (the trigger).
+  void restart() noexcept;
+  //! One servo cycle; stored when the cycle falls on the rate and there is room.
+  void record(const RecorderInput& in);
+  std::size_t points() const noexcept { return rows_.size(); }
+
+  //! DRR? answer (GCS framing applied: every line but the last ends with " \n"). start is 1-based;
+  //! count < 0: all from start; tables empty: every active table. Errors leave answer empty.
+  GcsError read(long long start, long long count, const std::vector<int>& tables,
+                double servo_cycle_s, std::string& answer) const;
+
+ private:
+  struct Table {
+    int option = 0;
+    int source = 0;  // axis 0..2 or channel 0..2
+  };
+  double value(const Table& t, const RecorderInput& in) const;
+  std::string name(const Table& t) const;
+
+  std::array<Table, kTables> tables_{};
+  int rate_ = 1;
+  std::uint64_t cycle_ = 0;
+  std::vector<std::array<double, kTables>> rows_;
+};
+
+}  // namespace piezoshift::host

@@ -1,0 +1,117 @@
+#pragma once
+// The GCS 2.0 command interpreter of `piezoshift serve` (docs/gcs.md has the command table): it
+// turns command lines into HostCommands for the real-time loop and answers queries from the
+// loop's HostSamples. It runs on the server's one network thread (LineHandler), never on the loop.
+//
+//   per client   an error queue: a failed command queues its GCS error number and answers
+//                nothing (a failed query too); ERR? pops the oldest, 0 when empty
+//   servo        one semi-closed loop drives all three axes, so SVO switches Z, U and V together
+//                (SVO with different values per axis is refused, 17); servo on starts from the
+//                position the gauges show (MOV? := POS?), servo off holds the volts applied
+//   motion       MOV and MVR set a whole pose, checked against StageModel::reachable (7);
+//                with the servo off they are refused (5); SVA with the servo on too (79)
+//   on target    ONT? of an axis is 1 when the servo is on, the loop has applied the last move
+//                and |POS? - MOV?| <= tolerance has held for settle_time_s
+//   faults       when the safety supervisor latches a fault, the servo is reported off and every
+//                client's queue gets -1024; SVO (either value) clears the fault
+//   STP          holds where the stage is (servo on: MOV? := POS?; off: the volts applied) and
+//                queues error 10 for the client that sent it, as a PI controller does
+// Sample drops (the host thread stalled for > 4 s) are counted, never blocking the loop.
+#include <cstdint>
+#include <deque>
+#include <string>
+#include <string_view>
+#include <unordered_map>
+#include <vector>
+
+#include "piezoshift/host/data_recorder.hpp"
+#include "piezoshift/host/gcs_error.hpp"
+#include "piezoshift/host/line_server.hpp"
+#include "piezoshift/host/stage_model.hpp"
+#include "piezoshift/runtime/host_link.hpp"
+
+namespace piezoshift::host {
+
+struct GcsOptions {
+  double on_target_tolerance_um = 0.01;   //!< Z: 10 nm, ~7 sigma of the gauges' 1.5 nm noise
+  double on_target_tolerance_urad = 0.5;  //!< U, V: 0.5 urad tilts P1..P3 by ~20 nm
+  double settle_time_s = 0.01;            //!< within tolerance this long
+  std::size_t error_queue_length = 16;    //!< per client; the oldest errors are kept when full
+  std::string identification = "piezoshift, semi-closed-loop PZT phase shifter, 0, 0.1.0";
+};
+
+struct GcsStats {
+  std::uint64_t samples = 0;         //!< HostSamples taken from the loop
+  std::uint64_t samples_missed = 0;  //!< ticks whose sample the ring dropped
+  std::uint64_t commands_sent = 0;   //!< HostCommands pushed to the loop
+  std::uint64_t lines = 0;           //!< command lines handled
+  std::uint64_t errors = 0;          //!< GCS errors queued
+  std::uint64_t faults = 0;          //!< supervisor faults seen
+};
+
+class GcsController final : public LineHandler {
+ public:
+  GcsController(const StageModel& model, runtime::HostLink& link, double servo_cycle_s,
+                const GcsOptions& options);
+
+  void on_connect(ClientId client) override;
+  void on_disconnect(ClientId client) override;
+  std::string on_line(ClientId client, std::string_view line) override;
+  std::string on_overlong_line(ClientId client) override;
+  void on_poll() override { drain(); }
+
+  //! Takes every sample the loop has pushed (also done before each command).
+  void drain();
+  const GcsStats& stats() const noexcept { return stats_; }
+  const StageModel& model() const noexcept { return model_; }
+
+ private:
+  using Args = std::vector<std::string_view>;
+  struct Session {
+    std::deque<GcsError> errors;
+  };
+
+  std::string execute(Session& session, std::string_view name, const Args& args);
+  void fail(Session& session, GcsError error);
+  //! answer, or nothing with the error queued.
+  std::string reply(Session& session, GcsError error, std::string& answer);
+  //! Pushes the command to the loop; false (and error 52 queued) when the ring is full.
+  bool send(Session& session, runtime::HostCommand command);
+  void take(const runtime::HostSample& sample);
+  void moved();
+
+  // Commands; each returns the answer (empty for set commands) or fails the session.
+  std::string move(Session& s, const Args& args, bool relative);
+  std::string servo(Session& s, const Args& args);
+  std::string open_loop(Session& s, const Args& args);
+  std::string stop(Session& s, const Args& args);
+  std::string recorder_config(Session& s, const Args& args);
+  std::string recorder_rate(Session& s, const Args& args);
+  std::string recorder_read(Session& s, const Args& args);
+
+  const StageModel& model_;
+  runtime::HostLink& link_;
+  double servo_cycle_s_;
+  GcsOptions options_;
+  std::uint64_t settle_samples_;
+  std::unordered_map<ClientId, Session> sessions_;
+  DataRecorder recorder_;
+  GcsStats stats_;
+
+  // The loop as last seen.
+  bool have_sample_ = false;
+  runtime::HostSample last_{};
+  bool faulted_ = false;
+  AxisValues position_{};
+
+  // What the host has asked for.
+  std::uint64_t sequence_ = 0;
+  std::uint64_t move_sequence_ = 0;   // the last command that set the target or servo state
+  std::uint64_t clear_sequence_ = 0;  // the last SVO (which clears a latched fault)
+  bool servo_on_ = false;
+  AxisValues target_{};
+  AxisValues open_loop_V_{};
+  std::array<std::uint64_t, 3> settled_{};
+};
+
+}  // namespace piezoshift::host

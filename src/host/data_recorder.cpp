@@ -1,0 +1,189 @@
+#include "piezoshift/host/data_recorder.hpp"
+
+#include <fmt/core.h>
+
+namespace piezoshift::host {
+
+namespace {
+
+constexpr int kTarget = 1;
+constexpr int kPosition = 2;
+constexpr int kError = 3;
+constexpr int kOutputVoltage = 7;
+constexpr int kSensor = 17;
+constexpr int kInterferometer = 90;
+
+bool is_axis_option(int option) {
+  return option == kTarget || option == kPosition || option == kError || option == kInterferometer;
+}
+bool is_channel_option(int option) {
+  return option == kOutputVoltage || option == kSensor;
+}
+
+int axis_index(std::string_view s) {
+  for (Axis a : kAxes)
+    if (s == axis_name(a))
+      return static_cast<int>(a);
+  return -1;
+}
+
+}  // namespace
+
+DataRecorder::DataRecorder() {
+  rows_.reserve(kPoints);
+  // As a PI controller ships: table 1 the target, table 2 the position of the first axis.
+  tables_[0] = Table{kTarget, 0};
+  tables_[1] = Table{kPosition, 0};
+}
+
+GcsError DataRecorder::configure(int table, std::string_view source, int option) {
+  if (!table_exists(table))
+    return GcsError::kNoRecordTable;
+  Table t{option, 0};
+  if (option == 0) {
+    t.source = 0;
+  } else if (is_axis_option(option)) {
+    t.source = axis_index(source);
+    if (t.source < 0)
+      return GcsError::kInvalidAxis;
+  } else if (is_channel_option(option)) {
+    if (source != "1" && source != "2" && source != "3")
+      return GcsError::kParamOutOfRange;
+    t.source = source[0] - '1';
+  } else {
+    return GcsError::kNoRecordOption;
+  }
+  tables_[static_cast<std::size_t>(table - 1)] = t;
+  restart();
+  return GcsError::kNone;
+}
+
+std::string DataRecorder::describe_table(int table) const {
+  const Table& t = tables_[static_cast<std::size_t>(table - 1)];
+  if (t.option == 0)
+    return "0 0";
+  if (is_axis_option(t.option))
+    return fmt::format("{} {}", axis_name(kAxes[static_cast<std::size_t>(t.source)]), t.option);
+  return fmt::format("{} {}", t.source + 1, t.option);
+}
+
+GcsError DataRecorder::set_rate(long long cycles) {
+  if (cycles < 1 || cycles > kMaxRate)
+    return GcsError::kParamOutOfRange;
+  rate_ = static_cast<int>(cycles);
+  restart();
+  return GcsError::kNone;
+}
+
+void DataRecorder::restart() noexcept {
+  rows_.clear();
+  cycle_ = 0;
+}
+
+double DataRecorder::value(const Table& t, const RecorderInput& in) const {
+  const auto i = static_cast<std::size_t>(t.source);
+  switch (t.option) {
+    case kTarget:
+      return in.target[i];
+    case kPosition:
+      return in.position[i];
+    case kError:
+      return in.target[i] - in.position[i];
+    case kInterferometer:
+      return in.interferometer[i];
+    case kOutputVoltage:
+      return in.channel_V[i];
+    case kSensor:
+      return in.sensor_um[i];
+    default:
+      return 0.0;
+  }
+}
+
+void DataRecorder::record(const RecorderInput& in) {
+  const bool on_rate = cycle_ % static_cast<std::uint64_t>(rate_) == 0;
+  ++cycle_;
+  if (!on_rate || rows_.size() >= kPoints)
+    return;
+  std::array<double, kTables> row{};
+  for (std::size_t t = 0; t < tables_.size(); ++t)
+    row[t] = tables_[t].option == 0 ? 0.0 : value(tables_[t], in);
+  rows_.push_back(row);
+}
+
+std::string DataRecorder::name(const Table& t) const {
+  const auto i = static_cast<std::size_t>(t.source);
+  switch (t.option) {
+    case kTarget:
+      return fmt::format("Target position of axis {} ({})", axis_name(kAxes[i]),
+                         axis_unit(kAxes[i]));
+    case kPosition:
+      return fmt::format("Current position of axis {} ({})", axis_name(kAxes[i]),
+                         axis_unit(kAxes[i]));
+    case kError:
+      return fmt::format("Position error of axis {} ({})", axis_name(kAxes[i]),
+                         axis_unit(kAxes[i]));
+    case kInterferometer:
+      return fmt::format("Interferometer position of axis {} ({})", axis_name(kAxes[i]),
+                         axis_unit(kAxes[i]));
+    case kOutputVoltage:
+      return fmt::format("Voltage of output channel {} (V)", i + 1);
+    case kSensor:
+      return fmt::format("Sensor of input channel {} (um)", i + 1);
+    default:
+      return "Nothing";
+  }
+}
+
+GcsError DataRecorder::read(long long start, long long count, const std::vector<int>& tables,
+                            double servo_cycle_s, std::string& answer) const {
+  answer.clear();
+  std::vector<int> chosen = tables;
+  if (chosen.empty()) {
+    for (int t = 1; t <= kTables; ++t)
+      if (tables_[static_cast<std::size_t>(t - 1)].option != 0)
+        chosen.push_back(t);
+  }
+  for (int t : chosen) {
+    if (!table_exists(t))
+      return GcsError::kNoRecordTable;
+    if (tables_[static_cast<std::size_t>(t - 1)].option == 0)
+      return GcsError::kTableDeactivated;
+  }
+  if (chosen.empty())
+    return GcsError::kTableDeactivated;
+  if (start < 1)
+    return GcsError::kParamOutOfRange;
+  const auto held = static_cast<long long>(rows_.size());
+  if (start > held + 1 || (count >= 0 && start - 1 + count > held))
+    return GcsError::kNotEnoughData;
+  const long long n = count < 0 ? held - (start - 1) : count;
+
+  std::vector<std::string> lines;
+  lines.push_back("# REM piezoshift data recorder");
+  lines.push_back("# VERSION = 1");
+  lines.push_back("# TYPE = 1");
+  lines.push_back("# SEPARATOR = 32");
+  lines.push_back(fmt::format("# DIM = {}", chosen.size()));
+  lines.push_back(fmt::format("# SAMPLE_TIME = {:.9g}", servo_cycle_s * rate_));
+  lines.push_back(fmt::format("# NDATA = {}", n));
+  for (std::size_t c = 0; c < chosen.size(); ++c)
+    lines.push_back(
+        fmt::format("# NAME{} = {}", c, name(tables_[static_cast<std::size_t>(chosen[c] - 1)])));
+  lines.push_back("# END_HEADER");
+  for (long long r = start - 1; r < start - 1 + n; ++r) {
+    std::string line;
+    for (std::size_t c = 0; c < chosen.size(); ++c) {
+      if (c > 0)
+        line += ' ';
+      line += fmt::format(
+          "{:.9g}", rows_[static_cast<std::size_t>(r)][static_cast<std::size_t>(chosen[c] - 1)]);
+    }
+    lines.push_back(std::move(line));
+  }
+  for (std::size_t l = 0; l < lines.size(); ++l)
+    answer += lines[l] + (l + 1 < lines.size() ? " \n" : "\n");
+  return GcsError::kNone;
+}
+
+}  // namespace piezoshift::host

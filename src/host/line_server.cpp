@@ -1,0 +1,383 @@
+#include "piezoshift/host/line_server.hpp"
+
+#include <arpa/inet.h>
+#include <netinet/in.h>
+#include <netinet/tcp.h>
+#include <poll.h>
+#include <sys/eventfd.h>
+#include <sys/socket.h>
+#include <unistd.h>
+
+#include <algorithm>
+#include <cerrno>
+#include <cmath>
+#include <cstring>
+#include <stdexcept>
+#include <utility>
+
+#include <fmt/format.h>
+
+#include "piezoshift/io/input_error.hpp"
+
+namespace piezoshift::host {
+
+namespace {
+
+//! Bytes taken from one client per turn: a client that floods cannot starve the others.
+constexpr std::size_t kReadChunkBytes = 64 * 1024;
+//! After accept() fails for lack of resources (EMFILE, ENOBUFS, ...), the listening socket stays
+//! readable; leave it alone this long instead of spinning on it.
+constexpr auto kAcceptPause = std::chrono::milliseconds(100);
+
+void close_fd(int& fd) noexcept {
+  if (fd >= 0)
+    ::close(fd);
+  fd = -1;
+}
+
+bool would_block(int err) {
+  return err == EAGAIN || err == EWOULDBLOCK;
+}
+
+void check_limits(const LineServerLimits& limits, const std::string& where) {
+  const auto fail = [&](const char* what) {
+    throw io::InputError(fmt::format("TCP server on {}: {}", where, what));
+  };
+  if (limits.max_clients < 1)
+    fail("max_clients must be at least 1");
+  if (limits.max_line_bytes < 1)
+    fail("max_line_bytes must be at least 1");
+  if (limits.max_pending_output_bytes < 1)
+    fail("max_pending_output_bytes must be at least 1");
+  if (!(limits.idle_timeout_s > 0.0))  // also rejects NaN
+    fail("idle_timeout_s must be > 0 (+inf: no timeout)");
+}
+
+}  // namespace
+
+LineServer::LineServer(const ListenAddress& address, const LineServerLimits& limits,
+                       LineHandler& handler)
+    : limits_(limits), handler_(handler), read_buffer_(kReadChunkBytes) {
+  const std::string where = fmt::format("{}:{}", address.host, address.port);
+  check_limits(limits, where);
+
+  in_addr ip{};
+  const std::string numeric = address.host == "localhost" ? "127.0.0.1" : address.host;
+  if (::inet_pton(AF_INET, numeric.c_str(), &ip) != 1)
+    throw io::InputError(
+        fmt::format("TCP server on {}: '{}' is not a numeric IPv4 address (nor localhost)", where,
+                    address.host));
+  const bool loopback = (ntohl(ip.s_addr) >> 24) == 127;
+  if (!loopback && !address.allow_remote)
+    throw io::InputError(fmt::format(
+        "TCP server on {} refuses non-loopback address {} without --allow-remote (GCS has no "
+        "authentication: anyone who reaches the port moves the stage)",
+        where, address.host));
+
+  try {
+    wake_fd_ = ::eventfd(0, EFD_NONBLOCK | EFD_CLOEXEC);
+    if (wake_fd_ < 0)
+      throw std::runtime_error(
+          fmt::format("TCP server on {}: eventfd: {}", where, std::strerror(errno)));
+    listen_fd_ = ::socket(AF_INET, SOCK_STREAM | SOCK_NONBLOCK | SOCK_CLOEXEC, 0);
+    if (listen_fd_ < 0)
+      throw std::runtime_error(
+          fmt::format("TCP server on {}: socket: {}", where, std::strerror(errno)));
+    // A restarted server can bind again while old connections are still in TIME_WAIT.
+    const int one = 1;
+    ::setsockopt(listen_fd_, SOL_SOCKET, SO_REUSEADDR, &one, sizeof one);
+
+    sockaddr_in sa{};
+    sa.sin_family = AF_INET;
+    sa.sin_port = htons(address.port);
+    sa.sin_addr = ip;
+    if (::bind(listen_fd_, reinterpret_cast<const sockaddr*>(&sa), sizeof sa) != 0)
+      throw io::InputError(
+          fmt::format("TCP server cannot bind {}: {}", where, std::strerror(errno)));
+    if (::listen(listen_fd_, SOMAXCONN) != 0)
+      throw io::InputError(
+          fmt::format("TCP server cannot listen on {}: {}", where, std::strerror(errno)));
+    socklen_t len = sizeof sa;
+    if (::getsockname(listen_fd_, reinterpret_cast<sockaddr*>(&sa), &len) != 0)
+      throw std::runtime_error(
+          fmt::format("TCP server on {}: getsockname: {}", where, std::strerror(errno)));
+    port_ = ntohs(sa.sin_port);
+  } catch (...) {
+    close_fd(listen_fd_);
+    close_fd(wake_fd_);
+    throw;
+  }
+}
+
+LineServer::~LineServer() {
+  for (Client& c : clients_)
+    close_fd(c.fd);
+  close_fd(listen_fd_);
+  close_fd(wake_fd_);
+}
+
+void LineServer::stop() noexcept {
+  const int saved_errno = errno;  // a signal handler must leave errno as it found it
+  stop_requested_.store(true);
+  const std::uint64_t one = 1;
+  if (::write(wake_fd_, &one, sizeof one) < 0) {
+    // EAGAIN: the counter is already non-zero, so poll() wakes anyway.
+  }
+  errno = saved_errno;
+}
+
+LineServerStats LineServer::stats() const {
+  constexpr auto r = std::memory_order_relaxed;
+  LineServerStats s;
+  s.accepted = stats_.accepted.load(r);
+  s.refused_max_clients = stats_.refused_max_clients.load(r);
+  s.disconnected_slow = stats_.disconnected_slow.load(r);
+  s.disconnected_idle = stats_.disconnected_idle.load(r);
+  s.overlong_lines = stats_.overlong_lines.load(r);
+  s.bytes_in = stats_.bytes_in.load(r);
+  s.bytes_out = stats_.bytes_out.load(r);
+  return s;
+}
+
+void LineServer::run(const std::atomic<int>* stop_flag, int poll_interval_ms) {
+  if (poll_interval_ms < 1)
+    throw std::invalid_argument("LineServer::run: poll_interval_ms must be at least 1");
+  const auto stopping = [&] {
+    return stop_requested_.load() || (stop_flag != nullptr && stop_flag->load() != 0);
+  };
+  const bool idle_limited = std::isfinite(limits_.idle_timeout_s);
+  const auto idle_limit = std::chrono::duration_cast<Clock::duration>(
+      std::chrono::duration<double>(idle_limited ? limits_.idle_timeout_s : 0.0));
+
+  std::vector<pollfd> fds;
+  try {
+    while (!stopping()) {
+      handler_.on_poll();
+
+      // [0] wake-up, [1] listener, [2 + i] clients_[i] (clients accepted later in this turn are
+      // polled from the next turn on).
+      fds.clear();
+      fds.push_back({wake_fd_, POLLIN, 0});
+      const bool accepting = Clock::now() >= accept_paused_until_;
+      fds.push_back({accepting ? listen_fd_ : -1, POLLIN, 0});  // fd -1: ignored by poll()
+      for (const Client& c : clients_) {
+        short events = c.input_ended ? 0 : POLLIN;
+        if (c.pending() > 0)
+          events |= POLLOUT;
+        fds.push_back({c.fd, events, 0});
+      }
+      if (::poll(fds.data(), fds.size(), poll_interval_ms) < 0) {
+        if (errno == EINTR)
+          continue;
+        throw std::runtime_error(fmt::format("TCP server: poll: {}", std::strerror(errno)));
+      }
+
+      if (fds[0].revents != 0) {
+        std::uint64_t count = 0;
+        if (::read(wake_fd_, &count, sizeof count) < 0) {
+          // EAGAIN: already drained.
+        }
+      }
+      for (std::size_t i = 0; i + 2 < fds.size(); ++i) {
+        Client& c = clients_[i];
+        const short revents = fds[i + 2].revents;
+        if (revents == 0)
+          continue;
+        if (revents & POLLNVAL) {
+          c.close = Client::Close::kNow;
+          continue;
+        }
+        // POLLHUP/POLLERR: recv() or send() reports what happened.
+        if (!c.input_ended && (revents & (POLLIN | POLLHUP | POLLERR)))
+          read_from(c);
+        if (c.close == Client::Close::kNo && c.pending() > 0)
+          flush(c);
+      }
+
+      if (idle_limited) {
+        const auto now = Clock::now();
+        for (Client& c : clients_)
+          if (c.close == Client::Close::kNo && now - c.last_input > idle_limit)
+            c.close = Client::Close::kIdle;
+      }
+      close_marked_clients();
+      // Accept after closing, so that a slot freed in this turn is available at once.
+      if (fds[1].revents & POLLIN)
+        accept_clients();
+    }
+  } catch (...) {
+    close_all_clients();
+    throw;
+  }
+  close_all_clients();
+}
+
+void LineServer::accept_clients() {
+  for (;;) {
+    const int fd = ::accept4(listen_fd_, nullptr, nullptr, SOCK_NONBLOCK | SOCK_CLOEXEC);
+    if (fd < 0) {
+      if (errno == EINTR || errno == ECONNABORTED)  // ECONNABORTED: that one left already
+        continue;
+      if (!would_block(errno))
+        accept_paused_until_ = Clock::now() + kAcceptPause;
+      return;
+    }
+    if (clients_.size() >= limits_.max_clients) {
+      // Accept and close rather than leave it in the backlog: the peer learns at once (EOF).
+      stats_.refused_max_clients.fetch_add(1, std::memory_order_relaxed);
+      ::close(fd);
+      continue;
+    }
+    // Answers are short and latency matters more than packet count.
+    const int one = 1;
+    ::setsockopt(fd, IPPROTO_TCP, TCP_NODELAY, &one, sizeof one);
+    Client c;
+    c.fd = fd;
+    c.id = next_id_++;
+    c.last_input = Clock::now();
+    clients_.push_back(std::move(c));
+    client_count_.store(clients_.size());
+    stats_.accepted.fetch_add(1, std::memory_order_relaxed);
+    handler_.on_connect(clients_.back().id);
+  }
+}
+
+void LineServer::read_from(Client& c) {
+  char* const buffer = read_buffer_.data();
+  const ssize_t n = ::recv(c.fd, buffer, read_buffer_.size(), 0);
+  if (n > 0) {
+    stats_.bytes_in.fetch_add(static_cast<std::uint64_t>(n), std::memory_order_relaxed);
+    c.last_input = Clock::now();
+    consume(c, std::string_view(buffer, static_cast<std::size_t>(n)));
+  } else if (n == 0) {
+    // EOF: the peer may have only shut down its sending side (`printf '*IDN?\n' | nc -N ...`),
+    // so its pending answers are still sent; a partial last line without LF is dropped.
+    c.input_ended = true;
+    if (c.pending() == 0)
+      c.close = Client::Close::kNow;
+  } else if (errno != EINTR && !would_block(errno)) {
+    c.close = Client::Close::kNow;  // ECONNRESET and the like
+  }
+}
+
+void LineServer::consume(Client& c, std::string_view data) {
+  while (!data.empty() && c.close == Client::Close::kNo) {
+    const std::size_t lf = data.find('\n');
+    if (c.discarding) {  // the rest of an overlong line, already reported
+      if (lf == std::string_view::npos)
+        return;
+      c.discarding = false;
+      data.remove_prefix(lf + 1);
+      continue;
+    }
+    if (lf == std::string_view::npos) {
+      c.input.append(data);
+      // One byte of slack: the last byte may be the CR of a CRLF that does not count.
+      if (c.input.size() > limits_.max_line_bytes + 1) {
+        c.input.clear();
+        c.discarding = true;
+        stats_.overlong_lines.fetch_add(1, std::memory_order_relaxed);
+        queue(c, handler_.on_overlong_line(c.id));
+      }
+      return;
+    }
+    // A complete line: straight from the chunk when nothing was buffered before.
+    std::string_view line = data.substr(0, lf);
+    if (!c.input.empty()) {
+      c.input.append(line);
+      line = c.input;
+    }
+    if (!line.empty() && line.back() == '\r')
+      line.remove_suffix(1);
+    if (line.size() > limits_.max_line_bytes) {
+      stats_.overlong_lines.fetch_add(1, std::memory_order_relaxed);
+      queue(c, handler_.on_overlong_line(c.id));
+    } else {
+      queue(c, handler_.on_line(c.id, line));
+    }
+    c.input.clear();
+    data.remove_prefix(lf + 1);
+  }
+}
+
+void LineServer::queue(Client& c, std::string&& answer) {
+  if (answer.empty())
+    return;
+  if (c.pending() == 0) {
+    c.output = std::move(answer);
+    c.output_sent = 0;
+  } else {
+    c.output += answer;
+  }
+  // Sending is normally left to the end of the read (one send() for several answers); only when
+  // the limit is crossed do we try to send now, and disconnect if the socket takes too little.
+  if (c.pending() > limits_.max_pending_output_bytes) {
+    flush(c);
+    if (c.close == Client::Close::kNo && c.pending() > limits_.max_pending_output_bytes)
+      c.close = Client::Close::kSlow;
+  }
+}
+
+void LineServer::flush(Client& c) {
+  while (c.pending() > 0) {
+    // MSG_NOSIGNAL: a peer that has gone away gives EPIPE here instead of killing the process.
+    const ssize_t n = ::send(c.fd, c.output.data() + c.output_sent, c.pending(), MSG_NOSIGNAL);
+    if (n > 0) {
+      c.output_sent += static_cast<std::size_t>(n);
+      stats_.bytes_out.fetch_add(static_cast<std::uint64_t>(n), std::memory_order_relaxed);
+    } else if (n < 0 && errno == EINTR) {
+      continue;
+    } else if (n < 0 && would_block(errno)) {
+      break;
+    } else {
+      c.close = Client::Close::kNow;  // EPIPE, ECONNRESET, ...
+      return;
+    }
+  }
+  if (c.pending() == 0) {
+    // Give back the memory of a large answer; keep a small buffer for the next ones.
+    if (c.output.capacity() > kReadChunkBytes)
+      std::string().swap(c.output);
+    c.output.clear();
+    c.output_sent = 0;
+    if (c.input_ended)
+      c.close = Client::Close::kNow;
+  } else if (c.output_sent > kReadChunkBytes && c.output_sent > c.output.size() / 2) {
+    // Drop what is sent once it is most of the buffer: amortised O(1) per byte.
+    c.output.erase(0, c.output_sent);
+    c.output_sent = 0;
+  }
+}
+
+void LineServer::close_marked_clients() {
+  std::vector<ClientId> closed;
+  for (Client& c : clients_) {
+    if (c.close == Client::Close::kNo)
+      continue;
+    if (c.close == Client::Close::kSlow)
+      stats_.disconnected_slow.fetch_add(1, std::memory_order_relaxed);
+    if (c.close == Client::Close::kIdle)
+      stats_.disconnected_idle.fetch_add(1, std::memory_order_relaxed);
+    close_fd(c.fd);
+    closed.push_back(c.id);
+  }
+  if (closed.empty())
+    return;
+  std::erase_if(clients_, [](const Client& c) { return c.fd < 0; });
+  client_count_.store(clients_.size());
+  for (ClientId id : closed)
+    handler_.on_disconnect(id);
+}
+
+void LineServer::close_all_clients() {
+  for (Client& c : clients_) {
+    if (c.close != Client::Close::kNo)
+      continue;  // already on its way out, with its reason
+    if (c.pending() > 0)
+      flush(c);  // best effort, non-blocking: whatever the socket takes now
+    c.close = Client::Close::kNow;
+  }
+  close_marked_clients();
+}
+
+}  // namespace piezoshift::host

@@ -1,0 +1,303 @@
+// `piezoshift serve` end to end: the program is spawned as an operator would start it, and the
+// in-project GCS client drives it over loopback. The loop runs on the real clock; the overrun rule
+// is lifted (--max-overruns) so that a loaded test machine cannot turn a test into a fault run:
+// timing is not what these tests check. No wall-clock asserts: waits are generous upper bounds.
+#include <signal.h>
+#include <unistd.h>
+
+#include <chrono>
+#include <cmath>
+#include <cstdio>
+#include <filesystem>
+#include <memory>
+#include <sstream>
+#include <string>
+#include <thread>
+#include <vector>
+
+#include <gtest/gtest.h>
+#include <nlohmann/json.hpp>
+
+#include "../support/spawned_process.hpp"
+#include "piezoshift/host/gcs_client.hpp"
+
+namespace {
+
+namespace fs = std::filesystem;
+using piezoshift::host::GcsClient;
+using piezoshift::testing::slurp;
+using piezoshift::testing::spawn;
+using piezoshift::testing::Spawned;
+using piezoshift::testing::wait_exit;
+
+// "Z=5.000000" -> 5.0 for the named axis; NaN when absent.
+double value_of(const std::vector<std::string>& lines, const std::string& key) {
+  for (const std::string& l : lines)
+    if (l.rfind(key + "=", 0) == 0)
+      return std::stod(l.substr(key.size() + 1));
+  return std::nan("");
+}
+
+class Serve : public ::testing::Test {
+ protected:
+  // One twin calibration for the suite (`calibrate --pid paper`, under a second): POS? is
+  // compared with the interferometer, which only a calibration of this twin makes agree.
+  static void SetUpTestSuite() {
+    suite_dir_ = fs::temp_directory_path() / ("piezoshift_serve_" + std::to_string(getpid()));
+    fs::create_directories(suite_dir_);
+    calibration_ = (suite_dir_ / "twin.toml").string();
+    const std::string cmd = std::string("'") + PIEZOSHIFT_CLI + "' calibrate --pid paper --out '" +
+                            calibration_ + "' >/dev/null";
+    ASSERT_EQ(std::system(cmd.c_str()), 0) << cmd;
+  }
+  static void TearDownTestSuite() { fs::remove_all(suite_dir_); }
+
+  void SetUp() override {
+    dir_ = suite_dir_ / ::testing::UnitTest::GetInstance()->current_test_info()->name();
+    fs::create_directories(dir_);
+  }
+  void TearDown() override {
+    if (server_.pid > 0) {  // a failed test: do not leave the server running
+      kill(server_.pid, SIGKILL);
+      wait_exit(server_);
+    }
+  }
+
+  std::string path(const std::string& name) const { return (dir_ / name).string(); }
+
+  // Starts the server on a free port; returns the port (0 when it did not come up).
+  std::uint16_t start(std::vector<std::string> extra = {}) {
+    std::vector<std::string> args{"serve",          "--port",    "0",
+                                  "--max-overruns", "1000000",   "--json",
+                                  "--calibration",  calibration_};
+    args.insert(args.end(), extra.begin(), extra.end());
+    server_ = spawn(args, path("out.txt"), path("err.txt"));
+    const std::string marker = "GCS 2.0 on 127.0.0.1:";
+    for (int i = 0; i < 3000; ++i) {  // up to 30 s
+      const std::string out = slurp(path("out.txt"));
+      const std::size_t at = out.find(marker);
+      if (at != std::string::npos && out.find(',', at) != std::string::npos)
+        return static_cast<std::uint16_t>(std::stoi(out.substr(at + marker.size())));
+      std::this_thread::sleep_for(std::chrono::milliseconds(10));
+    }
+    ADD_FAILURE() << "server did not start: " << slurp(path("err.txt"));
+    return 0;
+  }
+
+  // SIGTERM, exit status 0, and the JSON summary.
+  nlohmann::json stop() {
+    kill(server_.pid, SIGTERM);
+    const int status = wait_exit(server_);
+    server_.pid = -1;
+    EXPECT_EQ(status, 0) << slurp(path("err.txt"));
+    const std::string out = slurp(path("out.txt"));
+    const std::size_t brace = out.find('{');
+    if (brace == std::string::npos) {
+      ADD_FAILURE() << "no summary: " << out;
+      return {};
+    }
+    return nlohmann::json::parse(out.substr(brace));
+  }
+
+  // Polls ONT? until every axis is on target; false after 10 s.
+  static bool wait_on_target(GcsClient& c) {
+    for (int i = 0; i < 2000; ++i) {
+      const auto a = c.query_lines("ONT?");
+      if (a == std::vector<std::string>{"Z=1", "U=1", "V=1"})
+        return true;
+      std::this_thread::sleep_for(std::chrono::milliseconds(5));
+    }
+    return false;
+  }
+
+  static int error(GcsClient& c) { return std::stoi(c.query("ERR?")); }
+
+  static fs::path suite_dir_;
+  static std::string calibration_;
+  fs::path dir_;
+  Spawned server_;
+};
+
+fs::path Serve::suite_dir_;
+std::string Serve::calibration_;
+
+TEST_F(Serve, IdentifiesListsAxesMovesOnTargetAndAgreesWithTheInterferometer) {
+  const std::uint16_t port = start();
+  ASSERT_NE(port, 0);
+  GcsClient c("127.0.0.1", port);
+  EXPECT_NE(c.query("*IDN?").find("piezoshift"), std::string::npos);
+  EXPECT_EQ(c.query("CSV?"), "2.0\n");
+  EXPECT_EQ(c.query("SAI? ALL"), "Z \nU \nV\n");
+  EXPECT_EQ(c.query_lines("PUN?"), (std::vector<std::string>{"Z=um", "U=urad", "V=urad"}));
+  EXPECT_EQ(c.query_lines("SVO?"), (std::vector<std::string>{"Z=0", "U=0", "V=0"}));
+  // The calibration file's [travel] (11.5 um on the twin, Table 4's figure) bounds Z.
+  EXPECT_NEAR(value_of(c.query_lines("TMX?"), "Z"), 11.5, 0.15);
+  EXPECT_EQ(value_of(c.query_lines("TMN?"), "Z"), 0.0);
+
+  c.send("SVO Z 1 U 1 V 1");
+  EXPECT_EQ(error(c), 0);
+  c.send("MOV Z 5 U 20 V -15");
+  EXPECT_EQ(error(c), 0);
+  ASSERT_TRUE(wait_on_target(c));
+  const auto pos = c.query_lines("POS?");
+  EXPECT_NEAR(value_of(pos, "Z"), 5.0, 0.01);  // the --on-target-um default
+  EXPECT_NEAR(value_of(pos, "U"), 20.0, 0.5);
+  EXPECT_NEAR(value_of(pos, "V"), -15.0, 0.5);
+
+  // Position and interferometer side by side in the recorder, 200 points at rest.
+  const char* axes[] = {"Z", "U", "V"};
+  for (int i = 0; i < 3; ++i) {
+    c.send("DRC " + std::to_string(2 * i + 1) + " " + axes[i] + " 2");
+    c.send("DRC " + std::to_string(2 * i + 2) + " " + axes[i] + " 90");
+  }
+  EXPECT_EQ(error(c), 0);
+  for (int i = 0; i < 2000 && std::stoi(c.query_lines("DRL? 1")[0].substr(2)) < 200; ++i)
+    std::this_thread::sleep_for(std::chrono::milliseconds(5));
+  const auto data = c.query_lines("DRR? 1 200");
+  std::vector<std::vector<double>> rows;
+  for (const std::string& l : data) {
+    if (l.rfind('#', 0) == 0)
+      continue;
+    std::istringstream in(l);
+    std::vector<double> row;
+    for (double v; in >> v;)
+      row.push_back(v);
+    rows.push_back(row);
+  }
+  ASSERT_EQ(rows.size(), 200u);
+  double mean_diff[3] = {0, 0, 0};
+  for (const auto& r : rows) {
+    ASSERT_EQ(r.size(), 6u);
+    for (int i = 0; i < 3; ++i)
+      mean_diff[i] += (r[2 * i] - r[2 * i + 1]) / 200.0;
+  }
+  // The twin-calibrated feedforward, inverted, agrees with the interferometer to its linearity:
+  // measured 0.2 nm and < 0.04 urad; allowed 10 nm and 0.3 urad.
+  EXPECT_LT(std::fabs(mean_diff[0]), 0.01);
+  EXPECT_LT(std::fabs(mean_diff[1]), 0.3);
+  EXPECT_LT(std::fabs(mean_diff[2]), 0.3);
+
+  c.send("MVR Z 1");
+  EXPECT_EQ(value_of(c.query_lines("MOV? Z"), "Z"), 6.0);
+  ASSERT_TRUE(wait_on_target(c));
+  EXPECT_NEAR(value_of(c.query_lines("POS? Z"), "Z"), 6.0, 0.01);
+
+  const nlohmann::json summary = stop();
+  EXPECT_EQ(summary.at("stop_reason"), "SIGTERM");
+  EXPECT_EQ(summary.at("faults"), 0);
+  EXPECT_EQ(summary.at("gcs_errors"), 0);
+  EXPECT_EQ(summary.at("clients_accepted"), 1);
+}
+
+TEST_F(Serve, RecordsAtTheRateAskedAndAnswersInGcsDataForm) {
+  const std::uint16_t port = start();
+  ASSERT_NE(port, 0);
+  GcsClient c("127.0.0.1", port);
+  c.send("RTR 2");
+  EXPECT_EQ(c.query("RTR?"), "2\n");
+  c.send("DRC 1 1 7");  // amplifier voltage of channel 1
+  EXPECT_EQ(c.query_lines("DRC? 1"), (std::vector<std::string>{"1=1 7"}));
+  c.send("SVA Z 30");  // open loop: 30 V on every channel, the recording starts again
+  EXPECT_EQ(error(c), 0);
+  for (int i = 0; i < 2000 && std::stoi(c.query_lines("DRL? 1")[0].substr(2)) < 100; ++i)
+    std::this_thread::sleep_for(std::chrono::milliseconds(5));
+  const std::string answer = c.query("DRR? 1 100 1 2");
+  const auto lines = GcsClient::split_answer(answer);
+  ASSERT_GT(lines.size(), 100u);
+  EXPECT_NE(answer.find("# SAMPLE_TIME = 0.002 \n"), std::string::npos);  // 2 cycles of 1 ms
+  EXPECT_NE(answer.find("# NDATA = 100 \n"), std::string::npos);
+  EXPECT_NE(answer.find("# DIM = 2 \n"), std::string::npos);
+  EXPECT_NE(answer.find("# NAME0 = Voltage of output channel 1 (V) \n"), std::string::npos);
+  EXPECT_EQ(lines[lines.size() - 101], "# END_HEADER");
+  // The slew-limited ramp to 30 V (1.5 V/ms at the DAQ, 22.5 V/ms at the stack) then 30 V.
+  std::istringstream last(lines.back());
+  double volts = 0.0;
+  last >> volts;
+  EXPECT_NEAR(volts, 30.0, 1e-3);
+  EXPECT_EQ(value_of(c.query_lines("VOL? 2"), "2"), 30.0);
+  stop();
+}
+
+TEST_F(Serve, EveryErrorPathQueuesItsGcsNumberAndAnswersNothing) {
+  const std::uint16_t port = start();
+  ASSERT_NE(port, 0);
+  GcsClient c("127.0.0.1", port);
+  const std::vector<std::pair<std::string, int>> cases{
+      {"FOO?", 2},         {"MOV Z 5", 5},        {"POS? Q", 15},    {"MOV Z", 24},
+      {"SVO Z 1 U 0", 17}, {"SVA Z 151", 66},     {"SVA Z abc", 25}, {"DRC 9 Z 2", 57},
+      {"DRC 1 Z 4", 58},   {"DRR? 1 100000", 77}, {"DRC 2 Z 0", 0},  {"DRR? 1 1 2", 78},
+      {"RTR 0", 17},       {"SVO Z 1", 0},        {"SVA Z 10", 79},  {"MOV Z 11.6", 7},
+      {"MOV U 100000", 7}, {"MOV Z 1 Z 2", 22},   {"STP", 10}};
+  for (const auto& [command, code] : cases) {
+    c.send(command);
+    EXPECT_EQ(error(c), code) << command;
+  }
+  EXPECT_EQ(error(c), 0);  // the queue is empty again
+  const nlohmann::json summary = stop();
+  EXPECT_EQ(summary.at("gcs_errors"), 17);
+}
+
+TEST_F(Serve, SeveralClientsAtOnceEachWithItsOwnErrorQueue) {
+  const std::uint16_t port = start({"--max-clients", "3"});
+  ASSERT_NE(port, 0);
+  std::vector<std::unique_ptr<GcsClient>> clients;
+  for (int i = 0; i < 3; ++i)
+    clients.push_back(std::make_unique<GcsClient>("127.0.0.1", port));
+  clients[0]->send("NOPE");
+  clients[1]->send("SVO Z 1");
+  EXPECT_EQ(error(*clients[1]), 0);
+  EXPECT_EQ(clients[2]->query_lines("SVO? Z"), (std::vector<std::string>{"Z=1"}));
+  clients[2]->send("MOV Z 3");
+  EXPECT_TRUE(wait_on_target(*clients[0]));  // all see one stage
+  EXPECT_EQ(error(*clients[2]), 0);
+  EXPECT_EQ(error(*clients[0]), 2);
+  // A fourth is one too many: accepted and closed at once; the three go on.
+  GcsClient extra("127.0.0.1", port);
+  EXPECT_TRUE(extra.wait_closed(10.0));
+  EXPECT_NEAR(value_of(clients[1]->query_lines("POS? Z"), "Z"), 3.0, 0.01);
+  const nlohmann::json summary = stop();
+  EXPECT_EQ(summary.at("clients_accepted"), 3);
+  EXPECT_EQ(summary.at("clients_refused"), 1);
+}
+
+TEST_F(Serve, GarbageOversizedLinesAndDisconnectsMidAnswerLeaveTheLoopRunning) {
+  const std::uint16_t port = start({"--max-line-bytes", "256"});
+  ASSERT_NE(port, 0);
+  {
+    GcsClient rude("127.0.0.1", port);
+    rude.send_raw(std::string("\x00\xff\x01 MOV\r\n", 9));
+    rude.send_raw(std::string(10000, 'A') + "\n");
+    EXPECT_EQ(error(rude), 2);
+    EXPECT_EQ(error(rude), 3);
+    EXPECT_EQ(error(rude), 0);
+    // Ask for a long answer many times and hang up without reading it.
+    for (int i = 0; i < 200; ++i)
+      rude.send("HLP?");
+    rude.close();
+  }
+  GcsClient c("127.0.0.1", port);
+  c.send("SVO Z 1");
+  c.send("MOV Z 2");
+  EXPECT_TRUE(wait_on_target(c));
+  EXPECT_NEAR(value_of(c.query_lines("POS? Z"), "Z"), 2.0, 0.01);
+  const nlohmann::json summary = stop();
+  EXPECT_EQ(summary.at("faults"), 0);
+  EXPECT_EQ(summary.at("samples_dropped"), 0);
+  EXPECT_EQ(summary.at("clients_accepted"), 2);
+}
+
+TEST_F(Serve, RefusesARemoteAddressWithoutAllowRemoteAndBadInputWithExit2) {
+  const auto refused = [&](std::vector<std::string> args, const std::string& piece) {
+    const Spawned s = spawn(args, path("o.txt"), path("e.txt"));
+    EXPECT_EQ(wait_exit(s), 2) << args[1];
+    const std::string err = slurp(path("e.txt"));
+    EXPECT_NE(err.find(piece), std::string::npos) << err;
+  };
+  refused({"serve", "--bind", "0.0.0.0", "--port", "0"}, "--allow-remote");
+  refused({"serve", "--bind", "not-an-address", "--port", "0"}, "not-an-address");
+  refused({"serve", "--port", "70000"}, "--port 70000");
+  refused({"serve", "--port", "0", "--calibration", path("missing.toml")}, "missing.toml");
+  refused({"serve", "--port", "0", "--daq", "comedi:/dev/comedi_missing"}, "comedi_missing");
+}
+
+}  // namespace

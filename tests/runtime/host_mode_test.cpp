@@ -1,0 +1,158 @@
+// ControlLoop in host mode (`piezoshift serve`): set-points and servo state from HostCommands,
+// one HostSample back per tick. On the closed-form FakeBackend plant and a simulated clock.
+#include <cmath>
+#include <vector>
+
+#include <gtest/gtest.h>
+
+#include "allocation_counter.hpp"
+#include "fake_backend.hpp"
+#include "piezoshift/runtime/control_loop.hpp"
+
+namespace piezoshift::runtime {
+namespace {
+
+using testing::FakeBackend;
+
+struct HostRun {
+  LoopResult result;
+  std::vector<HostSample> samples;
+};
+
+// Runs duration_s in host mode with the commands queued before the start (applied at tick 0)
+// and, optionally, one more pushed by the plant at tick `later_at`.
+struct Later {
+  HostLink* link = nullptr;
+  HostCommand command{};
+};
+void push_later(void* context) {
+  auto* l = static_cast<Later*>(context);
+  l->link->commands.try_push(l->command);
+}
+
+HostRun run_host(const std::vector<HostCommand>& commands, double duration_s,
+                 const HostCommand* later = nullptr, std::uint64_t later_at = 0) {
+  FakeBackend daq;
+  daq.configure();
+  daq.activate();
+  SimulatedClock clock;
+  HostLink link;
+  Later l{&link, later != nullptr ? *later : HostCommand{}};
+  if (later != nullptr) {
+    daq.on_tick = push_later;
+    daq.on_tick_context = &l;
+    daq.on_tick_at = later_at;
+  }
+  for (const HostCommand& c : commands)
+    EXPECT_TRUE(link.commands.try_push(c));
+  LoopConfig cfg;
+  cfg.rate_Hz = 1000.0;
+  cfg.duration_s = duration_s;
+  cfg.host = &link;
+  ControlLoop loop(cfg, control::SemiClosedLoopParams{}, SafetyLimits{}, daq, clock,
+                   SetpointProfile::step(0.0));
+  HostRun r;
+  r.result = loop.run();
+  for (HostSample s{}; link.samples.try_pop(s);)
+    r.samples.push_back(s);
+  return r;
+}
+
+HostCommand command(HostCommand::Kind kind, std::uint64_t sequence, Vec3 zd = {}, Vec3 ao = {}) {
+  HostCommand c;
+  c.kind = kind;
+  c.sequence = sequence;
+  c.zd_um = zd;
+  c.ao_V = ao;
+  return c;
+}
+
+TEST(HostMode, StartsWithTheServoOffAtZeroVoltsAndSendsOneSamplePerTick) {
+  const HostRun r = run_host({}, 0.1);
+  EXPECT_FALSE(r.result.fault_detected);
+  ASSERT_EQ(r.samples.size(), r.result.ticks);
+  for (std::size_t k = 0; k < r.samples.size(); ++k) {
+    EXPECT_EQ(r.samples[k].tick, k);
+    EXPECT_EQ(r.samples[k].closed_loop, 0);
+    EXPECT_EQ(r.samples[k].applied_sequence, 0u);
+    EXPECT_EQ(r.samples[k].ao_V, Vec3{});
+  }
+  EXPECT_EQ(r.result.host_samples_dropped, 0u);
+}
+
+TEST(HostMode, ServoOnThenMoveTracksTheFeedforwardTargets) {
+  // A move while the servo is off is ignored; the servo-on command's Z_d is then the target.
+  const HostRun r = run_host({command(HostCommand::Kind::kMoveTo, 1, control::filled(3.0)),
+                              command(HostCommand::Kind::kServoOn, 2, control::filled(0.0)),
+                              command(HostCommand::Kind::kMoveTo, 3, control::filled(8.0))},
+                             0.3);
+  EXPECT_FALSE(r.result.fault_detected) << to_string(r.result.fault.reason);
+  EXPECT_EQ(r.result.host_commands_applied, 3u);
+  const HostSample& s = r.samples.at(299);  // the last tick before the ramp to 0 V
+  EXPECT_EQ(s.applied_sequence, 3u);
+  EXPECT_EQ(s.closed_loop, 1);
+  EXPECT_EQ(s.zd_um, control::filled(8.0));
+  const Vec3 target = control::SemiClosedLoopController{}.actuator_targets(control::filled(8.0));
+  for (std::size_t i = 0; i < 3; ++i) {
+    EXPECT_NEAR(s.target_um[i], target[i], 1e-12);
+    EXPECT_NEAR(s.sgs_V[i] * 1.6, target[i], 0.005) << i;  // the inner loop sits on S
+  }
+}
+
+TEST(HostMode, OpenLoopVoltsGoOutThroughTheSlewLimitAndTenVoltsIsNoFault) {
+  const HostRun r =
+      run_host({command(HostCommand::Kind::kOpenLoop, 1, {}, control::filled(10.0))}, 0.2);
+  EXPECT_FALSE(r.result.fault_detected) << to_string(r.result.fault.reason);
+  EXPECT_LE(r.result.max_output_slew_V_per_ms, 1.5 + 1e-9);
+  // 1.5 V per tick from tick 0: 10 V from tick 6 on, held to the end (no saturation rule).
+  EXPECT_NEAR(r.samples.at(5).ao_V[0], 9.0, 1e-12);
+  EXPECT_EQ(r.samples.at(6).ao_V[0], 10.0);
+  EXPECT_EQ(r.samples.at(199).ao_V, control::filled(10.0));
+  EXPECT_EQ(r.samples.at(199).closed_loop, 0);
+}
+
+TEST(HostMode, ServoOffHoldsTheAppliedVolts) {
+  // Closed loop to 8 um, servo off at tick 150: the outputs stay where they were.
+  const HostCommand off = command(HostCommand::Kind::kServoOff, 3);
+  const HostRun r = run_host({command(HostCommand::Kind::kServoOn, 1, control::filled(0.0)),
+                              command(HostCommand::Kind::kMoveTo, 2, control::filled(8.0))},
+                             0.3, &off, 150);
+  EXPECT_FALSE(r.result.fault_detected) << to_string(r.result.fault.reason);
+  const HostSample& before = r.samples.at(149);
+  const HostSample& after = r.samples.at(299);
+  EXPECT_EQ(before.closed_loop, 1);
+  EXPECT_EQ(after.closed_loop, 0);
+  EXPECT_EQ(after.applied_sequence, 3u);
+  for (std::size_t i = 0; i < 3; ++i)
+    EXPECT_NEAR(after.ao_V[i], before.ao_V[i], 1e-3) << i;
+}
+
+TEST(HostMode, CommandsAndSamplesMakeNoHeapAllocation) {
+  FakeBackend daq;
+  daq.configure();
+  daq.activate();
+  SimulatedClock clock;
+  HostLink link;
+  const std::vector<HostCommand> commands{
+      command(HostCommand::Kind::kServoOn, 1),
+      command(HostCommand::Kind::kMoveTo, 2, Vec3{3, 4, 5}),
+      command(HostCommand::Kind::kServoOff, 3),
+      command(HostCommand::Kind::kOpenLoop, 4, {}, Vec3{2, 2, 2})};
+  for (const HostCommand& c : commands)
+    ASSERT_TRUE(link.commands.try_push(c));
+  LoopConfig cfg;
+  cfg.rate_Hz = 10'000.0;
+  cfg.duration_s = 0.6;  // 6000 ticks: more than the sample ring holds
+  cfg.host = &link;
+  ControlLoop loop(cfg, control::SemiClosedLoopParams{}, SafetyLimits{}, daq, clock,
+                   SetpointProfile::step(0.0));
+  testing::AllocationCounter counter;
+  const LoopResult r = loop.run();
+  EXPECT_EQ(counter.stop(), 0);
+  EXPECT_EQ(r.host_commands_applied, 4u);
+  EXPECT_EQ(r.host_samples_dropped, r.ticks - HostLink::kSampleCapacity)
+      << "a full ring drops, never blocks";
+}
+
+}  // namespace
+}  // namespace piezoshift::runtime

@@ -1,0 +1,65 @@
+#pragma once
+// Tests that need the piezoshift program alive while they act on it (signals, a server): start
+// it with posix_spawn, stdout and stderr going to files, and wait for its exit status.
+#include <fcntl.h>
+#include <spawn.h>
+#include <sys/wait.h>
+#include <unistd.h>
+
+#include <fstream>
+#include <sstream>
+#include <string>
+#include <vector>
+
+#include <gtest/gtest.h>
+
+extern char** environ;
+
+namespace piezoshift::testing {
+
+struct Spawned {
+  pid_t pid = -1;
+};
+
+//! Starts `piezoshift <args>` (PIEZOSHIFT_CLI) with stdout and stderr to the given files.
+inline Spawned spawn(const std::vector<std::string>& args, const std::string& out,
+                     const std::string& err) {
+  std::vector<char*> argv;
+  std::string prog = PIEZOSHIFT_CLI;
+  argv.push_back(prog.data());
+  std::vector<std::string> copy = args;
+  for (auto& a : copy)
+    argv.push_back(a.data());
+  argv.push_back(nullptr);
+  posix_spawn_file_actions_t fa;
+  posix_spawn_file_actions_init(&fa);
+  posix_spawn_file_actions_addopen(&fa, 1, out.c_str(), O_WRONLY | O_CREAT | O_TRUNC, 0644);
+  posix_spawn_file_actions_addopen(&fa, 2, err.c_str(), O_WRONLY | O_CREAT | O_TRUNC, 0644);
+  Spawned s;
+  const int rc = posix_spawn(&s.pid, prog.c_str(), &fa, nullptr, argv.data(), environ);
+  posix_spawn_file_actions_destroy(&fa);
+  EXPECT_EQ(rc, 0);
+  return s;
+}
+
+//! Waits for the process; its exit status, or -1 when a signal ended it (reported through the
+//! optional outputs).
+inline int wait_exit(const Spawned& s, bool* signaled = nullptr, int* signo = nullptr) {
+  int status = 0;
+  waitpid(s.pid, &status, 0);
+  if (signaled)
+    *signaled = WIFSIGNALED(status);
+  if (signo && WIFSIGNALED(status))
+    *signo = WTERMSIG(status);
+  return WIFEXITED(status) ? WEXITSTATUS(status) : -1;
+}
+
+//! The whole content of a file (empty if it cannot be read).
+inline std::string slurp(const std::string& path) {
+  std::ifstream in(path);
+  std::stringstream s;
+  s << in.rdbuf();
+  return s.str();
+}
+
+}  // namespace piezoshift::testing
