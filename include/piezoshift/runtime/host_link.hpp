@@ -35,7 +35,7 @@ struct HostCommand {
 
 struct HostSample {
   std::uint64_t tick = 0;
-  double t_s = 0.0;                   //!< scheduled time since the loop started
+  double t_s = 0.0;                    //!< scheduled time since the loop started
   std::uint64_t applied_sequence = 0;  //!< the last HostCommand applied (0: none yet)
   Vec3 zd_um{};                        //!< Z_d in force (closed loop)
   Vec3 target_um{};                    //!< S = A p(Z_d), actuator targets (closed loop)
