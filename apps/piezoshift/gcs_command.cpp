@@ -18,7 +18,7 @@ namespace piezoshift::app {
 
 namespace {
 
-struct GcsOptions {
+struct GcsClientOptions {
   std::string host = "127.0.0.1";
   int port = 50000;
   double timeout_s = 5.0;
@@ -26,7 +26,7 @@ struct GcsOptions {
   std::vector<std::string> commands;
 };
 
-int gcs(const GcsOptions& o) {
+int gcs(const GcsClientOptions& o) {
   if (o.port < 1 || o.port > 65535)
     throw io::InputError(fmt::format("--port {}: must be 1 to 65535", o.port));
   if (!(o.timeout_s > 0.0))
@@ -51,7 +51,7 @@ int gcs(const GcsOptions& o) {
 }  // namespace
 
 void add_gcs_command(CLI::App& app, Action& action) {
-  auto o = std::make_shared<GcsOptions>();
+  auto o = std::make_shared<GcsClientOptions>();
   CLI::App* cmd = app.add_subcommand(
       "gcs", "Send GCS 2.0 commands to `piezoshift serve` and print the answers (docs/gcs.md)");
   cmd->add_option("commands", o->commands, "commands, one per argument (quote each)")->required();

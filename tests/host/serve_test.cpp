@@ -286,6 +286,24 @@ TEST_F(Serve, GarbageOversizedLinesAndDisconnectsMidAnswerLeaveTheLoopRunning) {
   EXPECT_EQ(summary.at("clients_accepted"), 2);
 }
 
+TEST_F(Serve, TheGcsCommandSendsCommandsAndPrintsTheAnswersOfQueries) {
+  const std::uint16_t port = start();
+  ASSERT_NE(port, 0);
+  const std::vector<std::string> args{
+      "gcs", "--port", std::to_string(port), "--transcript", "SVO Z 1", "SVO? Z", "FOO", "ERR?"};
+  const Spawned client = spawn(args, path("gcs.txt"), path("gcs_err.txt"));
+  EXPECT_EQ(wait_exit(client), 0) << slurp(path("gcs_err.txt"));
+  EXPECT_EQ(slurp(path("gcs.txt")), "> SVO Z 1\n> SVO? Z\nZ=1\n> FOO\n> ERR?\n2\n");
+  stop();
+  // Nobody listening any more: exit 2 naming the address.
+  const Spawned refused = spawn({"gcs", "--port", std::to_string(port), "*IDN?"}, path("gcs2.txt"),
+                                path("gcs2_err.txt"));
+  EXPECT_EQ(wait_exit(refused), 2);
+  EXPECT_NE(slurp(path("gcs2_err.txt")).find("127.0.0.1:" + std::to_string(port)),
+            std::string::npos)
+      << slurp(path("gcs2_err.txt"));
+}
+
 TEST_F(Serve, RefusesARemoteAddressWithoutAllowRemoteAndBadInputWithExit2) {
   const auto refused = [&](std::vector<std::string> args, const std::string& piece) {
     const Spawned s = spawn(args, path("o.txt"), path("e.txt"));
