@@ -1,6 +1,8 @@
 #include "loop_setup.hpp"
 
+#include <algorithm>
 #include <csignal>
+#include <limits>
 
 #include <fmt/core.h>
 
@@ -16,6 +18,21 @@ extern "C" void on_stop_signal(int signo) {
   g_stop_signal.store(signo, std::memory_order_relaxed);
 }
 }  // namespace
+
+void check_loop_rate(double rate_Hz) {
+  if (!(rate_Hz >= 1000.0 && rate_Hz <= 10000.0))
+    throw io::InputError(
+        fmt::format("--rate-hz {}: supported rates are 1000 to 10000 Hz", rate_Hz));
+}
+
+runtime::SafetyLimits loop_safety_limits(std::int64_t max_overruns) {
+  if (max_overruns < 1)
+    throw io::InputError(fmt::format("--max-overruns {}: must be >= 1", max_overruns));
+  runtime::SafetyLimits limits;
+  limits.max_consecutive_overruns = static_cast<std::uint32_t>(
+      std::min<std::int64_t>(max_overruns, std::numeric_limits<std::uint32_t>::max()));
+  return limits;
+}
 
 ChosenBackend make_backend(const std::string& daq, const io::ProjectConfig& config,
                            std::uint64_t seed, double rate_Hz) {

@@ -10,6 +10,7 @@
 #include "piezoshift/io/project_config.hpp"
 #include "piezoshift/runtime/daq_backend.hpp"
 #include "piezoshift/runtime/realtime.hpp"
+#include "piezoshift/runtime/safety_supervisor.hpp"
 #include "piezoshift/runtime/sim_backend.hpp"
 
 namespace piezoshift::app {
@@ -18,6 +19,14 @@ struct ChosenBackend {
   std::unique_ptr<runtime::DaqBackend> backend;
   runtime::SimBackend* sim = nullptr;  //!< the same object when it is the twin, else null
 };
+
+//! Throws io::InputError naming --rate-hz unless 1000 <= rate_Hz <= 10000 (the paper's 1 kHz to
+//! the DAQ's practical limit, docs/runtime.md).
+void check_loop_rate(double rate_Hz);
+
+//! The built-in safety limits with --max-overruns consecutive overruns; throws io::InputError
+//! when it is < 1.
+runtime::SafetyLimits loop_safety_limits(std::int64_t max_overruns);
 
 //! "sim" (the twin of config, at rate_Hz, with seed) or "comedi[:DEVICE]". Throws io::InputError
 //! for anything else. Not configured yet.

@@ -4,9 +4,7 @@
 // Exit status: 0 the run completed (duration, SIGINT or SIGTERM) without a fault; 3 the safety
 // supervisor latched a fault (the outputs were ramped to 0 V); 2 bad input, including a DAQ
 // device that cannot be opened; 1 internal error.
-#include <algorithm>
 #include <cstdint>
-#include <limits>
 #include <memory>
 #include <optional>
 #include <string>
@@ -54,10 +52,7 @@ double us(std::int64_t ns) {
 }
 
 int run(const RunOptions& o) {
-  if (!(o.rate_Hz >= 1000.0 && o.rate_Hz <= 10000.0)) {
-    throw io::InputError(
-        fmt::format("--rate-hz {}: supported rates are 1000 to 10000 Hz", o.rate_Hz));
-  }
+  check_loop_rate(o.rate_Hz);
   if (!(o.duration_s > 0.0) || o.duration_s > 1e6)
     throw io::InputError(fmt::format("--duration-s {}: must be > 0 s", o.duration_s));
 
@@ -108,11 +103,7 @@ int run(const RunOptions& o) {
   config.rate_Hz = o.rate_Hz;
   config.duration_s = o.duration_s;
   config.stop_signal = &g_stop_signal;
-  if (o.max_overruns < 1)
-    throw io::InputError(fmt::format("--max-overruns {}: must be >= 1", o.max_overruns));
-  SafetyLimits limits;
-  limits.max_consecutive_overruns = static_cast<std::uint32_t>(
-      std::min<std::int64_t>(o.max_overruns, std::numeric_limits<std::uint32_t>::max()));
+  const SafetyLimits limits = loop_safety_limits(o.max_overruns);
   ControlLoop loop(config, params, limits, *daq, *clock, std::move(profile),
                    logger ? &logger->ring() : nullptr);
 

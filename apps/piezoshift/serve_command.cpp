@@ -64,13 +64,14 @@ void check(bool ok, const std::string& message) {
 
 host::StageModel make_stage_model(const ServeOptions& o, const io::ProjectConfig& config,
                                   const control::SemiClosedLoopParams& params,
-                                  std::optional<double> travel_z_max_um) {
+                                  std::optional<double> travel_z_max_um,
+                                  const runtime::SafetyLimits& safety) {
   try {
     host::StageModelParams mp = host::stage_model_params(config.twin.geometry, params);
     if (travel_z_max_um)
       mp.z_max_um = *travel_z_max_um;
     mp.amplifier_gain = config.twin.amplifier.gain;
-    mp.channel_max_V = runtime::SafetyLimits{}.output_max_V * mp.amplifier_gain;
+    mp.channel_max_V = safety.output_max_V * mp.amplifier_gain;
     return host::StageModel(mp);
   } catch (const std::invalid_argument& e) {
     throw io::InputError(fmt::format(
@@ -79,8 +80,7 @@ host::StageModel make_stage_model(const ServeOptions& o, const io::ProjectConfig
 }
 
 int serve(const ServeOptions& o) {
-  check(o.rate_Hz >= 1000.0 && o.rate_Hz <= 10000.0,
-        fmt::format("--rate-hz {}: supported rates are 1000 to 10000 Hz", o.rate_Hz));
+  check_loop_rate(o.rate_Hz);
   check(o.duration_s > 0.0, fmt::format("--duration-s {}: must be > 0 s", o.duration_s));
   check(o.port >= 0 && o.port <= 65535, fmt::format("--port {}: must be 0 to 65535", o.port));
   check(o.max_clients >= 1 && o.max_clients <= 64,
@@ -95,7 +95,7 @@ int serve(const ServeOptions& o) {
         fmt::format("--on-target-urad {}: must be > 0", o.on_target_urad));
   check(o.settle_s >= 0.0 && o.settle_s <= 10.0,
         fmt::format("--settle-s {}: must be 0 to 10 s", o.settle_s));
-  check(o.max_overruns >= 1, fmt::format("--max-overruns {}: must be >= 1", o.max_overruns));
+  const runtime::SafetyLimits safety = loop_safety_limits(o.max_overruns);
 
   const io::ProjectConfig config =
       o.config.empty() ? io::ProjectConfig{} : io::load_project_config(o.config);
@@ -103,7 +103,7 @@ int serve(const ServeOptions& o) {
   std::optional<double> travel_z_max_um;
   if (!o.calibration.empty())
     params = calibration::load_calibration_file(o.calibration, &travel_z_max_um);
-  const host::StageModel model = make_stage_model(o, config, params, travel_z_max_um);
+  const host::StageModel model = make_stage_model(o, config, params, travel_z_max_um, safety);
 
   ChosenBackend chosen = make_backend(o.daq, config, o.seed, o.rate_Hz);
   runtime::DaqBackend& daq = *chosen.backend;
@@ -144,9 +144,6 @@ int serve(const ServeOptions& o) {
   lc.stop_signal = &g_stop_signal;
   lc.stop_when_safe_after_fault = false;  // a client clears faults (SVO)
   lc.host = &link;
-  runtime::SafetyLimits safety;
-  safety.max_consecutive_overruns = static_cast<std::uint32_t>(
-      std::min<std::int64_t>(o.max_overruns, std::numeric_limits<std::uint32_t>::max()));
   runtime::ControlLoop loop(lc, params, safety, daq, clock, runtime::SetpointProfile::step(0.0),
                             logger ? &logger->ring() : nullptr);
 

@@ -113,19 +113,18 @@ void DataRecorder::record(const RecorderInput& in) {
 
 std::string DataRecorder::name(const Table& t) const {
   const auto i = static_cast<std::size_t>(t.source);
+  const auto of_axis = [i](const char* signal) {
+    return fmt::format("{} of axis {} ({})", signal, axis_name(kAxes[i]), axis_unit(kAxes[i]));
+  };
   switch (t.option) {
     case kTarget:
-      return fmt::format("Target position of axis {} ({})", axis_name(kAxes[i]),
-                         axis_unit(kAxes[i]));
+      return of_axis("Target position");
     case kPosition:
-      return fmt::format("Current position of axis {} ({})", axis_name(kAxes[i]),
-                         axis_unit(kAxes[i]));
+      return of_axis("Current position");
     case kError:
-      return fmt::format("Position error of axis {} ({})", axis_name(kAxes[i]),
-                         axis_unit(kAxes[i]));
+      return of_axis("Position error");
     case kInterferometer:
-      return fmt::format("Interferometer position of axis {} ({})", axis_name(kAxes[i]),
-                         axis_unit(kAxes[i]));
+      return of_axis("Interferometer position");
     case kOutputVoltage:
       return fmt::format("Voltage of output channel {} (V)", i + 1);
     case kSensor:

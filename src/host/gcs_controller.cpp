@@ -273,19 +273,25 @@ void GcsController::take(const runtime::HostSample& s) {
   in.interferometer =
       s.has_truth != 0 ? model_.pose_from_points(s.interferometer_um) : AxisValues{nan, nan, nan};
   const auto& p = model_.params();
-  for (std::size_t i = 0; i < 3; ++i) {
-    in.channel_V[i] = s.ao_V[i] * p.amplifier_gain;
+  in.channel_V = model_.channel_V_from_daq(s.ao_V);
+  for (std::size_t i = 0; i < 3; ++i)
     in.sensor_um[i] = p.controller.scaling[i].sgs_to_um(s.sgs_V[i]);
-  }
   recorder_.record(in);
 }
 
+bool GcsController::accepted(Session& s, GcsError error) {
+  if (error == GcsError::kNone)
+    return true;
+  fail(s, error);
+  return false;
+}
+
 std::string GcsController::reply(Session& s, GcsError error, std::string& answer) {
-  if (error != GcsError::kNone) {
-    fail(s, error);
-    return {};
-  }
-  return std::move(answer);
+  return accepted(s, error) ? std::move(answer) : std::string{};
+}
+
+void GcsController::hold_applied_volts() {
+  open_loop_V_ = model_.open_loop_for(model_.channel_V_from_daq(last_.ao_V));
 }
 
 std::string GcsController::execute(Session& s, std::string_view name, const Args& args) {
@@ -367,9 +373,9 @@ std::string GcsController::execute(Session& s, std::string_view name, const Args
                  answer);
   }
   if (name == "VOL?") {
-    const auto volts = [this](int ch) {
-      const double v = last_.ao_V[static_cast<std::size_t>(ch - 1)];
-      return fmt::format("{:.4f}", v * model_.params().amplifier_gain);
+    const Vec3 channel_V = model_.channel_V_from_daq(last_.ao_V);
+    const auto volts = [&channel_V](int ch) {
+      return fmt::format("{:.4f}", channel_V[static_cast<std::size_t>(ch - 1)]);
     };
     return reply(s, id_lines(args, 3, GcsError::kParamOutOfRange, volts, answer), answer);
   }
@@ -401,10 +407,8 @@ std::string GcsController::execute(Session& s, std::string_view name, const Args
 
 std::string GcsController::move(Session& s, const Args& args, bool relative) {
   std::vector<AxisValue> pairs;
-  if (const GcsError e = parse_pairs(args, pairs); e != GcsError::kNone) {
-    fail(s, e);
+  if (!accepted(s, parse_pairs(args, pairs)))
     return {};
-  }
   if (!servo_on_) {
     fail(s, GcsError::kServoOff);
     return {};
@@ -428,10 +432,8 @@ std::string GcsController::move(Session& s, const Args& args, bool relative) {
 
 std::string GcsController::servo(Session& s, const Args& args) {
   std::vector<AxisValue> pairs;
-  if (const GcsError e = parse_pairs(args, pairs); e != GcsError::kNone) {
-    fail(s, e);
+  if (!accepted(s, parse_pairs(args, pairs)))
     return {};
-  }
   const double on = pairs.front().value;
   for (const AxisValue& p : pairs) {
     // One loop drives all three axes: the values must agree.
@@ -464,10 +466,7 @@ std::string GcsController::servo(Session& s, const Args& args) {
   if (servo_on_) {
     target_ = position_;
   } else {
-    Vec3 channel_V{};
-    for (std::size_t i = 0; i < 3; ++i)
-      channel_V[i] = last_.ao_V[i] * model_.params().amplifier_gain;
-    open_loop_V_ = model_.open_loop_for(channel_V);
+    hold_applied_volts();
   }
   moved();
   return {};
@@ -475,10 +474,8 @@ std::string GcsController::servo(Session& s, const Args& args) {
 
 std::string GcsController::open_loop(Session& s, const Args& args) {
   std::vector<AxisValue> pairs;
-  if (const GcsError e = parse_pairs(args, pairs); e != GcsError::kNone) {
-    fail(s, e);
+  if (!accepted(s, parse_pairs(args, pairs)))
     return {};
-  }
   if (servo_on_) {
     fail(s, GcsError::kOpenLoopWithServoOn);
     return {};
@@ -526,10 +523,7 @@ std::string GcsController::stop(Session& s, const Args& args) {
   if (servo_on_) {
     target_ = position_;
   } else {
-    Vec3 channel_V{};
-    for (std::size_t i = 0; i < 3; ++i)
-      channel_V[i] = last_.ao_V[i] * model_.params().amplifier_gain;
-    open_loop_V_ = model_.open_loop_for(channel_V);
+    hold_applied_volts();
   }
   moved();
   fail(s, GcsError::kStopped);
@@ -555,10 +549,7 @@ std::string GcsController::recorder_config(Session& s, const Args& args) {
     fail(s, GcsError::kNoRecordOption);
     return {};
   }
-  const GcsError e =
-      recorder_.configure(static_cast<int>(table), args[1], static_cast<int>(option));
-  if (e != GcsError::kNone)
-    fail(s, e);
+  accepted(s, recorder_.configure(static_cast<int>(table), args[1], static_cast<int>(option)));
   return {};
 }
 
@@ -572,8 +563,7 @@ std::string GcsController::recorder_rate(Session& s, const Args& args) {
     fail(s, GcsError::kParamSyntax);
     return {};
   }
-  if (const GcsError e = recorder_.set_rate(cycles); e != GcsError::kNone)
-    fail(s, e);
+  accepted(s, recorder_.set_rate(cycles));
   return {};
 }
 

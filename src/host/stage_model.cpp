@@ -18,14 +18,6 @@ kinematics::PlatePose to_pose(const AxisValues& v) {
   return kinematics::PlatePose{v[0], v[1], v[2]};
 }
 
-// S = A p(Z_d), the outer feedforward (Eq. 8).
-Vec3 actuator_targets(const control::SemiClosedLoopParams& c, const Vec3& zd_um) {
-  Vec3 zs{};
-  for (std::size_t i = 0; i < zs.size(); ++i)
-    zs[i] = c.polynomial(zd_um[i]);
-  return c.matrix(zs);
-}
-
 // The cubic's inversion interval: wide enough for any gauge reading of a working stage.
 double inverse_lo(double z_max_um) {
   return -z_max_um;
@@ -63,7 +55,7 @@ StageModelParams stage_model_params(const plant::GeometryParams& geometry,
 }
 
 StageModel::StageModel(const StageModelParams& params)
-    : params_(params), points_(params.measurement_points) {
+    : params_(params), points_(params.measurement_points), feedforward_(params.controller) {
   if (!(params.z_max_um > 0.0) || !std::isfinite(params.z_max_um))
     throw std::invalid_argument("stage model: the travel z_max_um must be > 0");
   if (!(params.amplifier_gain > 0.0) || !(params.channel_max_V > 0.0))
@@ -93,7 +85,7 @@ StageModel::StageModel(const StageModelParams& params)
         fmt::format("stage model: the cubic p is not increasing on [{:g}, {:g}] um", lo, hi));
   }
 
-  const Vec3 s_max = actuator_targets(params.controller, control::filled(params.z_max_um));
+  const Vec3 s_max = feedforward_.actuator_targets(control::filled(params.z_max_um));
   actuator_max_um_ = s_max;
 
   Eigen::Matrix3d mix;
@@ -186,7 +178,7 @@ std::string StageModel::unreachable_reason(const AxisValues& pose) const {
                          params_.z_max_um);
     }
   }
-  const Vec3 s = actuator_targets(params_.controller, z);
+  const Vec3 s = feedforward_.actuator_targets(z);
   for (std::size_t i = 0; i < 3; ++i) {
     if (s[i] < -kSlack || s[i] > actuator_max_um_[i] + kSlack) {
       return fmt::format("actuator {} would be asked for {:.4f} um, outside [0, {:.4f}] um", i + 1,
@@ -199,6 +191,13 @@ std::string StageModel::unreachable_reason(const AxisValues& pose) const {
 Vec3 StageModel::channel_V_for(const AxisValues& open_loop_V) const {
   const Eigen::Vector3d v = mix_ * Eigen::Vector3d(open_loop_V[0], open_loop_V[1], open_loop_V[2]);
   return Vec3{v[0], v[1], v[2]};
+}
+
+Vec3 StageModel::channel_V_from_daq(const Vec3& daq_V) const {
+  Vec3 v{};
+  for (std::size_t i = 0; i < v.size(); ++i)
+    v[i] = daq_V[i] * params_.amplifier_gain;
+  return v;
 }
 
 AxisValues StageModel::open_loop_for(const Vec3& channel_V) const {

@@ -73,6 +73,10 @@ class GcsController final : public LineHandler {
 
   std::string execute(Session& session, std::string_view name, const Args& args);
   void fail(Session& session, GcsError error);
+  //! True for kNone; otherwise queues the error and returns false.
+  bool accepted(Session& session, GcsError error);
+  //! Open-loop values := the volts the loop applies now (servo off, STP).
+  void hold_applied_volts();
   //! answer, or nothing with the error queued.
   std::string reply(Session& session, GcsError error, std::string& answer);
   //! Pushes the command to the loop; false (and error 52 queued) when the ring is full.

@@ -78,6 +78,8 @@ class StageModel {
 
   //! Channel volts at the amplifier outputs for open-loop axis values.
   Vec3 channel_V_for(const AxisValues& open_loop_V) const;
+  //! Amplifier output volts for DAQ output volts (x amplifier_gain).
+  Vec3 channel_V_from_daq(const Vec3& daq_V) const;
   //! The open-loop axis values that give these channel volts (inverse of channel_V_for).
   AxisValues open_loop_for(const Vec3& channel_V) const;
 
@@ -86,6 +88,7 @@ class StageModel {
  private:
   StageModelParams params_;
   kinematics::TripodGeometry points_;
+  control::SemiClosedLoopController feedforward_;  // its actuator_targets(): S = A p(Z_d)
   Eigen::Matrix3d a_inverse_;
   Vec3 actuator_max_um_{};
   Eigen::Matrix3d mix_;
