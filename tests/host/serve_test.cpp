@@ -38,7 +38,7 @@ double value_of(const std::vector<std::string>& lines, const std::string& key) {
   return std::nan("");
 }
 
-class Serve : public ::testing::Test {
+class Serve : public piezoshift::testing::TempDirTest {
  protected:
   // One twin calibration for the suite (`calibrate --pid paper`, under a second): POS? is
   // compared with the interferometer, which only a calibration of this twin makes agree.
@@ -52,18 +52,13 @@ class Serve : public ::testing::Test {
   }
   static void TearDownTestSuite() { fs::remove_all(suite_dir_); }
 
-  void SetUp() override {
-    dir_ = suite_dir_ / ::testing::UnitTest::GetInstance()->current_test_info()->name();
-    fs::create_directories(dir_);
-  }
   void TearDown() override {
     if (server_.pid > 0) {  // a failed test: do not leave the server running
       kill(server_.pid, SIGKILL);
       wait_exit(server_);
     }
+    TempDirTest::TearDown();
   }
-
-  std::string path(const std::string& name) const { return (dir_ / name).string(); }
 
   // Starts the server on a free port; returns the port (0 when it did not come up).
   std::uint16_t start(std::vector<std::string> extra = {}) {
@@ -110,11 +105,16 @@ class Serve : public ::testing::Test {
     return false;
   }
 
+  // Polls DRL? until table 1 holds n points (the assertions on the data follow); at most 10 s.
+  static void wait_recorded(GcsClient& c, int n) {
+    for (int i = 0; i < 2000 && std::stoi(c.query_lines("DRL? 1")[0].substr(2)) < n; ++i)
+      std::this_thread::sleep_for(std::chrono::milliseconds(5));
+  }
+
   static int error(GcsClient& c) { return std::stoi(c.query("ERR?")); }
 
   static fs::path suite_dir_;
   static std::string calibration_;
-  fs::path dir_;
   Spawned server_;
 };
 
@@ -151,8 +151,7 @@ TEST_F(Serve, IdentifiesListsAxesMovesOnTargetAndAgreesWithTheInterferometer) {
     c.send("DRC " + std::to_string(2 * i + 2) + " " + axes[i] + " 90");
   }
   EXPECT_EQ(error(c), 0);
-  for (int i = 0; i < 2000 && std::stoi(c.query_lines("DRL? 1")[0].substr(2)) < 200; ++i)
-    std::this_thread::sleep_for(std::chrono::milliseconds(5));
+  wait_recorded(c, 200);
   const auto data = c.query_lines("DRR? 1 200");
   std::vector<std::vector<double>> rows;
   for (const std::string& l : data) {
@@ -199,8 +198,7 @@ TEST_F(Serve, RecordsAtTheRateAskedAndAnswersInGcsDataForm) {
   EXPECT_EQ(c.query_lines("DRC? 1"), (std::vector<std::string>{"1=1 7"}));
   c.send("SVA Z 30");  // open loop: 30 V on every channel, the recording starts again
   EXPECT_EQ(error(c), 0);
-  for (int i = 0; i < 2000 && std::stoi(c.query_lines("DRL? 1")[0].substr(2)) < 100; ++i)
-    std::this_thread::sleep_for(std::chrono::milliseconds(5));
+  wait_recorded(c, 100);
   const std::string answer = c.query("DRR? 1 100 1 2");
   const auto lines = GcsClient::split_answer(answer);
   ASSERT_GT(lines.size(), 100u);

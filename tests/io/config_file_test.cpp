@@ -6,9 +6,10 @@
 #include <string>
 
 #include <gtest/gtest.h>
-#include <unistd.h>
 
 #include "piezoshift/io/input_error.hpp"
+
+#include "../support/temp_dir_test.hpp"
 
 namespace piezoshift::io {
 namespace {
@@ -231,22 +232,7 @@ TEST(ConfigFile, ThreeByThreeMatrices) {
   EXPECT_NO_THROW(f.reject_unknown());
 }
 
-class ConfigFileOnDisk : public ::testing::Test {
- protected:
-  void SetUp() override {
-    const auto* info = ::testing::UnitTest::GetInstance()->current_test_info();
-    dir_ = std::filesystem::temp_directory_path() /
-           ("piezoshift_" + std::string(info->name()) + "_" + std::to_string(::getpid()));
-    std::filesystem::create_directories(dir_);
-  }
-  void TearDown() override { std::filesystem::remove_all(dir_); }
-  std::string write(const std::string& name, const std::string& text) {
-    const std::filesystem::path p = dir_ / name;
-    std::ofstream(p) << text;
-    return p.string();
-  }
-  std::filesystem::path dir_;
-};
+using ConfigFileOnDisk = piezoshift::testing::TempDirTest;
 
 TEST_F(ConfigFileOnDisk, LoadsAFileAndNamesItInErrors) {
   const std::string path = write("good.toml", "[s]\nx = 3.0\n");

@@ -5,28 +5,17 @@
 #include <string>
 
 #include <gtest/gtest.h>
-#include <unistd.h>
 
 #include "piezoshift/io/input_error.hpp"
+
+#include "../support/temp_dir_test.hpp"
 
 namespace piezoshift::io {
 namespace {
 
-class ProjectConfigTest : public ::testing::Test {
+class ProjectConfigTest : public piezoshift::testing::TempDirTest {
  protected:
-  void SetUp() override {
-    const auto* info = ::testing::UnitTest::GetInstance()->current_test_info();
-    dir_ = std::filesystem::temp_directory_path() /
-           ("piezoshift_" + std::string(info->name()) + "_" + std::to_string(::getpid()));
-    std::filesystem::create_directories(dir_);
-  }
-  void TearDown() override { std::filesystem::remove_all(dir_); }
-
-  std::string write(const std::string& text) {
-    const std::filesystem::path p = dir_ / "config.toml";
-    std::ofstream(p) << text;
-    return p.string();
-  }
+  std::string write(const std::string& text) { return TempDirTest::write("config.toml", text); }
   // Loads text that must fail; returns the message, which must name the file.
   std::string error_for(const std::string& text) {
     const std::string path = write(text);
@@ -40,7 +29,6 @@ class ProjectConfigTest : public ::testing::Test {
     ADD_FAILURE() << "no InputError for:\n" << text;
     return "";
   }
-  std::filesystem::path dir_;
 };
 
 bool contains(const std::string& text, const std::string& part) {

@@ -60,18 +60,7 @@ bool wait_for_lines(const std::string& path, std::size_t n) {
   return false;
 }
 
-class RunCommand : public ::testing::Test {
- protected:
-  void SetUp() override {
-    dir_ = fs::temp_directory_path() /
-           ("piezoshift_run_" + std::to_string(getpid()) + "_" +
-            ::testing::UnitTest::GetInstance()->current_test_info()->name());
-    fs::create_directories(dir_);
-  }
-  void TearDown() override { fs::remove_all(dir_); }
-  std::string path(const std::string& name) const { return (dir_ / name).string(); }
-  fs::path dir_;
-};
+using RunCommand = piezoshift::testing::TempDirTest;
 
 // Checks a log's data rows: right width, consecutive ticks from 0, numbers everywhere.
 void expect_valid_log(const std::vector<std::string>& rows, std::size_t width) {

@@ -1,10 +1,6 @@
 // Set-up inputs of a run: setpoint profiles, the controller's TOML, atomic file replacement.
-#include <unistd.h>
-
 #include <filesystem>
-#include <fstream>
 #include <optional>
-#include <sstream>
 #include <string>
 
 #include <gtest/gtest.h>
@@ -14,33 +10,14 @@
 #include "piezoshift/io/input_error.hpp"
 #include "piezoshift/runtime/setpoint_profile.hpp"
 
+#include "../support/temp_dir_test.hpp"
+
 namespace piezoshift::runtime {
 namespace {
 
 namespace fs = std::filesystem;
 
-class TempDir : public ::testing::Test {
- protected:
-  void SetUp() override {
-    dir_ = fs::temp_directory_path() /
-           ("piezoshift_runtime_" + std::to_string(::getpid()) + "_" +
-            ::testing::UnitTest::GetInstance()->current_test_info()->name());
-    fs::create_directories(dir_);
-  }
-  void TearDown() override { fs::remove_all(dir_); }
-  std::string write(const std::string& name, const std::string& text) {
-    const fs::path p = dir_ / name;
-    std::ofstream(p) << text;
-    return p.string();
-  }
-  static std::string read(const std::string& path) {
-    std::ifstream in(path);
-    std::stringstream s;
-    s << in.rdbuf();
-    return s.str();
-  }
-  fs::path dir_;
-};
+using TempDir = piezoshift::testing::TempDirTest;
 
 using SetpointProfileTest = TempDir;
 using ControllerConfigTest = TempDir;
@@ -140,7 +117,7 @@ TEST_F(ControllerConfigTest, TravelSectionIsOptionalAndRoundTrips) {
 TEST_F(AtomicFileTest, ReplacesContentAndLeavesNoTemporary) {
   const std::string path = write("cal.toml", "old\n");
   io::write_file_atomically(path, "new content\n");
-  EXPECT_EQ(read(path), "new content\n");
+  EXPECT_EQ(read_text(path), "new content\n");
   int files = 0;
   for (const auto& e : fs::directory_iterator(dir_)) {
     (void)e;
@@ -153,7 +130,7 @@ TEST_F(AtomicFileTest, FailureLeavesTheOldFileIntact) {
   const std::string path = write("cal.toml", "old\n");
   EXPECT_THROW(io::write_file_atomically((dir_ / "missing" / "cal.toml").string(), "x"),
                io::InputError);
-  EXPECT_EQ(read(path), "old\n");
+  EXPECT_EQ(read_text(path), "old\n");
 }
 
 }  // namespace

@@ -6,12 +6,12 @@
 #include <sys/wait.h>
 #include <unistd.h>
 
-#include <fstream>
-#include <sstream>
 #include <string>
 #include <vector>
 
 #include <gtest/gtest.h>
+
+#include "temp_dir_test.hpp"
 
 extern char** environ;
 
@@ -52,14 +52,6 @@ inline int wait_exit(const Spawned& s, bool* signaled = nullptr, int* signo = nu
   if (signo && WIFSIGNALED(status))
     *signo = WTERMSIG(status);
   return WIFEXITED(status) ? WEXITSTATUS(status) : -1;
-}
-
-//! The whole content of a file (empty if it cannot be read).
-inline std::string slurp(const std::string& path) {
-  std::ifstream in(path);
-  std::stringstream s;
-  s << in.rdbuf();
-  return s.str();
 }
 
 }  // namespace piezoshift::testing
