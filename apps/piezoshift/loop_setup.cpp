@@ -6,6 +6,8 @@
 
 #include <fmt/core.h>
 
+#include "piezoshift/calibration/calibration_file.hpp"
+#include "piezoshift/calibration/calibration_procedure.hpp"
 #include "piezoshift/io/input_error.hpp"
 #include "piezoshift/runtime/comedi_backend.hpp"
 
@@ -55,6 +57,33 @@ ChosenBackend make_backend(const std::string& daq, const io::ProjectConfig& conf
     throw io::InputError(fmt::format("--daq '{}': expected sim or comedi:/dev/comediN", daq));
   }
   return chosen;
+}
+
+LoopCalibration resolve_calibration(const std::string& path, const std::string& daq,
+                                    const io::ProjectConfig& config, std::uint64_t seed) {
+  LoopCalibration c;
+  if (!path.empty()) {
+    c.params = calibration::load_calibration_file(path, &c.travel_z_max_um);
+    c.source = path;
+    return c;
+  }
+  if (daq != "sim") {
+    fmt::print(stderr,
+               "piezoshift: warning: no --calibration: running with the paper's gains, A and p "
+               "(Section 4), which describe the paper's stage, not this one\n");
+    c.source = "the paper's values (Section 4)";
+    return c;
+  }
+  fmt::print(stderr,
+             "piezoshift: no --calibration: calibrating the twin first (the paper's procedure "
+             "and gains, seed {})\n",
+             seed);
+  const calibration::CalibrationWithTravel ct = calibration::calibrate_with_travel(
+      config, seed, calibration::CalibrationOptions::paper_gains_only());
+  c.params = ct.calibration.controller;
+  c.travel_z_max_um = ct.travel.semi_closed_um;
+  c.source = fmt::format("the twin's own calibration (paper's procedure, seed {})", seed);
+  return c;
 }
 
 struct StopSignals::Saved {

@@ -5,8 +5,10 @@
 #include <atomic>
 #include <cstdint>
 #include <memory>
+#include <optional>
 #include <string>
 
+#include "piezoshift/control/semi_closed_loop.hpp"
 #include "piezoshift/io/project_config.hpp"
 #include "piezoshift/runtime/daq_backend.hpp"
 #include "piezoshift/runtime/realtime.hpp"
@@ -32,6 +34,21 @@ runtime::SafetyLimits loop_safety_limits(std::int64_t max_overruns);
 //! for anything else. Not configured yet.
 ChosenBackend make_backend(const std::string& daq, const io::ProjectConfig& config,
                            std::uint64_t seed, double rate_Hz);
+
+//! The controller a loop runs with, and where it came from.
+struct LoopCalibration {
+  control::SemiClosedLoopParams params;
+  std::optional<double> travel_z_max_um;  //!< the semi-closed-loop travel, when known
+  std::string source;                     //!< the file, or how it was obtained
+};
+
+//! --calibration FILE when given. Otherwise, on the twin (--daq sim), the paper's calibration
+//! procedure with the paper's gains run on that twin first (one line on stderr says so: a few
+//! hundred simulated seconds, well under a second on an idle machine), so that the controller
+//! and the twin agree and the advertised travel is the one measured; on hardware, the paper's
+//! own values (Section 4) with a warning, since nothing else is known of the stage.
+LoopCalibration resolve_calibration(const std::string& path, const std::string& daq,
+                                    const io::ProjectConfig& config, std::uint64_t seed);
 
 //! Set by the handlers StopSignals installs: the signal number, 0 until one arrives.
 extern std::atomic<int> g_stop_signal;

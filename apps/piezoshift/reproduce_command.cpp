@@ -36,15 +36,17 @@ int run(const Options& o) {
   ro.pid = o.pid == "search" ? calibration::PidChoice::kSearch : calibration::PidChoice::kPaper;
   reproduction::ReproductionResult result;
   {
-    // PID gains, matrix A, polynomial p, travel range, step, linearity, repeatability x 2
-    ProgressBar bar(8);
+    // PID gains, matrix A, polynomial p; then travel range, step, linearity, repeatability x 2,
+    // linearity on the 0.25 um grid and downwards, for the paper's controller and the oracle
+    ProgressBar bar(3 + 2 * 7);
     result = reproduction::reproduce(config, ro, bar.callback());
   }
   const std::string label = o.config.empty() ? "built-in defaults (configs/paper.toml)" : o.config;
   const reproduction::ReportFiles files = reproduction::write_report(result, o.out, label);
+  const int status = result.valid() ? 0 : reproduction::kExitInvalidExperiment;
   if (o.json) {
     fmt::print("{}\n", reproduction::summary_json(result).dump(2));
-    return 0;
+    return status;
   }
   const auto& t = result;
   fmt::print("piezoshift reproduce: {:.0f} s simulated in {:.2f} s\n", t.simulated_time_s,
@@ -60,8 +62,18 @@ int run(const Options& o) {
              t.linearity.metrics.linearity_best_fit_pct);
   fmt::print("  repeatability    {:.2f} nm at 5 um, {:.2f} nm at 10 um          (paper: 2, 3 nm)\n",
              t.repeat_5um.metrics.repeatability_nm, t.repeat_10um.metrics.repeatability_nm);
+  fmt::print(
+      "  oracle           {:.3f} % linearity, {:.2f} / {:.2f} nm repeatability (plate feedback, "
+      "impossible on hardware)\n",
+      t.oracle.linearity.metrics.linearity_zero_end_pct,
+      t.oracle.repeat_5um.metrics.repeatability_nm, t.oracle.repeat_10um.metrics.repeatability_nm);
   fmt::print("report: {}\n        {}\n", files.markdown.string(), files.html.string());
-  return 0;
+  if (status != 0) {
+    fmt::print(stderr, "piezoshift: reproduce: not valid, so the figures above are not results:\n");
+    for (const std::string& why : result.invalid_reasons())
+      fmt::print(stderr, "  {}\n", why);
+  }
+  return status;
 }
 
 }  // namespace

@@ -56,14 +56,18 @@ int run(const RunOptions& o) {
   if (!(o.duration_s > 0.0) || o.duration_s > 1e6)
     throw io::InputError(fmt::format("--duration-s {}: must be > 0 s", o.duration_s));
 
-  control::SemiClosedLoopParams params;
-  if (!o.calibration.empty())
-    params = calibration::load_calibration_file(o.calibration);
   SetpointProfile profile = !o.profile.empty() ? SetpointProfile::load_csv(o.profile)
                                                : SetpointProfile::step(o.step_um.value_or(0.0));
   std::vector<FaultSpec> faults;
   for (const std::string& f : o.faults)
     faults.push_back(parse_fault_spec(f));
+
+  const LoopCalibration cal = resolve_calibration(o.calibration, o.daq, io::ProjectConfig{}, o.seed);
+  const control::SemiClosedLoopParams& params = cal.params;
+  if (o.step_um && cal.travel_z_max_um && *o.step_um > *cal.travel_z_max_um)
+    throw io::InputError(fmt::format("--step-um {}: beyond the calibrated semi-closed-loop "
+                                     "travel, {} um ({})",
+                                     *o.step_um, *cal.travel_z_max_um, cal.source));
 
   // The backend.
   const bool comedi = o.daq.rfind("comedi", 0) == 0;

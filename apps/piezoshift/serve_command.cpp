@@ -99,11 +99,9 @@ int serve(const ServeOptions& o) {
 
   const io::ProjectConfig config =
       o.config.empty() ? io::ProjectConfig{} : io::load_project_config(o.config);
-  control::SemiClosedLoopParams params;
-  std::optional<double> travel_z_max_um;
-  if (!o.calibration.empty())
-    params = calibration::load_calibration_file(o.calibration, &travel_z_max_um);
-  const host::StageModel model = make_stage_model(o, config, params, travel_z_max_um, safety);
+  const LoopCalibration cal = resolve_calibration(o.calibration, o.daq, config, o.seed);
+  const control::SemiClosedLoopParams& params = cal.params;
+  const host::StageModel model = make_stage_model(o, config, params, cal.travel_z_max_um, safety);
 
   ChosenBackend chosen = make_backend(o.daq, config, o.seed, o.rate_Hz);
   runtime::DaqBackend& daq = *chosen.backend;

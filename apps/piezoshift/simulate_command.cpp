@@ -1,14 +1,17 @@
 // `piezoshift simulate`: runs the digital twin (docs/twin.md) open loop or with the paper's
-// semi-closed-loop controller, one control tick at a time, and reports where the plate ended up.
+// semi-closed-loop controller, through the loop `run` and `serve` ship (the simulated bench,
+// experiments/bench.hpp: DAQ read, controller, safety supervisor, DAQ write), and reports where
+// the plate ended up. A supervisor fault ends the run's control (outputs ramp to 0 V) and the
+// command exits with status 3, as `run` does.
 //
 //   piezoshift simulate --open-loop-volts 10,10,10 --duration-s 2
 //   piezoshift simulate --step-um 11 --duration-s 1 --log step.csv --json
 //   piezoshift simulate --profile staircase.csv --duration-s 120 --seed 7 --config my.toml
 //
-// Per tick: Z_d from the mode, controller (if any) on the last AI sample, twin.step(AO). The
-// profile is a staircase: from each row's t_s on, Z_d = zd_um (0 before the first row). The log
-// has one row per control tick, taken at the end of the tick (the AO held during it, the AI
-// sampled at its end, the truth and the interferometer's dynamic reading at its end).
+// Per tick: Z_d from the mode, then the shipping tick. The profile is a staircase: from each
+// row's t_s on, Z_d = zd_um (0 before the first row). The log has one row per control tick: the
+// AI read and the AO written in it, and the truth and the interferometer's dynamic reading at the
+// end of the period the AI closes.
 #include <cmath>
 #include <cstdint>
 #include <initializer_list>
@@ -26,10 +29,13 @@
 #include "piezoshift/io/csv_writer.hpp"
 #include "piezoshift/io/input_error.hpp"
 #include "piezoshift/io/project_config.hpp"
+#include "piezoshift/experiments/bench.hpp"
 #include "piezoshift/plant/twin.hpp"
 
 namespace piezoshift::app {
 namespace {
+
+constexpr int kExitFault = 3;  // the supervisor tripped, as `run`
 
 using Json = nlohmann::ordered_json;
 using control::Vec3;
@@ -111,9 +117,8 @@ int run_simulate(const SimulateOptions& opt) {
   io::ProjectConfig config;
   if (!opt.config_path.empty())
     config = io::load_project_config(opt.config_path);
-  plant::Twin twin(config.design, config.twin, opt.seed);
   const double range_V = config.twin.daq.range_V;
-  const double period_s = twin.model().control_period_s;
+  const double period_s = config.twin.daq.sample_time_s;
 
   const bool closed_loop = opt.open_loop_volts.empty();
   Vec3 open_loop{};
@@ -135,12 +140,20 @@ int run_simulate(const SimulateOptions& opt) {
 
   control::SemiClosedLoopParams cp;
   cp.sample_time_s = period_s;  // the paper's gains, re-expressed at the twin's DAQ period
-  control::SemiClosedLoopController controller(cp);
-
   const auto ticks = static_cast<std::uint64_t>(std::llround(opt.duration_s / period_s));
   if (ticks < 1)
     throw io::InputError(fmt::format("--duration-s = {} is shorter than one control period ({} s)",
                                      opt.duration_s, period_s));
+  std::unique_ptr<experiments::Bench> made;
+  try {
+    made = std::make_unique<experiments::Bench>(config, cp, opt.seed);
+  } catch (const std::invalid_argument& e) {
+    throw io::InputError(fmt::format("{}: {}", opt.config_path.empty() ? "configuration" :
+                                                                         opt.config_path,
+                                     e.what()));
+  }
+  experiments::Bench& bench = *made;
+  const plant::Twin& twin = bench.twin();
 
   std::unique_ptr<io::CsvWriter> log;
   if (!opt.log_path.empty()) {
@@ -150,24 +163,22 @@ int run_simulate(const SimulateOptions& opt) {
                              opt.duration_s, period_s));
   }
 
-  Vec3 ai = twin.read_ai();
   std::uint64_t saturated_ticks = 0;
   std::vector<double> row;
   for (std::uint64_t k = 0; k < ticks; ++k) {
     const double t = static_cast<double>(k) * period_s;
-    control::ControllerOutput out{};
     double zd = 0.0;
-    Vec3 ao = open_loop;
-    if (closed_loop) {
-      if (opt.step_um)
-        zd = t >= opt.step_at_s ? *opt.step_um : 0.0;
-      else
-        zd = profile.at(t);
-      out = controller.update(Vec3{zd, zd, zd}, ai);
-      ao = out.dac_V;
-      saturated_ticks += out.saturated_mask != 0 ? 1 : 0;
+    if (!closed_loop) {
+      bench.drive_open_loop(open_loop);
+    } else {
+      zd = opt.step_um ? (t >= opt.step_at_s ? *opt.step_um : 0.0) : profile.at(t);
+      bench.drive_points(Vec3{zd, zd, zd});
     }
-    ai = twin.step(ao);
+    bench.run(period_s);
+    const runtime::CycleSample& c = bench.last_cycle();
+    const control::ControllerOutput& out = c.controller;
+    if (closed_loop)
+      saturated_ticks += out.saturated_mask != 0 ? 1 : 0;
     if (log) {
       const plant::TwinTruth& s = twin.truth();
       const plant::InterferometerReading& r = twin.interferometer();
@@ -178,8 +189,9 @@ int run_simulate(const SimulateOptions& opt) {
         row.insert(row.end(), out.target_um.begin(), out.target_um.end());
         row.insert(row.end(), out.command_um.begin(), out.command_um.end());
       }
-      for (const Vec3* v : std::initializer_list<const Vec3*>{&s.ao_V, &s.amplifier_V, &ai,
-                                                              &s.stack_elongation_um, &s.leg_um})
+      for (const Vec3* v : std::initializer_list<const Vec3*>{&c.supervisor.ao_V, &s.amplifier_V,
+                                                              &c.ai_V, &s.stack_elongation_um,
+                                                              &s.leg_um})
         row.insert(row.end(), v->begin(), v->end());
       row.push_back(s.plate_z_um);
       row.push_back(s.theta_x_urad);
@@ -197,6 +209,9 @@ int run_simulate(const SimulateOptions& opt) {
   const plant::TwinTruth& s = twin.truth();
   const plant::InterferometerReading& r = twin.interferometer();
   const plant::TwinModel& m = twin.model();
+  const Vec3& ai = bench.last_cycle().ai_V;
+  const runtime::FaultRecord& fault = bench.fault();
+  const int status = bench.faulted() ? kExitFault : 0;
   const char* mode = !closed_loop ? "open_loop" : (opt.step_um ? "step" : "profile");
   if (opt.json) {
     Json j{{"mode", mode},
@@ -224,6 +239,12 @@ int run_simulate(const SimulateOptions& opt) {
               Json::array({m.loaded_modes_Hz[0], m.loaded_modes_Hz[1], m.loaded_modes_Hz[2]})},
              {"unloaded_mechanism_Hz", m.unloaded_mechanism_Hz},
              {"sgs_gain", vec_json(m.geometry.sgs_gain)}}}};
+    j["fault"] = bench.faulted() ? Json{{"reason", runtime::to_string(fault.reason)},
+                                        {"channel", fault.channel + 1},
+                                        {"time_s", static_cast<double>(fault.tick) * period_s},
+                                        {"value", fault.value},
+                                        {"limit", fault.limit}}
+                                 : Json(nullptr);
     if (opt.step_um) {
       j["step_um"] = *opt.step_um;
       j["step_at_s"] = opt.step_at_s;
@@ -231,7 +252,7 @@ int run_simulate(const SimulateOptions& opt) {
     if (!opt.log_path.empty())
       j["log_file"] = opt.log_path;
     fmt::print("{}\n", j.dump(2));
-    return 0;
+    return status;
   }
   fmt::print("piezoshift simulate ({}), seed {}, {} ticks of {} s\n", mode, opt.seed, ticks,
              period_s);
@@ -247,7 +268,13 @@ int run_simulate(const SimulateOptions& opt) {
     fmt::print("  saturated ticks       {:10d}\n", saturated_ticks);
   if (!opt.log_path.empty())
     fmt::print("  log                   {}\n", opt.log_path);
-  return 0;
+  if (bench.faulted())
+    fmt::print(stderr,
+               "piezoshift: simulate: the safety supervisor tripped: {} on channel {} at {:.3f} s "
+               "(value {:g}, limit {:g}); the outputs ramped to 0 V\n",
+               runtime::to_string(fault.reason), fault.channel + 1,
+               static_cast<double>(fault.tick) * period_s, fault.value, fault.limit);
+  return status;
 }
 
 }  // namespace

@@ -494,7 +494,7 @@ PYBIND11_MODULE(_piezoshift, m) {
           py::arg("duration_s"),
           "run() recording per tick: time_s, true mean of P1..P3 and mean SGS feedback [um]")
       .def("measure_static", &ex::Bench::measure_static)
-      .def_property_readonly("twin", py::overload_cast<>(&ex::Bench::twin),
+      .def_property_readonly("twin", &ex::Bench::twin,
                              py::return_value_policy::reference_internal)
       .def("last_output", &ex::Bench::last_output)
       .def_property_readonly("mode", &ex::Bench::mode)
@@ -728,6 +728,8 @@ PYBIND11_MODULE(_piezoshift, m) {
           "per_actuator",
           [](const Pt& t) { return std::vector<Ps>(t.per_actuator.begin(), t.per_actuator.end()); })
       .PS_RO(Pt, worst)
+      .PS_RO(Pt, plate_overshoot_pct)
+      .PS_RO(Pt, faulted)
       .PS_RO(Pt, acceptable)
       .PS_RO(Pt, simulated_time_s);
   using PtO = ca::PidTuningOptions;

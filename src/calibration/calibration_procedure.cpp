@@ -1,6 +1,36 @@
 #include "piezoshift/calibration/calibration_procedure.hpp"
 
+#include <fmt/core.h>
+
+#include "piezoshift/io/input_error.hpp"
+
 namespace piezoshift::calibration {
+
+CalibrationOptions CalibrationOptions::paper_gains_only() {
+  CalibrationOptions o;
+  o.pid = PidChoice::kPaper;
+  const control::PidGains paper{};
+  o.pid_tuning.kp_values = {paper.kp};
+  o.pid_tuning.ki_values = {paper.ki};
+  o.pid_tuning.kd_values = {paper.kd};
+  return o;
+}
+
+CalibrationWithTravel calibrate_with_travel(const io::ProjectConfig& config, std::uint64_t seed,
+                                            const CalibrationOptions& options,
+                                            const experiments::Progress& progress) {
+  CalibrationWithTravel out;
+  control::SemiClosedLoopParams base;
+  base.sample_time_s = config.twin.daq.sample_time_s;  // the controller runs at the DAQ's rate
+  out.calibration = calibrate(config, base, seed, options, progress);
+  out.travel =
+      experiments::run_travel_range(config, out.calibration.controller, seed + 3, options.travel);
+  if (!(out.travel.semi_closed_um > 0.0))
+    throw io::InputError(
+        fmt::format("calibration: the calibrated loop has no semi-closed-loop travel: {}",
+                    out.travel.validity.reason));
+  return out;
+}
 
 CalibrationOutcome calibrate(const io::ProjectConfig& config,
                              const control::SemiClosedLoopParams& base, std::uint64_t seed,

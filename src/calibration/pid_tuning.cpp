@@ -1,6 +1,7 @@
 #include "piezoshift/calibration/pid_tuning.hpp"
 
 #include <algorithm>
+#include <array>
 #include <cmath>
 #include <limits>
 #include <stdexcept>
@@ -83,33 +84,45 @@ PidTrial score_pid_gains(const io::ProjectConfig& config, const control::SemiClo
   const double rest_s = 0.2;
   bench.drive_actuators(Vec3{});
   bench.run(rest_s);
-  std::vector<double> t, y;
-  for (std::size_t i = 0; i < 3; ++i) {
-    Vec3 target{};
-    target[i] = step_target_um[i];
-    t.clear();
-    y.clear();
-    // one sample before the step sets y0
-    t.push_back(bench.time_s());
-    y.push_back(bench.last_output().feedback_um[i]);
-    const double t_step = bench.time_s();
-    bench.drive_actuators(target);
-    bench.run(options.step_duration_s, [&](const experiments::Bench& b) {
-      t.push_back(b.time_s());
-      y.push_back(b.last_output().feedback_um[i]);
-    });
-    trial.per_actuator[i] = score_trace(t, y, t_step, step_target_um[i], options);
-    bench.drive_actuators(Vec3{});
-    bench.run(rest_s);
-  }
+  // All three legs step together, as the stage moves in use; one sample before the step sets y0.
+  std::array<std::vector<double>, 3> y;
+  std::vector<double> t{bench.time_s()}, plate{};
+  for (std::size_t i = 0; i < 3; ++i)
+    y[i].push_back(bench.last_output().feedback_um[i]);
+  const auto& truth = bench.twin().truth();
+  const double plate_0 = (truth.points_um[0] + truth.points_um[1] + truth.points_um[2]) / 3.0;
+  double plate_max = plate_0;
+  const double t_step = bench.time_s();
+  bench.drive_actuators(step_target_um);
+  bench.run(options.step_duration_s, [&](const experiments::Bench& b) {
+    t.push_back(b.time_s());
+    for (std::size_t i = 0; i < 3; ++i)
+      y[i].push_back(b.last_output().feedback_um[i]);
+    const auto& tr = b.twin().truth();
+    plate.push_back((tr.points_um[0] + tr.points_um[1] + tr.points_um[2]) / 3.0);
+    plate_max = std::max(plate_max, tr.period_max_mean_points_um);
+  });
+  for (std::size_t i = 0; i < 3; ++i)
+    trial.per_actuator[i] = score_trace(t, y[i], t_step, step_target_um[i], options);
+  // The plate between ticks, against its own final value (mean over the steady window).
+  const auto window = static_cast<std::size_t>(
+      std::max(1.0, std::round(options.steady_window_s / bench.sample_time_s())));
+  double plate_final = 0.0;
+  for (std::size_t k = plate.size() - std::min(window, plate.size()); k < plate.size(); ++k)
+    plate_final += plate[k];
+  plate_final /= static_cast<double>(std::min(window, plate.size()));
+  trial.plate_overshoot_pct =
+      std::max(0.0, 100.0 * (plate_max - plate_final) / std::fabs(plate_final - plate_0));
   PidScore& w = trial.worst;
   for (const PidScore& s : trial.per_actuator) {
     w.overshoot_pct = std::max(w.overshoot_pct, s.overshoot_pct);
     w.settling_time_s = std::max(w.settling_time_s, s.settling_time_s);
     w.steady_state_error_nm = std::max(w.steady_state_error_nm, s.steady_state_error_nm);
   }
+  trial.faulted = bench.faulted();
   trial.simulated_time_s = bench.time_s();
-  trial.acceptable = w.overshoot_pct <= options.max_overshoot_pct &&
+  trial.acceptable = !trial.faulted && w.overshoot_pct <= options.max_overshoot_pct &&
+                     trial.plate_overshoot_pct <= options.max_overshoot_pct &&
                      std::isfinite(w.settling_time_s) &&
                      w.steady_state_error_nm <= options.max_steady_state_error_nm;
   return trial;

@@ -6,7 +6,6 @@
 
 #include <fmt/core.h>
 
-#include "piezoshift/experiments/bench.hpp"
 
 namespace piezoshift::experiments {
 namespace {
@@ -25,6 +24,31 @@ void require(bool ok, const char* what) {
     throw std::invalid_argument(what);
 }
 
+// "" when the loop is in authority at Z_d, else why not: a PID at its upper output limit, or at
+// its lower one above Z_d = 0 (at rest, 0 V is where the stage sits).
+std::string saturation_problem(const Bench& bench, double zd_um) {
+  const control::ControllerOutput& out = bench.last_output();
+  const control::SemiClosedLoopParams& p = bench.controller_params();
+  for (std::size_t i = 0; i < 3; ++i) {
+    if (out.command_um[i] >= p.output_max_um)
+      return fmt::format("PID {} at its upper output limit ({:g} um of command) at Z_d = {:g} um",
+                         i + 1, p.output_max_um, zd_um);
+    if (out.command_um[i] <= p.output_min_um && zd_um > 0.0)
+      return fmt::format("PID {} at its lower output limit at Z_d = {:g} um", i + 1, zd_um);
+  }
+  return {};
+}
+
+// Marks v invalid when the bench's supervisor has latched a fault.
+void check_fault(const Bench& bench, Validity& v, const char* during) {
+  if (bench.faulted()) {
+    const runtime::FaultRecord& f = bench.fault();
+    v.fail(fmt::format("the safety supervisor tripped ({}, channel {}, at {:.3f} s) {}",
+                       runtime::to_string(f.reason), f.channel + 1,
+                       static_cast<double>(f.tick) * bench.sample_time_s(), during));
+  }
+}
+
 }  // namespace
 
 TravelRangeResult run_travel_range(const io::ProjectConfig& config,
@@ -36,14 +60,15 @@ TravelRangeResult run_travel_range(const io::ProjectConfig& config,
           "travel range: increment > 0, max > start, tolerance > 0");
   TravelRangeResult r;
   {
-    Bench open(config, controller, seed);
+    Bench open(config, controller, seed, o.bench);
     open.drive_open_loop(all(10.0));
     open.run(o.open_loop_settle_s);
     r.open_loop_points_um = open.measure_static().points_um;
     r.open_loop_um = mean3(r.open_loop_points_um);
     r.simulated_time_s += open.time_s();
+    check_fault(open, r.validity, "during the open-loop reading");
   }
-  Bench bench(config, controller, seed + 1);
+  Bench bench(config, controller, seed + 1, o.bench);
   const auto levels = static_cast<int>(std::floor((o.max_um - o.start_um) / o.increment_um + 1e-9));
   for (int k = 0; k <= levels; ++k) {
     const double zd = o.start_um + o.increment_um * k;
@@ -56,9 +81,23 @@ TravelRangeResult run_travel_range(const io::ProjectConfig& config,
     r.saturated_mask.push_back(sat);
     if (progress)
       progress(k + 1, levels + 1, "travel range");
-    if (sat != 0 || std::fabs(z - zd) > o.tolerance_um)
+    // The first level not tracked (the loop out of authority, the supervisor tripped by it, or
+    // the plate too far from Z_d) ends the search: that is the travel's end, not a failure.
+    if (sat != 0 || bench.faulted() || std::fabs(z - zd) > o.tolerance_um)
       break;
     r.semi_closed_um = zd;
+    if (k == levels)
+      r.validity.fail(fmt::format("still tracking at the search's end, {:g} um", zd));
+  }
+  if (r.semi_closed_um == 0.0) {
+    const double z = r.measured_um.empty() ? 0.0 : r.measured_um.front();
+    r.validity.fail(
+        bench.faulted()
+            ? fmt::format("the first level, Z_d = {:g} um, was not tracked: the safety supervisor "
+                          "tripped ({})",
+                          o.start_um, runtime::to_string(bench.fault().reason))
+            : fmt::format("the first level, Z_d = {:g} um, was not tracked (measured {:.3f} um)",
+                          o.start_um, z));
   }
   r.simulated_time_s += bench.time_s();
   return r;
@@ -69,7 +108,7 @@ StepExperimentResult run_step_response(const io::ProjectConfig& config,
                                        std::uint64_t seed, const StepExperimentOptions& o,
                                        const Progress& progress) {
   require(o.step_um > 0.0 && o.pre_s > 0.0 && o.record_s > 0.0, "step response: bad options");
-  Bench bench(config, controller, seed);
+  Bench bench(config, controller, seed, o.bench);
   bench.drive_points(all(0.0));
   bench.run(o.pre_s);
   StepExperimentResult r;
@@ -90,6 +129,16 @@ StepExperimentResult run_step_response(const io::ProjectConfig& config,
   m.band_nm = o.band_nm;
   r.metrics = step_response_metrics(r.time_s, r.measured_um, m);
   r.simulated_time_s = bench.time_s();
+  check_fault(bench, r.validity, "during the step");
+  if (const std::string sat = saturation_problem(bench, o.step_um); !sat.empty())
+    r.validity.fail(sat + " at the end of the record");
+  if (!std::isfinite(r.metrics.settling_time_pct_s))
+    r.validity.fail(fmt::format("the step never settled within +-{:g} % in {:g} s", o.band_pct,
+                                o.record_s));
+  if (std::fabs(r.metrics.final_um - o.step_um) > o.target_tolerance_um)
+    r.validity.fail(fmt::format("the step did not reach its target: {:.3f} um for {:g} um "
+                                "(tolerance {:g} um)",
+                                r.metrics.final_um, o.step_um, o.target_tolerance_um));
   if (progress)
     progress(1, 1, "step response");
   return r;
@@ -100,13 +149,20 @@ LinearityResult run_linearity(const io::ProjectConfig& config,
                               const LinearityOptions& o, const Progress& progress) {
   require(o.max_um > 0.0 && o.increment_um > 0.0 && o.step_hold_s >= 1.0,
           "linearity: max > 0, increment > 0, at least 1 s per level");
-  Bench bench(config, controller, seed);
+  Bench bench(config, controller, seed, o.bench);
   const int levels = static_cast<int>(std::llround(o.max_um / o.increment_um));
-  bench.drive_points(all(0.0));
+  if (o.downward) {  // approach the top from below, as the upward sweep does
+    bench.drive_points(all(0.0));
+    bench.run(1.0);
+  }
+  bench.drive_points(all(o.downward ? o.increment_um * levels : 0.0));
   bench.run(1.0);
   LinearityResult r;
-  for (int k = 0; k <= levels; ++k) {
-    const double zd = o.increment_um * k;
+  // Downwards the sweep ends one increment above 0: after a descent the stacks' hysteresis leaves
+  // them above zero at 0 V, and the 0..150 V amplifier cannot pull them back.
+  const int last = o.downward ? levels - 1 : levels;
+  for (int k = 0; k <= last; ++k) {
+    const double zd = o.increment_um * (o.downward ? levels - k : k);
     bench.drive_points(all(zd));
     const double end = bench.time_s() + o.step_hold_s;
     std::uint64_t seen = bench.twin().interferometer().static_count;
@@ -130,11 +186,17 @@ LinearityResult run_linearity(const io::ProjectConfig& config,
     require(n > 0, "linearity: no sample left after skip_samples; hold longer");
     r.desired_um.push_back(zd);
     r.measured_um.push_back(sum / static_cast<double>(n));
+    if (const std::string sat = saturation_problem(bench, zd); !sat.empty())
+      r.validity.fail(sat);
+    if (std::fabs(r.measured_um.back() - zd) > o.reach_tolerance_um)
+      r.validity.fail(fmt::format("Z_d = {:g} um was not reached: {:.3f} um (tolerance {:g} um)",
+                                  zd, r.measured_um.back(), o.reach_tolerance_um));
     if (progress)
-      progress(k + 1, levels + 1, "linearity");
+      progress(k + 1, last + 1, "linearity");
   }
   r.metrics = linearity_metrics(r.desired_um, r.measured_um);
   r.simulated_time_s = bench.time_s();
+  check_fault(bench, r.validity, "during the linearity run");
   return r;
 }
 
@@ -144,7 +206,7 @@ RepeatabilityResult run_repeatability(const io::ProjectConfig& config,
                                       const Progress& progress) {
   require(o.moves >= 2 && o.target_um > 0.0 && o.rest_s >= 0.0 && o.settle_s >= 0.0,
           "repeatability: at least 2 moves and a positive target");
-  Bench bench(config, controller, seed);
+  Bench bench(config, controller, seed, o.bench);
   RepeatabilityResult r;
   r.target_um = o.target_um;
   const std::string label = fmt::format("repeat. {:g} um", o.target_um);
@@ -154,11 +216,18 @@ RepeatabilityResult run_repeatability(const io::ProjectConfig& config,
     bench.drive_points(all(o.target_um));
     bench.run(o.settle_s);
     r.measured_um.push_back(mean3(bench.measure_static().points_um));
+    if (const std::string sat = saturation_problem(bench, o.target_um); !sat.empty())
+      r.validity.fail(fmt::format("move {}: {}", i + 1, sat));
+    if (std::fabs(r.measured_um.back() - o.target_um) > o.target_tolerance_um)
+      r.validity.fail(fmt::format("move {} did not reach its target: {:.3f} um for {:g} um "
+                                  "(tolerance {:g} um)",
+                                  i + 1, r.measured_um.back(), o.target_um, o.target_tolerance_um));
     if (progress)
       progress(i + 1, o.moves, label);
   }
   r.metrics = repeatability_metrics(r.measured_um);
   r.simulated_time_s = bench.time_s();
+  check_fault(bench, r.validity, "during the repeatability run");
   return r;
 }
 

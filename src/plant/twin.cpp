@@ -38,6 +38,7 @@ Twin::Twin(const design::DesignInputs& design, const TwinParams& params, std::ui
   lab_rot_sin_ = std::sin(step_rad);
   lab_rot_cos_ = std::cos(step_rad);
   mechanics_ = model_.mechanics;
+  update_mean_point_weights();
   force_N_.assign(model_.substeps, {0.0, 0.0, 0.0});  // the one allocation, at set-up
   ifm_countdown_ = model_.interferometer_every;
   for (std::size_t i = 0; i < 3; ++i)
@@ -111,9 +112,15 @@ void Twin::advance() noexcept {
   double fm0 = filtered_modes_[0], fm1 = filtered_modes_[2], fm2 = filtered_modes_[4];
   std::size_t countdown = ifm_countdown_;
   bool pending_end_sample = false;
+  const double w0 = mean_point_modal_[0], w1 = mean_point_modal_[1], w2 = mean_point_modal_[2];
+  double z_max = -std::numeric_limits<double>::infinity();
+  double z_min = std::numeric_limits<double>::infinity();
   const double t0 = static_cast<double>(tick_) * m.control_period_s;
   for (std::size_t s = 0; s < n; ++s) {
     mech.step(ms, force_N_[s]);
+    const double z_mean = w0 * ms[0] + w1 * ms[2] + w2 * ms[4];
+    z_max = z_mean > z_max ? z_mean : z_max;
+    z_min = z_mean < z_min ? z_mean : z_min;
     fm0 += beta * (ms[0] - fm0);
     fm1 += beta * (ms[2] - fm1);
     fm2 += beta * (ms[4] - fm2);
@@ -156,6 +163,22 @@ void Twin::advance() noexcept {
     sample_interferometer(x, t, lab_.drift_um(air, structure));
   sample_ai(structure - lab_.structure_at_start_C());
   update_truth(x, air, structure);
+  truth_.period_max_mean_points_um = z_max;
+  truth_.period_min_mean_points_um = z_min;
+}
+
+void Twin::update_mean_point_weights() {
+  // mean(P) = c . x with c_i = mean_j w_ji (barycentric rows), and x = Phi eta.
+  const control::Mat3& w = model_.geometry.barycentric;
+  const Eigen::Matrix3d phi = mechanics_.mode_shapes();
+  for (Eigen::Index r = 0; r < 3; ++r) {
+    double v = 0.0;
+    for (Eigen::Index i = 0; i < 3; ++i) {
+      const auto iu = static_cast<std::size_t>(i);
+      v += (w[0][iu] + w[1][iu] + w[2][iu]) / 3.0 * phi(i, r);
+    }
+    mean_point_modal_[static_cast<std::size_t>(r)] = v;
+  }
 }
 
 void Twin::sample_ai(double structure_change_K) noexcept {
@@ -257,6 +280,7 @@ void Twin::set_fault(std::size_t channel, const ChannelFault& fault) {
   const Vec3 v = mechanics_.velocity_um_per_s(mech_);
   const Vec3 fx = mechanics_.displacement_um(filtered_modes_);
   mechanics_ = make_leg_plate_mechanics(model_, k);
+  update_mean_point_weights();
   const Eigen::Matrix3d phi_inv = mechanics_.mode_shapes().inverse();
   const Eigen::Vector3d eta = phi_inv * Eigen::Vector3d(x[0], x[1], x[2]);
   const Eigen::Vector3d eta_dot = phi_inv * Eigen::Vector3d(v[0], v[1], v[2]);

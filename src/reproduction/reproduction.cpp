@@ -8,6 +8,10 @@ Schedule Schedule::paper() {
   Schedule s;
   s.repeat_5um.target_um = 5.0;
   s.repeat_10um.target_um = 10.0;
+  s.linearity_grid = s.linearity;
+  s.linearity_grid.increment_um = 0.25;
+  s.linearity_down = s.linearity;
+  s.linearity_down.downward = true;
   return s;
 }
 
@@ -25,9 +29,67 @@ Schedule Schedule::quick() {
   s.travel.hold_s = 0.5;
   s.linearity.step_hold_s = 4.0;
   s.linearity.skip_samples = 1;
+  s.linearity_grid.step_hold_s = 2.0;
+  s.linearity_grid.skip_samples = 0;
+  s.linearity_down.step_hold_s = 4.0;
+  s.linearity_down.skip_samples = 1;
   // Repeatability keeps the paper's 230 moves: the twin's spread is dominated by the lab's slow
   // drift over the time the moves take, so fewer moves would measure something else.
   return s;
+}
+
+namespace {
+
+void with_feedback(Schedule& s, experiments::Feedback f) {
+  s.travel.bench.feedback = f;
+  s.step.bench.feedback = f;
+  s.linearity.bench.feedback = f;
+  s.linearity_grid.bench.feedback = f;
+  s.linearity_down.bench.feedback = f;
+  s.repeat_5um.bench.feedback = f;
+  s.repeat_10um.bench.feedback = f;
+}
+
+void run_set(ExperimentSet& r, const io::ProjectConfig& config,
+             const control::SemiClosedLoopParams& c, std::uint64_t seed, const Schedule& s,
+             const experiments::Progress& progress) {
+  namespace ex = experiments;
+  r.travel = ex::run_travel_range(config, c, seed + 10, s.travel, progress);
+  r.step = ex::run_step_response(config, c, seed + 20, s.step, progress);
+  r.linearity = ex::run_linearity(config, c, seed + 30, s.linearity, progress);
+  r.repeat_5um = ex::run_repeatability(config, c, seed + 40, s.repeat_5um, progress);
+  r.repeat_10um = ex::run_repeatability(config, c, seed + 50, s.repeat_10um, progress);
+  r.linearity_grid = ex::run_linearity(config, c, seed + 60, s.linearity_grid, progress);
+  r.linearity_down = ex::run_linearity(config, c, seed + 70, s.linearity_down, progress);
+}
+
+}  // namespace
+
+double ExperimentSet::experiments_simulated_time_s() const {
+  return travel.simulated_time_s + step.simulated_time_s + linearity.simulated_time_s +
+         linearity_grid.simulated_time_s + linearity_down.simulated_time_s +
+         repeat_5um.simulated_time_s + repeat_10um.simulated_time_s;
+}
+
+bool ExperimentSet::table4_valid() const {
+  return travel.validity.valid && step.validity.valid && linearity.validity.valid &&
+         repeat_5um.validity.valid && repeat_10um.validity.valid;
+}
+
+std::vector<std::string> ExperimentSet::invalid_reasons() const {
+  std::vector<std::string> out;
+  const auto add = [&](const char* name, const experiments::Validity& v) {
+    if (!v.valid)
+      out.push_back(std::string(name) + ": " + v.reason);
+  };
+  add("travel", travel.validity);
+  add("step", step.validity);
+  add("linearity", linearity.validity);
+  add("repeatability 5 um", repeat_5um.validity);
+  add("repeatability 10 um", repeat_10um.validity);
+  add("linearity (0.25 um grid)", linearity_grid.validity);
+  add("linearity (downwards)", linearity_down.validity);
+  return out;
 }
 
 ReproductionResult reproduce(const io::ProjectConfig& config, const ReproduceOptions& options,
@@ -42,16 +104,16 @@ ReproductionResult reproduce(const io::ProjectConfig& config, const ReproduceOpt
   control::SemiClosedLoopParams base{};
   base.sample_time_s = config.twin.daq.sample_time_s;  // the controller runs at the DAQ's rate
   r.calibration = calibration::calibrate(config, base, seed, s.calibration, progress);
-  const auto& c = r.calibration.controller;
-  r.travel = experiments::run_travel_range(config, c, seed + 10, s.travel, progress);
-  r.step = experiments::run_step_response(config, c, seed + 20, s.step, progress);
-  r.linearity = experiments::run_linearity(config, c, seed + 30, s.linearity, progress);
-  r.repeat_5um = experiments::run_repeatability(config, c, seed + 40, s.repeat_5um, progress);
-  r.repeat_10um = experiments::run_repeatability(config, c, seed + 50, s.repeat_10um, progress);
+  run_set(r, config, r.calibration.controller, seed, s, progress);
+  // The oracle: the same loop, gains and A, fed the plate's truth; nothing left for p to correct.
+  r.oracle_controller = r.calibration.controller;
+  r.oracle_controller.polynomial = control::CubicPolynomial::identity();
+  Schedule so = s;
+  with_feedback(so, experiments::Feedback::kOracle);
+  run_set(r.oracle, config, r.oracle_controller, seed, so, progress);
   r.simulated_time_s = r.calibration.pid.simulated_time_s + r.calibration.matrix.simulated_time_s +
-                       r.calibration.polynomial.simulated_time_s + r.travel.simulated_time_s +
-                       r.step.simulated_time_s + r.linearity.simulated_time_s +
-                       r.repeat_5um.simulated_time_s + r.repeat_10um.simulated_time_s;
+                       r.calibration.polynomial.simulated_time_s + r.experiments_simulated_time_s() +
+                       r.oracle.experiments_simulated_time_s();
   r.wall_time_s = std::chrono::duration<double>(std::chrono::steady_clock::now() - start).count();
   return r;
 }

@@ -38,28 +38,50 @@ nlohmann::json trial_json(const calibration::PidTrial& t) {
           {"per_actuator", per}};
 }
 
+// Table 4's figures and the extra sweeps of one controller, keys prefixed.
+void set_json(nlohmann::json& j, const std::string& prefix, const ExperimentSet& e) {
+  const auto& step = e.step.metrics;
+  j[prefix + "travel_open_loop_um"] = e.travel.open_loop_um;
+  j[prefix + "travel_semi_closed_um"] = e.travel.semi_closed_um;
+  j[prefix + "step_um"] = step.step_um;
+  j[prefix + "step_rise_time_s"] = time_or_null(step.rise_time_s);
+  j[prefix + "step_overshoot_pct"] = step.overshoot_pct;
+  j[prefix + "step_settling_time_s"] = time_or_null(step.settling_time_pct_s);
+  j[prefix + "step_settling_time_10nm_s"] = time_or_null(step.settling_time_abs_s);
+  j[prefix + "linearity_zero_end_pct"] = e.linearity.metrics.linearity_zero_end_pct;
+  j[prefix + "linearity_best_fit_pct"] = e.linearity.metrics.linearity_best_fit_pct;
+  j[prefix + "linearity_grid_zero_end_pct"] = e.linearity_grid.metrics.linearity_zero_end_pct;
+  j[prefix + "linearity_grid_best_fit_pct"] = e.linearity_grid.metrics.linearity_best_fit_pct;
+  j[prefix + "linearity_down_zero_end_pct"] = e.linearity_down.metrics.linearity_zero_end_pct;
+  j[prefix + "linearity_down_best_fit_pct"] = e.linearity_down.metrics.linearity_best_fit_pct;
+  j[prefix + "repeatability_5um_nm"] = e.repeat_5um.metrics.repeatability_nm;
+  j[prefix + "repeatability_10um_nm"] = e.repeat_10um.metrics.repeatability_nm;
+  j[prefix + "repeatability_5um_n"] = e.repeat_5um.metrics.n;
+  j[prefix + "repeatability_10um_n"] = e.repeat_10um.metrics.n;
+  j[prefix + "valid"] = e.table4_valid();
+  j[prefix + "invalid_reasons"] = e.invalid_reasons();
+  const auto validity = [](const experiments::Validity& v) {
+    return nlohmann::json{{"valid", v.valid}, {"reason", v.reason}};
+  };
+  j[prefix + "validity"] = {{"travel", validity(e.travel.validity)},
+                            {"step", validity(e.step.validity)},
+                            {"linearity", validity(e.linearity.validity)},
+                            {"linearity_grid", validity(e.linearity_grid.validity)},
+                            {"linearity_down", validity(e.linearity_down.validity)},
+                            {"repeatability_5um", validity(e.repeat_5um.validity)},
+                            {"repeatability_10um", validity(e.repeat_10um.validity)}};
+}
+
 }  // namespace
 
 nlohmann::json summary_json(const ReproductionResult& r) {
   const auto& cal = r.calibration;
-  const auto& step = r.step.metrics;
   nlohmann::json j;
   j["seed"] = r.options.seed;
   j["schedule"] = r.options.quick ? "quick" : "paper";
   j["pid"] = r.options.pid == calibration::PidChoice::kPaper ? "paper" : "search";
-  j["travel_open_loop_um"] = r.travel.open_loop_um;
-  j["travel_semi_closed_um"] = r.travel.semi_closed_um;
-  j["step_um"] = step.step_um;
-  j["step_rise_time_s"] = time_or_null(step.rise_time_s);
-  j["step_overshoot_pct"] = step.overshoot_pct;
-  j["step_settling_time_s"] = time_or_null(step.settling_time_pct_s);
-  j["step_settling_time_10nm_s"] = time_or_null(step.settling_time_abs_s);
-  j["linearity_zero_end_pct"] = r.linearity.metrics.linearity_zero_end_pct;
-  j["linearity_best_fit_pct"] = r.linearity.metrics.linearity_best_fit_pct;
-  j["repeatability_5um_nm"] = r.repeat_5um.metrics.repeatability_nm;
-  j["repeatability_10um_nm"] = r.repeat_10um.metrics.repeatability_nm;
-  j["repeatability_5um_n"] = r.repeat_5um.metrics.n;
-  j["repeatability_10um_n"] = r.repeat_10um.metrics.n;
+  set_json(j, "", r);
+  set_json(j, "oracle_", r.oracle);
   j["identified_A"] = matrix_json(cal.controller.matrix.a);
   j["identified_A_condition_number"] = cal.matrix.fit.condition_number;
   j["identified_A_rms_residual_um"] = cal.matrix.fit.rms_residual_um;

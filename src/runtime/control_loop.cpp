@@ -18,35 +18,46 @@ const char* to_string(StopReason reason) noexcept {
   return "unknown";
 }
 
+namespace {
+
+// The loop's period as the controller's sample time (its gains are rescaled from
+// gains_sample_time_s).
+std::int64_t period_ns_of(const LoopConfig& config) {
+  if (!(config.rate_Hz > 0.0) || !std::isfinite(config.rate_Hz))
+    throw std::invalid_argument("ControlLoop: rate_Hz must be > 0");
+  return std::llround(1e9 / config.rate_Hz);
+}
+
+control::SemiClosedLoopParams at_loop_period(control::SemiClosedLoopParams params,
+                                             const LoopConfig& config) {
+  params.sample_time_s = static_cast<double>(period_ns_of(config)) * 1e-9;
+  return params;
+}
+
+}  // namespace
+
 ControlLoop::ControlLoop(const LoopConfig& config, const control::SemiClosedLoopParams& params,
                          const SafetyLimits& limits, DaqBackend& daq, LoopClock& clock,
                          SetpointProfile profile, SpscRing<TelemetryRecord>* telemetry)
     : config_(config),
-      params_(params),
-      period_ns_(0),
+      params_(at_loop_period(params, config)),
+      period_ns_(period_ns_of(config)),
       duration_ticks_(0),
       daq_(daq),
       clock_(clock),
       profile_(std::move(profile)),
-      telemetry_(telemetry) {
-  if (!(config.rate_Hz > 0.0) || !std::isfinite(config.rate_Hz))
-    throw std::invalid_argument("ControlLoop: rate_Hz must be > 0");
+      telemetry_(telemetry),
+      cycle_(params_, limits) {
   if (!(config.duration_s >= 0.0) || std::isnan(config.duration_s))
     throw std::invalid_argument("ControlLoop: duration_s must be >= 0");
-  period_ns_ = std::llround(1e9 / config.rate_Hz);
   const double ticks = config.duration_s * config.rate_Hz;
   duration_ticks_ = ticks >= 1.8e19 ? std::numeric_limits<std::uint64_t>::max()
                                     : static_cast<std::uint64_t>(std::llround(ticks));
-  // The controller gets the real sample time; its gains are rescaled from gains_sample_time_s.
-  params_.sample_time_s = static_cast<double>(period_ns_) * 1e-9;
-  controller_.configure(params_);
-  supervisor_.configure(limits, params_.sample_time_s, params_.scaling);
 }
 
 LoopResult ControlLoop::run() noexcept {
   LoopResult result{};
-  controller_.configure(params_);
-  supervisor_.reset();
+  cycle_.reset();
   profile_.rewind();
   stats_.clear();
   const double period_s = params_.sample_time_s;
@@ -58,25 +69,21 @@ LoopResult ControlLoop::run() noexcept {
   std::int64_t deadline = start;
   std::int64_t previous_deadline = start - period_ns_;
   std::int64_t previous_wake = start;
-  DaqStatus previous_write = DaqStatus::kOk;
   bool previous_overran = false;
   bool stop_requested = false;
   Vec3 previous_ao{};
 
-  // Host mode state: servo off at 0 V until the host says otherwise.
+  // Host mode state: servo off at 0 V until the host says otherwise. Without a host the loop
+  // follows the profile from the first tick.
   HostLink* const host = config_.host;
-  bool closed_loop = host == nullptr;
-  Vec3 host_zd{};
-  Vec3 open_loop_V{};
+  if (host == nullptr)
+    cycle_.drive(DriveMode::kPoints, profile_.at(0.0));
   std::uint64_t applied_sequence = 0;
   const auto clear_latched_fault = [&]() noexcept {
-    if (supervisor_.clear_fault()) {
-      controller_.reset();
-      controller_.hold_integrators(false);
-      if (stop_requested)
-        supervisor_.request_stop();
-    }
+    if (cycle_.clear_fault() && stop_requested)
+      cycle_.request_stop();
   };
+  const SafetySupervisor& supervisor = cycle_.supervisor();
 
   for (std::uint64_t tick = 0;; ++tick) {
     clock_.sleep_until_ns(deadline);
@@ -94,7 +101,7 @@ LoopResult ControlLoop::run() noexcept {
         result.signal = config_.stop_signal->load(std::memory_order_relaxed);
       }
       if (stop_requested)
-        supervisor_.request_stop();
+        cycle_.request_stop();
     }
     if (clear_requested_.exchange(false, std::memory_order_acq_rel))
       clear_latched_fault();
@@ -104,69 +111,39 @@ LoopResult ControlLoop::run() noexcept {
          host != nullptr && n < HostLink::kMaxCommandsPerTick && host->commands.try_pop(cmd); ++n) {
       applied_sequence = cmd.sequence;
       ++result.host_commands_applied;
+      const bool closed_loop = cycle_.mode() != DriveMode::kOpenLoop;
       switch (cmd.kind) {
         case HostCommand::Kind::kMoveTo:
           if (closed_loop)
-            host_zd = cmd.zd_um;
+            cycle_.drive(DriveMode::kPoints, cmd.zd_um);
           break;
-        case HostCommand::Kind::kServoOn: {
+        case HostCommand::Kind::kServoOn:
           clear_latched_fault();
           // Bumpless: each PID resumes from the command the output already holds.
-          const Vec3& ao = supervisor_.last_output_V();
-          Vec3 command_um{};
-          for (std::size_t i = 0; i < command_um.size(); ++i) {
-            const control::SignalScaling& sc = params_.scaling[i];
-            command_um[i] = (ao[i] - sc.drive_offset_V) / sc.drive_V_per_um;
-          }
-          controller_.reset_to(command_um);
-          controller_.hold_integrators(false);
-          host_zd = cmd.zd_um;
-          closed_loop = true;
+          cycle_.drive(DriveMode::kPoints, cmd.zd_um);
+          cycle_.restart_from_outputs();
           break;
-        }
         case HostCommand::Kind::kServoOff:
           clear_latched_fault();
-          open_loop_V = supervisor_.last_output_V();
-          closed_loop = false;
+          cycle_.drive(DriveMode::kOpenLoop, supervisor.last_output_V());
           break;
         case HostCommand::Kind::kOpenLoop:
           if (!closed_loop)
-            open_loop_V = cmd.ao_V;
+            cycle_.drive(DriveMode::kOpenLoop, cmd.ao_V);
           break;
       }
     }
+    if (host == nullptr)
+      cycle_.drive(DriveMode::kPoints, profile_.at(static_cast<double>(ct.since_start_ns) * 1e-9));
 
-    Vec3 ai{};
-    const DaqStatus read_status = daq_.read(ct, ai);
-    const Vec3 zd =
-        host != nullptr ? host_zd : profile_.at(static_cast<double>(ct.since_start_ns) * 1e-9);
-    control::ControllerOutput c{};
-    if (closed_loop) {
-      c = controller_.update(zd, ai);
-    } else {
-      c.dac_V = open_loop_V;
-      for (std::size_t i = 0; i < ai.size(); ++i)
-        c.feedback_um[i] = params_.scaling[i].sgs_to_um(ai[i]);
-      c.target_um = c.feedback_um;
-    }
-    SupervisorInput in{};
-    in.closed_loop = closed_loop;
-    in.tick = tick;
-    in.period_s = static_cast<double>(ct.period_ns) * 1e-9;
-    in.sgs_V = ai;
-    in.request_V = c.dac_V;
-    in.target_um = c.target_um;
-    in.feedback_um = c.feedback_um;
-    in.read_status = read_status;
-    in.previous_write_status = previous_write;
-    in.previous_tick_overran = previous_overran;
-    const SupervisorOutput s = supervisor_.update(in);
-    controller_.hold_integrators(s.hold_integrators);
-    const DaqStatus write_status = daq_.write(ct, s.ao_V);
-    previous_write = write_status;
-    if (supervisor_.faulted() && !result.fault_detected) {
+    const CycleSample& cs = cycle_.step(daq_, ct, previous_overran);
+    const SupervisorOutput& s = cs.supervisor;
+    const control::ControllerOutput& c = cs.controller;
+    const bool closed_loop = cs.mode != DriveMode::kOpenLoop;
+    const Vec3 zd = closed_loop ? cs.setpoint : Vec3{};
+    if (supervisor.faulted() && !result.fault_detected) {
       result.fault_detected = true;
-      result.fault = supervisor_.fault();
+      result.fault = supervisor.fault();
     }
 
     for (std::size_t i = 0; i < s.ao_V.size(); ++i) {
@@ -180,7 +157,7 @@ LoopResult ControlLoop::run() noexcept {
         result.max_output_slew_V_per_ms = slew;
     }
     previous_ao = s.ao_V;
-    result.last_sgs_V = ai;
+    result.last_sgs_V = cs.ai_V;
 
     const std::int64_t end = clock_.now_ns();
     previous_overran = stats_.record(deadline, wake, end, previous_wake, period_ns_);
@@ -191,7 +168,7 @@ LoopResult ControlLoop::run() noexcept {
       r.t_s = static_cast<double>(ct.since_start_ns) * 1e-9;
       r.zd_um = zd;
       r.target_um = c.target_um;
-      r.sgs_V = ai;
+      r.sgs_V = cs.ai_V;
       r.request_V = c.dac_V;
       r.ao_V = s.ao_V;
       if (!daq_.truth(r.truth_um, r.interferometer_um)) {
@@ -205,10 +182,10 @@ LoopResult ControlLoop::run() noexcept {
       r.limited = s.limited ? 1 : 0;
       r.held = s.hold_integrators ? 1 : 0;
       r.state = static_cast<std::uint8_t>(s.state);
-      r.fault_reason = static_cast<std::uint8_t>(supervisor_.fault().reason);
-      r.fault_channel = static_cast<std::int8_t>(supervisor_.fault().channel);
-      r.read_status = static_cast<std::uint8_t>(read_status);
-      r.write_status = static_cast<std::uint8_t>(write_status);
+      r.fault_reason = static_cast<std::uint8_t>(supervisor.fault().reason);
+      r.fault_channel = static_cast<std::int8_t>(supervisor.fault().channel);
+      r.read_status = static_cast<std::uint8_t>(cs.read_status);
+      r.write_status = static_cast<std::uint8_t>(cs.write_status);
       if (!telemetry_->try_push(r))
         ++result.telemetry_dropped;
     }
@@ -220,19 +197,19 @@ LoopResult ControlLoop::run() noexcept {
       h.applied_sequence = applied_sequence;
       h.zd_um = zd;
       h.target_um = c.target_um;
-      h.sgs_V = ai;
+      h.sgs_V = cs.ai_V;
       h.ao_V = s.ao_V;
       Vec3 truth{};
       h.has_truth = daq_.truth(truth, h.interferometer_um) ? 1 : 0;
-      h.closed_loop = closed_loop && !supervisor_.faulted() ? 1 : 0;
+      h.closed_loop = closed_loop && !supervisor.faulted() ? 1 : 0;
       h.state = static_cast<std::uint8_t>(s.state);
-      h.fault_reason = static_cast<std::uint8_t>(supervisor_.fault().reason);
-      h.fault_channel = static_cast<std::int8_t>(supervisor_.fault().channel);
+      h.fault_reason = static_cast<std::uint8_t>(supervisor.fault().reason);
+      h.fault_channel = static_cast<std::int8_t>(supervisor.fault().channel);
       if (!host->samples.try_push(h))
         ++result.host_samples_dropped;
     }
 
-    const bool safe_after_fault = supervisor_.faulted() && supervisor_.outputs_at_zero();
+    const bool safe_after_fault = supervisor.faulted() && supervisor.outputs_at_zero();
     if (s.state == SupervisorState::kStopped ||
         (safe_after_fault && (config_.stop_when_safe_after_fault || stop_requested))) {
       result.ticks = tick + 1;
@@ -250,8 +227,8 @@ LoopResult ControlLoop::run() noexcept {
       stats_.skipped_slots += static_cast<std::uint64_t>(skip);
     }
   }
-  if (supervisor_.faulted())
-    result.fault = supervisor_.fault();
+  if (supervisor.faulted())
+    result.fault = supervisor.fault();
   return result;
 }
 

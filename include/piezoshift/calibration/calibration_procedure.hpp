@@ -10,6 +10,7 @@
 #include "piezoshift/calibration/matrix_identification.hpp"
 #include "piezoshift/calibration/pid_tuning.hpp"
 #include "piezoshift/calibration/polynomial_identification.hpp"
+#include "piezoshift/experiments/paper_experiments.hpp"
 #include "piezoshift/experiments/progress.hpp"
 
 namespace piezoshift::calibration {
@@ -20,10 +21,16 @@ enum class PidChoice : std::uint8_t {
 };
 
 struct CalibrationOptions {
-  PidChoice pid = PidChoice::kSearch;
+  PidChoice pid = PidChoice::kPaper;  //!< the paper's gains unless the search is asked for
   PidTuningOptions pid_tuning{};
   MatrixIdentificationOptions matrix{};
   PolynomialIdentificationOptions polynomial{};
+  //! The semi-closed-loop travel measured after the three stages (calibrate_with_travel).
+  experiments::TravelRangeOptions travel{};
+
+  //! The paper's gains, scored alone (no grid): the quickest calibration, for `run` and `serve`
+  //! on the twin without a calibration file.
+  static CalibrationOptions paper_gains_only();
 };
 
 struct CalibrationOutcome {
@@ -33,10 +40,23 @@ struct CalibrationOutcome {
   PolynomialIdentificationResult polynomial;
 };
 
+struct CalibrationWithTravel {
+  CalibrationOutcome calibration;
+  //! Section 4.1's semi-closed-loop travel with the calibrated controller, on a fourth session
+  //! (seed + 3): what the calibration file's [travel] z_max_um and `serve`'s TMX? Z advertise.
+  experiments::TravelRangeResult travel;
+};
+
 //! base supplies the sample time, limits and scaling; its gains, A and p are replaced.
 CalibrationOutcome calibrate(const io::ProjectConfig& config,
                              const control::SemiClosedLoopParams& base, std::uint64_t seed,
                              const CalibrationOptions& options = {},
                              const experiments::Progress& progress = {});
+
+//! calibrate() at the twin's DAQ rate, then the travel. Throws io::InputError when the calibrated
+//! loop cannot track even the travel search's first level (no travel to advertise).
+CalibrationWithTravel calibrate_with_travel(const io::ProjectConfig& config, std::uint64_t seed,
+                                            const CalibrationOptions& options = {},
+                                            const experiments::Progress& progress = {});
 
 }  // namespace piezoshift::calibration

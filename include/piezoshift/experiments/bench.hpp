@@ -1,35 +1,52 @@
 #pragma once
-// The simulated lab bench: the digital twin driven by the paper's controller exactly as the
-// xPC target drives the hardware (paper, Section 4, Figures 8 and 9). One control tick:
-//   sgs_V  = twin.read_ai()                  the AI sample taken at the end of the last period
-//   out    = controller(setpoint, sgs_V)     one SemiClosedLoopController tick
-//   twin.step(out.dac_V)                     AO written and held for one period of physics
-// so the controller sees y(k+1) from u(k): one period of delay, as in a read-compute-write loop.
+// The simulated lab bench: the digital twin as the `sim` DAQ backend (runtime/sim_backend.hpp),
+// closed through the one control tick every command ships (runtime/control_cycle.hpp: DAQ read,
+// controller, safety supervisor, DAQ write, with the runtime's timing contract), on a simulated
+// clock: tick k runs at k T_s and is never late, so the bench steps as fast as the twin allows.
+// It is the engine of the offline calibration procedures and of the paper's experiments, so every
+// figure piezoshift reports comes from the loop `run` and `serve` run.
 //
 // Three ways to drive it, as the paper's procedures need:
 //   drive_points(Z_d)       the full controller (feedforward p, A and the three PIDs)
 //   drive_actuators(S)      the inner loops alone (calibration stages 1 and 2)
 //   drive_open_loop(V)      DAQ volts straight to the amplifiers (travel range, open loop)
 // Switching from open loop to a closed loop hands over bumplessly (the PIDs start from the
-// command already applied).
+// command already applied). The supervisor is always there: a fault it latches ramps the outputs
+// to 0 V and stays latched (faulted(), fault()); the procedures and experiments report it.
+//
+// Feedback: the stacks' strain gauges (kGauges, what hardware has), or the oracle (kOracle,
+// runtime/oracle_backend.hpp: the plate's true point displacements through the calibrated A,
+// impossible on hardware, the floor of any gauge-fed controller).
 //
 // The interferometer is read in its static mode by measure_static(): the next full 1 s averaging
 // window (paper, Section 4.2), with the mean SGS feedback over the same window.
-//
-// Not real-time: it is the engine of offline calibration and experiments, stepping as fast as
-// the twin allows.
 #include <cstdint>
 #include <functional>
+#include <memory>
 
 #include "piezoshift/control/semi_closed_loop.hpp"
 #include "piezoshift/io/project_config.hpp"
 #include "piezoshift/plant/twin.hpp"
+#include "piezoshift/runtime/control_cycle.hpp"
+#include "piezoshift/runtime/oracle_backend.hpp"
+#include "piezoshift/runtime/safety_supervisor.hpp"
+#include "piezoshift/runtime/sim_backend.hpp"
 
 namespace piezoshift::experiments {
 
 using control::Vec3;
+using runtime::DriveMode;
 
-enum class DriveMode : std::uint8_t { kOpenLoop, kActuators, kPoints };
+enum class Feedback : std::uint8_t {
+  kGauges,  //!< the stacks' strain gauges (the paper's semi-closed loop)
+  kOracle,  //!< the plate's true point displacements (impossible on hardware)
+};
+const char* to_string(Feedback feedback) noexcept;
+
+struct BenchOptions {
+  Feedback feedback = Feedback::kGauges;
+  runtime::SafetyLimits limits{};  //!< the supervisor's, as `run` and `serve` use by default
+};
 
 struct StaticMeasurement {
   Vec3 points_um{};  //!< interferometer, static mode: mean over one window, P1..P3 [um]
@@ -39,13 +56,17 @@ struct StaticMeasurement {
 
 class Bench {
  public:
-  //! Throws std::invalid_argument when the configuration cannot make a twin.
+  //! Throws std::invalid_argument when the configuration cannot make a twin or the controller's
+  //! sample time is not the DAQ's period.
   Bench(const io::ProjectConfig& config, const control::SemiClosedLoopParams& controller,
-        std::uint64_t seed);
+        std::uint64_t seed, const BenchOptions& options = {});
+  ~Bench();
+  Bench(const Bench&) = delete;
+  Bench& operator=(const Bench&) = delete;
 
   //! Replaces the controller's parameters; the PIDs restart from the present commands.
   void set_controller(const control::SemiClosedLoopParams& params);
-  const control::SemiClosedLoopParams& controller_params() const { return controller_.params(); }
+  const control::SemiClosedLoopParams& controller_params() const { return cycle_->params(); }
 
   void drive_open_loop(const Vec3& ao_V);
   void drive_actuators(const Vec3& target_um);
@@ -58,24 +79,30 @@ class Bench {
   //! and returns it (between 1 and 2 static windows of simulated time).
   StaticMeasurement measure_static();
 
-  const plant::Twin& twin() const { return twin_; }
-  plant::Twin& twin() { return twin_; }
-  const control::ControllerOutput& last_output() const { return out_; }
-  DriveMode mode() const { return mode_; }
-  double time_s() const { return twin_.time_s(); }
+  const plant::Twin& twin() const { return sim_->twin(); }
+  const control::ControllerOutput& last_output() const { return cycle_->last().controller; }
+  //! The last tick as a whole: AI, controller, supervisor (ao_V is what went out), statuses.
+  const runtime::CycleSample& last_cycle() const { return cycle_->last(); }
+  DriveMode mode() const { return cycle_->mode(); }
+  Feedback feedback() const { return options_.feedback; }
+  bool faulted() const { return cycle_->supervisor().faulted(); }
+  //! The latched fault (reason kNone when none).
+  const runtime::FaultRecord& fault() const { return cycle_->supervisor().fault(); }
+  double time_s() const { return sim_->twin().time_s(); }
   double sample_time_s() const { return sample_time_s_; }
-  std::uint64_t ticks() const { return twin_.ticks(); }
+  std::uint64_t ticks() const { return tick_; }
 
  private:
   void tick();
-  Vec3 present_command_um() const;
 
-  plant::Twin twin_;
-  control::SemiClosedLoopController controller_;
+  BenchOptions options_;
   double sample_time_s_;
-  DriveMode mode_ = DriveMode::kOpenLoop;
-  Vec3 setpoint_{};  // V, S or Z_d according to mode_
-  control::ControllerOutput out_{};
+  std::int64_t period_ns_;
+  std::unique_ptr<runtime::SimBackend> sim_;
+  std::unique_ptr<runtime::OracleBackend> oracle_;
+  runtime::DaqBackend* daq_ = nullptr;
+  std::unique_ptr<runtime::ControlCycle> cycle_;
+  std::uint64_t tick_ = 0;
 };
 
 }  // namespace piezoshift::experiments

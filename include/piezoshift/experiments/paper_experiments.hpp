@@ -15,17 +15,27 @@
 //                      mean of P1..P3.
 // Linearity (4.2)      Z_d = 0, 1, ..., 11 um, step_hold_s each, one static (1 s) sample per
 //                      second; the displacement of a level is the mean of its samples after the
-//                      first skip_samples; metrics_linearity.hpp.
+//                      first skip_samples; metrics_linearity.hpp. The same protocol also runs on
+//                      a grid the calibration never saw (increment_um = 0.25) and downwards.
 // Repeatability (4.3)  moves times: Z_d = 0 for rest_s, Z_d = target for settle_s, one static
 //                      reading; z_i = mean of P1..P3; metrics_repeatability.hpp (Eq. 9).
+//
+// Every experiment runs on the shipping loop (bench.hpp), supervisor included, and says whether
+// it is valid (validity.hpp). Not valid: the supervisor tripped (travel: except at the level that
+// ends the search); a PID at its output limit where a value is measured; the step's final value
+// further than target_tolerance_um from the step, or no settling within the record; a linearity
+// level further than reach_tolerance_um from Z_d; a repeatability reading further than
+// target_tolerance_um from the target; no semi-closed level tracked at all.
 #include <cstdint>
 #include <vector>
 
 #include "piezoshift/control/semi_closed_loop.hpp"
+#include "piezoshift/experiments/bench.hpp"
 #include "piezoshift/experiments/metrics_linearity.hpp"
 #include "piezoshift/experiments/metrics_repeatability.hpp"
 #include "piezoshift/experiments/metrics_step_response.hpp"
 #include "piezoshift/experiments/progress.hpp"
+#include "piezoshift/experiments/validity.hpp"
 #include "piezoshift/io/project_config.hpp"
 
 namespace piezoshift::experiments {
@@ -37,6 +47,7 @@ struct TravelRangeOptions {
   double max_um = 16.0;  //!< give up above this (the nominal stroke)
   double hold_s = 1.0;
   double tolerance_um = 0.05;
+  BenchOptions bench{};  //!< feedback (gauges or oracle) and the supervisor's limits
 };
 
 struct TravelRangeResult {
@@ -46,6 +57,7 @@ struct TravelRangeResult {
   std::vector<double> desired_um;   //!< every level tried
   std::vector<double> measured_um;  //!< mean of P1..P3
   std::vector<int> saturated_mask;  //!< controller saturation at the end of each level
+  Validity validity;  //!< see validity.hpp and the header comment
   double simulated_time_s = 0.0;
 };
 
@@ -55,6 +67,10 @@ struct StepExperimentOptions {
   double record_s = 1.0;
   double band_pct = 2.0;
   double band_nm = 10.0;
+  //! Final value (mean of the record's last samples) within this of the step, else not reached.
+  //! The travel search's tracking tolerance.
+  double target_tolerance_um = 0.05;
+  BenchOptions bench{};  //!< feedback (gauges or oracle) and the supervisor's limits
 };
 
 struct StepExperimentResult {
@@ -62,14 +78,23 @@ struct StepExperimentResult {
   std::vector<double> measured_um;  //!< interferometer, dynamic mode, mean of P1..P3
   std::vector<double> desired_um;
   StepResponseMetrics metrics;
+  Validity validity;  //!< see validity.hpp and the header comment
   double simulated_time_s = 0.0;
 };
 
 struct LinearityOptions {
   double max_um = 11.0;
   double increment_um = 1.0;
+  //! Sweep from max_um down to increment_um (after approaching max_um from below) instead of
+  //! upwards. Not to 0: after a descent the stacks' hysteresis leaves them above zero at 0 V,
+  //! which the 0..150 V amplifier cannot undo, so Z_d = 0 is out of reach from above.
+  bool downward = false;
   double step_hold_s = 10.0;
   std::size_t skip_samples = 2;  //!< static samples left out at the start of each level
+  //! A level further than this from Z_d was not reached (5 % of the span: far beyond any
+  //! nonlinearity, so only a loop out of authority or a wrong calibration gets there).
+  double reach_tolerance_um = 0.5;
+  BenchOptions bench{};  //!< feedback (gauges or oracle) and the supervisor's limits
 };
 
 struct LinearityResult {
@@ -79,6 +104,7 @@ struct LinearityResult {
   std::vector<double> sample_desired_um;
   std::vector<double> sample_measured_um;
   LinearityMetrics metrics;
+  Validity validity;  //!< see validity.hpp and the header comment
   double simulated_time_s = 0.0;
 };
 
@@ -87,12 +113,16 @@ struct RepeatabilityOptions {
   int moves = 230;  //!< the paper's count
   double rest_s = 0.5;
   double settle_s = 0.5;
+  //! A reading further than this from the target means the move did not reach it.
+  double target_tolerance_um = 0.05;
+  BenchOptions bench{};  //!< feedback (gauges or oracle) and the supervisor's limits
 };
 
 struct RepeatabilityResult {
   double target_um = 0.0;
   std::vector<double> measured_um;  //!< z_i
   RepeatabilityMetrics metrics;
+  Validity validity;  //!< see validity.hpp and the header comment
   double simulated_time_s = 0.0;
 };
 

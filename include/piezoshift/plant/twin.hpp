@@ -57,6 +57,10 @@ struct TwinTruth {
   double theta_x_urad = 0.0;   //!< tip about x, since the start
   double theta_y_urad = 0.0;   //!< tilt about y, since the start
   Vec3 points_um{};            //!< displacement of P1..P3 since the start
+  //! The extremes of mean(P1..P3) over the physics steps of the last period: overshoot and
+  //! ringing between control ticks, which the tick-rate samples miss.
+  double period_max_mean_points_um = 0.0;
+  double period_min_mean_points_um = 0.0;
   Vec3 sgs_V{};                //!< conditioner outputs before the ADC (noise included)
   double air_temperature_C = 0.0;
   double structure_temperature_C = 0.0;
@@ -117,6 +121,8 @@ class Twin {
   void sample_interferometer(const Vec3& x_um, double t_s, double drift_um) noexcept;
   void sample_ai(double structure_change_K) noexcept;
   void update_truth(const Vec3& x_um, double air_C, double structure_C) noexcept;
+  //! mean(P1..P3) = this . (eta_1, eta_2, eta_3), the modal displacements.
+  void update_mean_point_weights();
   double quantize_V(double v) const noexcept;
 
   TwinModel model_;
@@ -139,6 +145,7 @@ class Twin {
   double lsb_V_ = 0.0, inv_lsb_V_ = 0.0;  // DAQ
   double code_min_ = 0.0, code_max_ = 0.0;
   LinearMechanics mechanics_;
+  std::array<double, 3> mean_point_modal_{};  // see update_mean_point_weights
   std::vector<std::array<double, 3>> force_N_;  // stack forces of one period, per physics step
 
   // State

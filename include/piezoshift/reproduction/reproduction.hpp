@@ -6,13 +6,24 @@
 //   linearity               seed + 30
 //   repeatability 5 um      seed + 40
 //   repeatability 10 um     seed + 50
-// all with the calibrated controller (the paper's structure: PID, A, p). Deterministic: the same
+//   linearity, 0.25 um grid seed + 60   (levels the calibration never saw)
+//   linearity, downwards    seed + 70
+// all with the calibrated controller (the paper's structure: PID, A, p), through the loop `run`
+// and `serve` ship (experiments/bench.hpp), supervisor included. Then the same experiments, same
+// seeds, with the oracle (runtime/oracle_backend.hpp): the same loop fed the plate's true point
+// displacements, with the calibrated A and an identity polynomial. Impossible on hardware, it is
+// the floor no controller fed by the strain gauges can beat. Deterministic: the same
 // configuration, seed and schedule give the same numbers bit for bit.
+//
+// valid() is false when any Table 4 experiment of the paper's controller is not valid
+// (experiments/validity.hpp); `reproduce` then exits with kExitInvalidExperiment.
 //
 // Schedules: the full one is the paper's (230 moves per target, 10 s per linearity level, the
 // full PID grid); the quick one keeps every step but shortens the calibration, the travel search
 // and the linearity levels (tests, a first look). It keeps the 230 repeatability moves.
 #include <cstdint>
+#include <string>
+#include <vector>
 
 #include "piezoshift/calibration/calibration_procedure.hpp"
 #include "piezoshift/experiments/paper_experiments.hpp"
@@ -33,22 +44,46 @@ struct Schedule {
   experiments::LinearityOptions linearity;
   experiments::RepeatabilityOptions repeat_5um;
   experiments::RepeatabilityOptions repeat_10um;
+  experiments::LinearityOptions linearity_grid;  //!< the unseen 0.25 um grid
+  experiments::LinearityOptions linearity_down;  //!< the paper's levels, downwards
 
   static Schedule paper();  //!< the full schedule (Section 4)
   static Schedule quick();  //!< shortened steps, same procedure
 };
 
-struct ReproductionResult {
+//! Exit status of `reproduce` when a Table 4 experiment is not valid (documented in
+//! docs/experiments.md; 2 stays bad input, 3 a supervisor fault of `run`).
+inline constexpr int kExitInvalidExperiment = 4;
+
+//! Table 4's experiments and the two extra linearity sweeps, for one controller.
+struct ExperimentSet {
+  experiments::TravelRangeResult travel;
+  experiments::StepExperimentResult step;
+  experiments::LinearityResult linearity;       //!< the paper's protocol (Section 4.2)
+  experiments::LinearityResult linearity_grid;  //!< 0.25 um grid, upwards
+  experiments::LinearityResult linearity_down;  //!< the paper's levels, downwards
+  experiments::RepeatabilityResult repeat_5um;
+  experiments::RepeatabilityResult repeat_10um;
+
+  double experiments_simulated_time_s() const;
+  //! Every Table 4 row (travel, step, linearity by the paper's protocol, repeatability) valid.
+  bool table4_valid() const;
+  //! "name: reason" for every experiment that is not valid (the extra sweeps included).
+  std::vector<std::string> invalid_reasons() const;
+};
+
+//! The paper's controller's set (the base, so result.travel, result.step, ... are it) and the
+//! oracle's.
+struct ReproductionResult : ExperimentSet {
   ReproduceOptions options;
   Schedule schedule;  //!< what was run
   calibration::CalibrationOutcome calibration;
-  experiments::TravelRangeResult travel;
-  experiments::StepExperimentResult step;
-  experiments::LinearityResult linearity;
-  experiments::RepeatabilityResult repeat_5um;
-  experiments::RepeatabilityResult repeat_10um;
+  control::SemiClosedLoopParams oracle_controller;  //!< gains and A calibrated, p = identity
+  ExperimentSet oracle;
   double simulated_time_s = 0.0;  //!< twin time over every stage and experiment
   double wall_time_s = 0.0;
+
+  bool valid() const { return table4_valid(); }
 };
 
 ReproductionResult reproduce(const io::ProjectConfig& config, const ReproduceOptions& options,

@@ -7,13 +7,11 @@
 //     clear requested (request_clear())                  -> supervisor.clear_fault(),
 //                                                           controller reset (bumpless from 0 V)
 //     host mode: apply the host's commands (host_link.hpp)
-//     ai  = daq.read(k)                                  (applies the outputs staged at k-1)
-//     Z_d = profile(k T), or the host's last move
-//     c   = controller.update(Z_d, ai)                   Eqs. 6-8, sample time T
-//           (host mode with the servo off: c = the host's open-loop volts)
-//     s   = supervisor.update(ai, c, statuses, overrun(k-1))
-//     controller.hold_integrators(s.hold_integrators)
-//     daq.write(k, s.ao_V)                               E_k = end of work
+//     Z_d = profile(k T), or the host's last move        (host mode with the servo off: the
+//                                                         host's open-loop volts)
+//     cycle.step(daq, k, overrun(k-1))                   the one control tick (control_cycle.hpp):
+//                                                        read, controller, supervisor, write
+//                                                        E_k = end of work
 //     stats (period error, wake latency, compute, overrun = E_k - D_k > T), telemetry push,
 //     host sample push
 //     done when the supervisor has stopped, or has faulted and the outputs are at 0 V
@@ -28,6 +26,7 @@
 #include <cstdint>
 
 #include "piezoshift/control/semi_closed_loop.hpp"
+#include "piezoshift/runtime/control_cycle.hpp"
 #include "piezoshift/runtime/daq_backend.hpp"
 #include "piezoshift/runtime/host_link.hpp"
 #include "piezoshift/runtime/loop_clock.hpp"
@@ -84,8 +83,10 @@ class ControlLoop {
   std::int64_t period_ns() const noexcept { return period_ns_; }
   std::uint64_t duration_ticks() const noexcept { return duration_ticks_; }
   const LoopStats& stats() const noexcept { return stats_; }
-  const SafetySupervisor& supervisor() const noexcept { return supervisor_; }
-  const control::SemiClosedLoopController& controller() const noexcept { return controller_; }
+  const SafetySupervisor& supervisor() const noexcept { return cycle_.supervisor(); }
+  const control::SemiClosedLoopController& controller() const noexcept {
+    return cycle_.controller();
+  }
 
  private:
   LoopConfig config_;
@@ -96,8 +97,7 @@ class ControlLoop {
   LoopClock& clock_;
   SetpointProfile profile_;
   SpscRing<TelemetryRecord>* telemetry_;
-  control::SemiClosedLoopController controller_;
-  SafetySupervisor supervisor_;
+  ControlCycle cycle_;
   LoopStats stats_;
   std::atomic<bool> clear_requested_{false};
 };

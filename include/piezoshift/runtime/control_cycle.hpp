@@ -1,0 +1,91 @@
+#pragma once
+// One control tick, the only one piezoshift has: `run`, `serve`, `simulate`, the simulated bench
+// (the calibration procedures, the paper's experiments, `reproduce`) all close the loop through
+// it, against any DAQ backend (the twin is one more backend, daq_backend.hpp). Per tick:
+//
+//   ai = daq.read(t)                     the outputs staged at the previous tick go out, then the
+//                                        three AI are sampled (daq_backend.hpp's timing contract)
+//   c  = by drive mode:
+//          points     controller.update(Z_d, ai)           feedforward (Eq. 8) + PIDs (Eqs. 6, 7)
+//          actuators  controller.update_actuators(S, ai)   the PIDs alone (calibration stages 1, 2)
+//          open loop  c.dac_V = V                          volts straight to the amplifiers
+//   s  = supervisor.update(ai, c, statuses, previous tick overran)
+//   controller.hold_integrators(s.hold_integrators)
+//   daq.write(t, s.ao_V)
+//
+// Hand-overs are bumpless: going from open loop to a closed mode, each PID restarts from the
+// command the outputs already hold. A latched fault ramps the outputs to 0 V (the supervisor)
+// until clear_fault(), after which the PIDs restart from 0 V and the outputs follow them through
+// the slew limit from where the ramp left them.
+//
+// step() is real-time safe: no heap, no exceptions, no I/O. Construction and configure() are
+// set-up (they may throw std::invalid_argument on inconsistent limits).
+#include <cstdint>
+
+#include "piezoshift/control/semi_closed_loop.hpp"
+#include "piezoshift/runtime/daq_backend.hpp"
+#include "piezoshift/runtime/safety_supervisor.hpp"
+
+namespace piezoshift::runtime {
+
+enum class DriveMode : std::uint8_t { kOpenLoop, kActuators, kPoints };
+const char* to_string(DriveMode mode) noexcept;
+
+//! What one tick saw and did.
+struct CycleSample {
+  std::uint64_t tick = 0;
+  DriveMode mode = DriveMode::kOpenLoop;
+  Vec3 setpoint{};  //!< V (open loop), S (actuators) or Z_d (points)
+  Vec3 ai_V{};      //!< the AI as read
+  //! The controller's tick (open loop: dac_V = the requested volts, feedback_um from the AI,
+  //! target_um = feedback_um).
+  control::ControllerOutput controller{};
+  SupervisorOutput supervisor{};  //!< ao_V is what was written
+  DaqStatus read_status = DaqStatus::kOk;
+  DaqStatus write_status = DaqStatus::kOk;
+};
+
+class ControlCycle {
+ public:
+  //! params.sample_time_s must be the loop's period (the PIDs' gains are rescaled to it).
+  ControlCycle(const control::SemiClosedLoopParams& params, const SafetyLimits& limits);
+
+  //! Set-up: replaces the controller's parameters; the PIDs restart from the command the outputs
+  //! hold (bumpless). The sample time must not change.
+  void configure(const control::SemiClosedLoopParams& params);
+
+  //! Real-time safe. Sets what the next ticks follow; bumpless from open loop to closed loop.
+  void drive(DriveMode mode, const Vec3& setpoint) noexcept;
+  //! Real-time safe. Every PID restarts from the command the outputs hold (servo on).
+  void restart_from_outputs() noexcept;
+  //! Real-time safe. One tick (see the header comment).
+  const CycleSample& step(DaqBackend& daq, const CycleTime& t, bool previous_tick_overran) noexcept;
+
+  //! Real-time safe. Unlatches a fault; the PIDs restart from 0 V. False when none was latched.
+  bool clear_fault() noexcept;
+  //! Real-time safe. Ramps to 0 V without a fault.
+  void request_stop() noexcept { supervisor_.request_stop(); }
+  //! Back to the start: supervisor running, outputs assumed at 0 V, PIDs from 0 V, open loop at
+  //! 0 V.
+  void reset() noexcept;
+
+  DriveMode mode() const noexcept { return mode_; }
+  const Vec3& setpoint() const noexcept { return setpoint_; }
+  const CycleSample& last() const noexcept { return last_; }
+  const control::SemiClosedLoopController& controller() const noexcept { return controller_; }
+  const SafetySupervisor& supervisor() const noexcept { return supervisor_; }
+  const control::SemiClosedLoopParams& params() const noexcept { return controller_.params(); }
+
+ private:
+  //! The command (um) that produced the outputs now held.
+  Vec3 held_command_um() const noexcept;
+
+  control::SemiClosedLoopController controller_;
+  SafetySupervisor supervisor_;
+  DriveMode mode_ = DriveMode::kOpenLoop;
+  Vec3 setpoint_{};
+  DaqStatus previous_write_ = DaqStatus::kOk;
+  CycleSample last_{};
+};
+
+}  // namespace piezoshift::runtime

@@ -1,0 +1,116 @@
+#include "piezoshift/runtime/control_cycle.hpp"
+
+#include <cmath>
+#include <stdexcept>
+
+namespace piezoshift::runtime {
+
+const char* to_string(DriveMode mode) noexcept {
+  switch (mode) {
+    case DriveMode::kOpenLoop:
+      return "open-loop";
+    case DriveMode::kActuators:
+      return "actuators";
+    case DriveMode::kPoints:
+      return "points";
+  }
+  return "unknown";
+}
+
+ControlCycle::ControlCycle(const control::SemiClosedLoopParams& params,
+                           const SafetyLimits& limits) {
+  if (!(params.sample_time_s > 0.0) || !std::isfinite(params.sample_time_s))
+    throw std::invalid_argument("control cycle: sample_time_s must be > 0");
+  controller_.configure(params);
+  supervisor_.configure(limits, params.sample_time_s, params.scaling);
+}
+
+void ControlCycle::configure(const control::SemiClosedLoopParams& params) {
+  if (std::fabs(params.sample_time_s - controller_.params().sample_time_s) >
+      1e-12 * controller_.params().sample_time_s)
+    throw std::invalid_argument("control cycle: the controller's sample time differs from the loop's");
+  const Vec3 held = held_command_um();
+  controller_.configure(params);
+  controller_.reset_to(held);
+}
+
+Vec3 ControlCycle::held_command_um() const noexcept {
+  const Vec3& ao = supervisor_.last_output_V();
+  Vec3 u{};
+  for (std::size_t i = 0; i < u.size(); ++i) {
+    const control::SignalScaling& s = controller_.params().scaling[i];
+    u[i] = (ao[i] - s.drive_offset_V) / s.drive_V_per_um;
+  }
+  return u;
+}
+
+void ControlCycle::restart_from_outputs() noexcept {
+  controller_.reset_to(held_command_um());
+  controller_.hold_integrators(false);
+}
+
+void ControlCycle::drive(DriveMode mode, const Vec3& setpoint) noexcept {
+  if (mode_ == DriveMode::kOpenLoop && mode != DriveMode::kOpenLoop)
+    restart_from_outputs();
+  mode_ = mode;
+  setpoint_ = setpoint;
+}
+
+bool ControlCycle::clear_fault() noexcept {
+  if (!supervisor_.clear_fault())
+    return false;
+  controller_.reset();
+  controller_.hold_integrators(false);
+  return true;
+}
+
+void ControlCycle::reset() noexcept {
+  supervisor_.reset();
+  controller_.configure(controller_.params());
+  mode_ = DriveMode::kOpenLoop;
+  setpoint_ = Vec3{};
+  previous_write_ = DaqStatus::kOk;
+  last_ = CycleSample{};
+}
+
+const CycleSample& ControlCycle::step(DaqBackend& daq, const CycleTime& t,
+                                      bool previous_tick_overran) noexcept {
+  CycleSample& c = last_;
+  c.tick = t.tick;
+  c.mode = mode_;
+  c.setpoint = setpoint_;
+  c.read_status = daq.read(t, c.ai_V);
+  switch (mode_) {
+    case DriveMode::kPoints:
+      c.controller = controller_.update(setpoint_, c.ai_V);
+      break;
+    case DriveMode::kActuators:
+      c.controller = controller_.update_actuators(setpoint_, c.ai_V);
+      break;
+    case DriveMode::kOpenLoop:
+      c.controller = control::ControllerOutput{};
+      c.controller.dac_V = setpoint_;
+      for (std::size_t i = 0; i < c.ai_V.size(); ++i)
+        c.controller.feedback_um[i] = controller_.params().scaling[i].sgs_to_um(c.ai_V[i]);
+      c.controller.target_um = c.controller.feedback_um;
+      break;
+  }
+  SupervisorInput in{};
+  in.closed_loop = mode_ != DriveMode::kOpenLoop;
+  in.tick = t.tick;
+  in.period_s = static_cast<double>(t.period_ns) * 1e-9;
+  in.sgs_V = c.ai_V;
+  in.request_V = c.controller.dac_V;
+  in.target_um = c.controller.target_um;
+  in.feedback_um = c.controller.feedback_um;
+  in.read_status = c.read_status;
+  in.previous_write_status = previous_write_;
+  in.previous_tick_overran = previous_tick_overran;
+  c.supervisor = supervisor_.update(in);
+  controller_.hold_integrators(c.supervisor.hold_integrators);
+  c.write_status = daq.write(t, c.supervisor.ao_V);
+  previous_write_ = c.write_status;
+  return c;
+}
+
+}  // namespace piezoshift::runtime
