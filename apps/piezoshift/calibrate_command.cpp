@@ -50,7 +50,7 @@ int run(const Options& o) {
                   "calibrate`\nseed {}, configuration: {}, PID gains: {}",
                   o.seed, o.config.empty() ? "built-in defaults" : o.config,
                   o.pid == "paper" ? "the paper's" : "searched"),
-      travel.semi_closed_um);
+      travel.single_move_um, travel.single_move_min_um);
   const auto& g = c.controller.gains;
   const auto& p = c.controller.polynomial;
   if (o.json) {
@@ -64,7 +64,9 @@ int run(const Options& o) {
     j["A_rms_residual_um"] = c.matrix.fit.rms_residual_um;
     j["condition_number"] = c.matrix.fit.condition_number;
     j["p_rms_residual_um"] = c.polynomial.fit.rms_residual_um;
-    j["travel_z_max_um"] = travel.semi_closed_um;
+    j["travel_z_max_um"] = travel.single_move_um;
+    j["travel_semi_closed_um"] = travel.semi_closed_um;
+    j["travel_z_min_um"] = travel.single_move_min_um;
     fmt::print("{}\n", j.dump(2));
     return 0;
   }
@@ -80,7 +82,9 @@ int run(const Options& o) {
   }
   fmt::print("stage 3  cubic p    p3 {:.4e}, p2 {:.4e}, p1 {:.5f}, p0 {:.4f} um (rms {:.4f} um)\n",
              p.p3, p.p2, p.p1, p.p0, c.polynomial.fit.rms_residual_um);
-  fmt::print("travel   semi-closed loop {:.2f} um (Section 4.1)\n", travel.semi_closed_um);
+  fmt::print("travel   semi-closed loop {:.2f} um (Section 4.1); one move reaches {:.2f} to "
+             "{:.2f} um (written as z_min_um, z_max_um)\n",
+             travel.semi_closed_um, travel.single_move_min_um, travel.single_move_um);
   fmt::print("written: {}\n", o.out);
   return 0;
 }

@@ -63,7 +63,7 @@ LoopCalibration resolve_calibration(const std::string& path, const std::string& 
                                     const io::ProjectConfig& config, std::uint64_t seed) {
   LoopCalibration c;
   if (!path.empty()) {
-    c.params = calibration::load_calibration_file(path, &c.travel_z_max_um);
+    c.params = calibration::load_calibration_file(path, &c.travel_z_max_um, &c.travel_z_min_um);
     c.source = path;
     return c;
   }
@@ -81,7 +81,8 @@ LoopCalibration resolve_calibration(const std::string& path, const std::string& 
   const calibration::CalibrationWithTravel ct = calibration::calibrate_with_travel(
       config, seed, calibration::CalibrationOptions::paper_gains_only());
   c.params = ct.calibration.controller;
-  c.travel_z_max_um = ct.travel.semi_closed_um;
+  c.travel_z_max_um = ct.travel.single_move_um;
+  c.travel_z_min_um = ct.travel.single_move_min_um;
   c.source = fmt::format("the twin's own calibration (paper's procedure, seed {})", seed);
   return c;
 }

@@ -38,7 +38,8 @@ ChosenBackend make_backend(const std::string& daq, const io::ProjectConfig& conf
 //! The controller a loop runs with, and where it came from.
 struct LoopCalibration {
   control::SemiClosedLoopParams params;
-  std::optional<double> travel_z_max_um;  //!< the semi-closed-loop travel, when known
+  std::optional<double> travel_z_max_um;  //!< the travel one move reaches, when known
+  std::optional<double> travel_z_min_um;  //!< the lowest Z a move from the top reaches
   std::string source;                     //!< the file, or how it was obtained
 };
 

@@ -51,25 +51,46 @@ int run(const Options& o) {
   const auto& t = result;
   fmt::print("piezoshift reproduce: {:.0f} s simulated in {:.2f} s\n", t.simulated_time_s,
              t.wall_time_s);
-  fmt::print(
-      "  travel range     {:.2f} um open loop, {:.1f} um semi-closed loop   (paper: 12.9, 11.5)\n",
-      t.travel.open_loop_um, t.travel.semi_closed_um);
-  fmt::print(
-      "  step response    settles (+-2 %) in {:.3f} s at {:g} um            (paper: < 0.3 s)\n",
-      t.step.metrics.settling_time_pct_s, t.step.desired_um.back());
-  fmt::print("  linearity        {:.3f} % zero-end, {:.3f} % best fit         (paper: 0.21 %)\n",
-             t.linearity.metrics.linearity_zero_end_pct,
-             t.linearity.metrics.linearity_best_fit_pct);
-  fmt::print("  repeatability    {:.2f} nm at 5 um, {:.2f} nm at 10 um          (paper: 2, 3 nm)\n",
-             t.repeat_5um.metrics.repeatability_nm, t.repeat_10um.metrics.repeatability_nm);
-  fmt::print(
-      "  oracle           {:.3f} % linearity, {:.2f} / {:.2f} nm repeatability (plate feedback, "
-      "impossible on hardware)\n",
-      t.oracle.linearity.metrics.linearity_zero_end_pct,
-      t.oracle.repeat_5um.metrics.repeatability_nm, t.oracle.repeat_10um.metrics.repeatability_nm);
+  // A row that is not valid shows why, never a number.
+  const auto row = [](const char* name, const experiments::Validity& v, const std::string& value,
+                      const char* paper) {
+    if (v.valid)
+      fmt::print("  {:<16} {:<46} (paper: {})\n", name, value, paper);
+    else
+      fmt::print("  {:<16} NOT VALID: {}\n", name, v.reason);
+  };
+  row("travel range", t.travel.validity,
+      fmt::format("{:.2f} um open loop, {:.1f} um semi-closed loop", t.travel.open_loop_um,
+                  t.travel.semi_closed_um),
+      "12.9, 11.5");
+  row("step response", t.step.validity,
+      fmt::format("settles (+-2 %) in {:.3f} s at {:g} um", t.step.metrics.settling_time_pct_s,
+                  t.step.desired_um.back()),
+      "< 0.3 s");
+  row("linearity", t.linearity.validity,
+      fmt::format("{:.3f} % zero-end, {:.3f} % best fit",
+                  t.linearity.metrics.linearity_zero_end_pct,
+                  t.linearity.metrics.linearity_best_fit_pct),
+      "0.21 %");
+  experiments::Validity repeat = t.repeat_5um.validity;
+  if (!t.repeat_10um.validity.valid)
+    repeat.fail(t.repeat_10um.validity.reason);
+  row("repeatability", repeat,
+      fmt::format("{:.2f} nm at 5 um, {:.2f} nm at 10 um", t.repeat_5um.metrics.repeatability_nm,
+                  t.repeat_10um.metrics.repeatability_nm),
+      "2, 3 nm");
+  experiments::Validity oracle;
+  if (!t.oracle.table4_valid())
+    oracle.fail(t.oracle.invalid_reasons().front());
+  row("oracle", oracle,
+      fmt::format("{:.3f} %, {:.2f} / {:.2f} nm (plate feedback: impossible on hardware)",
+                  t.oracle.linearity.metrics.linearity_zero_end_pct,
+                  t.oracle.repeat_5um.metrics.repeatability_nm,
+                  t.oracle.repeat_10um.metrics.repeatability_nm),
+      "-");
   fmt::print("report: {}\n        {}\n", files.markdown.string(), files.html.string());
   if (status != 0) {
-    fmt::print(stderr, "piezoshift: reproduce: not valid, so the figures above are not results:\n");
+    fmt::print(stderr, "piezoshift: reproduce: not valid (exit status 4):\n");
     for (const std::string& why : result.invalid_reasons())
       fmt::print(stderr, "  {}\n", why);
   }

@@ -64,12 +64,14 @@ void check(bool ok, const std::string& message) {
 
 host::StageModel make_stage_model(const ServeOptions& o, const io::ProjectConfig& config,
                                   const control::SemiClosedLoopParams& params,
-                                  std::optional<double> travel_z_max_um,
+                                  const LoopCalibration& cal,
                                   const runtime::SafetyLimits& safety) {
   try {
     host::StageModelParams mp = host::stage_model_params(config.twin.geometry, params);
-    if (travel_z_max_um)
-      mp.z_max_um = *travel_z_max_um;
+    if (cal.travel_z_max_um)
+      mp.z_max_um = *cal.travel_z_max_um;
+    if (cal.travel_z_min_um)
+      mp.z_min_um = *cal.travel_z_min_um;
     mp.amplifier_gain = config.twin.amplifier.gain;
     mp.channel_max_V = safety.output_max_V * mp.amplifier_gain;
     return host::StageModel(mp);
@@ -101,7 +103,7 @@ int serve(const ServeOptions& o) {
       o.config.empty() ? io::ProjectConfig{} : io::load_project_config(o.config);
   const LoopCalibration cal = resolve_calibration(o.calibration, o.daq, config, o.seed);
   const control::SemiClosedLoopParams& params = cal.params;
-  const host::StageModel model = make_stage_model(o, config, params, cal.travel_z_max_um, safety);
+  const host::StageModel model = make_stage_model(o, config, params, cal, safety);
 
   ChosenBackend chosen = make_backend(o.daq, config, o.seed, o.rate_Hz);
   runtime::DaqBackend& daq = *chosen.backend;

@@ -7,6 +7,7 @@
 
 #include "piezoshift/io/atomic_file.hpp"
 #include "piezoshift/io/config_file.hpp"
+#include "piezoshift/io/input_error.hpp"
 
 namespace piezoshift::calibration {
 
@@ -24,20 +25,29 @@ void read_controller_section(const io::ConfigFile& file, control::SemiClosedLoop
 }
 
 control::SemiClosedLoopParams load_calibration_file(const std::string& path,
-                                                    std::optional<double>* travel_z_max_um) {
+                                                    std::optional<double>* travel_z_max_um,
+                                                    std::optional<double>* travel_z_min_um) {
   const io::ConfigFile file = io::ConfigFile::load(path);
   control::SemiClosedLoopParams params;
   read_controller_section(file, params);
-  double z_max_um = 0.0;
-  const bool has_travel = file.section("travel").read("z_max_um", z_max_um, io::Bounds::positive());
+  double z_max_um = 0.0, z_min_um = 0.0;
+  const bool has_max = file.section("travel").read("z_max_um", z_max_um, io::Bounds::positive());
+  const bool has_min =
+      file.section("travel").read("z_min_um", z_min_um, io::Bounds::non_negative());
   file.reject_unknown();
+  if (has_min && has_max && !(z_min_um < z_max_um))
+    throw io::InputError(fmt::format("{}: [travel] z_min_um = {} must be below z_max_um = {}",
+                                     path, z_min_um, z_max_um));
   if (travel_z_max_um != nullptr)
-    *travel_z_max_um = has_travel ? std::optional<double>(z_max_um) : std::nullopt;
+    *travel_z_max_um = has_max ? std::optional<double>(z_max_um) : std::nullopt;
+  if (travel_z_min_um != nullptr)
+    *travel_z_min_um = has_min ? std::optional<double>(z_min_um) : std::nullopt;
   return params;
 }
 
 std::string format_calibration(const control::SemiClosedLoopParams& params,
-                               const std::string& header, std::optional<double> travel_z_max_um) {
+                               const std::string& header, std::optional<double> travel_z_max_um,
+                               std::optional<double> travel_z_min_um) {
   std::string out;
   std::istringstream lines(header);
   for (std::string line; std::getline(lines, line);)
@@ -59,15 +69,22 @@ std::string format_calibration(const control::SemiClosedLoopParams& params,
   }
   if (travel_z_max_um) {
     out += "\n[travel]\n";
-    out += fmt::format("z_max_um = {:.17g}  # semi-closed-loop travel, Section 4.1\n",
-                       *travel_z_max_um);
+    out += fmt::format(
+        "z_max_um = {:.17g}  # the travel one move from rest reaches (Section 4.1's search, then "
+        "single moves)\n",
+        *travel_z_max_um);
+    if (travel_z_min_um)
+      out += fmt::format("z_min_um = {:.17g}  # the lowest Z a move from the top reaches\n",
+                         *travel_z_min_um);
   }
   return out;
 }
 
 void write_calibration_file(const std::string& path, const control::SemiClosedLoopParams& params,
-                            const std::string& header, std::optional<double> travel_z_max_um) {
-  io::write_file_atomically(path, format_calibration(params, header, travel_z_max_um));
+                            const std::string& header, std::optional<double> travel_z_max_um,
+                            std::optional<double> travel_z_min_um) {
+  io::write_file_atomically(path,
+                            format_calibration(params, header, travel_z_max_um, travel_z_min_um));
 }
 
 }  // namespace piezoshift::calibration

@@ -25,7 +25,7 @@ CalibrationWithTravel calibrate_with_travel(const io::ProjectConfig& config, std
   out.calibration = calibrate(config, base, seed, options, progress);
   out.travel =
       experiments::run_travel_range(config, out.calibration.controller, seed + 3, options.travel);
-  if (!(out.travel.semi_closed_um > 0.0))
+  if (!(out.travel.single_move_um > 0.0))
     throw io::InputError(
         fmt::format("calibration: the calibrated loop has no semi-closed-loop travel: {}",
                     out.travel.validity.reason));

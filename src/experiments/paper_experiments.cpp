@@ -1,6 +1,7 @@
 #include "piezoshift/experiments/paper_experiments.hpp"
 
 #include <cmath>
+#include <limits>
 #include <stdexcept>
 #include <string>
 
@@ -68,38 +69,83 @@ TravelRangeResult run_travel_range(const io::ProjectConfig& config,
     r.simulated_time_s += open.time_s();
     check_fault(open, r.validity, "during the open-loop reading");
   }
-  Bench bench(config, controller, seed + 1, o.bench);
-  const auto levels = static_cast<int>(std::floor((o.max_um - o.start_um) / o.increment_um + 1e-9));
-  for (int k = 0; k <= levels; ++k) {
-    const double zd = o.start_um + o.increment_um * k;
-    bench.drive_points(all(zd));
-    bench.run(o.hold_s);
-    const double z = mean3(bench.measure_static().points_um);
-    const int sat = bench.last_output().saturated_mask;
-    r.desired_um.push_back(zd);
-    r.measured_um.push_back(z);
-    r.saturated_mask.push_back(sat);
-    if (progress)
-      progress(k + 1, levels + 1, "travel range");
-    // The first level not tracked (the loop out of authority, the supervisor tripped by it, or
-    // the plate too far from Z_d) ends the search: that is the travel's end, not a failure.
-    if (sat != 0 || bench.faulted() || std::fabs(z - zd) > o.tolerance_um)
+  // The search starts at start_um; a stage that cannot track even that is searched again from
+  // one coarse_step_um lower, so a short stage gets its real travel, not a 0.
+  double start = o.start_um;
+  bool ended_tracking = false;
+  double searched_s = 0.0;
+  for (int attempt = 0; start > 0.0 && r.semi_closed_um == 0.0; ++attempt) {
+    if (attempt > 0)
+      start -= o.coarse_step_um;
+    if (start <= 0.0)
       break;
-    r.semi_closed_um = zd;
-    if (k == levels)
-      r.validity.fail(fmt::format("still tracking at the search's end, {:g} um", zd));
+    Bench bench(config, controller, seed + 1, o.bench);
+    const auto levels = static_cast<int>(std::floor((o.max_um - start) / o.increment_um + 1e-9));
+    for (int k = 0; k <= levels; ++k) {
+      const double zd = start + o.increment_um * k;
+      bench.drive_points(all(zd));
+      bench.run(o.hold_s);
+      const double z = mean3(bench.measure_static().points_um);
+      const int sat = bench.last_output().saturated_mask;
+      r.desired_um.push_back(zd);
+      r.measured_um.push_back(z);
+      r.saturated_mask.push_back(sat);
+      if (progress)
+        progress(k + 1, levels + 1, "travel range");
+      // The first level not tracked (the loop out of authority, the supervisor tripped by it, or
+      // the plate too far from Z_d) ends the search: that is the travel's end, not a failure.
+      if (sat != 0 || bench.faulted() || std::fabs(z - zd) > o.tolerance_um)
+        break;
+      r.semi_closed_um = zd;
+      r.tracked_levels.push_back(zd);
+      ended_tracking = k == levels;
+    }
+    searched_s += bench.time_s();
   }
-  if (r.semi_closed_um == 0.0) {
-    const double z = r.measured_um.empty() ? 0.0 : r.measured_um.front();
-    r.validity.fail(
-        bench.faulted()
-            ? fmt::format("the first level, Z_d = {:g} um, was not tracked: the safety supervisor "
-                          "tripped ({})",
-                          o.start_um, runtime::to_string(bench.fault().reason))
-            : fmt::format("the first level, Z_d = {:g} um, was not tracked (measured {:.3f} um)",
-                          o.start_um, z));
+  if (ended_tracking)
+    r.validity.fail(fmt::format("still tracking at the search's end, {:g} um", o.max_um));
+  if (r.semi_closed_um == 0.0)
+    r.validity.fail(fmt::format("no level from {:g} um down to {:g} um was tracked", o.start_um,
+                                o.coarse_step_um));
+  r.simulated_time_s += searched_s;
+  // The travel one move reaches from rest: creeping up lets the stacks' creep lower the drive a
+  // level needs, which a single move does not wait for.
+  for (std::size_t k = r.validity.valid ? r.tracked_levels.size() : 0; k-- > 0;) {
+    const double z = r.tracked_levels[k];
+    Bench single(config, controller, seed + 2, o.bench);
+    single.drive_points(all(0.0));
+    single.run(0.2);
+    single.drive_points(all(z));
+    single.run(o.hold_s);
+    const double measured = mean3(single.measure_static().points_um);
+    r.simulated_time_s += single.time_s();
+    if (!single.faulted() && single.last_output().saturated_mask == 0 &&
+        std::fabs(measured - z) <= o.tolerance_um) {
+      r.single_move_um = z;
+      break;
+    }
   }
-  r.simulated_time_s += bench.time_s();
+  if (r.validity.valid && r.single_move_um == 0.0)
+    r.validity.fail(fmt::format("no level from {:g} um up was reached by a single move from rest",
+                                o.start_um));
+  // The lowest level one move from the top reaches: after a descent the stacks' hysteresis
+  // leaves them above zero at 0 V, which the 0..150 V amplifier cannot undo.
+  for (int k = 0; r.single_move_um > 0.0 && k * o.min_increment_um < r.single_move_um; ++k) {
+    const double z = k * o.min_increment_um;
+    Bench down(config, controller, seed + 3, o.bench);
+    down.drive_points(all(r.single_move_um));
+    down.run(o.hold_s);
+    down.drive_points(all(z));
+    down.run(o.hold_s);
+    const double measured = mean3(down.measure_static().points_um);
+    r.simulated_time_s += down.time_s();
+    // In authority (no PID at 0 V, where only the stacks' creep would bring the plate down).
+    if (!down.faulted() && down.last_output().saturated_mask == 0 &&
+        std::fabs(measured - z) <= o.tolerance_um) {
+      r.single_move_min_um = z;
+      break;
+    }
+  }
   return r;
 }
 
@@ -127,7 +173,13 @@ StepExperimentResult run_step_response(const io::ProjectConfig& config,
   m.step_time_s = 0.0;
   m.band_pct = o.band_pct;
   m.band_nm = o.band_nm;
-  r.metrics = step_response_metrics(r.time_s, r.measured_um, m);
+  try {
+    r.metrics = step_response_metrics(r.time_s, r.measured_um, m);
+  } catch (const MetricsError& e) {
+    r.validity.fail(fmt::format("the step response has no metrics: {}", e.what()));
+    r.metrics.settling_time_pct_s = r.metrics.settling_time_abs_s =
+        std::numeric_limits<double>::infinity();
+  }
   r.simulated_time_s = bench.time_s();
   check_fault(bench, r.validity, "during the step");
   if (const std::string sat = saturation_problem(bench, o.step_um); !sat.empty())
@@ -194,7 +246,11 @@ LinearityResult run_linearity(const io::ProjectConfig& config,
     if (progress)
       progress(k + 1, last + 1, "linearity");
   }
-  r.metrics = linearity_metrics(r.desired_um, r.measured_um);
+  try {
+    r.metrics = linearity_metrics(r.desired_um, r.measured_um);
+  } catch (const MetricsError& e) {
+    r.validity.fail(fmt::format("the sweep has no linearity: {}", e.what()));
+  }
   r.simulated_time_s = bench.time_s();
   check_fault(bench, r.validity, "during the linearity run");
   return r;
@@ -225,7 +281,11 @@ RepeatabilityResult run_repeatability(const io::ProjectConfig& config,
     if (progress)
       progress(i + 1, o.moves, label);
   }
-  r.metrics = repeatability_metrics(r.measured_um);
+  try {
+    r.metrics = repeatability_metrics(r.measured_um);
+  } catch (const MetricsError& e) {
+    r.validity.fail(fmt::format("the moves have no repeatability: {}", e.what()));
+  }
   r.simulated_time_s = bench.time_s();
   check_fault(bench, r.validity, "during the repeatability run");
   return r;

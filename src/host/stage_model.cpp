@@ -58,6 +58,8 @@ StageModel::StageModel(const StageModelParams& params)
     : params_(params), points_(params.measurement_points), feedforward_(params.controller) {
   if (!(params.z_max_um > 0.0) || !std::isfinite(params.z_max_um))
     throw std::invalid_argument("stage model: the travel z_max_um must be > 0");
+  if (!(params.z_min_um >= 0.0 && params.z_min_um < params.z_max_um))
+    throw std::invalid_argument("stage model: the travel z_min_um must be in [0, z_max_um)");
   if (!(params.amplifier_gain > 0.0) || !(params.channel_max_V > 0.0))
     throw std::invalid_argument("stage model: amplifier gain and channel range must be > 0");
   Eigen::Matrix3d a;
@@ -110,7 +112,7 @@ StageModel::StageModel(const StageModelParams& params)
 
   // Travel limits (header comment): Z over the calibrated travel, U and V by bisection from the
   // mid-travel pose, where every actuator has room both ways.
-  min_ = {0.0, 0.0, 0.0};
+  min_ = {params.z_min_um, 0.0, 0.0};
   max_ = {params.z_max_um, 0.0, 0.0};
   const double z_mid = 0.5 * params.z_max_um;
   if (reachable({z_mid, 0.0, 0.0})) {
@@ -173,9 +175,9 @@ std::string StageModel::unreachable_reason(const AxisValues& pose) const {
       return "the pose is not finite";
   const Vec3 z = points_for(pose);
   for (std::size_t i = 0; i < 3; ++i) {
-    if (z[i] < -kSlack || z[i] > params_.z_max_um + kSlack) {
-      return fmt::format("point P{} would be at {:.4f} um, outside [0, {:.4f}] um", i + 1, z[i],
-                         params_.z_max_um);
+    if (z[i] < params_.z_min_um - kSlack || z[i] > params_.z_max_um + kSlack) {
+      return fmt::format("point P{} would be at {:.4f} um, outside [{:.4f}, {:.4f}] um", i + 1,
+                         z[i], params_.z_min_um, params_.z_max_um);
     }
   }
   const Vec3 s = feedforward_.actuator_targets(z);

@@ -308,24 +308,35 @@ ReportFiles write_report(const ReproductionResult& r, const fs::path& dir,
       config_label, r.simulated_time_s, r.wall_time_s));
 
   h(2, "Table 4: results");
-  const auto travel_cell = [](const ExperimentSet& e) {
-    return fmt::format("{:.2f} um @open loop; {:.1f} um @semi-closed loop", e.travel.open_loop_um,
-                       e.travel.semi_closed_um);
+  // A cell whose experiment is not valid says so, never a number.
+  const auto valid_or = [](const experiments::Validity& v, std::string text) {
+    return v.valid ? text : "NOT VALID: " + v.reason;
   };
-  const auto step_cell = [&seconds_of = seconds](const ExperimentSet& e) {
-    return fmt::format("{} @{:g} um (+-2 %); {} to +-10 nm",
-                       seconds_of(e.step.metrics.settling_time_pct_s), e.step.desired_um.back(),
-                       seconds_of(e.step.metrics.settling_time_abs_s));
+  const auto travel_cell = [&](const ExperimentSet& e) {
+    return valid_or(e.travel.validity, fmt::format("{:.2f} um @open loop; {:.1f} um @semi-closed loop", e.travel.open_loop_um,
+                       e.travel.semi_closed_um));
   };
-  const auto linearity_cell = [](const ExperimentSet& e) {
-    return fmt::format("{:.3f} % (zero-end); {:.3f} % (best fit)",
-                       e.linearity.metrics.linearity_zero_end_pct,
-                       e.linearity.metrics.linearity_best_fit_pct);
+  const auto step_cell = [&](const ExperimentSet& e) {
+    return valid_or(e.step.validity,
+                    fmt::format("{} @{:g} um (+-2 %); {} to +-10 nm",
+                                seconds(e.step.metrics.settling_time_pct_s),
+                                e.step.desired_um.back(),
+                                seconds(e.step.metrics.settling_time_abs_s)));
   };
-  const auto repeat_cell = [](const ExperimentSet& e) {
-    return fmt::format("{:.2f} nm @5 um (n = {}); {:.2f} nm @10 um (n = {})",
-                       e.repeat_5um.metrics.repeatability_nm, e.repeat_5um.metrics.n,
-                       e.repeat_10um.metrics.repeatability_nm, e.repeat_10um.metrics.n);
+  const auto linearity_cell = [&](const ExperimentSet& e) {
+    return valid_or(e.linearity.validity,
+                    fmt::format("{:.3f} % (zero-end); {:.3f} % (best fit)",
+                                e.linearity.metrics.linearity_zero_end_pct,
+                                e.linearity.metrics.linearity_best_fit_pct));
+  };
+  const auto repeat_cell = [&](const ExperimentSet& e) {
+    return valid_or(e.repeat_5um.validity,
+                    fmt::format("{:.2f} nm @5 um (n = {})", e.repeat_5um.metrics.repeatability_nm,
+                                e.repeat_5um.metrics.n)) +
+           "; " +
+           valid_or(e.repeat_10um.validity,
+                    fmt::format("{:.2f} nm @10 um (n = {})",
+                                e.repeat_10um.metrics.repeatability_nm, e.repeat_10um.metrics.n));
   };
   table({{"", "Travel range", "Step response", "Linearity", "Repeatability (1 sigma)"},
          {"This paper", "12.9 um @open loop; 11.5 um @semi-closed loop", "<0.3 s @11 um", "0.21 %",
@@ -356,14 +367,13 @@ ReportFiles write_report(const ReproductionResult& r, const fs::path& dir,
     "instead of the strain gauges (and so with no cubic to correct): the floor no controller fed "
     "by the gauges can beat.");
   h(3, "Linearity beyond the paper's protocol");
-  const auto lin_row = [](const char* name, const experiments::LinearityResult& a,
-                          const experiments::LinearityResult& b) {
-    return std::vector<std::string>{
-        name,
-        fmt::format("{:.3f} % / {:.3f} %", a.metrics.linearity_zero_end_pct,
-                    a.metrics.linearity_best_fit_pct),
-        fmt::format("{:.3f} % / {:.3f} %", b.metrics.linearity_zero_end_pct,
-                    b.metrics.linearity_best_fit_pct)};
+  const auto lin_cell = [&](const experiments::LinearityResult& l) {
+    return valid_or(l.validity, fmt::format("{:.3f} % / {:.3f} %", l.metrics.linearity_zero_end_pct,
+                                            l.metrics.linearity_best_fit_pct));
+  };
+  const auto lin_row = [&](const char* name, const experiments::LinearityResult& a,
+                           const experiments::LinearityResult& b) {
+    return std::vector<std::string>{name, lin_cell(a), lin_cell(b)};
   };
   table({{"sweep (zero-end / best fit)", "paper's controller", "oracle"},
          lin_row("0 to 11 um in 1 um, upwards (the paper's)", r.linearity, r.oracle.linearity),

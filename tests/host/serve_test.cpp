@@ -15,6 +15,7 @@
 #include <thread>
 #include <vector>
 
+#include <fmt/core.h>
 #include <gtest/gtest.h>
 #include <nlohmann/json.hpp>
 
@@ -121,6 +122,28 @@ class Serve : public piezoshift::testing::TempDirTest {
 fs::path Serve::suite_dir_;
 std::string Serve::calibration_;
 
+// What TMN? and TMX? advertise is reachable by one move, from rest and from mid-travel, without
+// a fault; one step beyond is refused up front (error 7), never a fault halfway.
+TEST_F(Serve, EveryZUpToTheAdvertisedTravelIsReachedByOneMove) {
+  const std::uint16_t port = start();
+  ASSERT_NE(port, 0);
+  GcsClient c("127.0.0.1", port);
+  const double z_max = value_of(c.query_lines("TMX?"), "Z");
+  const double z_min = value_of(c.query_lines("TMN?"), "Z");
+  c.send("SVO Z 1 U 1 V 1");
+  for (const double z : {z_max, 5.0, z_max, z_min, z_max}) {
+    c.send(fmt::format("MOV Z {} U 0 V 0", z));
+    EXPECT_EQ(error(c), 0) << z;
+    ASSERT_TRUE(wait_on_target(c)) << "MOV Z " << z;
+    EXPECT_NEAR(value_of(c.query_lines("POS?"), "Z"), z, 0.01);
+  }
+  c.send(fmt::format("MOV Z {}", z_max + 0.1));
+  EXPECT_EQ(error(c), 7);
+  c.send(fmt::format("MOV Z {}", z_min - 0.1));
+  EXPECT_EQ(error(c), 7);
+  EXPECT_EQ(c.query_lines("SVO?"), (std::vector<std::string>{"Z=1", "U=1", "V=1"}));
+}
+
 TEST_F(Serve, IdentifiesListsAxesMovesOnTargetAndAgreesWithTheInterferometer) {
   const std::uint16_t port = start();
   ASSERT_NE(port, 0);
@@ -130,9 +153,11 @@ TEST_F(Serve, IdentifiesListsAxesMovesOnTargetAndAgreesWithTheInterferometer) {
   EXPECT_EQ(c.query("SAI? ALL"), "Z \nU \nV\n");
   EXPECT_EQ(c.query_lines("PUN?"), (std::vector<std::string>{"Z=um", "U=urad", "V=urad"}));
   EXPECT_EQ(c.query_lines("SVO?"), (std::vector<std::string>{"Z=0", "U=0", "V=0"}));
-  // The calibration file's [travel] (11.5 um on the twin, Table 4's figure) bounds Z.
-  EXPECT_NEAR(value_of(c.query_lines("TMX?"), "Z"), 11.5, 0.15);
-  EXPECT_EQ(value_of(c.query_lines("TMN?"), "Z"), 0.0);
+  // The calibration file's [travel] bounds Z: the travel one move from rest reaches (11.1 um on
+  // this twin; Section 4.1's creeping search reaches 11.5), and the lowest Z one move down from
+  // there reaches (0.05 um: the stacks' hysteresis at 0 V).
+  EXPECT_NEAR(value_of(c.query_lines("TMX?"), "Z"), 11.1, 0.3);
+  EXPECT_NEAR(value_of(c.query_lines("TMN?"), "Z"), 0.05, 0.05);
 
   c.send("SVO Z 1 U 1 V 1");
   EXPECT_EQ(error(c), 0);

@@ -14,8 +14,10 @@
 //        [0.6321, 0.4397, -0.2980]]
 //
 //   [travel]                   # optional
-//   z_max_um = 11.5            # semi-closed-loop travel with this controller (Section 4.1);
-//                              # `piezoshift serve` takes its Z travel limit from it
+//   z_max_um = 11.1            # the travel one move from rest reaches with this controller
+//                              # (Section 4.1's search, then single moves); `serve`'s TMX? Z
+//   z_min_um = 0.1             # optional: the lowest Z a move from the top reaches (the stacks'
+//                              # hysteresis at 0 V); `serve`'s TMN? Z
 //
 // Every key is optional (absent: the paper's value, Section 4); an unknown key or section, a
 // wrong type or a bad value throws io::InputError naming file, key and reason. The run's own
@@ -38,15 +40,18 @@ void read_controller_section(const io::ConfigFile& file, control::SemiClosedLoop
 //! Loads a file holding [controller] and optionally [travel]; rejects anything else. The travel
 //! (empty when the file has none) goes to travel_z_max_um when given.
 control::SemiClosedLoopParams load_calibration_file(
-    const std::string& path, std::optional<double>* travel_z_max_um = nullptr);
+    const std::string& path, std::optional<double>* travel_z_max_um = nullptr,
+    std::optional<double>* travel_z_min_um = nullptr);
 
 //! The file's text; header lines (each prefixed with "# ") describe where it came from.
 std::string format_calibration(const control::SemiClosedLoopParams& params,
                                const std::string& header,
-                               std::optional<double> travel_z_max_um = std::nullopt);
+                               std::optional<double> travel_z_max_um = std::nullopt,
+                               std::optional<double> travel_z_min_um = std::nullopt);
 //! Writes format_calibration() atomically; throws io::InputError when the path is not writable.
 void write_calibration_file(const std::string& path, const control::SemiClosedLoopParams& params,
                             const std::string& header,
-                            std::optional<double> travel_z_max_um = std::nullopt);
+                            std::optional<double> travel_z_max_um = std::nullopt,
+                            std::optional<double> travel_z_min_um = std::nullopt);
 
 }  // namespace piezoshift::calibration

@@ -6,10 +6,15 @@
 //
 // Travel range (4.1)   open loop: all AO at 10 V (150 V) for open_loop_settle_s, then one static
 //                      reading; travel = mean of P1..P3.
-//                      semi-closed loop: Z_d from start_um upwards in increment_um, hold_s each,
+//                      semi-closed loop: Z_d from start_um upwards in increment_um, hold_s each
+//                      (from coarse_step_um lower, again, while start_um is not tracked),
 //                      one static reading; a level is tracked when no PID is at its output limit
 //                      and |mean(P) - Z_d| <= tolerance_um; travel = the last level tracked
-//                      before the first that is not.
+//                      before the first that is not. Then the single-move travel: from that
+//                      level down, the first that one move from rest reaches and tracks (what
+//                      `serve` advertises: creeping up lets creep lower the drive a level needs),
+//                      and the lowest level one move down from there reaches (the stacks'
+//                      hysteresis at 0 V leaves them above zero after a descent).
 // Step response (4.1)  Z_d = 0 for pre_s, then a step to step_um, record_s recorded with the
 //                      interferometer's dynamic mode (1 kHz); metrics_step_response.hpp on the
 //                      mean of P1..P3.
@@ -47,6 +52,9 @@ struct TravelRangeOptions {
   double max_um = 16.0;  //!< give up above this (the nominal stroke)
   double hold_s = 1.0;
   double tolerance_um = 0.05;
+  double min_increment_um = 0.05;  //!< grid of the lowest level reached from the top
+  //! When start_um is not tracked, the search starts again this much lower (down to > 0).
+  double coarse_step_um = 1.0;
   BenchOptions bench{};  //!< feedback (gauges or oracle) and the supervisor's limits
 };
 
@@ -54,7 +62,14 @@ struct TravelRangeResult {
   double open_loop_um = 0.0;
   control::Vec3 open_loop_points_um{};
   double semi_closed_um = 0.0;      //!< 0 when even start_um was not tracked
+  //! The largest level, from semi_closed_um down in increment_um, that one move from rest at 0
+  //! reaches and tracks (a fresh session, seed + 2): the travel a user can command.
+  double single_move_um = 0.0;
+  //! The lowest level, from 0 up in min_increment_um, that one move down from single_move_um
+  //! reaches and tracks (a fresh session, seed + 3).
+  double single_move_min_um = 0.0;
   std::vector<double> desired_um;   //!< every level tried
+  std::vector<double> tracked_levels;  //!< the levels tracked, in order (semi_closed_um last)
   std::vector<double> measured_um;  //!< mean of P1..P3
   std::vector<int> saturated_mask;  //!< controller saturation at the end of each level
   Validity validity;  //!< see validity.hpp and the header comment

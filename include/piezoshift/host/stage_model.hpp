@@ -49,6 +49,9 @@ struct StageModelParams {
   std::array<kinematics::PlatePoint, 3> actuators{};           //!< legs 1..3 in the plate frame
   //! Semi-closed-loop travel: Table 4, 11.5 um, unless the calibration file measured its own.
   double z_max_um = 11.5;
+  //! The lowest Z reachable from above: after a descent the stacks' hysteresis leaves them above
+  //! zero at 0 V, which the 0..150 V amplifier cannot undo. 0 unless the calibration measured it.
+  double z_min_um = 0.0;
   double amplifier_gain = 15.0;  //!< stack V per DAQ V, Section 4
   double channel_max_V = 150.0;  //!< amplifier output range, Section 4
 };
