@@ -135,5 +135,26 @@ TEST(CalibrationFile, WritesAtomicallyAndReadsBackTheSameDoubles) {
   std::filesystem::remove_all(dir);
 }
 
+// The procedure on a plant other than the default: a loose set screw (15 N/um of contact instead
+// of the identified 41.9) takes stroke the gauges never see. The calibration still closes, and
+// the travel search, restarting lower, reports the stage's real travel instead of 0.
+TEST(CalibrationWithTravel, ASoftContactPlantGetsItsRealTravel) {
+  io::ProjectConfig config;
+  config.twin.contact.stiffness_N_per_um = 15.0;
+  CalibrationOptions o = CalibrationOptions::paper_gains_only();
+  o.matrix.repeats = 1;
+  o.travel.open_loop_settle_s = 1.0;
+  o.travel.hold_s = 0.5;
+  o.travel.increment_um = 0.5;
+  const CalibrationWithTravel r = calibrate_with_travel(config, 5, o);
+  EXPECT_TRUE(r.travel.validity.valid) << r.travel.validity.reason;
+  EXPECT_GT(r.travel.semi_closed_um, 2.0);
+  EXPECT_LT(r.travel.semi_closed_um, 10.0);
+  EXPECT_GT(r.travel.single_move_um, 0.0);
+  EXPECT_LE(r.travel.single_move_um, r.travel.semi_closed_um);
+  // The open-loop travel falls with the contact (Eq. 1 with k_s in series): below the default's.
+  EXPECT_LT(r.travel.open_loop_um, 12.0);
+}
+
 }  // namespace
 }  // namespace piezoshift::calibration
