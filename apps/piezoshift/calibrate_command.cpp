@@ -82,9 +82,10 @@ int run(const Options& o) {
   }
   fmt::print("stage 3  cubic p    p3 {:.4e}, p2 {:.4e}, p1 {:.5f}, p0 {:.4f} um (rms {:.4f} um)\n",
              p.p3, p.p2, p.p1, p.p0, c.polynomial.fit.rms_residual_um);
-  fmt::print("travel   semi-closed loop {:.2f} um (Section 4.1); one move reaches {:.2f} to "
-             "{:.2f} um (written as z_min_um, z_max_um)\n",
-             travel.semi_closed_um, travel.single_move_min_um, travel.single_move_um);
+  fmt::print(
+      "travel   semi-closed loop {:.2f} um (Section 4.1); one move reaches {:.2f} to "
+      "{:.2f} um (written as z_min_um, z_max_um)\n",
+      travel.semi_closed_um, travel.single_move_min_um, travel.single_move_um);
   fmt::print("written: {}\n", o.out);
   return 0;
 }
@@ -98,8 +99,9 @@ void add_calibrate_command(CLI::App& app, Action& action) {
   cmd->add_option("--out", o->out, "calibration file to write (TOML, replaced atomically)");
   cmd->add_option("--seed", o->seed, "seed of the twin's random numbers");
   cmd->add_option("--config", o->config, "TOML configuration (configs/paper.toml's sections)");
-  cmd->add_option("--pid", o->pid,
-                  "paper: keep 0.6/0.2/0.001 (default); search: grid-search the gains on the full loop")
+  cmd->add_option(
+         "--pid", o->pid,
+         "paper: keep 0.6/0.2/0.001 (default); search: grid-search the gains on the full loop")
       ->check(CLI::IsMember({"paper", "search"}));
   cmd->add_flag("--json", o->json, "print a JSON summary");
   cmd->callback([o, &action] { action = [o] { return run(*o); }; });

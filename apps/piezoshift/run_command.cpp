@@ -62,12 +62,14 @@ int run(const RunOptions& o) {
   for (const std::string& f : o.faults)
     faults.push_back(parse_fault_spec(f));
 
-  const LoopCalibration cal = resolve_calibration(o.calibration, o.daq, io::ProjectConfig{}, o.seed);
+  const LoopCalibration cal =
+      resolve_calibration(o.calibration, o.daq, io::ProjectConfig{}, o.seed);
   const control::SemiClosedLoopParams& params = cal.params;
   if (o.step_um && cal.travel_z_max_um && *o.step_um > *cal.travel_z_max_um)
-    throw io::InputError(fmt::format("--step-um {}: beyond the calibrated semi-closed-loop "
-                                     "travel, {} um ({})",
-                                     *o.step_um, *cal.travel_z_max_um, cal.source));
+    throw io::InputError(
+        fmt::format("--step-um {}: beyond the calibrated semi-closed-loop "
+                    "travel, {} um ({})",
+                    *o.step_um, *cal.travel_z_max_um, cal.source));
 
   // The backend.
   const bool comedi = o.daq.rfind("comedi", 0) == 0;

@@ -64,8 +64,7 @@ void check(bool ok, const std::string& message) {
 
 host::StageModel make_stage_model(const ServeOptions& o, const io::ProjectConfig& config,
                                   const control::SemiClosedLoopParams& params,
-                                  const LoopCalibration& cal,
-                                  const runtime::SafetyLimits& safety) {
+                                  const LoopCalibration& cal, const runtime::SafetyLimits& safety) {
   try {
     host::StageModelParams mp = host::stage_model_params(config.twin.geometry, params);
     if (cal.travel_z_max_um)

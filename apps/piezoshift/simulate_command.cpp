@@ -25,11 +25,11 @@
 
 #include "command.hpp"
 #include "piezoshift/control/semi_closed_loop.hpp"
+#include "piezoshift/experiments/bench.hpp"
 #include "piezoshift/io/csv_table.hpp"
 #include "piezoshift/io/csv_writer.hpp"
 #include "piezoshift/io/input_error.hpp"
 #include "piezoshift/io/project_config.hpp"
-#include "piezoshift/experiments/bench.hpp"
 #include "piezoshift/plant/twin.hpp"
 
 namespace piezoshift::app {
@@ -148,9 +148,8 @@ int run_simulate(const SimulateOptions& opt) {
   try {
     made = std::make_unique<experiments::Bench>(config, cp, opt.seed);
   } catch (const std::invalid_argument& e) {
-    throw io::InputError(fmt::format("{}: {}", opt.config_path.empty() ? "configuration" :
-                                                                         opt.config_path,
-                                     e.what()));
+    throw io::InputError(fmt::format(
+        "{}: {}", opt.config_path.empty() ? "configuration" : opt.config_path, e.what()));
   }
   experiments::Bench& bench = *made;
   const plant::Twin& twin = bench.twin();
@@ -189,9 +188,8 @@ int run_simulate(const SimulateOptions& opt) {
         row.insert(row.end(), out.target_um.begin(), out.target_um.end());
         row.insert(row.end(), out.command_um.begin(), out.command_um.end());
       }
-      for (const Vec3* v : std::initializer_list<const Vec3*>{&c.supervisor.ao_V, &s.amplifier_V,
-                                                              &c.ai_V, &s.stack_elongation_um,
-                                                              &s.leg_um})
+      for (const Vec3* v : std::initializer_list<const Vec3*>{
+               &c.supervisor.ao_V, &s.amplifier_V, &c.ai_V, &s.stack_elongation_um, &s.leg_um})
         row.insert(row.end(), v->begin(), v->end());
       row.push_back(s.plate_z_um);
       row.push_back(s.theta_x_urad);

@@ -494,8 +494,7 @@ PYBIND11_MODULE(_piezoshift, m) {
           py::arg("duration_s"),
           "run() recording per tick: time_s, true mean of P1..P3 and mean SGS feedback [um]")
       .def("measure_static", &ex::Bench::measure_static)
-      .def_property_readonly("twin", &ex::Bench::twin,
-                             py::return_value_policy::reference_internal)
+      .def_property_readonly("twin", &ex::Bench::twin, py::return_value_policy::reference_internal)
       .def("last_output", &ex::Bench::last_output)
       .def_property_readonly("mode", &ex::Bench::mode)
       .def_property_readonly("time_s", &ex::Bench::time_s)

@@ -36,8 +36,8 @@ control::SemiClosedLoopParams load_calibration_file(const std::string& path,
       file.section("travel").read("z_min_um", z_min_um, io::Bounds::non_negative());
   file.reject_unknown();
   if (has_min && has_max && !(z_min_um < z_max_um))
-    throw io::InputError(fmt::format("{}: [travel] z_min_um = {} must be below z_max_um = {}",
-                                     path, z_min_um, z_max_um));
+    throw io::InputError(fmt::format("{}: [travel] z_min_um = {} must be below z_max_um = {}", path,
+                                     z_min_um, z_max_um));
   if (travel_z_max_um != nullptr)
     *travel_z_max_um = has_max ? std::optional<double>(z_max_um) : std::nullopt;
   if (travel_z_min_um != nullptr)

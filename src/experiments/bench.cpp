@@ -34,7 +34,8 @@ Bench::Bench(const io::ProjectConfig& config, const control::SemiClosedLoopParam
   }
   daq_ = sim_.get();
   if (options.feedback == Feedback::kOracle) {
-    oracle_ = std::make_unique<runtime::OracleBackend>(*sim_, controller.matrix, controller.scaling);
+    oracle_ =
+        std::make_unique<runtime::OracleBackend>(*sim_, controller.matrix, controller.scaling);
     daq_ = oracle_.get();
   }
   cycle_ = std::make_unique<runtime::ControlCycle>(controller, options.limits);

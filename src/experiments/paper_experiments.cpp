@@ -1,12 +1,12 @@
 #include "piezoshift/experiments/paper_experiments.hpp"
 
+#include <algorithm>
 #include <cmath>
 #include <limits>
 #include <stdexcept>
 #include <string>
 
 #include <fmt/core.h>
-
 
 namespace piezoshift::experiments {
 namespace {
@@ -126,8 +126,8 @@ TravelRangeResult run_travel_range(const io::ProjectConfig& config,
     }
   }
   if (r.validity.valid && r.single_move_um == 0.0)
-    r.validity.fail(fmt::format("no level from {:g} um up was reached by a single move from rest",
-                                o.start_um));
+    r.validity.fail(
+        fmt::format("no level from {:g} um up was reached by a single move from rest", o.start_um));
   // The lowest level one move from the top reaches: after a descent the stacks' hysteresis
   // leaves them above zero at 0 V, which the 0..150 V amplifier cannot undo.
   for (int k = 0; r.single_move_um > 0.0 && k * o.min_increment_um < r.single_move_um; ++k) {
@@ -163,12 +163,24 @@ StepExperimentResult run_step_response(const io::ProjectConfig& config,
   r.time_s.push_back(0.0);
   r.measured_um.push_back(mean3(bench.twin().interferometer().dynamic_um));
   r.desired_um.push_back(0.0);
+  r.truth_um.push_back(mean3(bench.twin().truth().points_um));
+  double truth_peak = r.truth_um.front();
   bench.drive_points(all(o.step_um));
   bench.run(o.record_s, [&](const Bench& b) {
     r.time_s.push_back(b.time_s() - t0);
     r.measured_um.push_back(mean3(b.twin().interferometer().dynamic_um));
     r.desired_um.push_back(o.step_um);
+    r.truth_um.push_back(mean3(b.twin().truth().points_um));
+    truth_peak = std::max(truth_peak, b.twin().truth().period_max_mean_points_um);
   });
+  // The plate between the ticks: its peak over every physics step against its final value (the
+  // mean of the last tenth of the record, as the interferometer's metrics take it).
+  const std::size_t tail = std::max<std::size_t>(1, r.truth_um.size() / 10);
+  double truth_final = 0.0;
+  for (std::size_t k = r.truth_um.size() - tail; k < r.truth_um.size(); ++k)
+    truth_final += r.truth_um[k] / static_cast<double>(tail);
+  r.truth_overshoot_pct =
+      std::max(0.0, 100.0 * (truth_peak - truth_final) / std::fabs(truth_final - r.truth_um[0]));
   StepResponseOptions m;
   m.step_time_s = 0.0;
   m.band_pct = o.band_pct;
@@ -185,12 +197,13 @@ StepExperimentResult run_step_response(const io::ProjectConfig& config,
   if (const std::string sat = saturation_problem(bench, o.step_um); !sat.empty())
     r.validity.fail(sat + " at the end of the record");
   if (!std::isfinite(r.metrics.settling_time_pct_s))
-    r.validity.fail(fmt::format("the step never settled within +-{:g} % in {:g} s", o.band_pct,
-                                o.record_s));
+    r.validity.fail(
+        fmt::format("the step never settled within +-{:g} % in {:g} s", o.band_pct, o.record_s));
   if (std::fabs(r.metrics.final_um - o.step_um) > o.target_tolerance_um)
-    r.validity.fail(fmt::format("the step did not reach its target: {:.3f} um for {:g} um "
-                                "(tolerance {:g} um)",
-                                r.metrics.final_um, o.step_um, o.target_tolerance_um));
+    r.validity.fail(
+        fmt::format("the step did not reach its target: {:.3f} um for {:g} um "
+                    "(tolerance {:g} um)",
+                    r.metrics.final_um, o.step_um, o.target_tolerance_um));
   if (progress)
     progress(1, 1, "step response");
   return r;
@@ -275,9 +288,10 @@ RepeatabilityResult run_repeatability(const io::ProjectConfig& config,
     if (const std::string sat = saturation_problem(bench, o.target_um); !sat.empty())
       r.validity.fail(fmt::format("move {}: {}", i + 1, sat));
     if (std::fabs(r.measured_um.back() - o.target_um) > o.target_tolerance_um)
-      r.validity.fail(fmt::format("move {} did not reach its target: {:.3f} um for {:g} um "
-                                  "(tolerance {:g} um)",
-                                  i + 1, r.measured_um.back(), o.target_um, o.target_tolerance_um));
+      r.validity.fail(
+          fmt::format("move {} did not reach its target: {:.3f} um for {:g} um "
+                      "(tolerance {:g} um)",
+                      i + 1, r.measured_um.back(), o.target_um, o.target_tolerance_um));
     if (progress)
       progress(i + 1, o.moves, label);
   }

@@ -112,8 +112,8 @@ ReproductionResult reproduce(const io::ProjectConfig& config, const ReproduceOpt
   with_feedback(so, experiments::Feedback::kOracle);
   run_set(r.oracle, config, r.oracle_controller, seed, so, progress);
   r.simulated_time_s = r.calibration.pid.simulated_time_s + r.calibration.matrix.simulated_time_s +
-                       r.calibration.polynomial.simulated_time_s + r.experiments_simulated_time_s() +
-                       r.oracle.experiments_simulated_time_s();
+                       r.calibration.polynomial.simulated_time_s +
+                       r.experiments_simulated_time_s() + r.oracle.experiments_simulated_time_s();
   r.wall_time_s = std::chrono::duration<double>(std::chrono::steady_clock::now() - start).count();
   return r;
 }

@@ -46,6 +46,7 @@ void set_json(nlohmann::json& j, const std::string& prefix, const ExperimentSet&
   j[prefix + "step_um"] = step.step_um;
   j[prefix + "step_rise_time_s"] = time_or_null(step.rise_time_s);
   j[prefix + "step_overshoot_pct"] = step.overshoot_pct;
+  j[prefix + "step_truth_overshoot_pct"] = e.step.truth_overshoot_pct;
   j[prefix + "step_settling_time_s"] = time_or_null(step.settling_time_pct_s);
   j[prefix + "step_settling_time_10nm_s"] = time_or_null(step.settling_time_abs_s);
   j[prefix + "linearity_zero_end_pct"] = e.linearity.metrics.linearity_zero_end_pct;

@@ -28,7 +28,8 @@ ControlCycle::ControlCycle(const control::SemiClosedLoopParams& params,
 void ControlCycle::configure(const control::SemiClosedLoopParams& params) {
   if (std::fabs(params.sample_time_s - controller_.params().sample_time_s) >
       1e-12 * controller_.params().sample_time_s)
-    throw std::invalid_argument("control cycle: the controller's sample time differs from the loop's");
+    throw std::invalid_argument(
+        "control cycle: the controller's sample time differs from the loop's");
   const Vec3 held = held_command_um();
   controller_.configure(params);
   controller_.reset_to(held);

@@ -40,6 +40,39 @@ TEST_F(ReproduceCommand, CalibrateWritesAFileThatRunLoads) {
   EXPECT_EQ(r.status, 0) << r.err;
 }
 
+// A plant whose experiments cannot be done is reported not valid, with the reason and exit status
+// 4, never as a plausible number: one stack with 80 % of its stroke cannot make the 11 um step.
+TEST_F(ReproduceCommand, AnInvalidExperimentIsAFailureWithItsReason) {
+  const std::string cfg = write("short.toml", "[twin.piezo]\nfree_stroke_scale = [1, 0.8, 1]\n");
+  const testing::CliResult r =
+      run("reproduce --quick --json --config '" + cfg + "' --out '" + path("o") + "'");
+  EXPECT_EQ(r.status, 4) << r.err;
+  const auto j = nlohmann::json::parse(r.out);
+  EXPECT_FALSE(j["valid"].get<bool>());
+  EXPECT_FALSE(j["validity"]["step"]["valid"].get<bool>());
+  EXPECT_NE(j["validity"]["step"]["reason"].get<std::string>().find("supervisor"),
+            std::string::npos);
+  EXPECT_TRUE(j["oracle_travel_open_loop_um"].is_number());
+  const testing::CliResult text =
+      run("reproduce --quick --config '" + cfg + "' --out '" + path("o2") + "'");
+  EXPECT_EQ(text.status, 4);
+  EXPECT_NE(text.out.find("step response    NOT VALID: "), std::string::npos) << text.out;
+  EXPECT_NE(text.err.find("not valid"), std::string::npos) << text.err;
+}
+
+// Without a calibration file, `run --daq sim` calibrates the twin first, so the paper's 11 um
+// step (Figure 10) runs without a fault; a step beyond the measured travel is refused up front.
+TEST_F(ReproduceCommand, RunOnTheTwinWithoutACalibrationMakesThePapersStep) {
+  testing::CliResult r = run("run --daq sim --free-run --step-um 11 --duration-s 1 --json");
+  ASSERT_EQ(r.status, 0) << r.err;
+  EXPECT_FALSE(nlohmann::json::parse(r.out)["fault_detected"].get<bool>());
+  EXPECT_NE(r.err.find("calibrating the twin first"), std::string::npos) << r.err;
+  r = run("run --daq sim --free-run --step-um 12 --duration-s 1");
+  EXPECT_EQ(r.status, 2);
+  EXPECT_NE(r.err.find("beyond the calibrated semi-closed-loop travel"), std::string::npos)
+      << r.err;
+}
+
 TEST_F(ReproduceCommand, BadInputExitsWithStatusTwo) {
   const std::string bad = write("bad.toml", "[twin.piezo]\nfree_stroke_scale = [1, -1, 1]\n");
   testing::CliResult r = run("reproduce --quick --config '" + bad + "' --out '" + path("o") + "'");

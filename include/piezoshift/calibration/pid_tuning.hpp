@@ -15,9 +15,9 @@
 // overshoot is <= max_overshoot_pct ("little or even no overshoot"), it settled within the
 // record and the steady-state error is <= max_steady_state_error_nm. (An actuator stepped alone
 // scores a different loop: the plate couples the legs, and the overshoot the single-leg score
-// passed showed on the full step, 3 to 9 %, and between the ticks.) Among acceptable candidates the one with the shortest worst
-// settling time wins, ties going to the smaller error; if none is acceptable, the smallest
-// worst-case overshoot wins and `acceptable` says so.
+// passed showed on the full step, 3 to 9 %, and between the ticks.) Among acceptable candidates the
+// one with the shortest worst settling time wins, ties going to the smaller error; if none is
+// acceptable, the smallest worst-case overshoot wins and `acceptable` says so.
 //
 // S_max,i is what actuator i's SGS reads at the full 10 V open loop (measured first, on the
 // same twin), times step_fraction (< 1, so that the step scores the loop and not the amplifier's
@@ -40,7 +40,7 @@ struct PidScore {
 struct PidTrial {
   control::PidGains gains{};
   std::array<PidScore, 3> per_actuator{};
-  PidScore worst{};  //!< element-wise worst over the three actuators
+  PidScore worst{};                  //!< element-wise worst over the three actuators
   double plate_overshoot_pct = 0.0;  //!< the plate between ticks (physics-rate truth)
   bool faulted = false;              //!< the supervisor tripped during the step
   bool acceptable = false;

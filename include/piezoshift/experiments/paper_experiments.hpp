@@ -17,7 +17,8 @@
 //                      hysteresis at 0 V leaves them above zero after a descent).
 // Step response (4.1)  Z_d = 0 for pre_s, then a step to step_um, record_s recorded with the
 //                      interferometer's dynamic mode (1 kHz); metrics_step_response.hpp on the
-//                      mean of P1..P3.
+//                      mean of P1..P3; and the true plate's overshoot between the ticks (the
+//                      twin's physics-rate truth).
 // Linearity (4.2)      Z_d = 0, 1, ..., 11 um, step_hold_s each, one static (1 s) sample per
 //                      second; the displacement of a level is the mean of its samples after the
 //                      first skip_samples; metrics_linearity.hpp. The same protocol also runs on
@@ -61,18 +62,18 @@ struct TravelRangeOptions {
 struct TravelRangeResult {
   double open_loop_um = 0.0;
   control::Vec3 open_loop_points_um{};
-  double semi_closed_um = 0.0;      //!< 0 when even start_um was not tracked
+  double semi_closed_um = 0.0;  //!< 0 when even start_um was not tracked
   //! The largest level, from semi_closed_um down in increment_um, that one move from rest at 0
   //! reaches and tracks (a fresh session, seed + 2): the travel a user can command.
   double single_move_um = 0.0;
   //! The lowest level, from 0 up in min_increment_um, that one move down from single_move_um
   //! reaches and tracks (a fresh session, seed + 3).
   double single_move_min_um = 0.0;
-  std::vector<double> desired_um;   //!< every level tried
+  std::vector<double> desired_um;      //!< every level tried
   std::vector<double> tracked_levels;  //!< the levels tracked, in order (semi_closed_um last)
-  std::vector<double> measured_um;  //!< mean of P1..P3
-  std::vector<int> saturated_mask;  //!< controller saturation at the end of each level
-  Validity validity;  //!< see validity.hpp and the header comment
+  std::vector<double> measured_um;     //!< mean of P1..P3
+  std::vector<int> saturated_mask;     //!< controller saturation at the end of each level
+  Validity validity;                   //!< see validity.hpp and the header comment
   double simulated_time_s = 0.0;
 };
 
@@ -92,7 +93,11 @@ struct StepExperimentResult {
   std::vector<double> time_s;       //!< from the step instant
   std::vector<double> measured_um;  //!< interferometer, dynamic mode, mean of P1..P3
   std::vector<double> desired_um;
+  std::vector<double> truth_um;  //!< the twin's true mean of P1..P3 at each tick
   StepResponseMetrics metrics;
+  //! Overshoot of the true plate over every physics step, between the ticks included [% of the
+  //! step]: what the 1 kHz samples can miss.
+  double truth_overshoot_pct = 0.0;
   Validity validity;  //!< see validity.hpp and the header comment
   double simulated_time_s = 0.0;
 };

@@ -61,7 +61,7 @@ struct TwinTruth {
   //! ringing between control ticks, which the tick-rate samples miss.
   double period_max_mean_points_um = 0.0;
   double period_min_mean_points_um = 0.0;
-  Vec3 sgs_V{};                //!< conditioner outputs before the ADC (noise included)
+  Vec3 sgs_V{};  //!< conditioner outputs before the ADC (noise included)
   double air_temperature_C = 0.0;
   double structure_temperature_C = 0.0;
 };
@@ -145,7 +145,7 @@ class Twin {
   double lsb_V_ = 0.0, inv_lsb_V_ = 0.0;  // DAQ
   double code_min_ = 0.0, code_max_ = 0.0;
   LinearMechanics mechanics_;
-  std::array<double, 3> mean_point_modal_{};  // see update_mean_point_weights
+  std::array<double, 3> mean_point_modal_{};    // see update_mean_point_weights
   std::vector<std::array<double, 3>> force_N_;  // stack forces of one period, per physics step
 
   // State
