@@ -57,7 +57,9 @@ def test_zernike_fit_and_unwrap():
     y, x = np.mgrid[0:n, 0:n]
     xn, yn = (x - 31.5) / 31.5, (31.5 - y) / 31.5
     mask = (xn**2 + yn**2) <= 1.0
-    z2 = 2 * xn  # Noll Z2
+    # the unit disk is the pupil of the mask: centroid and largest pixel distance (grid.hpp)
+    r = np.sqrt((x - 31.5)**2 + (y - 31.5)**2)[mask].max()
+    z2 = 2 * (x - 31.5) / r  # Noll Z2
     c = ps.zernike_fit(np.where(mask, 5.0 * z2, np.nan), mask, 11)
     assert c[1] == pytest.approx(5.0, abs=1e-9)
     phi = 0.8 * x
