@@ -17,8 +17,9 @@
 //   Schwider et al. 1983):        n = (0, -2, 0, 2, 0),  d = (1, 0, -2, 0, 1),  steps pi/2
 //     under a step of pi/2 (1 + eps): tan(psi') = tan(psi) / cos(pi eps / 2), psi = phi + pi
 //   de Groot 7-frame (de Groot 1995, Appl. Opt. 34(22):4723):
-//                                 n = (1, 0, -7, 0, 7, 0, -1) ... as the literature's
-//                                 (-I1 + 7 I3 - 7 I5 + I7) / (-4 I2 + 8 I4 - 4 I6), steps pi/2
+//                                 n = (-1, 0, 7, 0, -7, 0, 1),  d = (0, -4, 0, 8, 0, -4, 0):
+//                                 the literature's (-I1 + 7 I3 - 7 I5 + I7) / (-4 I2 + 8 I4 - 4 I6)
+//                                 with 1-based frames, phase at the centre frame; steps pi/2
 //   13-frame pi/4: a Hann-windowed DFT over 13 frames at pi/4 (de Groot's data-sampling-window
 //     construction), projected so that it rejects the background and the conjugate term exactly
 //     and the conjugate term to first order in a linear step error. Built here, not copied from
