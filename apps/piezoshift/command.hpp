@@ -20,5 +20,6 @@ void add_reproduce_command(CLI::App& app, Action& action);  // reproduce_command
 void add_calibrate_command(CLI::App& app, Action& action);  // calibrate_command.cpp
 void add_serve_command(CLI::App& app, Action& action);      // serve_command.cpp
 void add_gcs_command(CLI::App& app, Action& action);        // gcs_command.cpp
+void add_psi_command(CLI::App& app, Action& action);        // psi_command.cpp
 
 }  // namespace piezoshift::app

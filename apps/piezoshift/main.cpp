@@ -23,6 +23,7 @@ int main(int argc, char** argv) {
   piezoshift::app::add_serve_command(app, action);
   piezoshift::app::add_gcs_command(app, action);
   piezoshift::app::add_reproduce_command(app, action);
+  piezoshift::app::add_psi_command(app, action);
 
   try {
     app.parse(argc, argv);

@@ -118,6 +118,8 @@ py::object json_to_python(const nlohmann::json& j) {
       #f, [](const T& s) { return to_numpy(s.f); }, \
       [](T& s, const decltype(T::f)& v) { s.f = v; })
 
+void bind_psi(py::module_& m);  // psi_py.cpp
+
 PYBIND11_MODULE(_piezoshift, m) {
   m.doc() = "piezoshift: design, digital twin, calibration and experiments (offline API)";
 
@@ -138,6 +140,7 @@ PYBIND11_MODULE(_piezoshift, m) {
       input_error(e.what());
     }
   });
+  bind_psi(m);
 
   // ---- control (the parameters the offline API takes) -------------------------------------
   py::class_<ps::control::PidGains>(m, "PidGains")
