@@ -1,12 +1,12 @@
 // End-to-end test of the dashboard in a real browser (ctest: dashboard_e2e). Starts
-// `piezoshift serve --daq sim --http-port 0 --fault sgs-open@T`, opens the page in Debian's
+// `piezoshift serve --daq sim --http-port 0` (then a second one with --fault sgs-open@T), opens the page in Debian's
 // headless Chromium through playwright-core (no browser is downloaded), and checks:
 //   the stream runs at >= 20 updates/s; a click on "Move absolute" to Z = 5 um shows in the scope's
 //   position trace and the readout within 2 s; GCS POS? (a second client) sees that move; a GCS
 //   MOV is seen on the page; the injected fault is shown with its reason; screenshots are kept.
 //   node e2e/dashboard_e2e.mjs --cli PATH/piezoshift --artifacts DIR
 import { spawn } from "node:child_process";
-import { existsSync, mkdirSync } from "node:fs";
+import { existsSync, mkdirSync, readFileSync } from "node:fs";
 import net from "node:net";
 import { join } from "node:path";
 
@@ -15,7 +15,8 @@ const opt = (n) => (args.indexOf(n) >= 0 ? args[args.indexOf(n) + 1] : undefined
 const cli = opt("--cli");
 const artifacts = opt("--artifacts") || ".";
 const CHROMIUM = "/usr/bin/chromium";
-const FAULT_AT_S = 20;
+// A second server gets the fault, this long after its start (servo on and a move first).
+const FAULT_AT_S = 3;
 
 let failures = 0;
 let passes = 0;
@@ -40,22 +41,31 @@ try {
 }
 mkdirSync(artifacts, { recursive: true });
 
-// ---- the server
-const server = spawn(cli, ["serve", "--daq", "sim", "--port", "0", "--http-port", "0",
-  "--max-overruns", "1000000", "--fault", `sgs-open@${FAULT_AT_S}`, "--json"],
-  { stdio: ["ignore", "pipe", "pipe"] });
-let out = "";
-server.stdout.on("data", (d) => { out += d; });
-server.stderr.on("data", (d) => process.stderr.write(d));
-const started = Date.now();
-while (!/GCS 2\.0 on 127\.0\.0\.1:\d+/.test(out)) {
-  if (Date.now() - started > 30000 || server.exitCode !== null) fatal(`serve did not start:\n${out}`);
-  await new Promise((r) => setTimeout(r, 20));
+// ---- the server: started, its ports read from its start-up lines
+async function startServe(extra) {
+  const proc = spawn(cli, ["serve", "--daq", "sim", "--port", "0", "--http-port", "0",
+    "--max-overruns", "1000000", "--json", ...extra], { stdio: ["ignore", "pipe", "pipe"] });
+  let out = "";
+  proc.stdout.on("data", (d) => { out += d; });
+  proc.stderr.on("data", (d) => process.stderr.write(d));
+  const started = Date.now();
+  while (!/GCS 2\.0 on 127\.0\.0\.1:\d+/.test(out)) {
+    if (Date.now() - started > 30000 || proc.exitCode !== null) fatal(`serve did not start:\n${out}`);
+    await new Promise((r) => setTimeout(r, 20));
+  }
+  const http = Number(/dashboard on http:\/\/127\.0\.0\.1:(\d+)\//.exec(out)[1]);
+  const gcs = Number(/GCS 2\.0 on 127\.0\.0\.1:(\d+)/.exec(out)[1]);
+  console.log(`serve ${extra.join(" ")}: dashboard http://127.0.0.1:${http}/, GCS port ${gcs}`);
+  return { proc, url: `http://127.0.0.1:${http}/`, gcs };
 }
-const httpPort = Number(/dashboard on http:\/\/127\.0\.0\.1:(\d+)\//.exec(out)[1]);
-const gcsPort = Number(/GCS 2\.0 on 127\.0\.0\.1:(\d+)/.exec(out)[1]);
-const url = `http://127.0.0.1:${httpPort}/`;
-console.log(`serve: dashboard ${url}, GCS port ${gcsPort}`);
+async function stopServe(s) {
+  s.proc.kill("SIGTERM");
+  const code = await new Promise((r) => (s.proc.exitCode !== null ? r(s.proc.exitCode) : s.proc.on("exit", r)));
+  check(code === 0, `serve exited with ${code} after SIGTERM`);
+}
+let server = await startServe([]);
+let gcsPort = server.gcs;
+const url = server.url;
 
 // A tiny GCS client (one line out, one answer in).
 function gcsQuery(line) {
@@ -133,16 +143,60 @@ try {
   // An error from the server is shown: a move beyond the travel is GCS error 7.
   await page.fill("#move-z", "50");
   await page.click("#btn-move");
+  await page.fill("#move-z", "5");
   const shown = await page.waitForFunction(() =>
     document.getElementById("log").textContent.includes("GCS error 7"),
   null, { timeout: 3000 }).then(() => true, () => false);
   check(shown, "a refused move shows GCS error 7 on the page");
 
-  // The fault, with its reason.
+  // A lambda/8 step sequence: 4 steps of 79.1 nm from 3 um.
+  await page.click("#btn-lambda8");
+  check((await page.inputValue("#seq-step")) === "79.1", "the lambda/8 preset is 79.1 nm");
+  await page.fill("#seq-count", "4");
+  await page.fill("#seq-dwell", "50");
+  const seqStart = Date.now();
+  await page.click("#btn-seq");
+  await page.waitForFunction(() => document.getElementById("seq-state").textContent !== "idle",
+    null, { timeout: 5000, polling: 10 }).catch(() => {});
+  const stepped = await page.waitForFunction(() =>
+    Math.abs(Number(document.getElementById("tgt-z").textContent) - 3.3164) < 0.0005 &&
+    document.getElementById("seq-state").textContent === "idle",
+  null, { timeout: 15000, polling: 50 }).then(() => true, () => false);
+  console.log(`     (sequence and readout: ${Date.now() - seqStart} ms)`);
+  const zAfter = zOf(await gcsQuery("MOV?"));
+  check(stepped && Math.abs(zAfter - 3.3164) < 1e-6, `4 lambda/8 steps from 3 um: GCS MOV? Z=${zAfter}`);
+
+  // Pause freezes the scope; Export CSV saves what is on screen.
+  await page.selectOption("#window", "0.5");
+  await page.click("#btn-pause");
+  const frozen = await page.evaluate(() => window.piezoshift.charts.z.data[0].at(-1));
+  await page.waitForTimeout(300);
+  const still = await page.evaluate(() => window.piezoshift.charts.z.data[0].at(-1));
+  check(frozen === still, "Pause freezes the scope");
+  const [download] = await Promise.all([page.waitForEvent("download"), page.click("#btn-csv")]);
+  const csvPath = join(artifacts, "dashboard-export.csv");
+  await download.saveAs(csvPath);
+  const csv = readFileSync(csvPath, "utf8").trim().split("\n");
+  check(csv[0].startsWith("t_s,setpoint_z_um,position_z_um") && csv.length > 400 && csv.length < 600,
+    `CSV export of the 0.5 s on screen: ${csv.length - 1} rows`);
+  await page.click("#btn-pause");
+  await page.selectOption("#window", "2");
+
+  check(await page.$eval("#fault-banner", (e) => e.classList.contains("hidden")),
+    "no fault shown while none is injected");
+
+  // The fault, with its reason: a second server whose gauge 1 opens FAULT_AT_S after its start,
+  // at Z = 5 um (a fault latched with the servo off stays shown too: the latch waits for SVO).
+  await stopServe(server);
+  server = await startServe(["--fault", `sgs-open@${FAULT_AT_S}`]);
+  gcsPort = server.gcs;
+  await gcsQuery("SVO Z 1 U 1 V 1");
+  await gcsQuery("MOV Z 5");
+  await page.goto(server.url);
   const faulted = await page.waitForFunction(() =>
     !document.getElementById("fault-banner").classList.contains("hidden") &&
     document.getElementById("fault-reason").textContent.includes("sgs-rail"),
-  null, { timeout: (FAULT_AT_S + 20) * 1000 }).then(() => true, () => false);
+  null, { timeout: (FAULT_AT_S + 30) * 1000 }).then(() => true, () => false);
   const reason = await page.textContent("#fault-banner");
   check(faulted, `fault shown: ${reason.replace(/\s+/g, " ").trim()}`);
   await page.waitForTimeout(300);
@@ -152,9 +206,7 @@ try {
   check(false, `unexpected: ${e.stack || e}`);
 } finally {
   await browser.close();
-  server.kill("SIGTERM");
-  const code = await new Promise((r) => (server.exitCode !== null ? r(server.exitCode) : server.on("exit", r)));
-  check(code === 0, `serve exited with ${code} after SIGTERM`);
+  await stopServe(server);
 }
 console.log(`dashboard_e2e: ${passes} passed, ${failures} failed`);
 process.exit(failures === 0 ? 0 : 1);
