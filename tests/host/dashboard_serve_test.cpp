@@ -186,7 +186,8 @@ TEST_F(Dashboard, DashboardAndGcsMoveTheSameStage) {
 // only to copy samples out and run its own command lines (microseconds), and the streams are
 // written from the HTTP thread, so GCS answers should not see them; the figures are printed and
 // documented in docs/performance.md. Asserted: p99 within 5 ms of the baseline's, and the max
-// under a generous 50 ms (a shared 2-core CI machine can deschedule any thread for tens of ms).
+// under a generous 100 ms: a shared 2-core CI machine deschedules any thread for tens of ms (27 ms
+// seen without streams, 36 ms with them under ASan), which says nothing about the dashboard.
 TEST_F(Dashboard, TenStreamsDoNotDelayGcsAnswers) {
   ASSERT_TRUE(start({}));
   GcsClient gcs("127.0.0.1", gcs_port_);
@@ -250,7 +251,7 @@ TEST_F(Dashboard, TenStreamsDoNotDelayGcsAnswers) {
                   static_cast<double>(bytes[k]) / 1e3 / (span_s + 0.5));
   }
   EXPECT_LT(pct(loaded, 0.99), pct(base, 0.99) + 5.0);
-  EXPECT_LT(loaded.back(), 50.0);
+  EXPECT_LT(loaded.back(), 100.0);
   EXPECT_EQ(stop(), 0);
   const std::string out = slurp(path("out.txt"));
   const nlohmann::json j = nlohmann::json::parse(out.substr(out.find('{')));

@@ -179,7 +179,7 @@ setInterval(() => {
 }, 1000);
 let lastFrame = 0;
 function frame(now) {
-  if (now - lastFrame >= 33) { // ~30 frames/s at most
+  if (now - lastFrame >= 40) { // 25 frames/s at most: the stream's own rate
     lastFrame = now;
     render();
   }
