@@ -1,31 +1,41 @@
 // `piezoshift serve`: the real-time loop (docs/runtime.md) driven by GCS 2.0 clients over TCP
 // (docs/gcs.md). Two threads: the loop (real-time when granted) and one network thread that owns
 // every socket and the GCS interpreter; they meet only in runtime::HostLink's lock-free rings.
+// With --http-port a third, normal thread serves the dashboard (docs/dashboard.md): it reads the
+// samples the GCS interpreter drains and sends its controls through it, under one mutex.
 //
 // Exit status: 0 stopped by SIGINT/SIGTERM or --duration-s; 2 bad input (including an address
 // that cannot be bound or a DAQ device that cannot be opened); 1 internal error.
 #include <cmath>
 #include <cstdio>
 #include <exception>
+#include <fstream>
 #include <limits>
 #include <memory>
+#include <mutex>
 #include <optional>
 #include <string>
 #include <thread>
+#include <vector>
 
 #include <fmt/core.h>
 #include <nlohmann/json.hpp>
 
 #include "command.hpp"
+#include "dashboard_page.hpp"
 #include "loop_setup.hpp"
 #include "piezoshift/calibration/calibration_file.hpp"
+#include "piezoshift/host/dashboard.hpp"
 #include "piezoshift/host/gcs_controller.hpp"
+#include "piezoshift/host/http_server.hpp"
 #include "piezoshift/host/line_server.hpp"
+#include "piezoshift/host/locked_line_handler.hpp"
 #include "piezoshift/host/stage_model.hpp"
 #include "piezoshift/io/input_error.hpp"
 #include "piezoshift/io/project_config.hpp"
 #include "piezoshift/runtime/control_loop.hpp"
 #include "piezoshift/runtime/csv_logger.hpp"
+#include "piezoshift/runtime/fault_injection.hpp"
 #include "piezoshift/runtime/loop_clock.hpp"
 
 namespace piezoshift::app {
@@ -55,11 +65,39 @@ struct ServeOptions {
   int cpu = -1;
   std::string log;
   bool json = false;
+  std::vector<std::string> faults;
+  int http_port = -1;  // -1: no dashboard
+  std::string http_bind = "127.0.0.1";
+  std::string http_token;
+  std::string http_token_file;
+  int http_max_clients = 16;
 };
 
 void check(bool ok, const std::string& message) {
   if (!ok)
     throw io::InputError(message);
+}
+
+// --http-token, or the first line of --http-token-file (without surrounding blanks).
+std::string http_token(const ServeOptions& o) {
+  check(o.http_token.empty() || o.http_token_file.empty(),
+        "--http-token and --http-token-file: give one of them");
+  std::string token = o.http_token;
+  if (!o.http_token_file.empty()) {
+    std::ifstream in(o.http_token_file);
+    check(in.good(), fmt::format("--http-token-file {}: cannot read it", o.http_token_file));
+    std::getline(in, token);
+    const auto blank = [](char c) { return c == ' ' || c == '\t' || c == '\r'; };
+    while (!token.empty() && blank(token.back()))
+      token.pop_back();
+    while (!token.empty() && blank(token.front()))
+      token.erase(token.begin());
+    check(!token.empty(),
+          fmt::format("--http-token-file {}: the first line is empty", o.http_token_file));
+  }
+  check(token.empty() || token.size() >= 16,
+        "--http-token: at least 16 characters (e.g. `openssl rand -hex 16`)");
+  return token;
 }
 
 host::StageModel make_stage_model(const ServeOptions& o, const io::ProjectConfig& config,
@@ -96,7 +134,15 @@ int serve(const ServeOptions& o) {
         fmt::format("--on-target-urad {}: must be > 0", o.on_target_urad));
   check(o.settle_s >= 0.0 && o.settle_s <= 10.0,
         fmt::format("--settle-s {}: must be 0 to 10 s", o.settle_s));
+  check(o.http_port >= -1 && o.http_port <= 65535,
+        fmt::format("--http-port {}: must be 0 to 65535", o.http_port));
+  check(o.http_max_clients >= 1 && o.http_max_clients <= 256,
+        fmt::format("--http-max-clients {}: must be 1 to 256", o.http_max_clients));
+  const std::string token = http_token(o);
   const runtime::SafetyLimits safety = loop_safety_limits(o.max_overruns);
+  std::vector<runtime::FaultSpec> faults;
+  for (const std::string& f : o.faults)
+    faults.push_back(runtime::parse_fault_spec(f));
 
   const io::ProjectConfig config =
       o.config.empty() ? io::ProjectConfig{} : io::load_project_config(o.config);
@@ -105,11 +151,18 @@ int serve(const ServeOptions& o) {
   const host::StageModel model = make_stage_model(o, config, params, cal, safety);
 
   ChosenBackend chosen = make_backend(o.daq, config, o.seed, o.rate_Hz);
-  runtime::DaqBackend& daq = *chosen.backend;
+  check(faults.empty() || chosen.sim != nullptr,
+        "--fault needs --daq sim (faults are injected into the twin)");
+  runtime::MonotonicClock clock;
+  const std::int64_t period_ns = std::llround(1e9 / o.rate_Hz);
+  std::unique_ptr<runtime::FaultInjectingBackend> injector;
+  if (!faults.empty())
+    injector = std::make_unique<runtime::FaultInjectingBackend>(
+        *chosen.backend, clock, period_ns, faults, runtime::FaultInjectionParams{}, chosen.sim);
+  runtime::DaqBackend& daq = injector ? *injector : *chosen.backend;
   daq.configure();  // comedi: names the device it cannot open (exit 2)
 
-  runtime::MonotonicClock clock;
-  const double period_s = static_cast<double>(std::llround(1e9 / o.rate_Hz)) * 1e-9;
+  const double period_s = static_cast<double>(period_ns) * 1e-9;
   runtime::HostLink link;
   host::GcsOptions gopts;
   gopts.on_target_tolerance_um = o.on_target_um;
@@ -119,6 +172,25 @@ int serve(const ServeOptions& o) {
       fmt::format("piezoshift, semi-closed-loop PZT phase shifter ({}), 0, 0.1.0", daq.name());
   host::GcsController gcs(model, link, period_s, gopts);
 
+  // The dashboard shares the interpreter with the GCS thread: one mutex around it.
+  std::mutex gcs_mutex;
+  host::LockedLineHandler locked_gcs(gcs, gcs_mutex);
+  std::unique_ptr<host::Dashboard> dashboard;
+  std::unique_ptr<host::HttpServer> http;
+  if (o.http_port >= 0) {
+    host::DashboardOptions dopts;
+    dopts.loop_rate_Hz = o.rate_Hz;
+    dopts.daq_name = daq.name();
+    dashboard = std::make_unique<host::Dashboard>(gcs, gcs_mutex, dashboard_page(), dopts);
+    gcs.set_sample_observer(dashboard.get());
+    host::HttpServerOptions hopts;
+    hopts.host = o.http_bind;
+    hopts.port = static_cast<std::uint16_t>(o.http_port);
+    hopts.token = token;
+    hopts.max_clients = static_cast<std::size_t>(o.http_max_clients);
+    http = std::make_unique<host::HttpServer>(hopts, *dashboard);  // binds now
+  }
+
   host::ListenAddress address;
   address.host = o.bind;
   address.port = static_cast<std::uint16_t>(o.port);
@@ -127,7 +199,8 @@ int serve(const ServeOptions& o) {
   limits.max_clients = static_cast<std::size_t>(o.max_clients);
   limits.max_line_bytes = static_cast<std::size_t>(o.max_line_bytes);
   limits.idle_timeout_s = o.idle_timeout_s;
-  host::LineServer server(address, limits, gcs);  // binds now: refusals before the loop starts
+  host::LineServer server(address, limits,
+                          dashboard ? static_cast<host::LineHandler&>(locked_gcs) : gcs);
 
   std::unique_ptr<runtime::CsvLogger> logger;
   if (!o.log.empty()) {
@@ -159,20 +232,42 @@ int serve(const ServeOptions& o) {
       g_stop_signal.store(kNetworkFailed);
     }
   });
+  std::exception_ptr http_error;
+  std::thread http_thread;
+  if (http) {
+    http_thread = std::thread([&] {
+      try {
+        http->run(&g_stop_signal);
+      } catch (...) {
+        http_error = std::current_exception();
+        g_stop_signal.store(kNetworkFailed);
+      }
+    });
+    fmt::print("piezoshift serve: dashboard on http://{}:{}/{}\n", o.http_bind, http->port(),
+               token.empty() ? "" : " (token required)");
+  }
   fmt::print("piezoshift serve: GCS 2.0 on {}:{}, loop at {:g} Hz on {}\n", o.bind, server.port(),
              o.rate_Hz, daq.name());
   std::fflush(stdout);
   const runtime::RealtimeReport rt = request_realtime_or_warn(o.cpu);
+  if (dashboard)
+    dashboard->set_realtime({true, rt.fifo, rt.memory_locked, rt.cpu});
 
   daq.activate();
   const runtime::LoopResult r = loop.run();
   daq.deactivate();
   server.stop();
   network.join();
+  if (http) {
+    http->stop();
+    http_thread.join();
+  }
   if (logger)
     logger->stop();
   if (network_error)
     std::rethrow_exception(network_error);
+  if (http_error)
+    std::rethrow_exception(http_error);
 
   const host::GcsStats& gs = gcs.stats();
   const host::LineServerStats ns = server.stats();
@@ -187,6 +282,13 @@ int serve(const ServeOptions& o) {
     j["ticks"] = r.ticks;
     j["stop_reason"] = stop_reason;
     j["overruns"] = st.overruns;
+    const auto us = [](std::int64_t t_ns) { return static_cast<double>(t_ns) * 1e-3; };
+    j["period_error_p50_us"] = us(st.period_error.percentile_ns(0.5));
+    j["period_error_p99_us"] = us(st.period_error.percentile_ns(0.99));
+    j["period_error_max_us"] = us(st.period_error.max_ns());
+    j["wake_latency_p50_us"] = us(st.wake_latency.percentile_ns(0.5));
+    j["wake_latency_p99_us"] = us(st.wake_latency.percentile_ns(0.99));
+    j["wake_latency_max_us"] = us(st.wake_latency.max_ns());
     j["realtime"] = {{"sched_fifo", rt.fifo}, {"mlockall", rt.memory_locked}};
     j["faults"] = gs.faults;
     j["clients_accepted"] = ns.accepted;
@@ -198,6 +300,12 @@ int serve(const ServeOptions& o) {
     j["loop_commands_applied"] = r.host_commands_applied;
     j["samples_dropped"] = r.host_samples_dropped;
     j["max_output_slew_V_per_ms"] = r.max_output_slew_V_per_ms;
+    if (http) {
+      const host::HttpServerStats hs = http->stats();
+      j["http"] = {{"requests", hs.requests},         {"refused", hs.refused},
+                   {"unauthorised", hs.unauthorised}, {"streams_opened", hs.streams_opened},
+                   {"dropped_slow", hs.dropped_slow}, {"events_sent", dashboard->events_sent()}};
+    }
     fmt::print("{}\n", j.dump(2));
   } else {
     fmt::print(
@@ -248,6 +356,19 @@ void add_serve_command(CLI::App& app, Action& action) {
   cmd->add_option("--cpu", o->cpu, "CPU to pin the loop to (-1: the last one, -2: none)")
       ->capture_default_str();
   cmd->add_option("--log", o->log, "CSV log of every tick (flushed every 0.25 s)");
+  cmd->add_option("--fault", o->faults,
+                  "inject a fault into the twin: KIND@T_S[:CHANNEL], repeatable (docs/safety.md)");
+  cmd->add_option("--http-port", o->http_port,
+                  "serve the live dashboard on this port (0: any free port; docs/dashboard.md)");
+  cmd->add_option("--http-bind", o->http_bind,
+                  "IPv4 address of the dashboard; outside loopback only with a token")
+      ->capture_default_str();
+  cmd->add_option("--http-token", o->http_token,
+                  "access token every dashboard request must carry (>= 16 characters)");
+  cmd->add_option("--http-token-file", o->http_token_file,
+                  "file whose first line is the access token");
+  cmd->add_option("--http-max-clients", o->http_max_clients, "dashboard connections at once")
+      ->capture_default_str();
   cmd->add_flag("--json", o->json, "print the summary at exit as JSON");
   cmd->callback([&action, o] { action = [o] { return serve(*o); }; });
 }

@@ -277,6 +277,8 @@ void GcsController::take(const runtime::HostSample& s) {
   for (std::size_t i = 0; i < 3; ++i)
     in.sensor_um[i] = p.controller.scaling[i].sgs_to_um(s.sgs_V[i]);
   recorder_.record(in);
+  if (observer_ != nullptr)
+    observer_->on_sample(s, in);
 }
 
 bool GcsController::accepted(Session& s, GcsError error) {

@@ -432,6 +432,8 @@ ReportFiles write_report(const ReproductionResult& r, const fs::path& dir,
   p("Data beside this report (CSV columns carry their units; `piezoshift fit` and `piezoshift "
     "analyze` read them): " +
     list);
+  p("To watch the stage live: `piezoshift serve --daq sim --http-port 8080`, then open "
+    "http://127.0.0.1:8080/ (docs/dashboard.md).");
 
   files.markdown = dir / "report.md";
   files.html = dir / "report.html";

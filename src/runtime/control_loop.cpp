@@ -199,8 +199,9 @@ LoopResult ControlLoop::run() noexcept {
       h.target_um = c.target_um;
       h.sgs_V = cs.ai_V;
       h.ao_V = s.ao_V;
-      Vec3 truth{};
-      h.has_truth = daq_.truth(truth, h.interferometer_um) ? 1 : 0;
+      h.has_truth = daq_.truth(h.truth_um, h.interferometer_um) ? 1 : 0;
+      h.wake_latency_us = static_cast<double>(wake - deadline) * 1e-3;
+      h.overrun = previous_overran ? 1 : 0;
       h.closed_loop = closed_loop && !supervisor.faulted() ? 1 : 0;
       h.state = static_cast<std::uint8_t>(s.state);
       h.fault_reason = static_cast<std::uint8_t>(supervisor.fault().reason);

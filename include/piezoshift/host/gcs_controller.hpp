@@ -27,6 +27,7 @@
 #include "piezoshift/host/data_recorder.hpp"
 #include "piezoshift/host/gcs_error.hpp"
 #include "piezoshift/host/line_server.hpp"
+#include "piezoshift/host/sample_observer.hpp"
 #include "piezoshift/host/stage_model.hpp"
 #include "piezoshift/runtime/host_link.hpp"
 
@@ -64,6 +65,8 @@ class GcsController final : public LineHandler {
   void drain();
   const GcsStats& stats() const noexcept { return stats_; }
   const StageModel& model() const noexcept { return model_; }
+  //! Also hands every sample to observer (null: none) after the recorder.
+  void set_sample_observer(SampleObserver* observer) noexcept { observer_ = observer; }
 
  private:
   using Args = std::vector<std::string_view>;
@@ -100,6 +103,7 @@ class GcsController final : public LineHandler {
   std::uint64_t settle_samples_;
   std::unordered_map<ClientId, Session> sessions_;
   DataRecorder recorder_;
+  SampleObserver* observer_ = nullptr;
   GcsStats stats_;
 
   // The loop as last seen.

@@ -42,6 +42,9 @@ struct HostSample {
   Vec3 sgs_V{};                        //!< the three AI as read
   Vec3 ao_V{};                         //!< the outputs sent to the DAQ
   Vec3 interferometer_um{};            //!< the twin's interferometer at P1..P3 (has_truth)
+  Vec3 truth_um{};                     //!< the twin's true displacement of P1..P3 (has_truth)
+  double wake_latency_us = 0.0;        //!< wake-up - deadline of this tick
+  std::uint8_t overrun = 0;            //!< this tick's work ended after the next deadline
   std::uint8_t closed_loop = 0;        //!< servo on
   std::uint8_t has_truth = 0;          //!< the backend is the twin
   std::uint8_t state = 0;              //!< SupervisorState as a number

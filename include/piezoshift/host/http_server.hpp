@@ -1,0 +1,148 @@
+#pragma once
+// A small, bounded HTTP/1.1 server on one poll() thread: the dashboard of `piezoshift serve`
+// (docs/dashboard.md). It knows the protocol only; what a request means is the HttpHandler's.
+//
+//   request    one per connection: "METHOD target HTTP/1.x", headers, a body only with
+//              Content-Length (no chunked uploads); the answer carries "Connection: close"
+//   bounds     max_clients (one more gets 503 and is closed), max_request_bytes for the
+//              request line and headers (431), max_body_bytes (413), request_timeout_s for a
+//              request to arrive whole (408) and for its answer to be taken (else closed),
+//              max_pending_output_bytes per client (a reader that slow is dropped); malformed
+//              requests get 400, other methods 405
+//   access     with a token, every request must carry "Authorization: Bearer TOKEN" or
+//              "?token=TOKEN" (EventSource cannot set headers), else 401. A non-loopback bind
+//              is refused without a token. Without a token the Host header must name this
+//              server (a page of another site reaching 127.0.0.1 through DNS rebinding gets 403);
+//              a POST must be application/json (a cross-site form cannot send that) from no Origin
+//              or this server's own (403)
+//   streams    a handler may answer with a stream (Server-Sent Events): the connection stays
+//              open and receives every broadcast() until it closes or reads too slowly
+// Why not a library: Debian 12's cpp-httplib (0.11) serves each connection on a pool thread with
+// an unbounded queue, so every open event stream holds a thread and the bounds above are not
+// expressible; this is ~400 lines in the same shape as LineServer. Not real-time code.
+#include <atomic>
+#include <chrono>
+#include <cstddef>
+#include <cstdint>
+#include <map>
+#include <string>
+#include <string_view>
+#include <vector>
+
+namespace piezoshift::host {
+
+struct HttpServerOptions {
+  std::string host = "127.0.0.1";  //!< numeric IPv4 address, or localhost
+  std::uint16_t port = 0;          //!< 0: the kernel picks a free one, see HttpServer::port()
+  //! Required on every request when set; required to bind outside 127.0.0.0/8.
+  std::string token;
+  std::size_t max_clients = 16;          //!< connections at once
+  std::size_t max_request_bytes = 8192;  //!< request line + headers
+  std::size_t max_body_bytes = 16384;    //!< POST bodies
+  double request_timeout_s = 10.0;       //!< for a request to arrive and its answer to be taken
+  std::size_t max_pending_output_bytes = std::size_t{4} << 20;  //!< per client
+};
+
+struct HttpRequest {
+  std::string method;                          //!< "GET", "POST"
+  std::string path;                            //!< "/api/stream", without the query
+  std::map<std::string, std::string> query;    //!< decoded ?key=value pairs
+  std::map<std::string, std::string> headers;  //!< names in lower case
+  std::string body;
+  std::string header(const std::string& lower_name) const;
+};
+
+struct HttpResponse {
+  int status = 200;
+  std::string content_type = "text/plain; charset=utf-8";
+  std::string body;
+  //! Keep the connection open as a text/event-stream that receives HttpServer::broadcast();
+  //! body is sent first (e.g. a first event).
+  bool stream = false;
+
+  static HttpResponse text(int status, std::string body);
+  static HttpResponse json(int status, std::string body);
+};
+
+//! "OK", "Not Found", ... for the codes this server uses.
+const char* http_reason(int status) noexcept;
+
+class HttpServer;
+
+class HttpHandler {
+ public:
+  virtual ~HttpHandler() = default;
+  //! A complete, authorised request. Called from the run() thread.
+  virtual HttpResponse on_request(const HttpRequest& request) = 0;
+  //! Every turn of run(), at least every poll interval: where a handler broadcasts.
+  virtual void on_poll(HttpServer&) {}
+};
+
+struct HttpServerStats {
+  std::uint64_t requests = 0;         //!< answered, any status
+  std::uint64_t refused = 0;          //!< 4xx/5xx answers, 401 included
+  std::uint64_t unauthorised = 0;     //!< 401
+  std::uint64_t streams_opened = 0;   //!< event streams started
+  std::uint64_t dropped_slow = 0;     //!< readers beyond max_pending_output_bytes
+  std::uint64_t broadcast_bytes = 0;  //!< bytes queued by broadcast(), all streams
+};
+
+class HttpServer {
+ public:
+  //! Binds and listens. Throws io::InputError naming host:port for a bad address, a non-loopback
+  //! one without a token, bad limits or a failed bind.
+  HttpServer(const HttpServerOptions& options, HttpHandler& handler);
+  ~HttpServer();
+  HttpServer(const HttpServer&) = delete;
+  HttpServer& operator=(const HttpServer&) = delete;
+
+  std::uint16_t port() const noexcept { return port_; }
+  //! Serves until stop() or *stop_flag != 0, then closes every connection.
+  void run(const std::atomic<int>* stop_flag = nullptr, int poll_interval_ms = 5);
+  //! Thread-safe and async-signal-safe.
+  void stop() noexcept;
+
+  //! Queues bytes for every open stream (run() thread only, i.e. from HttpHandler::on_poll).
+  void broadcast(std::string_view bytes);
+  //! Open event streams (run() thread only).
+  std::size_t stream_count() const noexcept;
+  HttpServerStats stats() const;
+
+ private:
+  using Clock = std::chrono::steady_clock;
+  struct Client {
+    int fd = -1;
+    std::string input;
+    std::string output;
+    std::size_t output_sent = 0;
+    Clock::time_point accepted;
+    bool answered = false;  // a response is queued: close once it is sent (unless a stream)
+    bool stream = false;
+    bool close = false;
+    std::size_t pending() const { return output.size() - output_sent; }
+  };
+
+  void accept_clients();
+  void read_from(Client& c);
+  //! Parses c.input when a whole request is there; answers it (or an error).
+  void try_answer(Client& c);
+  HttpResponse answer(const HttpRequest& request);
+  void respond(Client& c, const HttpResponse& response);
+  void queue(Client& c, std::string_view bytes);
+  void flush(Client& c);
+
+  HttpServerOptions options_;
+  HttpHandler& handler_;
+  std::vector<std::string> allowed_hosts_;  // Host header values naming this server
+  int listen_fd_ = -1;
+  int wake_fd_ = -1;
+  std::uint16_t port_ = 0;
+  std::vector<Client> clients_;
+  std::atomic<bool> stop_requested_{false};
+  struct AtomicStats {
+    std::atomic<std::uint64_t> requests{0}, refused{0}, unauthorised{0}, streams_opened{0},
+        dropped_slow{0}, broadcast_bytes{0};
+  } stats_;
+};
+
+}  // namespace piezoshift::host

@@ -1,0 +1,44 @@
+#pragma once
+// A LineHandler that takes a mutex around every call into another one: `piezoshift serve` with
+// the dashboard (docs/dashboard.md) shares the GCS interpreter between the GCS network thread and
+// the HTTP thread. The HTTP side holds the mutex only to copy samples out and to run its command
+// lines, never across I/O, so a GCS answer waits at most that long.
+#include <mutex>
+#include <string>
+#include <string_view>
+
+#include "piezoshift/host/line_server.hpp"
+
+namespace piezoshift::host {
+
+class LockedLineHandler final : public LineHandler {
+ public:
+  LockedLineHandler(LineHandler& inner, std::mutex& mutex) : inner_(inner), mutex_(mutex) {}
+
+  void on_connect(ClientId id) override {
+    const std::lock_guard lock(mutex_);
+    inner_.on_connect(id);
+  }
+  void on_disconnect(ClientId id) override {
+    const std::lock_guard lock(mutex_);
+    inner_.on_disconnect(id);
+  }
+  std::string on_line(ClientId id, std::string_view line) override {
+    const std::lock_guard lock(mutex_);
+    return inner_.on_line(id, line);
+  }
+  std::string on_overlong_line(ClientId id) override {
+    const std::lock_guard lock(mutex_);
+    return inner_.on_overlong_line(id);
+  }
+  void on_poll() override {
+    const std::lock_guard lock(mutex_);
+    inner_.on_poll();
+  }
+
+ private:
+  LineHandler& inner_;
+  std::mutex& mutex_;
+};
+
+}  // namespace piezoshift::host

@@ -1,0 +1,262 @@
+// `piezoshift serve --http-port` end to end, without a browser (dashboard_e2e has the browser):
+// the access token on a non-loopback bind, the dashboard and a GCS client moving the same stage,
+// and 10 event streams beside GCS round trips. As in serve_test.cpp the overrun rule is lifted
+// so that a loaded machine cannot turn a test into a fault run.
+#include <signal.h>
+
+#include <algorithm>
+#include <atomic>
+#include <chrono>
+#include <cmath>
+#include <functional>
+#include <regex>
+#include <string>
+#include <thread>
+#include <vector>
+
+#include <fmt/format.h>
+#include <gtest/gtest.h>
+#include <nlohmann/json.hpp>
+
+#include "../support/http_client.hpp"
+#include "../support/spawned_process.hpp"
+#include "piezoshift/host/gcs_client.hpp"
+
+namespace {
+
+using piezoshift::host::GcsClient;
+using piezoshift::testing::http_body;
+using piezoshift::testing::http_exchange;
+using piezoshift::testing::http_status;
+using piezoshift::testing::HttpConnection;
+using piezoshift::testing::slurp;
+using piezoshift::testing::spawn;
+using piezoshift::testing::Spawned;
+using piezoshift::testing::wait_exit;
+using Clock = std::chrono::steady_clock;
+
+double z_of(const std::vector<std::string>& lines) {
+  for (const std::string& l : lines)
+    if (l.rfind("Z=", 0) == 0)
+      return std::stod(l.substr(2));
+  return std::nan("");
+}
+
+class Dashboard : public piezoshift::testing::TempDirTest {
+ protected:
+  void TearDown() override {
+    if (server_.pid > 0) {
+      kill(server_.pid, SIGKILL);
+      wait_exit(server_);
+    }
+    TempDirTest::TearDown();
+  }
+
+  // Starts serve; fills http_port_ and gcs_port_ from its start-up lines.
+  bool start(std::vector<std::string> extra) {
+    std::vector<std::string> args{"serve", "--port",         "0",       "--http-port",
+                                  "0",     "--max-overruns", "1000000", "--json"};
+    args.insert(args.end(), extra.begin(), extra.end());
+    server_ = spawn(args, path("out.txt"), path("err.txt"));
+    const std::regex http(R"(dashboard on http://[0-9.]+:(\d+)/)");
+    const std::regex gcs(R"(GCS 2\.0 on [0-9.]+:(\d+),)");
+    for (int i = 0; i < 3000; ++i) {
+      const std::string out = slurp(path("out.txt"));
+      std::smatch mh, mg;
+      if (std::regex_search(out, mh, http) && std::regex_search(out, mg, gcs)) {
+        http_port_ = static_cast<std::uint16_t>(std::stoi(mh[1]));
+        gcs_port_ = static_cast<std::uint16_t>(std::stoi(mg[1]));
+        return true;
+      }
+      std::this_thread::sleep_for(std::chrono::milliseconds(10));
+    }
+    ADD_FAILURE() << "serve did not start: " << slurp(path("err.txt"));
+    return false;
+  }
+
+  int stop() {
+    kill(server_.pid, SIGTERM);
+    const int code = wait_exit(server_);
+    server_.pid = -1;
+    return code;
+  }
+
+  std::string host() const { return fmt::format("Host: 127.0.0.1:{}\r\n", http_port_); }
+
+  std::string post_commands(const std::vector<std::string>& commands) {
+    const std::string body = nlohmann::json{{"commands", commands}}.dump();
+    return http_exchange(http_port_, "POST /api/command HTTP/1.1\r\n" + host() +
+                                         "Content-Type: application/json\r\nContent-Length: " +
+                                         std::to_string(body.size()) + "\r\n\r\n" + body);
+  }
+
+  // The dashboard's status position of Z as the stream shows it, waiting until pred holds.
+  bool stream_shows(const std::function<bool(const nlohmann::json&)>& pred, double timeout_s) {
+    HttpConnection c(http_port_);
+    c.send("GET /api/stream HTTP/1.1\r\n" + host() + "\r\n");
+    std::string got;
+    std::size_t scanned = 0;
+    const auto end = Clock::now() + std::chrono::duration<double>(timeout_s);
+    while (Clock::now() < end) {
+      c.read_some(got, 0.05);
+      for (std::size_t at; (at = got.find("data: ", scanned)) != std::string::npos;) {
+        const std::size_t eol = got.find('\n', at);
+        if (eol == std::string::npos)
+          break;
+        const nlohmann::json j = nlohmann::json::parse(got.substr(at + 6, eol - at - 6));
+        scanned = eol;
+        if (pred(j))
+          return true;
+      }
+    }
+    return false;
+  }
+
+  Spawned server_;
+  std::uint16_t http_port_ = 0;
+  std::uint16_t gcs_port_ = 0;
+};
+
+TEST_F(Dashboard, ANonLoopbackBindRefusesRequestsWithoutTheToken) {
+  const std::string token = "e2e-token-0123456789abcdef";
+  ASSERT_TRUE(
+      start({"--http-bind", "0.0.0.0", "--http-token-file", write("token.txt", token + "\n")}));
+  // Over 127.0.0.1 (the only traffic allowed here) to the 0.0.0.0 bind.
+  const std::string refused = http_exchange(http_port_, "GET / HTTP/1.1\r\n" + host() + "\r\n");
+  EXPECT_EQ(http_status(refused), 401) << refused;
+  EXPECT_EQ(
+      http_status(http_exchange(http_port_, "GET /api/stream HTTP/1.1\r\n" + host() + "\r\n")),
+      401);
+  const std::string page = http_exchange(
+      http_port_, "GET / HTTP/1.1\r\n" + host() + "Authorization: Bearer " + token + "\r\n\r\n");
+  EXPECT_EQ(http_status(page), 200);
+  EXPECT_NE(page.find("<title>piezoshift"), std::string::npos);
+  EXPECT_EQ(http_status(http_exchange(
+                http_port_, "GET /api/status?token=" + token + " HTTP/1.1\r\n" + host() + "\r\n")),
+            200);
+  EXPECT_EQ(stop(), 0);
+  const nlohmann::json j =
+      nlohmann::json::parse(slurp(path("out.txt")).substr(slurp(path("out.txt")).find('{')));
+  EXPECT_EQ(j["http"]["unauthorised"], 2);
+}
+
+TEST(DashboardOptions, ANonLoopbackBindWithoutATokenIsRefusedAtStartUp) {
+  const std::string cmd = std::string("'") + PIEZOSHIFT_CLI +
+                          "' serve --port 0 --http-port 0 --http-bind 0.0.0.0 --duration-s 1 "
+                          ">/dev/null 2>&1";
+  const int status = std::system(cmd.c_str());
+  EXPECT_EQ(WEXITSTATUS(status), 2);
+}
+
+TEST_F(Dashboard, DashboardAndGcsMoveTheSameStage) {
+  ASSERT_TRUE(start({}));
+  std::string a = post_commands({"SVO Z 1 U 1 V 1", "MOV Z 4"});
+  ASSERT_EQ(http_status(a), 200) << a;
+  GcsClient gcs("127.0.0.1", gcs_port_);
+  double z = 0.0;
+  for (int i = 0; i < 200 && std::fabs(z - 4.0) > 0.01; ++i) {
+    std::this_thread::sleep_for(std::chrono::milliseconds(10));
+    z = z_of(gcs.query_lines("POS?"));
+  }
+  EXPECT_NEAR(z, 4.0, 0.01) << "GCS POS? after the dashboard's MOV Z 4";
+
+  gcs.send("MOV Z 6");
+  EXPECT_TRUE(stream_shows(
+      [](const nlohmann::json& j) {
+        const auto& p = j["status"]["position"]["z_um"];
+        return p.is_number() && std::fabs(p.get<double>() - 6.0) < 0.01;
+      },
+      5.0))
+      << "the stream's position after GCS MOV Z 6";
+
+  // The same limits as GCS: beyond the travel is error 7, named in the answer.
+  a = post_commands({"MOV Z 50"});
+  EXPECT_EQ(http_status(a), 422) << a;
+  const nlohmann::json e = nlohmann::json::parse(http_body(a));
+  EXPECT_EQ(e["error"]["code"], 7);
+  EXPECT_EQ(e["error"]["command"], "MOV Z 50");
+  // Bad bodies are named, not ignored.
+  EXPECT_EQ(http_status(post_commands({})), 400);
+  EXPECT_EQ(http_status(post_commands({"MOV Z 1\nSVO Z 0"})), 400);
+  EXPECT_EQ(stop(), 0);
+}
+
+// 10 event streams read at full speed while a GCS client times POS? round trips, against the
+// same number of round trips without streams. The interpreter's mutex is held by the HTTP thread
+// only to copy samples out and run its own command lines (microseconds), and the streams are
+// written from the HTTP thread, so GCS answers should not see them; the figures are printed and
+// documented in docs/performance.md. Asserted: p99 within 5 ms of the baseline's, and the max
+// under a generous 100 ms: a shared 2-core CI machine deschedules any thread for tens of ms (27 ms
+// seen without streams, 36 ms with them under ASan), which says nothing about the dashboard.
+TEST_F(Dashboard, TenStreamsDoNotDelayGcsAnswers) {
+  ASSERT_TRUE(start({}));
+  GcsClient gcs("127.0.0.1", gcs_port_);
+  const auto round_trips = [&](int n) {
+    std::vector<double> ms;
+    for (int i = 0; i < n; ++i) {
+      const auto t0 = Clock::now();
+      gcs.query_lines("POS?");
+      ms.push_back(std::chrono::duration<double, std::milli>(Clock::now() - t0).count());
+      std::this_thread::sleep_for(std::chrono::milliseconds(2));
+    }
+    std::sort(ms.begin(), ms.end());
+    return ms;
+  };
+  const auto pct = [](const std::vector<double>& v, double q) {
+    return v[static_cast<std::size_t>(q * static_cast<double>(v.size() - 1))];
+  };
+  const std::vector<double> base = round_trips(1000);
+
+  std::atomic<bool> done{false};
+  std::vector<std::size_t> events(10, 0);
+  std::vector<std::size_t> bytes(10, 0);
+  std::vector<std::thread> readers;
+  for (std::size_t k = 0; k < 10; ++k) {
+    readers.emplace_back([&, k] {
+      HttpConnection c(http_port_);
+      c.send("GET /api/stream HTTP/1.1\r\n" + host() + "\r\n");
+      std::string got;
+      while (!done.load()) {
+        c.read_some(got, 0.05);
+        std::size_t at = 0;
+        while ((at = got.find("event: update", at)) != std::string::npos) {
+          ++events[k];
+          at += 13;
+        }
+        bytes[k] += got.size();
+        got.erase(0, got.size() > 16 ? got.size() - 16 : 0);  // keep a split marker's head
+      }
+    });
+  }
+  std::this_thread::sleep_for(std::chrono::milliseconds(500));
+  const auto t0 = Clock::now();
+  const std::vector<std::size_t> events_at_start = events;
+  const std::vector<double> loaded = round_trips(1000);
+  const double span_s = std::chrono::duration<double>(Clock::now() - t0).count();
+  const std::vector<std::size_t> events_at_end = events;
+  done = true;
+  for (std::thread& t : readers)
+    t.join();
+
+  std::printf(
+      "GCS POS? round trip [ms]: no streams p50 %.3f p99 %.3f max %.3f; "
+      "10 streams p50 %.3f p99 %.3f max %.3f\n",
+      pct(base, 0.5), pct(base, 0.99), base.back(), pct(loaded, 0.5), pct(loaded, 0.99),
+      loaded.back());
+  for (std::size_t k = 0; k < 10; ++k) {
+    const double rate = static_cast<double>(events_at_end[k] - events_at_start[k]) / span_s;
+    EXPECT_GE(rate, 20.0) << "stream " << k << " updates/s";
+    if (k == 0)
+      std::printf("stream 0: %.1f updates/s, %.0f kB/s\n", rate,
+                  static_cast<double>(bytes[k]) / 1e3 / (span_s + 0.5));
+  }
+  EXPECT_LT(pct(loaded, 0.99), pct(base, 0.99) + 5.0);
+  EXPECT_LT(loaded.back(), 100.0);
+  EXPECT_EQ(stop(), 0);
+  const std::string out = slurp(path("out.txt"));
+  const nlohmann::json j = nlohmann::json::parse(out.substr(out.find('{')));
+  EXPECT_EQ(j["samples_dropped"], 0);
+  EXPECT_EQ(j["http"]["dropped_slow"], 0);
+}
+
+}  // namespace

@@ -1,0 +1,199 @@
+// The dashboard's HTTP server over loopback: every bound answers with its HTTP error, the access
+// token and the Host/Origin rules hold, and event streams receive broadcasts.
+#include "piezoshift/host/http_server.hpp"
+
+#include <atomic>
+#include <string>
+#include <thread>
+
+#include <gtest/gtest.h>
+
+#include "../support/http_client.hpp"
+#include "piezoshift/io/input_error.hpp"
+
+namespace {
+
+using piezoshift::host::HttpHandler;
+using piezoshift::host::HttpRequest;
+using piezoshift::host::HttpResponse;
+using piezoshift::host::HttpServer;
+using piezoshift::host::HttpServerOptions;
+using piezoshift::testing::http_body;
+using piezoshift::testing::http_exchange;
+using piezoshift::testing::http_status;
+using piezoshift::testing::HttpConnection;
+
+// Answers "/" with the path and body it got; "/stream" opens a stream; broadcasts "tick" events.
+class EchoHandler : public HttpHandler {
+ public:
+  HttpResponse on_request(const HttpRequest& r) override {
+    if (r.path == "/stream") {
+      HttpResponse s;
+      s.stream = true;
+      s.body = "retry: 1000\n\n";
+      return s;
+    }
+    if (r.path != "/")
+      return HttpResponse::text(404, "no");
+    return HttpResponse::text(200, r.method + " " + r.path + " " + r.body);
+  }
+  void on_poll(HttpServer& server) override {
+    if (++turns % 4 == 0)
+      server.broadcast("event: tick\ndata: {}\n\n");
+  }
+  int turns = 0;
+};
+
+class Http : public ::testing::Test {
+ protected:
+  void start(HttpServerOptions o = {}) {
+    server_ = std::make_unique<HttpServer>(o, handler_);
+    thread_ = std::thread([this] { server_->run(nullptr, 2); });
+  }
+  void TearDown() override {
+    if (server_) {
+      server_->stop();
+      thread_.join();
+    }
+  }
+  std::string get(const std::string& target, const std::string& extra = "") {
+    return http_exchange(server_->port(), "GET " + target + " HTTP/1.1\r\nHost: 127.0.0.1:" +
+                                              std::to_string(server_->port()) + "\r\n" + extra +
+                                              "\r\n");
+  }
+  std::string host() const { return "Host: 127.0.0.1:" + std::to_string(server_->port()) + "\r\n"; }
+
+  EchoHandler handler_;
+  std::unique_ptr<HttpServer> server_;
+  std::thread thread_;
+};
+
+TEST_F(Http, AnswersAGetAndClosesTheConnection) {
+  start();
+  const std::string a = get("/");
+  EXPECT_EQ(http_status(a), 200) << a;
+  EXPECT_EQ(http_body(a), "GET / \n");
+  EXPECT_NE(a.find("Connection: close"), std::string::npos);
+  EXPECT_EQ(http_status(get("/nothing")), 404);
+}
+
+TEST_F(Http, MalformedRequestsGet400) {
+  start();
+  for (const std::string bad :
+       {"GARBAGE\r\n\r\n", "GET / HTTP/9.9\r\n\r\n", "GET nopath HTTP/1.1\r\n\r\n",
+        "GET / HTTP/1.1\r\nno colon\r\n\r\n", "GET /?a=%zz HTTP/1.1\r\n\r\n",
+        "POST / HTTP/1.1\r\nContent-Length: x\r\n\r\n",
+        "POST / HTTP/1.1\r\nTransfer-Encoding: chunked\r\n\r\n"})
+    EXPECT_EQ(http_status(http_exchange(server_->port(), bad)), 400) << bad;
+}
+
+TEST_F(Http, OversizedHeadersGet431AndBodies413) {
+  HttpServerOptions o;
+  o.max_request_bytes = 1024;
+  o.max_body_bytes = 100;
+  start(o);
+  EXPECT_EQ(http_status(get("/", "X-Big: " + std::string(2000, 'a') + "\r\n")), 431);
+  // No end of headers at all, and still more than the limit: 431 without waiting for the rest.
+  EXPECT_EQ(
+      http_status(http_exchange(server_->port(), "GET / HTTP/1.1\r\n" + std::string(4000, 'b'))),
+      431);
+  const std::string post = "POST / HTTP/1.1\r\n" + host() +
+                           "Content-Type: application/json\r\nContent-Length: 101\r\n\r\n" +
+                           std::string(101, '{');
+  EXPECT_EQ(http_status(http_exchange(server_->port(), post)), 413);
+}
+
+TEST_F(Http, AnIncompleteRequestTimesOutWith408) {
+  HttpServerOptions o;
+  o.request_timeout_s = 0.2;
+  start(o);
+  HttpConnection c(server_->port());
+  c.send("GET / HTTP/1.1\r\nHost: x");
+  const std::string a = c.read_all(3.0);
+  EXPECT_EQ(http_status(a), 408) << a;
+}
+
+TEST_F(Http, OtherMethodsGet405) {
+  start();
+  EXPECT_EQ(http_status(http_exchange(server_->port(), "DELETE / HTTP/1.1\r\n" + host() + "\r\n")),
+            405);
+}
+
+TEST_F(Http, WithoutATokenTheHostMustNameThisServer) {
+  start();
+  // DNS rebinding: a page of evil.example resolved to 127.0.0.1 still sends its own Host.
+  EXPECT_EQ(http_status(
+                http_exchange(server_->port(), "GET / HTTP/1.1\r\nHost: evil.example:80\r\n\r\n")),
+            403);
+  EXPECT_EQ(
+      http_status(http_exchange(server_->port(), "GET / HTTP/1.1\r\nHost: localhost:" +
+                                                     std::to_string(server_->port()) + "\r\n\r\n")),
+      200);
+}
+
+TEST_F(Http, PostsMustBeJsonFromThisOrigin) {
+  start();
+  const std::string p = std::to_string(server_->port());
+  const auto post = [&](const std::string& headers) {
+    return http_status(http_exchange(
+        server_->port(), "POST / HTTP/1.1\r\n" + host() + headers + "Content-Length: 2\r\n\r\n{}"));
+  };
+  EXPECT_EQ(post("Content-Type: text/plain\r\n"), 415);  // what a cross-site form can send
+  EXPECT_EQ(post("Content-Type: application/json\r\nOrigin: http://evil.example\r\n"), 403);
+  EXPECT_EQ(post("Content-Type: application/json\r\nOrigin: http://127.0.0.1:" + p + "\r\n"), 200);
+  EXPECT_EQ(post("Content-Type: application/json\r\n"), 200);  // curl sends no Origin
+}
+
+TEST_F(Http, ATokenIsRequiredOnEveryRequest) {
+  HttpServerOptions o;
+  o.token = "0123456789abcdef-secret";
+  start(o);
+  const std::string a = get("/");
+  EXPECT_EQ(http_status(a), 401) << a;
+  EXPECT_NE(a.find("WWW-Authenticate: Bearer"), std::string::npos);
+  EXPECT_EQ(http_status(get("/", "Authorization: Bearer wrong\r\n")), 401);
+  EXPECT_EQ(http_status(get("/?token=0123456789abcdef-secreT")), 401);
+  EXPECT_EQ(http_status(get("/", "Authorization: Bearer 0123456789abcdef-secret\r\n")), 200);
+  EXPECT_EQ(http_status(get("/?token=0123456789abcdef-secret")), 200);
+  EXPECT_EQ(server_->stats().unauthorised, 3u);
+}
+
+TEST(HttpBind, ANonLoopbackAddressNeedsAToken) {
+  EchoHandler h;
+  HttpServerOptions o;
+  o.host = "0.0.0.0";
+  EXPECT_THROW(HttpServer(o, h), piezoshift::io::InputError);
+  o.token = "0123456789abcdef";
+  EXPECT_NO_THROW(HttpServer(o, h));
+  o.host = "not-an-address";
+  EXPECT_THROW(HttpServer(o, h), piezoshift::io::InputError);
+}
+
+TEST_F(Http, OneClientTooManyGets503) {
+  HttpServerOptions o;
+  o.max_clients = 2;
+  start(o);
+  HttpConnection a(server_->port());
+  HttpConnection b(server_->port());
+  a.send("GET /stream HTTP/1.1\r\n" + host() + "\r\n");
+  b.send("GET /stream HTTP/1.1\r\n" + host() + "\r\n");
+  std::string sa, sb;
+  a.read_some(sa, 2.0);
+  b.read_some(sb, 2.0);
+  EXPECT_EQ(http_status(get("/")), 503);
+}
+
+TEST_F(Http, StreamsReceiveEveryBroadcast) {
+  start();
+  HttpConnection c(server_->port());
+  c.send("GET /stream HTTP/1.1\r\n" + host() + "\r\n");
+  std::string got;
+  const auto end = std::chrono::steady_clock::now() + std::chrono::seconds(5);
+  while (std::chrono::steady_clock::now() < end && got.find("event: tick") == std::string::npos)
+    c.read_some(got, 0.1);
+  EXPECT_EQ(http_status(got), 200);
+  EXPECT_NE(got.find("Content-Type: text/event-stream"), std::string::npos);
+  EXPECT_NE(got.find("event: tick\ndata: {}\n\n"), std::string::npos);
+}
+
+}  // namespace

@@ -1,0 +1,212 @@
+// End-to-end test of the dashboard in a real browser (ctest: dashboard_e2e). Starts
+// `piezoshift serve --daq sim --http-port 0` (then a second one with --fault sgs-open@T), opens the page in Debian's
+// headless Chromium through playwright-core (no browser is downloaded), and checks:
+//   the stream runs at >= 20 updates/s; a click on "Move absolute" to Z = 5 um shows in the scope's
+//   position trace and the readout within 2 s; GCS POS? (a second client) sees that move; a GCS
+//   MOV is seen on the page; the injected fault is shown with its reason; screenshots are kept.
+//   node e2e/dashboard_e2e.mjs --cli PATH/piezoshift --artifacts DIR
+import { spawn } from "node:child_process";
+import { existsSync, mkdirSync, readFileSync } from "node:fs";
+import net from "node:net";
+import { join } from "node:path";
+
+const args = process.argv.slice(2);
+const opt = (n) => (args.indexOf(n) >= 0 ? args[args.indexOf(n) + 1] : undefined);
+const cli = opt("--cli");
+const artifacts = opt("--artifacts") || ".";
+const CHROMIUM = "/usr/bin/chromium";
+// A second server gets the fault, this long after its start (servo on and a move first).
+const FAULT_AT_S = 3;
+
+let failures = 0;
+let passes = 0;
+function check(ok, what) {
+  if (ok) passes++;
+  else failures++;
+  console.log(`${ok ? "ok  " : "FAIL"} ${what}`);
+}
+function fatal(msg) {
+  console.error(`dashboard_e2e: ${msg}`);
+  process.exit(1);
+}
+
+if (!cli || !existsSync(cli)) fatal(`--cli ${cli}: no such program`);
+// A missing browser is a failure, never a skip: scripts/install-deps installs it.
+if (!existsSync(CHROMIUM)) fatal(`${CHROMIUM} is missing: run scripts/install-deps (Debian's chromium)`);
+let chromium;
+try {
+  ({ chromium } = await import("playwright-core"));
+} catch (e) {
+  fatal(`playwright-core is missing (${e.message}): run scripts/install-deps (npm ci in web/dashboard)`);
+}
+mkdirSync(artifacts, { recursive: true });
+
+// ---- the server: started, its ports read from its start-up lines
+async function startServe(extra) {
+  const proc = spawn(cli, ["serve", "--daq", "sim", "--port", "0", "--http-port", "0",
+    "--max-overruns", "1000000", "--json", ...extra], { stdio: ["ignore", "pipe", "pipe"] });
+  let out = "";
+  proc.stdout.on("data", (d) => { out += d; });
+  proc.stderr.on("data", (d) => process.stderr.write(d));
+  const started = Date.now();
+  while (!/GCS 2\.0 on 127\.0\.0\.1:\d+/.test(out)) {
+    if (Date.now() - started > 30000 || proc.exitCode !== null) fatal(`serve did not start:\n${out}`);
+    await new Promise((r) => setTimeout(r, 20));
+  }
+  const http = Number(/dashboard on http:\/\/127\.0\.0\.1:(\d+)\//.exec(out)[1]);
+  const gcs = Number(/GCS 2\.0 on 127\.0\.0\.1:(\d+)/.exec(out)[1]);
+  console.log(`serve ${extra.join(" ")}: dashboard http://127.0.0.1:${http}/, GCS port ${gcs}`);
+  return { proc, url: `http://127.0.0.1:${http}/`, gcs };
+}
+async function stopServe(s) {
+  s.proc.kill("SIGTERM");
+  const code = await new Promise((r) => (s.proc.exitCode !== null ? r(s.proc.exitCode) : s.proc.on("exit", r)));
+  check(code === 0, `serve exited with ${code} after SIGTERM`);
+}
+let server = await startServe([]);
+let gcsPort = server.gcs;
+const url = server.url;
+
+// A tiny GCS client (one line out, one answer in).
+function gcsQuery(line) {
+  return new Promise((resolve, reject) => {
+    // A set command answers nothing: half-close, and the server closes once it is handled.
+    const query = line.includes("?");
+    const sock = net.connect(gcsPort, "127.0.0.1", () => {
+      sock.write(line + "\n");
+      if (!query) sock.end();
+    });
+    let buf = "";
+    sock.setTimeout(5000, () => { sock.destroy(); reject(new Error(`GCS ${line}: timeout`)); });
+    sock.on("data", (d) => {
+      buf += d;
+      if (query && /[^ ]\n$/.test(buf)) { sock.end(); resolve(buf); }
+    });
+    sock.on("end", () => resolve(buf));
+    sock.on("error", reject);
+  });
+}
+const zOf = (answer) => Number(/Z=(-?[\d.]+)/.exec(answer)?.[1]);
+
+const browser = await chromium.launch({ executablePath: CHROMIUM, args: ["--no-sandbox"] });
+try {
+  const page = await browser.newPage({ viewport: { width: 1500, height: 960 } });
+  page.on("pageerror", (e) => check(false, `page error: ${e.message}`));
+  await page.goto(url);
+  await page.waitForFunction(() => document.getElementById("pill-link").textContent === "STREAM LIVE",
+    null, { timeout: 10000 });
+  check(true, "page loaded, event stream live");
+
+  // Update rate as the page receives it, over 4 s.
+  const e0 = await page.evaluate(() => window.piezoshift.events());
+  await page.waitForTimeout(4000);
+  const e1 = await page.evaluate(() => window.piezoshift.events());
+  const rate = (e1 - e0) / 4;
+  check(rate >= 20, `stream: ${rate} updates/s (>= 20)`);
+
+  await page.click("#btn-servo-on");
+  await page.waitForFunction(() => document.getElementById("pill-servo").textContent === "SERVO ON",
+    null, { timeout: 5000 });
+  await page.fill("#move-z", "5");
+  await page.fill("#move-u", "0");
+  await page.fill("#move-v", "0");
+  // Timed in the page, from the click's own event to the frame that shows 5 um, so that
+  // playwright's own latency (actionability checks, polling) is not counted.
+  await page.evaluate(() => {
+    document.getElementById("btn-move").addEventListener("click", () => {
+      window.__clicked = performance.now();
+    }, { capture: true, once: true });
+  });
+  await page.click("#btn-move");
+  // The scope's Z position trace (series 2) and the readout, both within 10 nm of 5 um.
+  const handle = await page.waitForFunction(() => {
+    const z = window.piezoshift.charts.z.data[2];
+    const last = z.length ? z[z.length - 1] : NaN;
+    const readout = Number(document.getElementById("pos-z").textContent);
+    return Math.abs(last - 5) < 0.01 && Math.abs(readout - 5) < 0.01 &&
+      performance.now() - window.__clicked;
+  }, null, { timeout: 4000, polling: "raf" }).catch(() => null);
+  const ms = handle ? await handle.jsonValue() : NaN;
+  check(ms < 2000, `move to Z = 5 um seen in the scope trace and the readout ${ms.toFixed(0)} ms after the click (< 2000)`);
+
+  const pos = zOf(await gcsQuery("POS?"));
+  check(Math.abs(pos - 5) < 0.01, `GCS POS? after the dashboard's move: Z=${pos}`);
+  await page.screenshot({ path: join(artifacts, "dashboard.png") });
+
+  await gcsQuery("SVO Z 1 U 1 V 1");
+  await gcsQuery("MOV Z 3");
+  const seen = await page.waitForFunction(() =>
+    Math.abs(Number(document.getElementById("pos-z").textContent) - 3) < 0.01,
+  null, { timeout: 2000, polling: 20 }).then(() => true, () => false);
+  check(seen, "a GCS client's MOV Z 3 shows on the page within 2 s");
+
+  // An error from the server is shown: a move beyond the travel is GCS error 7.
+  await page.fill("#move-z", "50");
+  await page.click("#btn-move");
+  await page.fill("#move-z", "5");
+  const shown = await page.waitForFunction(() =>
+    document.getElementById("log").textContent.includes("GCS error 7"),
+  null, { timeout: 3000 }).then(() => true, () => false);
+  check(shown, "a refused move shows GCS error 7 on the page");
+
+  // A lambda/8 step sequence: 4 steps of 79.1 nm from 3 um.
+  await page.click("#btn-lambda8");
+  check((await page.inputValue("#seq-step")) === "79.1", "the lambda/8 preset is 79.1 nm");
+  await page.fill("#seq-count", "4");
+  await page.fill("#seq-dwell", "50");
+  const seqStart = Date.now();
+  await page.click("#btn-seq");
+  await page.waitForFunction(() => document.getElementById("seq-state").textContent !== "idle",
+    null, { timeout: 5000, polling: 10 }).catch(() => {});
+  const stepped = await page.waitForFunction(() =>
+    Math.abs(Number(document.getElementById("tgt-z").textContent) - 3.3164) < 0.0005 &&
+    document.getElementById("seq-state").textContent === "idle",
+  null, { timeout: 15000, polling: 50 }).then(() => true, () => false);
+  console.log(`     (sequence and readout: ${Date.now() - seqStart} ms)`);
+  const zAfter = zOf(await gcsQuery("MOV?"));
+  check(stepped && Math.abs(zAfter - 3.3164) < 1e-6, `4 lambda/8 steps from 3 um: GCS MOV? Z=${zAfter}`);
+
+  // Pause freezes the scope; Export CSV saves what is on screen.
+  await page.selectOption("#window", "0.5");
+  await page.click("#btn-pause");
+  const frozen = await page.evaluate(() => window.piezoshift.charts.z.data[0].at(-1));
+  await page.waitForTimeout(300);
+  const still = await page.evaluate(() => window.piezoshift.charts.z.data[0].at(-1));
+  check(frozen === still, "Pause freezes the scope");
+  const [download] = await Promise.all([page.waitForEvent("download"), page.click("#btn-csv")]);
+  const csvPath = join(artifacts, "dashboard-export.csv");
+  await download.saveAs(csvPath);
+  const csv = readFileSync(csvPath, "utf8").trim().split("\n");
+  check(csv[0].startsWith("t_s,setpoint_z_um,position_z_um") && csv.length > 400 && csv.length < 600,
+    `CSV export of the 0.5 s on screen: ${csv.length - 1} rows`);
+  await page.click("#btn-pause");
+  await page.selectOption("#window", "2");
+
+  check(await page.$eval("#fault-banner", (e) => e.classList.contains("hidden")),
+    "no fault shown while none is injected");
+
+  // The fault, with its reason: a second server whose gauge 1 opens FAULT_AT_S after its start,
+  // at Z = 5 um (a fault latched with the servo off stays shown too: the latch waits for SVO).
+  await stopServe(server);
+  server = await startServe(["--fault", `sgs-open@${FAULT_AT_S}`]);
+  gcsPort = server.gcs;
+  await gcsQuery("SVO Z 1 U 1 V 1");
+  await gcsQuery("MOV Z 5");
+  await page.goto(server.url);
+  const faulted = await page.waitForFunction(() =>
+    !document.getElementById("fault-banner").classList.contains("hidden") &&
+    document.getElementById("fault-reason").textContent.includes("sgs-rail"),
+  null, { timeout: (FAULT_AT_S + 30) * 1000 }).then(() => true, () => false);
+  const reason = await page.textContent("#fault-banner");
+  check(faulted, `fault shown: ${reason.replace(/\s+/g, " ").trim()}`);
+  await page.waitForTimeout(300);
+  await page.screenshot({ path: join(artifacts, "dashboard-fault.png") });
+  console.log(`screenshots: ${join(artifacts, "dashboard.png")}, dashboard-fault.png`);
+} catch (e) {
+  check(false, `unexpected: ${e.stack || e}`);
+} finally {
+  await browser.close();
+  await stopServe(server);
+}
+console.log(`dashboard_e2e: ${passes} passed, ${failures} failed`);
+process.exit(failures === 0 ? 0 : 1);

@@ -1,0 +1,280 @@
+// The dashboard page of `piezoshift serve --http-port` (docs/dashboard.md): one EventSource on
+// /api/stream feeds the scope and the status; every control is a list of GCS lines POSTed to
+// /api/command, so the server applies the same limits and errors as to a GCS client.
+import uPlot from "uplot";
+import "uplot/dist/uPlot.min.css";
+
+const $ = (id) => document.getElementById(id);
+const token = new URLSearchParams(location.search).get("token");
+
+// Column store of everything received, trimmed to the longest window (60 s) plus slack.
+const KEEP_S = 65;
+const COLUMNS = [
+  "t_s",
+  "setpoint_z_um", "position_z_um", "interferometer_z_um", "true_z_um",
+  "setpoint_u_urad", "position_u_urad", "interferometer_u_urad", "true_u_urad",
+  "setpoint_v_urad", "position_v_urad", "interferometer_v_urad", "true_v_urad",
+  "sgs1_V", "sgs2_V", "sgs3_V", "amp1_V", "amp2_V", "amp3_V",
+];
+const store = Object.fromEntries(COLUMNS.map((c) => [c, []]));
+
+function append(samples) {
+  if (!samples || !samples.t_s || samples.t_s.length === 0) return;
+  for (const c of COLUMNS) {
+    const src = samples[c] || [];
+    const dst = store[c];
+    for (let i = 0; i < samples.t_s.length; i++) dst.push(src[i] ?? null);
+  }
+  const t = store.t_s;
+  const cut = lowerBound(t, t[t.length - 1] - KEEP_S);
+  if (cut > 20000) for (const c of COLUMNS) store[c].splice(0, cut);
+}
+
+function lowerBound(a, x) {
+  let lo = 0, hi = a.length;
+  while (lo < hi) {
+    const mid = (lo + hi) >> 1;
+    if (a[mid] < x) lo = mid + 1; else hi = mid;
+  }
+  return lo;
+}
+
+// ---- charts
+const palette = { sp: "#e3b341", pos: "#58a6ff", ifm: "#3fb950", tru: "#db61a2",
+  c1: "#58a6ff", c2: "#e3b341", c3: "#3fb950" };
+const axisStyle = { stroke: "#8a94a3", grid: { stroke: "#262c36", width: 1 },
+  ticks: { stroke: "#2c323c", width: 1 } };
+
+function chart(el, title, unit, series, height) {
+  const width = () => Math.max(300, $(el).clientWidth - 4);
+  const opts = {
+    title, width: width(), height,
+    legend: { live: true },
+    cursor: { drag: { x: false, y: false } },
+    scales: { x: { time: false } },
+    axes: [
+      { ...axisStyle, label: "t [s]", labelSize: 14, size: 36 },
+      { ...axisStyle, label: unit, labelSize: 16, size: 60 },
+    ],
+    series: [{ label: "t [s]", value: (u, v) => (v == null ? "—" : v.toFixed(3)) },
+      ...series.map(([label, stroke, dash]) => ({ label, stroke, width: 1.4, dash,
+        spanGaps: false, value: (u, v) => (v == null ? "—" : v.toFixed(4)) }))],
+  };
+  const data = [[], ...series.map(() => [])];
+  const u = new uPlot(opts, data, $(el));
+  window.addEventListener("resize", () => u.setSize({ width: width(), height }));
+  return u;
+}
+
+const charts = {
+  z: chart("chart-z", "Piston Z", "µm", [["set-point", palette.sp, [6, 3]],
+    ["position (SGS)", palette.pos], ["interferometer", palette.ifm], ["true plate", palette.tru, [2, 3]]], 250),
+  uv: chart("chart-uv", "Tip U / tilt V", "µrad", [["U set-point", palette.sp, [6, 3]],
+    ["U position", palette.pos], ["U interferometer", palette.ifm], ["U true", palette.tru, [2, 3]],
+    ["V set-point", "#a5a5a5", [6, 3]], ["V position", "#79c0ff"], ["V interferometer", "#7ee787"],
+    ["V true", "#f2a7d0", [2, 3]]], 190),
+  sgs: chart("chart-sgs", "Strain gauges", "V", [["SGS 1", palette.c1], ["SGS 2", palette.c2],
+    ["SGS 3", palette.c3]], 170),
+  amp: chart("chart-amp", "Amplifier outputs", "V", [["ch 1", palette.c1], ["ch 2", palette.c2],
+    ["ch 3", palette.c3]], 170),
+};
+const chartColumns = {
+  z: ["setpoint_z_um", "position_z_um", "interferometer_z_um", "true_z_um"],
+  uv: ["setpoint_u_urad", "position_u_urad", "interferometer_u_urad", "true_u_urad",
+    "setpoint_v_urad", "position_v_urad", "interferometer_v_urad", "true_v_urad"],
+  sgs: ["sgs1_V", "sgs2_V", "sgs3_V"],
+  amp: ["amp1_V", "amp2_V", "amp3_V"],
+};
+
+let windowS = 2;
+let paused = false;
+let view = null; // what is on screen: {from, to} indices into store (frozen while paused)
+
+function render() {
+  const t = store.t_s;
+  if (t.length === 0) return;
+  if (!paused) {
+    const to = t.length;
+    const from = lowerBound(t, t[to - 1] - windowS);
+    view = { from, to, t0: t[to - 1] - windowS, t1: t[to - 1] };
+  }
+  if (!view) return;
+  const x = t.slice(view.from, view.to);
+  for (const [name, u] of Object.entries(charts)) {
+    const data = [x, ...chartColumns[name].map((c) => store[c].slice(view.from, view.to))];
+    u.batch(() => {
+      u.setData(data, false);
+      u.setScale("x", { min: view.t0, max: view.t1 });
+      // Legends show the newest values unless the cursor is over the chart.
+      if (u.cursor.left == null || u.cursor.left < 0) u.setLegend({ idx: x.length - 1 });
+    });
+  }
+}
+
+// ---- status
+const fmt = (v, d) => (v == null || !Number.isFinite(v) ? "—" : v.toFixed(d));
+function pill(id, text, cls) {
+  const el = $(id);
+  el.textContent = text;
+  el.className = "pill " + cls;
+}
+
+let lastStatus = null;
+function showStatus(s) {
+  lastStatus = s;
+  $("t-s").textContent = fmt(s.t_s, 2);
+  $("daq").textContent = s.daq;
+  pill("pill-servo", s.servo_on ? "SERVO ON" : "SERVO OFF", s.servo_on ? "ok" : "off");
+  const ont = s.on_target || {};
+  const allOn = ont.z_um && ont.u_urad && ont.v_urad;
+  pill("pill-ont", allOn ? "ON TARGET" : "NOT ON TARGET", allOn ? "ok" : s.servo_on ? "warn" : "off");
+  const sup = (s.supervisor || "—").toUpperCase();
+  pill("pill-sup", "SUPERVISOR " + sup, s.fault ? "bad" : sup === "RUNNING" ? "ok" : "warn");
+  const rt = s.realtime;
+  pill("pill-rt", rt ? (rt.sched_fifo ? "RT FIFO" : "RT NOT GRANTED") : "RT —",
+    rt ? (rt.sched_fifo && rt.mlockall ? "ok" : "warn") : "off");
+  for (const [k, a] of [["z", "z_um"], ["u", "u_urad"], ["v", "v_urad"]]) {
+    $("tgt-" + k).textContent = fmt(s.target?.[a], k === "z" ? 4 : 2);
+    $("pos-" + k).textContent = fmt(s.position?.[a], k === "z" ? 4 : 2);
+  }
+  const tm = s.timing || {};
+  $("tm-rate").textContent = `${s.loop_rate_Hz} Hz loop, ${s.stream_rate_Hz} Hz stream`;
+  $("tm-per").textContent = `${fmt(tm.period_error_p50_us, 1)} / ${fmt(tm.period_error_p99_us, 1)} / ${fmt(tm.period_error_max_us, 1)} µs`;
+  $("tm-lat").textContent = `${fmt(tm.wake_latency_p50_us, 1)} / ${fmt(tm.wake_latency_p99_us, 1)} / ${fmt(tm.wake_latency_max_us, 1)} µs`;
+  $("tm-window").textContent = `${fmt(tm.window_s, 1)} s`;
+  $("tm-overruns").textContent = tm.overruns ?? "—";
+  $("tm-dropped").textContent = tm.samples_dropped ?? "—";
+  $("tm-rt").textContent = rt
+    ? `SCHED_FIFO ${rt.sched_fifo ? "yes" : "no"}, mlockall ${rt.mlockall ? "yes" : "no"}, CPU ${rt.cpu >= 0 ? rt.cpu : "not pinned"}`
+    : "—";
+  const lf = s.last_fault;
+  $("tm-last-fault").textContent = lf ? `${lf.reason} at t = ${fmt(lf.t_s, 3)} s` : "none";
+  const banner = $("fault-banner");
+  if (s.fault) {
+    banner.classList.remove("hidden");
+    $("fault-reason").textContent = s.fault.reason + (s.fault.channel ? ` (channel ${s.fault.channel})` : "");
+    $("fault-text").textContent = `— ${s.fault.text}; outputs ramped to 0 V at t = ${fmt(s.fault.t_s, 3)} s`;
+  } else {
+    banner.classList.add("hidden");
+  }
+}
+
+// ---- stream
+let events = 0;
+let eventsAtLastSecond = 0;
+function connect() {
+  const es = new EventSource("/api/stream" + (token ? "?token=" + encodeURIComponent(token) : ""));
+  es.onopen = () => pill("pill-link", "STREAM LIVE", "ok");
+  es.onerror = () => pill("pill-link", "STREAM LOST", "bad");
+  es.addEventListener("update", (e) => {
+    const msg = JSON.parse(e.data);
+    append(msg.samples);
+    if (msg.status) showStatus(msg.status);
+    events++;
+  });
+}
+setInterval(() => {
+  $("rate").textContent = `${events - eventsAtLastSecond} updates/s`;
+  eventsAtLastSecond = events;
+}, 1000);
+let lastFrame = 0;
+function frame(now) {
+  if (now - lastFrame >= 40) { // 25 frames/s at most: the stream's own rate
+    lastFrame = now;
+    render();
+  }
+  requestAnimationFrame(frame);
+}
+
+// ---- controls
+function log(text, ok) {
+  const li = document.createElement("li");
+  li.className = ok ? "ok" : "err";
+  li.textContent = `${new Date().toLocaleTimeString()}  ${text}`;
+  const list = $("log");
+  list.prepend(li);
+  while (list.children.length > 50) list.lastChild.remove();
+}
+
+async function gcs(commands, quiet) {
+  const headers = { "Content-Type": "application/json" };
+  if (token) headers.Authorization = "Bearer " + token;
+  let res;
+  try {
+    res = await fetch("/api/command", { method: "POST", headers, body: JSON.stringify({ commands }) });
+  } catch (e) {
+    log(`${commands.join("; ")}: server unreachable (${e.message})`, false);
+    return false;
+  }
+  const type = res.headers.get("Content-Type") || "";
+  const body = type.startsWith("application/json") ? await res.json() : { error: { text: await res.text() } };
+  if (res.ok && body.ok) {
+    if (!quiet) log(commands.join("; "), true);
+    return true;
+  }
+  const e = body.error || {};
+  log(`${e.command || commands.join("; ")}: ${e.code !== undefined ? "GCS error " + e.code + ", " : "HTTP " + res.status + ", "}${(e.text || "").trim()}`, false);
+  return false;
+}
+
+const num = (id) => Number($(id).value);
+$("btn-servo-on").onclick = () => gcs(["SVO Z 1 U 1 V 1"]);
+$("btn-servo-off").onclick = () => gcs(["SVO Z 0 U 0 V 0"]);
+$("btn-clear").onclick = $("btn-clear-banner").onclick = () =>
+  gcs([lastStatus && lastStatus.servo_on ? "SVO Z 1 U 1 V 1" : "SVO Z 0 U 0 V 0"]);
+$("btn-stop").onclick = async () => {
+  sequenceAbort = true;
+  // STP answers error 10 by design (PI controllers do); the page says it plainly.
+  const headers = { "Content-Type": "application/json" };
+  if (token) headers.Authorization = "Bearer " + token;
+  const res = await fetch("/api/command", { method: "POST", headers, body: JSON.stringify({ commands: ["STP"] }) });
+  const body = await res.json().catch(() => ({}));
+  log(body.error && body.error.code === 10 ? "STP: stopped, holding position" : "STP failed", body.error?.code === 10);
+};
+$("btn-move").onclick = () => gcs([`MOV Z ${num("move-z")} U ${num("move-u")} V ${num("move-v")}`]);
+$("btn-move-rel").onclick = () => gcs([`MVR Z ${num("move-z")} U ${num("move-u")} V ${num("move-v")}`]);
+$("btn-lambda8").onclick = () => { $("seq-step").value = (632.8 / 8).toFixed(1); };
+
+let sequenceAbort = false;
+let sequenceRunning = false;
+$("btn-seq-stop").onclick = () => { sequenceAbort = true; };
+$("btn-seq").onclick = async () => {
+  if (sequenceRunning) return;
+  const stepUm = num("seq-step") / 1000;
+  const count = Math.max(1, Math.min(1000, Math.round(num("seq-count"))));
+  const dwell = Math.max(10, num("seq-dwell"));
+  sequenceRunning = true;
+  sequenceAbort = false;
+  log(`sequence: ${count} steps of ${(stepUm * 1000).toFixed(1)} nm, ${dwell} ms dwell`, true);
+  for (let i = 0; i < count && !sequenceAbort; i++) {
+    $("seq-state").textContent = `step ${i + 1} / ${count}`;
+    if (!(await gcs([`MVR Z ${stepUm}`], true))) break;
+    await new Promise((r) => setTimeout(r, dwell));
+  }
+  $("seq-state").textContent = sequenceAbort ? "aborted" : "idle";
+  sequenceRunning = false;
+};
+
+$("window").onchange = (e) => { windowS = Number(e.target.value); if (paused) paused = false; render(); };
+$("btn-pause").onclick = (e) => {
+  paused = !paused;
+  e.target.textContent = paused ? "Resume" : "Pause";
+  e.target.classList.toggle("active", paused);
+};
+$("btn-csv").onclick = () => {
+  if (!view) return;
+  const rows = [COLUMNS.join(",")];
+  for (let i = view.from; i < view.to; i++)
+    rows.push(COLUMNS.map((c) => (store[c][i] == null ? "" : store[c][i])).join(","));
+  const blob = new Blob([rows.join("\n") + "\n"], { type: "text/csv" });
+  const a = document.createElement("a");
+  a.href = URL.createObjectURL(blob);
+  a.download = `piezoshift-${view.t0.toFixed(3)}s-${windowS}s.csv`;
+  a.click();
+  URL.revokeObjectURL(a.href);
+};
+
+// For tests and the console: the charts and the last status.
+window.piezoshift = { charts, store, status: () => lastStatus, events: () => events };
+connect();
+requestAnimationFrame(frame);
