@@ -28,7 +28,7 @@ using Vec = Controller::Vec;
 // The host's double parameters (the paper's defaults), rounded to float once, at compile time.
 constexpr Controller::Params kParams = control::convert<float>(control::SemiClosedLoopParams{});
 
-// The controller lives in .data/.bss: its RAM is sizeof(Controller). Constant-initialized, so no
+// The controller lives in .data: its RAM is sizeof(Controller). Constant-initialized, so no
 // constructor runs at start-up.
 Controller g_controller{kParams};
 
