@@ -6,7 +6,7 @@ BUILD_DIR = build/$(PRESET)
 PIEZOSHIFT = $(BUILD_DIR)/apps/piezoshift/piezoshift
 DEMO_OUT ?= out/demo
 
-.PHONY: all deps configure build test demo python python-install sanitize bench format format-check clean
+.PHONY: all deps configure build test demo mcu python python-install sanitize bench format format-check clean
 
 all: build
 
@@ -24,6 +24,15 @@ test: build
 
 demo: build
 	@$(PIEZOSHIFT) reproduce --out $(DEMO_OUT)
+
+# The controller in float on a Cortex-M4F under QEMU (docs/mcu.md): cross-builds the firmware,
+# runs it and prints its sizes, the equivalence with the host controller and the cost per tick.
+mcu: configure
+	@cmake --build --preset $(PRESET) -j $(JOBS) --target piezoshift_firmware test_mcu
+	@arm-none-eabi-size $(BUILD_DIR)/firmware/piezoshift_firmware.elf
+	@grep -E 'controller_tick|g_controller|g_test_vector_begin' \
+	  $(BUILD_DIR)/firmware/piezoshift_firmware.symbols
+	@$(BUILD_DIR)/tests/mcu/test_mcu
 
 # The Python package (docs/python.md): built into $(BUILD_DIR)/python/piezoshift.
 python: configure

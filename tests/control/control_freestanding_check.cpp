@@ -19,6 +19,18 @@ constexpr double kExpected = 0.801 * kP5 * (-0.4218 + 0.6030 + 0.6547) * 0.625;
 static_assert(first_tick_dac_V() - kExpected < 1e-12 && kExpected - first_tick_dac_V() < 1e-12);
 static_assert(noexcept(SemiClosedLoopController{}.update(Vec3{}, Vec3{})));
 
+// The float instantiation the firmware runs (firmware/, docs/mcu.md): the same tick, in float.
+constexpr float first_tick_dac_V_float() {
+  using piezoshift::control::BasicSemiClosedLoopController;
+  using piezoshift::control::SemiClosedLoopParams;
+  BasicSemiClosedLoopController<float> c(
+      piezoshift::control::convert<float>(SemiClosedLoopParams{}));
+  const auto out = c.update({5.0F, 5.0F, 5.0F}, {0.0F, 0.0F, 0.0F});
+  return out.dac_V[0];
+}
+static_assert(first_tick_dac_V_float() - kExpected < 1e-6 &&
+              kExpected - first_tick_dac_V_float() < 1e-6);
+
 }  // namespace
 
 int main() {

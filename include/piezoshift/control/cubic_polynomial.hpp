@@ -6,25 +6,33 @@
 //
 // Real-time safe: no heap, no exceptions, no I/O.
 #include <cstdint>
+#include <type_traits>
 
 namespace piezoshift::control {
 
-struct CubicPolynomial {
+template <class T>
+struct BasicCubicPolynomial {
   // Paper, Section 4: p3 = -0.0001009, p2 = 0.000389, p1 = 1.014, p0 = 0.2914 (um-based).
-  double p3 = -0.0001009;  //!< [1/um^2]
-  double p2 = 0.000389;    //!< [1/um]
-  double p1 = 1.014;       //!< [-]
-  double p0 = 0.2914;      //!< [um]
+  T p3 = T(-0.0001009);  //!< [1/um^2]
+  T p2 = T(0.000389);    //!< [1/um]
+  T p1 = T(1.014);       //!< [-]
+  T p0 = T(0.2914);      //!< [um]
 
-  static constexpr CubicPolynomial identity() noexcept { return {0.0, 0.0, 1.0, 0.0}; }
+  static constexpr BasicCubicPolynomial identity() noexcept { return {T(0), T(0), T(1), T(0)}; }
 
   //! p(x), Horner form.
-  constexpr double operator()(double x) const noexcept { return ((p3 * x + p2) * x + p1) * x + p0; }
+  constexpr T operator()(T x) const noexcept { return ((p3 * x + p2) * x + p1) * x + p0; }
   //! dp/dx
-  constexpr double derivative(double x) const noexcept {
-    return (3.0 * p3 * x + 2.0 * p2) * x + p1;
-  }
+  constexpr T derivative(T x) const noexcept { return (T(3) * p3 * x + T(2) * p2) * x + p1; }
 };
+
+using CubicPolynomial = BasicCubicPolynomial<double>;
+
+template <class To, class From>
+constexpr BasicCubicPolynomial<To> convert(const BasicCubicPolynomial<From>& p) noexcept {
+  return {static_cast<To>(p.p3), static_cast<To>(p.p2), static_cast<To>(p.p1),
+          static_cast<To>(p.p0)};
+}
 
 enum class InverseStatus : std::uint8_t {
   kOk,
@@ -33,56 +41,61 @@ enum class InverseStatus : std::uint8_t {
   kBadInterval,   //!< lo >= hi or a non-finite bound
 };
 
-struct InverseResult {
-  double x = 0.0;
+template <class T>
+struct BasicInverseResult {
+  T x = T(0);
   InverseStatus status = InverseStatus::kOk;
 };
 
+using InverseResult = BasicInverseResult<double>;
+
 //! x in [lo, hi] with p(x) = y, to |p(x) - y| <= tol. Safeguarded Newton (bisection fallback),
 //! so it always converges when p is monotonic on the interval.
-constexpr InverseResult inverse(const CubicPolynomial& p, double y, double lo, double hi,
-                                double tol = 1e-12) noexcept {
-  if (!(lo < hi) || lo - lo != 0.0 || hi - hi != 0.0)
-    return {0.0, InverseStatus::kBadInterval};
+template <class T>
+constexpr BasicInverseResult<T> inverse(const BasicCubicPolynomial<T>& p, std::type_identity_t<T> y,
+                                        std::type_identity_t<T> lo, std::type_identity_t<T> hi,
+                                        std::type_identity_t<T> tol = T(1e-12)) noexcept {
+  if (!(lo < hi) || lo - lo != T(0) || hi - hi != T(0))
+    return {T(0), InverseStatus::kBadInterval};
   // p' is quadratic: monotonic on [lo, hi] iff p' keeps one sign at both ends and at its vertex.
-  const double d_lo = p.derivative(lo);
-  const double d_hi = p.derivative(hi);
-  bool monotonic = (d_lo > 0.0 && d_hi > 0.0) || (d_lo < 0.0 && d_hi < 0.0);
-  if (monotonic && p.p3 != 0.0) {
-    const double vertex = -p.p2 / (3.0 * p.p3);
+  const T d_lo = p.derivative(lo);
+  const T d_hi = p.derivative(hi);
+  bool monotonic = (d_lo > T(0) && d_hi > T(0)) || (d_lo < T(0) && d_hi < T(0));
+  if (monotonic && p.p3 != T(0)) {
+    const T vertex = -p.p2 / (T(3) * p.p3);
     if (vertex > lo && vertex < hi) {
-      const double d_v = p.derivative(vertex);
-      monotonic = (d_lo > 0.0) ? d_v > 0.0 : d_v < 0.0;
+      const T d_v = p.derivative(vertex);
+      monotonic = (d_lo > T(0)) ? d_v > T(0) : d_v < T(0);
     }
   }
   if (!monotonic)
-    return {0.0, InverseStatus::kNotMonotonic};
-  const bool increasing = d_lo > 0.0;
-  double a = lo;
-  double b = hi;
-  const double ya = p(a) - y;
-  const double yb = p(b) - y;
-  if (ya == 0.0)
+    return {T(0), InverseStatus::kNotMonotonic};
+  const bool increasing = d_lo > T(0);
+  T a = lo;
+  T b = hi;
+  const T ya = p(a) - y;
+  const T yb = p(b) - y;
+  if (ya == T(0))
     return {a, InverseStatus::kOk};
-  if (yb == 0.0)
+  if (yb == T(0))
     return {b, InverseStatus::kOk};
-  if ((ya > 0.0) == (yb > 0.0))
-    return {0.0, InverseStatus::kOutOfRange};
-  double x = a + (b - a) * (-ya) / (yb - ya);  // secant start
+  if ((ya > T(0)) == (yb > T(0)))
+    return {T(0), InverseStatus::kOutOfRange};
+  T x = a + (b - a) * (-ya) / (yb - ya);  // secant start
   for (int i = 0; i < 100; ++i) {
-    const double f = p(x) - y;
-    if ((f < 0.0 ? -f : f) <= tol)
+    const T f = p(x) - y;
+    if ((f < T(0) ? -f : f) <= tol)
       break;
     // keep the bracket [a, b] around the root
-    if ((f > 0.0) == increasing) {
+    if ((f > T(0)) == increasing) {
       b = x;
     } else {
       a = x;
     }
-    const double d = p.derivative(x);
-    double next = x - f / d;
+    const T d = p.derivative(x);
+    T next = x - f / d;
     if (!(next > a && next < b))
-      next = 0.5 * (a + b);
+      next = T(0.5) * (a + b);
     if (next == x)
       break;
     x = next;

@@ -16,66 +16,80 @@
 //
 // Real-time safe: no heap, no exceptions, no I/O; every member is noexcept.
 #include <cstdint>
+#include <type_traits>
 
 namespace piezoshift::control {
 
 //! Gains per sample (dimensionless when error and output share a unit). Paper, Section 4:
 //! kp = 0.6, ki = 0.2, kd = 0.001 at T_s = 1 ms.
-struct PidGains {
-  double kp = 0.6;
-  double ki = 0.2;
-  double kd = 0.001;
+template <class T>
+struct BasicPidGains {
+  T kp = T(0.6);
+  T ki = T(0.2);
+  T kd = T(0.001);
 };
+
+using PidGains = BasicPidGains<double>;
 
 //! Per-sample gains tuned at one sample time, re-expressed for another so that the continuous-time
 //! controller they stand for is unchanged: ki scales with T, kd with 1/T, kp stays.
-constexpr PidGains rescale_gains(const PidGains& g, double from_sample_time_s,
-                                 double to_sample_time_s) noexcept {
-  const double r = to_sample_time_s / from_sample_time_s;
-  return PidGains{g.kp, g.ki * r, g.kd / r};
+template <class T>
+constexpr BasicPidGains<T> rescale_gains(const BasicPidGains<T>& g,
+                                         std::type_identity_t<T> from_sample_time_s,
+                                         std::type_identity_t<T> to_sample_time_s) noexcept {
+  const T r = to_sample_time_s / from_sample_time_s;
+  return BasicPidGains<T>{g.kp, g.ki * r, g.kd / r};
 }
 
-struct PidParams {
-  PidGains gains{};
-  double output_min = 0.0;         //!< lower output limit, in the output's unit
-  double output_max = 16.0;        //!< upper output limit (paper: nominal stroke, 16 um)
-  double deadband = 0.0;           //!< |error| below this counts as zero
-  double derivative_filter = 0.0;  //!< a in d2f = a d2f + (1 - a) d2; 0 = unfiltered
+template <class T>
+struct BasicPidParams {
+  BasicPidGains<T> gains{};
+  T output_min = T(0.0);         //!< lower output limit, in the output's unit
+  T output_max = T(16.0);        //!< upper output limit (paper: nominal stroke, 16 um)
+  T deadband = T(0.0);           //!< |error| below this counts as zero
+  T derivative_filter = T(0.0);  //!< a in d2f = a d2f + (1 - a) d2; 0 = unfiltered
 };
 
-struct PidState {
-  double error = 0.0;    //!< e(k)
-  double error_1 = 0.0;  //!< e(k-1)
-  double error_2 = 0.0;  //!< e(k-2)
-  double derivative_filtered = 0.0;
-  double output = 0.0;  //!< u(k), after clamping
+using PidParams = BasicPidParams<double>;
+
+template <class T>
+struct BasicPidState {
+  T error = T(0);    //!< e(k)
+  T error_1 = T(0);  //!< e(k-1)
+  T error_2 = T(0);  //!< e(k-2)
+  T derivative_filtered = T(0);
+  T output = T(0);  //!< u(k), after clamping
   bool saturated = false;
   std::uint32_t saturated_count = 0;  //!< consecutive saturated ticks
   std::uint64_t saturated_total = 0;  //!< saturated ticks since reset
 };
 
-class IncrementalPid {
+using PidState = BasicPidState<double>;
+
+template <class T>
+class BasicIncrementalPid {
  public:
-  constexpr IncrementalPid() noexcept = default;
-  constexpr explicit IncrementalPid(const PidParams& params) noexcept : params_(params) {}
+  constexpr BasicIncrementalPid() noexcept = default;
+  constexpr explicit BasicIncrementalPid(const BasicPidParams<T>& params) noexcept
+      : params_(params) {}
 
   //! One controller tick; returns u(k).
-  constexpr double update(double command, double feedback) noexcept {
+  constexpr T update(T command, T feedback) noexcept {
     if (!enabled_) {
-      reset(0.0);
-      return 0.0;
+      reset(T(0));
+      return T(0);
     }
-    double e = command - feedback;
-    if (!((e < 0.0 ? -e : e) > params_.deadband))
-      e = 0.0;  // also maps a NaN error to 0
-    const PidGains& g = params_.gains;
-    const double d2 = e - 2.0 * state_.error_1 + state_.error_2;
-    const double a = params_.derivative_filter;
-    state_.derivative_filtered = a * state_.derivative_filtered + (1.0 - a) * d2;
-    const double integral = integrator_held_ ? 0.0 : g.ki * e;
-    const double du = g.kp * (e - state_.error_1) + integral + g.kd * state_.derivative_filtered;
-    const double raw = state_.output + du;
-    double u = raw;
+    T e = command - feedback;
+    if (!((e < T(0) ? -e : e) > params_.deadband))
+      e = T(0);  // also maps a NaN error to 0
+    const BasicPidGains<T>& g = params_.gains;
+    const T d2 = e - T(2) * state_.error_1 + state_.error_2;
+    const T a = params_.derivative_filter;
+    state_.derivative_filtered = a * state_.derivative_filtered + (T(1) - a) * d2;
+    const T integral = integrator_held_ ? T(0) : g.ki * e;
+    const T du = g.kp * (e - state_.error_1) + integral + g.kd * state_.derivative_filtered;
+    const T raw = state_.output + du;
+    T u = raw;
     if (u > params_.output_max)
       u = params_.output_max;
     if (u < params_.output_min)
@@ -97,8 +111,8 @@ class IncrementalPid {
   }
 
   //! Clears the error history and counters and sets u(k-1) (bumpless start from a known output).
-  constexpr void reset(double output = 0.0) noexcept {
-    state_ = PidState{};
+  constexpr void reset(T output = T(0)) noexcept {
+    state_ = BasicPidState<T>{};
     state_.output = output;
   }
 
@@ -106,18 +120,20 @@ class IncrementalPid {
   constexpr void set_enabled(bool enabled) noexcept { enabled_ = enabled; }
   //! Held: the integral term ki e(k) is left out of the increment (used by the safety supervisor).
   constexpr void hold_integrator(bool held) noexcept { integrator_held_ = held; }
-  constexpr void set_params(const PidParams& params) noexcept { params_ = params; }
+  constexpr void set_params(const BasicPidParams<T>& params) noexcept { params_ = params; }
 
   constexpr bool enabled() const noexcept { return enabled_; }
   constexpr bool integrator_held() const noexcept { return integrator_held_; }
-  constexpr const PidParams& params() const noexcept { return params_; }
-  constexpr const PidState& state() const noexcept { return state_; }
+  constexpr const BasicPidParams<T>& params() const noexcept { return params_; }
+  constexpr const BasicPidState<T>& state() const noexcept { return state_; }
 
  private:
-  PidParams params_{};
-  PidState state_{};
+  BasicPidParams<T> params_{};
+  BasicPidState<T> state_{};
   bool enabled_ = true;
   bool integrator_held_ = false;
 };
+
+using IncrementalPid = BasicIncrementalPid<double>;
 
 }  // namespace piezoshift::control

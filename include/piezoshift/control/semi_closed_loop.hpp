@@ -8,7 +8,10 @@
 // Z_d are the desired displacements of the measurement points P1..P3 (um). update_actuators()
 // skips the feedforward and takes actuator targets S directly (calibration stages 1 and 2).
 //
-// Real-time safe: no heap, no exceptions, no I/O; every member is noexcept.
+// Real-time safe: no heap, no exceptions, no I/O; every member is noexcept. Templated on the
+// scalar type (see vec3.hpp): SemiClosedLoopController is the double one, the firmware runs
+// BasicSemiClosedLoopController<float>.
+#include <cstddef>
 #include <cstdint>
 
 #include "piezoshift/control/cubic_polynomial.hpp"
@@ -19,44 +22,74 @@
 
 namespace piezoshift::control {
 
-struct SemiClosedLoopParams {
-  double sample_time_s = 1e-3;        //!< T_s, Section 4: 1 ms
-  PidGains gains{};                   //!< per-sample gains, valid at gains_sample_time_s
-  double gains_sample_time_s = 1e-3;  //!< the sample time the gains were tuned at (paper: 1 ms)
-  double output_min_um = 0.0;         //!< PID output limits, in um of command (0 V)
-  double output_max_um = 16.0;        //!< 16 um nominal stroke -> 10 V DAQ -> 150 V
-  double deadband_um = 0.0;
-  double derivative_filter = 0.0;  //!< see PidParams
-  CubicPolynomial polynomial{};
-  TransmissionMatrix matrix{};
-  std::array<SignalScaling, kChannels> scaling{};
+template <class T>
+struct BasicSemiClosedLoopParams {
+  T sample_time_s = T(1e-3);        //!< T_s, Section 4: 1 ms
+  BasicPidGains<T> gains{};         //!< per-sample gains, valid at gains_sample_time_s
+  T gains_sample_time_s = T(1e-3);  //!< the sample time the gains were tuned at (paper: 1 ms)
+  T output_min_um = T(0.0);         //!< PID output limits, in um of command (0 V)
+  T output_max_um = T(16.0);        //!< 16 um nominal stroke -> 10 V DAQ -> 150 V
+  T deadband_um = T(0.0);
+  T derivative_filter = T(0.0);  //!< see PidParams
+  BasicCubicPolynomial<T> polynomial{};
+  BasicTransmissionMatrix<T> matrix{};
+  std::array<BasicSignalScaling<T>, kChannels> scaling{};
 
   //! The PID parameters each channel runs with, gains re-expressed at sample_time_s.
-  constexpr PidParams pid_params() const noexcept {
-    return PidParams{rescale_gains(gains, gains_sample_time_s, sample_time_s), output_min_um,
-                     output_max_um, deadband_um, derivative_filter};
+  constexpr BasicPidParams<T> pid_params() const noexcept {
+    return BasicPidParams<T>{rescale_gains(gains, gains_sample_time_s, sample_time_s),
+                             output_min_um, output_max_um, deadband_um, derivative_filter};
   }
 };
 
-struct ControllerOutput {
-  Vec3 dac_V{};                     //!< the three analog outputs
-  Vec3 target_um{};                 //!< S, actuator targets in SGS micrometres
-  Vec3 feedback_um{};               //!< SGS feedback in micrometres
-  Vec3 command_um{};                //!< PID outputs u, in um of command
+using SemiClosedLoopParams = BasicSemiClosedLoopParams<double>;
+
+//! The same parameters in another scalar type, each value rounded once (the firmware's float
+//! controller is configured from the host's double parameters this way).
+template <class To, class From>
+constexpr BasicSemiClosedLoopParams<To> convert(const BasicSemiClosedLoopParams<From>& p) noexcept {
+  BasicSemiClosedLoopParams<To> q{};
+  q.sample_time_s = static_cast<To>(p.sample_time_s);
+  q.gains = {static_cast<To>(p.gains.kp), static_cast<To>(p.gains.ki), static_cast<To>(p.gains.kd)};
+  q.gains_sample_time_s = static_cast<To>(p.gains_sample_time_s);
+  q.output_min_um = static_cast<To>(p.output_min_um);
+  q.output_max_um = static_cast<To>(p.output_max_um);
+  q.deadband_um = static_cast<To>(p.deadband_um);
+  q.derivative_filter = static_cast<To>(p.derivative_filter);
+  q.polynomial = convert<To>(p.polynomial);
+  q.matrix = convert<To>(p.matrix);
+  for (std::size_t i = 0; i < kChannels; ++i)
+    q.scaling[i] = convert<To>(p.scaling[i]);
+  return q;
+}
+
+template <class T>
+struct BasicControllerOutput {
+  BasicVec3<T> dac_V{};             //!< the three analog outputs
+  BasicVec3<T> target_um{};         //!< S, actuator targets in SGS micrometres
+  BasicVec3<T> feedback_um{};       //!< SGS feedback in micrometres
+  BasicVec3<T> command_um{};        //!< PID outputs u, in um of command
   std::uint8_t saturated_mask = 0;  //!< bit i set when channel i's PID is at a limit
 };
 
-class SemiClosedLoopController {
+using ControllerOutput = BasicControllerOutput<double>;
+
+template <class T>
+class BasicSemiClosedLoopController {
  public:
-  constexpr SemiClosedLoopController() noexcept { configure(SemiClosedLoopParams{}); }
-  constexpr explicit SemiClosedLoopController(const SemiClosedLoopParams& params) noexcept {
+  using Params = BasicSemiClosedLoopParams<T>;
+  using Output = BasicControllerOutput<T>;
+  using Vec = BasicVec3<T>;
+
+  constexpr BasicSemiClosedLoopController() noexcept { configure(Params{}); }
+  constexpr explicit BasicSemiClosedLoopController(const Params& params) noexcept {
     configure(params);
   }
 
   //! Replaces the parameters and resets every channel.
-  constexpr void configure(const SemiClosedLoopParams& params) noexcept {
+  constexpr void configure(const Params& params) noexcept {
     params_ = params;
-    const PidParams pid = params.pid_params();
+    const BasicPidParams<T> pid = params.pid_params();
     for (auto& c : pid_) {
       c.set_params(pid);
       c.reset(params.output_min_um);
@@ -64,24 +97,24 @@ class SemiClosedLoopController {
   }
 
   //! Outer feedforward only: S = A p(Z_d).
-  constexpr Vec3 actuator_targets(const Vec3& zd_um) const noexcept {
-    Vec3 zs{};
+  constexpr Vec actuator_targets(const Vec& zd_um) const noexcept {
+    Vec zs{};
     for (std::size_t i = 0; i < kChannels; ++i)
       zs[i] = params_.polynomial(zd_um[i]);
     return params_.matrix(zs);
   }
 
   //! A full tick from desired point displacements.
-  constexpr ControllerOutput update(const Vec3& zd_um, const Vec3& sgs_V) noexcept {
+  constexpr Output update(const Vec& zd_um, const Vec& sgs_V) noexcept {
     return update_actuators(actuator_targets(zd_um), sgs_V);
   }
 
   //! A tick from actuator targets in SGS micrometres (inner loop only).
-  constexpr ControllerOutput update_actuators(const Vec3& target_um, const Vec3& sgs_V) noexcept {
-    ControllerOutput out{};
+  constexpr Output update_actuators(const Vec& target_um, const Vec& sgs_V) noexcept {
+    Output out{};
     out.target_um = target_um;
     for (std::size_t i = 0; i < kChannels; ++i) {
-      const SignalScaling& s = params_.scaling[i];
+      const BasicSignalScaling<T>& s = params_.scaling[i];
       out.feedback_um[i] = s.sgs_to_um(sgs_V[i]);
       out.command_um[i] = pid_[i].update(target_um[i], out.feedback_um[i]);
       out.dac_V[i] = s.um_to_dac(out.command_um[i]);
@@ -97,7 +130,7 @@ class SemiClosedLoopController {
   }
   //! Clears the history and starts each channel from a given command (bumpless hand-over, e.g.
   //! from open loop to closed loop at the voltage already applied).
-  constexpr void reset_to(const Vec3& command_um) noexcept {
+  constexpr void reset_to(const Vec& command_um) noexcept {
     for (std::size_t i = 0; i < kChannels; ++i)
       pid_[i].reset(command_um[i]);
   }
@@ -110,12 +143,14 @@ class SemiClosedLoopController {
       c.hold_integrator(held);
   }
 
-  constexpr const SemiClosedLoopParams& params() const noexcept { return params_; }
-  constexpr const IncrementalPid& channel(std::size_t i) const noexcept { return pid_[i]; }
+  constexpr const Params& params() const noexcept { return params_; }
+  constexpr const BasicIncrementalPid<T>& channel(std::size_t i) const noexcept { return pid_[i]; }
 
  private:
-  SemiClosedLoopParams params_{};
-  std::array<IncrementalPid, kChannels> pid_{};
+  Params params_{};
+  std::array<BasicIncrementalPid<T>, kChannels> pid_{};
 };
+
+using SemiClosedLoopController = BasicSemiClosedLoopController<double>;
 
 }  // namespace piezoshift::control

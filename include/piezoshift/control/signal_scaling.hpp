@@ -9,18 +9,23 @@
 // Real-time safe: no heap, no exceptions, no I/O.
 namespace piezoshift::control {
 
-struct SignalScaling {
-  double sgs_um_per_V = 1.6;      //!< 16 um nominal stroke over the conditioner's 10 V
-  double sgs_offset_V = 0.0;      //!< conditioner output at zero elongation
-  double drive_V_per_um = 0.625;  //!< 10 V DAQ (150 V stack) over 16 um nominal free stroke
-  double drive_offset_V = 0.0;    //!< DAQ volts at zero command
+template <class T>
+struct BasicSignalScaling {
+  T sgs_um_per_V = T(1.6);      //!< 16 um nominal stroke over the conditioner's 10 V
+  T sgs_offset_V = T(0.0);      //!< conditioner output at zero elongation
+  T drive_V_per_um = T(0.625);  //!< 10 V DAQ (150 V stack) over 16 um nominal free stroke
+  T drive_offset_V = T(0.0);    //!< DAQ volts at zero command
 
-  constexpr double sgs_to_um(double sgs_V) const noexcept {
-    return (sgs_V - sgs_offset_V) * sgs_um_per_V;
-  }
-  constexpr double um_to_dac(double u_um) const noexcept {
-    return drive_offset_V + u_um * drive_V_per_um;
-  }
+  constexpr T sgs_to_um(T sgs_V) const noexcept { return (sgs_V - sgs_offset_V) * sgs_um_per_V; }
+  constexpr T um_to_dac(T u_um) const noexcept { return drive_offset_V + u_um * drive_V_per_um; }
 };
+
+using SignalScaling = BasicSignalScaling<double>;
+
+template <class To, class From>
+constexpr BasicSignalScaling<To> convert(const BasicSignalScaling<From>& s) noexcept {
+  return {static_cast<To>(s.sgs_um_per_V), static_cast<To>(s.sgs_offset_V),
+          static_cast<To>(s.drive_V_per_um), static_cast<To>(s.drive_offset_V)};
+}
 
 }  // namespace piezoshift::control

@@ -9,16 +9,28 @@
 
 namespace piezoshift::control {
 
-struct TransmissionMatrix {
+template <class T>
+struct BasicTransmissionMatrix {
   //! Paper, Section 4: A identified by least squares with the laser interferometer.
-  Mat3 a{{{-0.4218, 0.6030, 0.6547}, {0.3482, -0.1491, 0.6962}, {0.6321, 0.4397, -0.2980}}};
+  BasicMat3<T> a = convert<T>(
+      Mat3{{{-0.4218, 0.6030, 0.6547}, {0.3482, -0.1491, 0.6962}, {0.6321, 0.4397, -0.2980}}});
 
-  static constexpr TransmissionMatrix identity() noexcept {
-    return TransmissionMatrix{Mat3{{{1.0, 0.0, 0.0}, {0.0, 1.0, 0.0}, {0.0, 0.0, 1.0}}}};
+  static constexpr BasicTransmissionMatrix identity() noexcept {
+    return BasicTransmissionMatrix{
+        BasicMat3<T>{{{T(1), T(0), T(0)}, {T(0), T(1), T(0)}, {T(0), T(0), T(1)}}}};
   }
 
   //! S = A Z_S
-  constexpr Vec3 operator()(const Vec3& z_s_um) const noexcept { return multiply(a, z_s_um); }
+  constexpr BasicVec3<T> operator()(const BasicVec3<T>& z_s_um) const noexcept {
+    return multiply(a, z_s_um);
+  }
 };
+
+using TransmissionMatrix = BasicTransmissionMatrix<double>;
+
+template <class To, class From>
+constexpr BasicTransmissionMatrix<To> convert(const BasicTransmissionMatrix<From>& m) noexcept {
+  return BasicTransmissionMatrix<To>{convert<To>(m.a)};
+}
 
 }  // namespace piezoshift::control
