@@ -67,6 +67,7 @@ LoopResult ControlLoop::run() noexcept {
   HostLink* const host = config_.host;
   bool closed_loop = host == nullptr;
   Vec3 host_zd{};
+  WaveGenerator wave;  // fixed-size; the tables are the host's (wave_generator.hpp)
   Vec3 open_loop_V{};
   std::uint64_t applied_sequence = 0;
   const auto clear_latched_fault = [&]() noexcept {
@@ -133,13 +134,16 @@ LoopResult ControlLoop::run() noexcept {
           if (!closed_loop)
             open_loop_V = cmd.ao_V;
           break;
+        case HostCommand::Kind::kWave:
+          wave.apply(cmd.wave, host_zd);
+          break;
       }
     }
 
     Vec3 ai{};
     const DaqStatus read_status = daq_.read(ct, ai);
-    const Vec3 zd =
-        host != nullptr ? host_zd : profile_.at(static_cast<double>(ct.since_start_ns) * 1e-9);
+    const Vec3 zd = host != nullptr ? wave.next(host_zd, closed_loop && !supervisor_.faulted())
+                                    : profile_.at(static_cast<double>(ct.since_start_ns) * 1e-9);
     control::ControllerOutput c{};
     if (closed_loop) {
       c = controller_.update(zd, ai);
@@ -228,6 +232,7 @@ LoopResult ControlLoop::run() noexcept {
       h.state = static_cast<std::uint8_t>(s.state);
       h.fault_reason = static_cast<std::uint8_t>(supervisor_.fault().reason);
       h.fault_channel = static_cast<std::int8_t>(supervisor_.fault().channel);
+      h.wave_running = wave.running_mask();
       if (!host->samples.try_push(h))
         ++result.host_samples_dropped;
     }
