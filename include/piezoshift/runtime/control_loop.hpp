@@ -8,7 +8,8 @@
 //                                                           controller reset (bumpless from 0 V)
 //     host mode: apply the host's commands (host_link.hpp)
 //     ai  = daq.read(k)                                  (applies the outputs staged at k-1)
-//     Z_d = profile(k T), or the host's last move
+//     Z_d = profile(k T), or the host's last move plus its running wave generators
+//           (wave_generator.hpp; they stop when the servo is off or a fault is latched)
 //     c   = controller.update(Z_d, ai)                   Eqs. 6-8, sample time T
 //           (host mode with the servo off: c = the host's open-loop volts)
 //     s   = supervisor.update(ai, c, statuses, overrun(k-1))
