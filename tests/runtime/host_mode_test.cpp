@@ -191,6 +191,21 @@ TEST(HostMode, AWaveStopsWhereItIsOnAStopAndWhenTheServoGoesOff) {
   EXPECT_EQ(o.samples[7].wave_running, 0);
 }
 
+TEST(HostMode, ARestartedWaveKeepsTheReferenceItsSetPointHolds) {
+  // The host's target stays the first start's reference while the generator runs, so a restart
+  // (whose own reference is ignored) plays the new table on the same base.
+  std::vector<double> first{1.0, 2.0};
+  std::vector<double> second{5.0};
+  const HostCommand start = wave_start(2, first.data(), 2, 1, 0, 0.0);
+  const HostCommand restart = wave_start(3, second.data(), 1, 1, 0, 99.0);
+  const HostRun r = run_host({command(HostCommand::Kind::kServoOn, 1, control::filled(0.0)), start},
+                             0.02, &restart, 3);
+  ASSERT_GE(r.samples.size(), 8u);
+  EXPECT_DOUBLE_EQ(r.samples[3].zd_um[0], 2.0);
+  for (std::size_t k = 4; k < 8; ++k)
+    EXPECT_DOUBLE_EQ(r.samples[k].zd_um[0], 5.0) << k;
+}
+
 TEST(HostMode, CommandsAndSamplesMakeNoHeapAllocation) {
   FakeBackend daq;
   daq.configure();

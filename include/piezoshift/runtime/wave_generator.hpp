@@ -35,30 +35,39 @@ struct WaveCommand {
   std::uint32_t cycles = 1;         //!< passes through the table; 0: until stopped
   control::Vec3 points_per_unit{};  //!< d Z_d / d axis value (the tripod's column for the axis)
   double reference = 0.0;           //!< the axis value the host's set-point already holds
+                                    //!< (ignored when the generator runs: it keeps its own)
 };
 
 class WaveGenerator {
  public:
   static constexpr std::size_t kGenerators = 3;
 
-  //! Start (restarts a running one) or stop one generator. Real-time safe.
+  //! Start (restarts a running one from its first point) or stop one generator. Real-time
+  //! safe.
   void apply(const WaveCommand& c, control::Vec3& base) noexcept {
     if (c.generator >= kGenerators)
       return;
     Playback& p = playing_[c.generator];
-    if (p.running)
+    const bool start =
+        c.action == WaveCommand::Action::kStart && c.values != nullptr && c.length > 0;
+    if (p.running && !start) {
       fold(p, base);
-    p = Playback{};
-    if (c.action == WaveCommand::Action::kStart && c.values != nullptr && c.length > 0) {
-      p.running = true;
-      p.values = c.values;
-      p.length = c.length;
-      p.rate = c.rate > 0 ? c.rate : 1;
-      p.cycles = c.cycles;
-      p.points_per_unit = c.points_per_unit;
-      p.reference = c.reference;
-      p.last = c.reference;
+      p.running = false;
+      return;
     }
+    if (!start)
+      return;
+    // A restart keeps the reference base already holds (the host's target is still it).
+    const double reference = p.running ? p.reference : c.reference;
+    p = Playback{};
+    p.running = true;
+    p.values = c.values;
+    p.length = c.length;
+    p.rate = c.rate > 0 ? c.rate : 1;
+    p.cycles = c.cycles;
+    p.points_per_unit = c.points_per_unit;
+    p.reference = reference;
+    p.last = reference;
   }
 
   //! The set-point of this tick (see the header comment), and one tick on. With enabled false,
