@@ -355,22 +355,25 @@ bool GcsController::slot_free(std::size_t g) {
 }
 
 bool GcsController::stop_waves(Session& s) {
-  for (std::size_t g = 0; g < kGenerators; ++g) {
-    if (!wave_running_[g] && wave_mode_[g] == 0)
-      continue;
-    HostCommand c{};
-    c.kind = HostCommand::Kind::kWave;
-    c.wave.action = runtime::WaveCommand::Action::kStop;
-    c.wave.generator = static_cast<std::uint8_t>(g);
-    const AxisValues now = commanded();
-    if (!send(s, c))
+  for (std::size_t g = 0; g < kGenerators; ++g)
+    if ((wave_running_[g] || wave_mode_[g] != 0) && !stop_wave(s, g))
       return false;
-    wave_sequence_[g] = sequence_;
-    if (wave_running_[g])
-      target_[g] = now[g];  // where the loop folds it, to within the ticks until it applies this
-    wave_running_[g] = false;
-    wave_mode_[g] = 0;
-  }
+  return true;
+}
+
+bool GcsController::stop_wave(Session& s, std::size_t g) {
+  HostCommand c{};
+  c.kind = HostCommand::Kind::kWave;
+  c.wave.action = runtime::WaveCommand::Action::kStop;
+  c.wave.generator = static_cast<std::uint8_t>(g);
+  const AxisValues now = commanded();
+  if (!send(s, c))
+    return false;
+  wave_sequence_[g] = sequence_;
+  if (wave_running_[g])
+    target_[g] = now[g];  // where the loop folds it, to within the ticks until it applies this
+  wave_running_[g] = false;
+  wave_mode_[g] = 0;
   return true;
 }
 
@@ -1047,19 +1050,8 @@ std::string GcsController::wave_start(Session& s, const Args& args) {
   }
   for (const auto& [g, mode] : pairs) {
     if (mode == 0) {
-      if (wave_running_[g] || wave_mode_[g] != 0) {
-        HostCommand c{};
-        c.kind = HostCommand::Kind::kWave;
-        c.wave.action = runtime::WaveCommand::Action::kStop;
-        c.wave.generator = static_cast<std::uint8_t>(g);
-        const AxisValues now = commanded();
-        if (!send(s, c))
-          return {};
-        wave_sequence_[g] = sequence_;
-        if (wave_running_[g])
-          target_[g] = now[g];
-        wave_running_[g] = false;
-      }
+      if ((wave_running_[g] || wave_mode_[g] != 0) && !stop_wave(s, g))
+        return {};
       wave_mode_[g] = 0;
       continue;
     }

@@ -104,8 +104,10 @@ class GcsController final : public LineHandler {
   //! Bit a: axis a not on target or its generator running, or its command not applied yet.
   unsigned moving_mask() const;
   unsigned wave_mask() const;
-  //! Stops every generator (STP, #24, SVO); false (52 queued) when the ring is full.
+  //! Stops every generator (STP, #24); false (52 queued) when the ring is full.
   bool stop_waves(Session& s);
+  //! Stops generator g (it holds where it is); false (52 queued) when the ring is full.
+  bool stop_wave(Session& s, std::size_t g);
 
   // Commands; each returns the answer (empty for set commands) or fails the session.
   std::string move(Session& s, const Args& args, bool relative);
