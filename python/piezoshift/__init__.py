@@ -9,6 +9,7 @@ from ._piezoshift import *  # noqa: F401,F403
 # the exception types are not always picked up by the star import
 from ._piezoshift import InputError, FitError, MetricsError  # noqa: F401
 from . import _piezoshift as _ext
+import inspect as _inspect
 
 __all__ = [name for name in dir(_ext) if not name.startswith("_")]
 __version__ = "0.1.0"
@@ -46,10 +47,43 @@ def to_dict(obj):
     return {name: to_dict(getattr(obj, name)) for name in fields}
 
 
-# Every bound struct prints its fields; enums keep pybind11's own repr.
+def _keyword_init(cls):
+    """Lets cls(field=value, ...) set fields after the C++ constructor (positional arguments go
+    to it unchanged), with a signature that names every field and its default."""
+    fields = [name for name, v in vars(cls).items()
+              if isinstance(v, property) and v.fset is not None and not name.startswith("_")]
+    if not fields:
+        return
+    try:
+        default = cls()
+    except TypeError:  # no default constructor: not a parameter struct
+        return
+    original = cls.__init__
+
+    def __init__(self, *args, **kwargs):
+        original(self, *args)
+        for name, value in kwargs.items():
+            if name not in fields:
+                raise TypeError("%s() got an unexpected keyword argument %r; its fields: %s"
+                                % (cls.__name__, name, ", ".join(fields)))
+            setattr(self, name, value)
+
+    kw = _inspect.Parameter.KEYWORD_ONLY
+    __init__.__signature__ = _inspect.Signature(
+        [_inspect.Parameter("self", _inspect.Parameter.POSITIONAL_OR_KEYWORD)]
+        + [_inspect.Parameter(f, kw, default=getattr(default, f)) for f in fields])
+    __init__.__doc__ = ("%s(*, %s): the C++ defaults (the paper's values), with any field given "
+                        "by keyword.\n\n%s" % (cls.__name__, ", ".join(fields),
+                                                original.__doc__ or ""))
+    cls.__init__ = __init__
+
+
+# Every bound struct prints its fields and takes its fields as keyword arguments; enums keep
+# pybind11's own repr.
 for _cls in vars(_ext).values():
     if isinstance(_cls, type) and not hasattr(_cls, "__members__") and not issubclass(
             _cls, BaseException):
         _cls.__repr__ = _repr
+        _keyword_init(_cls)
 del _cls
 __all__.append("to_dict")

@@ -15,6 +15,7 @@
 #include <string>
 #include <vector>
 
+#include "piezoshift/calibration/calibration_file.hpp"
 #include "piezoshift/calibration/calibration_procedure.hpp"
 #include "piezoshift/calibration/fit_error.hpp"
 #include "piezoshift/calibration/matrix_fit.hpp"
@@ -22,6 +23,7 @@
 #include "piezoshift/design/design_evaluation.hpp"
 #include "piezoshift/design/design_inputs.hpp"
 #include "piezoshift/design/flexure.hpp"
+#include "piezoshift/design/hinge_search.hpp"
 #include "piezoshift/experiments/bench.hpp"
 #include "piezoshift/experiments/metrics_error.hpp"
 #include "piezoshift/experiments/metrics_linearity.hpp"
@@ -32,6 +34,7 @@
 #include "piezoshift/io/project_config.hpp"
 #include "piezoshift/plant/twin.hpp"
 #include "piezoshift/plant/twin_params.hpp"
+#include "piezoshift/reproduction/report.hpp"
 #include "piezoshift/reproduction/reproduction.hpp"
 #include "piezoshift/reproduction/summary.hpp"
 
@@ -561,7 +564,7 @@ PYBIND11_MODULE(_piezoshift, m) {
         const auto yv = from_numpy_1d(y, "y_um");
         return ex::step_response_metrics(tv, yv, o);
       },
-      py::arg("t_s"), py::arg("y_um"), py::arg("options") = SrO{});
+      py::arg("t_s"), py::arg("y_um"), py::arg_v("options", SrO{}, "StepResponseOptions()"));
   m.def(
       "running_median",
       [](const In& y, std::size_t window) {
@@ -658,28 +661,32 @@ PYBIND11_MODULE(_piezoshift, m) {
         py::gil_scoped_release nogil;
         return ex::run_travel_range(c, p, seed, o);
       },
-      py::arg("config"), py::arg("controller"), py::arg("seed"), py::arg("options") = TrO{});
+      py::arg("config"), py::arg("controller"), py::arg("seed"),
+      py::arg_v("options", TrO{}, "TravelRangeOptions()"));
   m.def(
       "run_step_response",
       [](const ps::io::ProjectConfig& c, const Scl& p, std::uint64_t seed, const StO& o) {
         py::gil_scoped_release nogil;
         return ex::run_step_response(c, p, seed, o);
       },
-      py::arg("config"), py::arg("controller"), py::arg("seed"), py::arg("options") = StO{});
+      py::arg("config"), py::arg("controller"), py::arg("seed"),
+      py::arg_v("options", StO{}, "StepExperimentOptions()"));
   m.def(
       "run_linearity",
       [](const ps::io::ProjectConfig& c, const Scl& p, std::uint64_t seed, const LiO& o) {
         py::gil_scoped_release nogil;
         return ex::run_linearity(c, p, seed, o);
       },
-      py::arg("config"), py::arg("controller"), py::arg("seed"), py::arg("options") = LiO{});
+      py::arg("config"), py::arg("controller"), py::arg("seed"),
+      py::arg_v("options", LiO{}, "LinearityOptions()"));
   m.def(
       "run_repeatability",
       [](const ps::io::ProjectConfig& c, const Scl& p, std::uint64_t seed, const RpO& o) {
         py::gil_scoped_release nogil;
         return ex::run_repeatability(c, p, seed, o);
       },
-      py::arg("config"), py::arg("controller"), py::arg("seed"), py::arg("options") = RpO{});
+      py::arg("config"), py::arg("controller"), py::arg("seed"),
+      py::arg_v("options", RpO{}, "RepeatabilityOptions()"));
 
   // ---- calibration --------------------------------------------------------------------------
   namespace ca = ps::calibration;
@@ -798,7 +805,8 @@ PYBIND11_MODULE(_piezoshift, m) {
         py::gil_scoped_release nogil;
         return ca::calibrate(c, base, seed, o);
       },
-      py::arg("config"), py::arg("base"), py::arg("seed"), py::arg("options") = CaO{},
+      py::arg("config"), py::arg("base"), py::arg("seed"),
+      py::arg_v("options", CaO{}, "CalibrationOptions()"),
       "The paper's calibration on the twin: PID gains, A, then p (Section 3)");
 
   // ---- reproduction -----------------------------------------------------------------------
@@ -841,9 +849,104 @@ PYBIND11_MODULE(_piezoshift, m) {
         py::gil_scoped_release nogil;
         return rp::reproduce(c, o);
       },
-      py::arg("config"), py::arg("options") = RoO{},
+      py::arg("config"), py::arg_v("options", RoO{}, "ReproduceOptions()"),
       "Calibration and the paper's four experiments on the twin (docs/experiments.md)");
   m.def(
       "summary_json", [](const RR& r) { return json_to_python(rp::summary_json(r)); },
       py::arg("result"), "The machine-readable summary as a dict (json.loads of its dump())");
+  // ---- hinge search (docs/design.md), calibration files, the report -------------------------
+  py::class_<d::SearchRange>(m, "SearchRange", "Grid values min, min + step, ... up to max [m]")
+      .def(py::init<>())
+      .def(py::init([](double min_m, double max_m, double step_m) {
+             return d::SearchRange{min_m, max_m, step_m};
+           }),
+           py::arg("min_m"), py::arg("max_m"), py::arg("step_m"))
+      .PS_RW(d::SearchRange, min_m)
+      .PS_RW(d::SearchRange, max_m)
+      .PS_RW(d::SearchRange, step_m);
+  py::class_<d::HingeSearchSpace>(m, "HingeSearchSpace",
+                                  "The grid over t, R, b and L; the default holds Table 3")
+      .def(py::init<>())
+      .PS_RW(d::HingeSearchSpace, thickness)
+      .PS_RW(d::HingeSearchSpace, radius)
+      .PS_RW(d::HingeSearchSpace, width)
+      .PS_RW(d::HingeSearchSpace, link_length);
+  py::class_<d::SearchConstraints>(m, "SearchConstraints")
+      .def(py::init<>())
+      .PS_RW(d::SearchConstraints, max_stiffness_ratio)
+      .PS_RW(d::SearchConstraints, min_stress_margin)
+      .PS_RW(d::SearchConstraints, max_thickness_to_radius)
+      .PS_RW(d::SearchConstraints, min_natural_frequency_Hz);
+  py::enum_<d::SearchRanking>(m, "SearchRanking")
+      .value("NATURAL_FREQUENCY", d::SearchRanking::natural_frequency)
+      .value("STRESS_MARGIN", d::SearchRanking::stress_margin);
+  py::class_<d::HingeCandidate>(m, "HingeCandidate")
+      .PS_RO(d::HingeCandidate, hinge)
+      .PS_RO(d::HingeCandidate, evaluation);
+  py::class_<d::HingeSearchResult>(m, "HingeSearchResult")
+      .PS_RO(d::HingeSearchResult, evaluated_count)
+      .PS_RO(d::HingeSearchResult, geometry_rejected_count)
+      .PS_RO(d::HingeSearchResult, feasible_count)
+      .PS_RO(d::HingeSearchResult, candidates);
+  m.def(
+      "search_hinge_designs",
+      [](const d::DesignInputs& base, const d::HingeSearchSpace& space,
+         const d::SearchConstraints& constraints, std::size_t max_candidates,
+         d::SearchRanking ranking) {
+        py::gil_scoped_release nogil;
+        return d::search_hinge_designs(base, space, constraints, max_candidates, ranking);
+      },
+      py::arg("base"), py::arg_v("space", d::HingeSearchSpace{}, "HingeSearchSpace()"),
+      py::arg_v("constraints", d::SearchConstraints{}, "SearchConstraints()"),
+      py::arg("max_candidates") = 10,
+      py::arg_v("ranking", d::SearchRanking::natural_frequency, "SearchRanking.NATURAL_FREQUENCY"),
+      "Grid search over the hinge dimensions (`piezoshift design --search`), best first");
+
+  m.def(
+      "load_calibration_file",
+      [](const std::string& path) {
+        std::optional<double> z_max_um;
+        const Scl params = ps::calibration::load_calibration_file(path, &z_max_um);
+        return py::make_tuple(params, z_max_um ? py::cast(*z_max_um) : py::none());
+      },
+      py::arg("path"),
+      "A calibration file (`piezoshift calibrate --out`) -> (SemiClosedLoopParams, travel z_max_um "
+      "or None); raises InputError naming file, key and reason");
+  m.def(
+      "write_calibration_file",
+      [](const std::string& path, const Scl& params, const std::string& header,
+         std::optional<double> z_max_um) {
+        ps::calibration::write_calibration_file(path, params, header, z_max_um);
+      },
+      py::arg("path"), py::arg("params"), py::arg("header") = "written by piezoshift (Python)",
+      py::arg("z_max_um") = py::none(),
+      "Writes params (gains, p, A, scaling) and the travel as `piezoshift serve` and `run` read "
+      "them; atomically");
+  m.def(
+      "format_calibration",
+      [](const Scl& params, const std::string& header, std::optional<double> z_max_um) {
+        return ps::calibration::format_calibration(params, header, z_max_um);
+      },
+      py::arg("params"), py::arg("header") = "written by piezoshift (Python)",
+      py::arg("z_max_um") = py::none(), "The calibration file's text");
+  m.def(
+      "write_report",
+      [](const RR& result, const std::string& directory, const std::string& config_label) {
+        const rp::ReportFiles f = rp::write_report(result, directory, config_label);
+        py::dict out;
+        out["markdown"] = f.markdown.string();
+        out["html"] = f.html.string();
+        py::list figures;
+        for (const auto& p : f.figures)
+          figures.append(p.string());
+        py::list data;
+        for (const auto& p : f.data)
+          data.append(p.string());
+        out["figures"] = figures;
+        out["data"] = data;
+        return out;
+      },
+      py::arg("result"), py::arg("directory"), py::arg("config_label") = "built-in (paper)",
+      "Writes report.md, report.html, the figures (gnuplot) and the data of a reproduce() result; "
+      "returns their paths");
 }

@@ -2,8 +2,10 @@
 
 #include <algorithm>
 #include <charconv>
+#include <chrono>
 #include <cmath>
 #include <limits>
+#include <thread>
 #include <utility>
 
 #include <fmt/core.h>
@@ -17,10 +19,11 @@ namespace {
 using runtime::HostCommand;
 
 // The commands HLP? lists, with their syntax; the table in docs/gcs.md says more.
-constexpr std::array<std::string_view, 25> kHelp{
+constexpr std::string_view kHelp[] = {
     "*IDN? - identification",
     "CSV? - GCS syntax version",
     "SAI? [ALL] - axis identifiers",
+    "CST? [{axis} ...] - stage type of each axis",
     "PUN? [{axis}] - position units",
     "HLP? - this list",
     "ERR? - oldest queued error number (0: none), removed from the queue",
@@ -31,7 +34,11 @@ constexpr std::array<std::string_view, 25> kHelp{
     "MOV? [{axis} ...] - target position",
     "POS? [{axis} ...] - position from the strain gauges",
     "ONT? [{axis} ...] - on target",
-    "STP - stop: hold where the stage is (sets error 10)",
+    "VEL {axis} {velocity} ... - closed-loop velocity, stored (velocity control is off)",
+    "VEL? [{axis} ...] - velocity; VCO? [{axis} ...] - velocity control, 0",
+    "STP - stop: wave generators off, hold where the stage is (sets error 10)",
+    "#5 - moving axes as a hex bit mask; #7 - ready (0xB1); #8 - macro running (0)",
+    "#9 - running wave generators as a hex bit mask; #24 - stop all, as STP",
     "SVA {axis} {volts} ... - open-loop value in amplifier volts (servo off)",
     "SVA? [{axis} ...] - open-loop value",
     "VOL? [{channel} ...] - amplifier output voltage of channel 1, 2, 3",
@@ -39,10 +46,24 @@ constexpr std::array<std::string_view, 25> kHelp{
     "TMX? [{axis} ...] - upper travel limit",
     "DRC {table} {source} {option} - record option of source in table",
     "DRC? [{table} ...] - record configuration",
+    "DRT {table} {source} [{value}] - record trigger (0, 1: motion, 2: next command, 4: now)",
+    "DRT? [{table} ...] - record trigger",
     "RTR {cycles} - record every n-th servo cycle",
     "RTR? - record rate in servo cycles",
     "DRL? [{table} ...] - points recorded",
-    "DRR? [{start} [{count} [{table} ...]]] - read recorded data; TNR? - number of tables"};
+    "DRR? [{start} [{count} [{table} ...]]] - read recorded data; TNR? - number of tables",
+    "HDR? - data recorder options, triggers and sizes",
+    "SPA? [{item} {parameter} ...] - parameter values; SEP? - the same; HPA? - parameter list",
+    "WAV {table} {X|&|+} {PNT|LIN|SIN_P} {parameters} - define wave table 1 to 8",
+    "WAV? [{table} {1} ...] - number of points of the wave table",
+    "WSL {generator} {table} ... - wave table of wave generator 1 to 3 (axis Z, U, V)",
+    "WSL? [{generator} ...] - wave table of the generator",
+    "WGC {generator} {cycles} ... - cycles to play, 0: until stopped",
+    "WGC? [{generator} ...] - cycles",
+    "WTR {generator} {rate} {0} ... - servo cycles per table point (no interpolation)",
+    "WTR? [{generator} ...] - table rate and interpolation",
+    "WGO {generator} {0|1} ... - stop or start the generator (servo on)",
+    "WGO? [{generator} ...] - start mode; WGR - restart the recording; TWG? - generators, 3"};
 
 // GCS framing: every line but the last ends with a space before the LF.
 std::string framed(const std::vector<std::string>& lines) {
@@ -74,10 +95,31 @@ bool parse_real(std::string_view s, double& value) {
 }
 
 bool parse_integer(std::string_view s, long long& value) {
+  int base = 10;
+  if (s.size() > 2 && s[0] == '0' && (s[1] == 'x' || s[1] == 'X')) {
+    s.remove_prefix(2);  // GCS writes bit masks and parameter ids in hex: 0x101, 0x16000200
+    base = 16;
+  }
   const char* end = s.data() + s.size();
-  const auto r = std::from_chars(s.data(), end, value);
+  const auto r = std::from_chars(s.data(), end, value, base);
   return r.ec == std::errc{} && r.ptr == end;
 }
+
+// The parameters SPA?/SEP? answer (all controller-wide: any item is accepted), as HPA? lists
+// them: id, PI's data type and description. The ids are PI's (PIPython's datarectools reads
+// 0x0E000200, 0x16000200 and 0x16000300 to size a recording).
+struct Parameter {
+  long long id;
+  const char* type;
+  const char* group;
+  const char* description;
+};
+constexpr Parameter kParameters[] = {
+    {0x0E000200, "FLOAT", "Controller", "Servo Update Time (s)"},
+    {0x16000200, "INT", "Data Recorder", "Data Recorder Max Points (all tables)"},
+    {0x16000300, "INT", "Data Recorder", "Data Recorder Chan Number"},
+    {0x13000004, "INT", "Wave Generator", "Max Wave Points (per table)"},
+};
 
 int axis_of(std::string_view s) {
   for (Axis a : kAxes)
@@ -181,7 +223,8 @@ GcsController::GcsController(const StageModel& model, runtime::HostLink& link, d
       servo_cycle_s_(servo_cycle_s),
       options_(options),
       settle_samples_(static_cast<std::uint64_t>(
-          std::max(1.0, std::round(options.settle_time_s / servo_cycle_s)))) {
+          std::max(1.0, std::round(options.settle_time_s / servo_cycle_s)))),
+      slots_(std::make_unique<std::array<Slot, 2 * kGenerators>>()) {
   position_ = model_.pose_from_sgs(Vec3{});
 }
 
@@ -213,7 +256,41 @@ std::string GcsController::on_line(ClientId client, std::string_view line) {
     return {};
   const std::string_view name = tokens.front();
   tokens.erase(tokens.begin());
-  return execute(session, name, tokens);
+  std::string answer = execute(session, name, tokens);
+  if (trigger_ == 2 && name != "DRT") {  // "next command": this one, then back to the default
+    recorder_.restart();
+    record_from_sequence_ = sequence_;
+    trigger_ = 0;
+  }
+  // A query that failed answers one empty line: a client reading up to the answer's last LF
+  // never waits in vain, and finds the reason with ERR? (PIPython does so after every query).
+  if (answer.empty() && name.back() == '?')
+    return std::string(1, '\n');  // (not `answer = "\n"`: GCC 12 warns -Wrestrict wrongly)
+  return answer;
+}
+
+bool GcsController::is_immediate(char byte) const {
+  return byte == 5 || byte == 7 || byte == 8 || byte == 9 || byte == 24;
+}
+
+std::string GcsController::on_immediate(ClientId client, char byte) {
+  drain();
+  ++stats_.lines;
+  Session& session = sessions_[client];
+  switch (byte) {
+    case 5:
+      return fmt::format("{:X}\n", moving_mask());
+    case 7:
+      return "\xB1\n";  // ready: PI answers the byte 0xB1
+    case 8:
+      return "0\n";  // no macros
+    case 9:
+      return fmt::format("{:X}\n", wave_mask());
+    case 24:
+      return stop(session, {});
+    default:
+      return {};
+  }
 }
 
 bool GcsController::send(Session& session, HostCommand command) {
@@ -229,7 +306,75 @@ bool GcsController::send(Session& session, HostCommand command) {
 void GcsController::moved() {
   move_sequence_ = sequence_;
   settled_ = {};
-  recorder_.restart();
+  motion_trigger();
+}
+
+void GcsController::motion_trigger() {
+  if (trigger_ <= 1) {  // 0 (default) and 1: any command that changes the position
+    recorder_.restart();
+    record_from_sequence_ = sequence_;
+  }
+}
+
+AxisValues GcsController::commanded() const {
+  AxisValues c = target_;
+  if (!have_sample_)
+    return c;
+  const AxisValues live = model_.pose_from_points(last_.zd_um);
+  for (std::size_t g = 0; g < kGenerators; ++g)
+    if (wave_running_[g] && last_.applied_sequence >= wave_sequence_[g])
+      c[g] = live[g];
+  return c;
+}
+
+unsigned GcsController::moving_mask() const {
+  unsigned mask = 0;
+  for (std::size_t a = 0; a < 3; ++a) {
+    const bool moving =
+        wave_running_[a] || (servo_on_ && !faulted_ && settled_[a] < settle_samples_);
+    if (moving)
+      mask |= 1u << a;
+  }
+  return mask;
+}
+
+unsigned GcsController::wave_mask() const {
+  unsigned mask = 0;
+  for (std::size_t g = 0; g < kGenerators; ++g)
+    if (wave_running_[g])
+      mask |= 1u << g;
+  return mask;
+}
+
+bool GcsController::slot_free(std::size_t g) {
+  for (int i = 0; i < 50 && last_.applied_sequence < wave_sequence_[g]; ++i) {
+    std::this_thread::sleep_for(std::chrono::milliseconds(1));
+    drain();
+  }
+  return last_.applied_sequence >= wave_sequence_[g];
+}
+
+bool GcsController::stop_waves(Session& s) {
+  for (std::size_t g = 0; g < kGenerators; ++g)
+    if ((wave_running_[g] || wave_mode_[g] != 0) && !stop_wave(s, g))
+      return false;
+  return true;
+}
+
+bool GcsController::stop_wave(Session& s, std::size_t g) {
+  HostCommand c{};
+  c.kind = HostCommand::Kind::kWave;
+  c.wave.action = runtime::WaveCommand::Action::kStop;
+  c.wave.generator = static_cast<std::uint8_t>(g);
+  const AxisValues now = commanded();
+  if (!send(s, c))
+    return false;
+  wave_sequence_[g] = sequence_;
+  if (wave_running_[g])
+    target_[g] = now[g];  // where the loop folds it, to within the ticks until it applies this
+  wave_running_[g] = false;
+  wave_mode_[g] = 0;
+  return true;
 }
 
 void GcsController::drain() {
@@ -258,16 +403,34 @@ void GcsController::take(const runtime::HostSample& s) {
     faulted_ = faulted;
   }
 
+  // A generator the loop reports stopped (its cycles done, WGO 0, servo off, a fault) leaves
+  // its axis where the wave ended: that is the target from now on.
+  for (std::size_t g = 0; g < kGenerators; ++g) {
+    if (s.applied_sequence < wave_sequence_[g])
+      continue;
+    const bool running = ((s.wave_running >> g) & 1u) != 0;
+    if (wave_running_[g] && !running) {
+      target_[g] = model_.pose_from_points(s.zd_um)[g];
+      wave_mode_[g] = 0;
+    }
+    wave_running_[g] = running;
+  }
+  const AxisValues target = commanded();
+
   position_ = model_.pose_from_sgs(s.sgs_V);
   const bool counting =
       servo_on_ && !faulted && s.closed_loop != 0 && s.applied_sequence >= move_sequence_;
   for (std::size_t a = 0; a < 3; ++a) {
     const double tol = a == 0 ? options_.on_target_tolerance_um : options_.on_target_tolerance_urad;
-    settled_[a] = counting && std::fabs(position_[a] - target_[a]) <= tol ? settled_[a] + 1 : 0;
+    settled_[a] = counting && !wave_running_[a] && std::fabs(position_[a] - target[a]) <= tol
+                      ? settled_[a] + 1
+                      : 0;
   }
 
+  if (s.applied_sequence < record_from_sequence_)
+    return;  // from before the command that started this recording took effect
   RecorderInput in{};
-  in.target = target_;
+  in.target = target;
   in.position = position_;
   const double nan = std::numeric_limits<double>::quiet_NaN();
   in.interferometer =
@@ -353,8 +516,9 @@ std::string GcsController::execute(Session& s, std::string_view name, const Args
   const auto fixed = [](const AxisValues& v, int digits) {
     return [&v, digits](std::size_t a) { return fmt::format("{:.{}f}", v[a], digits); };
   };
+  const AxisValues target = commanded();
   if (name == "MOV?")
-    return reply(s, axis_lines(args, fixed(target_, 6), answer), answer);
+    return reply(s, axis_lines(args, fixed(target, 6), answer), answer);
   if (name == "POS?")
     return reply(s, axis_lines(args, fixed(position_, 6), answer), answer);
   if (name == "SVA?")
@@ -403,6 +567,68 @@ std::string GcsController::execute(Session& s, std::string_view name, const Args
   }
   if (name == "DRR?")
     return recorder_read(s, args);
+  if (name == "DRT")
+    return recorder_trigger(s, args);
+  if (name == "DRT?") {
+    const auto trigger = [this](int) { return fmt::format("{} 0", trigger_); };
+    return reply(s,
+                 id_lines(args, DataRecorder::kTables, GcsError::kNoRecordTable, trigger, answer),
+                 answer);
+  }
+  if (name == "HDR?") {
+    if (!no_args())
+      return {};
+    return framed({"#RecordOptions", "0=Nothing is recorded", "1=Commanded position of axis",
+                   "2=Actual position of axis", "3=Position error of axis",
+                   "7=Piezo voltage of output channel",
+                   "17=Sensor (strain gauge) of input channel, um of actuator stroke",
+                   "90=Interferometer position of axis (piezoshift; NaN on hardware)",
+                   "#TriggerOptions", "0=Default setting: any command changing the position",
+                   "1=Any command changing the position (MOV, MVR, SVA, SVO, STP, WGO)",
+                   "2=Next command, then the default again", "4=Immediately",
+                   "#Parameters to be set with SPA", "none: the recorder is set with DRC, DRT, RTR",
+                   "#Additional information",
+                   fmt::format("{} datarecorder tables", DataRecorder::kTables),
+                   fmt::format("{} datapoints per table", DataRecorder::kPoints), "end of help"});
+  }
+  if (name == "CST?") {
+    const auto stage = [](std::size_t) { return std::string{"PIEZOSHIFT_TRIPOD"}; };
+    return reply(s, axis_lines(args, stage, answer), answer);
+  }
+  if (name == "VEL")
+    return velocity(s, args);
+  if (name == "VEL?")
+    return reply(s, axis_lines(args, fixed(velocity_, 6), answer), answer);
+  if (name == "VCO?")
+    return reply(s,
+                 axis_lines(
+                     args, [](std::size_t) { return 0; }, answer),
+                 answer);
+  if (name == "SPA?" || name == "SEP?")
+    return parameters(s, args);
+  if (name == "HPA?") {
+    if (!no_args())
+      return {};
+    std::vector<std::string> lines;
+    for (const Parameter& p : kParameters)
+      lines.push_back(
+          fmt::format("0x{:08X}=\t0\t1\t{}\t{}\t{}", p.id, p.type, p.group, p.description));
+    return framed(lines);
+  }
+  if (name == "WAV")
+    return wave_define(s, args);
+  if (name == "WAV?")
+    return wave_query(s, args);
+  if (name == "WGO")
+    return wave_start(s, args);
+  if (name == "WSL" || name == "WGC" || name == "WTR")
+    return wave_setting(s, name, args);
+  if (name == "WSL?" || name == "WGC?" || name == "WGO?" || name == "WTR?")
+    return wave_setting_query(s, name, args);
+  if (name == "WGR")
+    return wave_record_restart(s, args);
+  if (name == "TWG?")
+    return no_args() ? fmt::format("{}\n", kGenerators) : std::string{};
   fail(s, GcsError::kUnknownCommand);
   return {};
 }
@@ -414,6 +640,12 @@ std::string GcsController::move(Session& s, const Args& args, bool relative) {
   if (!servo_on_) {
     fail(s, GcsError::kServoOff);
     return {};
+  }
+  for (const AxisValue& p : pairs) {
+    if (wave_running_[p.axis]) {
+      fail(s, GcsError::kWaveGeneratorActive);
+      return {};
+    }
   }
   AxisValues target = target_;
   for (const AxisValue& p : pairs)
@@ -445,7 +677,7 @@ std::string GcsController::servo(Session& s, const Args& args) {
     }
   }
   if ((on == 1.0) == servo_on_ && !faulted_) {
-    recorder_.restart();  // already so; still a motion command for the recorder's trigger
+    motion_trigger();  // already so; still a motion command for the recorder's trigger
     return {};
   }
   HostCommand c{};
@@ -512,6 +744,8 @@ std::string GcsController::stop(Session& s, const Args& args) {
     fail(s, GcsError::kParamCount);
     return {};
   }
+  if (!stop_waves(s))
+    return {};
   HostCommand c{};
   if (servo_on_) {
     c.kind = HostCommand::Kind::kMoveTo;
@@ -598,6 +832,358 @@ std::string GcsController::recorder_read(Session& s, const Args& args) {
     return {};
   }
   return answer;
+}
+
+std::string GcsController::recorder_trigger(Session& s, const Args& args) {
+  // "DRT {table} {source}" (PIPython with one trigger for all: table 0) or triples with a value.
+  const std::size_t step = args.size() == 2 ? 2 : 3;
+  if (args.empty() || args.size() % step != 0) {
+    fail(s, GcsError::kParamCount);
+    return {};
+  }
+  int source = trigger_;
+  for (std::size_t i = 0; i < args.size(); i += step) {
+    long long table = 0;
+    long long src = 0;
+    if (!parse_integer(args[i], table) || !parse_integer(args[i + 1], src)) {
+      fail(s, GcsError::kParamSyntax);
+      return {};
+    }
+    if (table < 0 || table > DataRecorder::kTables) {
+      fail(s, GcsError::kNoRecordTable);
+      return {};
+    }
+    if (src != 0 && src != 1 && src != 2 && src != 4) {
+      fail(s, GcsError::kParamOutOfRange);
+      return {};
+    }
+    source = static_cast<int>(src);  // one trigger serves all tables (they share one clock)
+  }
+  trigger_ = source;
+  if (trigger_ == 4) {
+    recorder_.restart();
+    record_from_sequence_ = sequence_;
+  }
+  return {};
+}
+
+std::string GcsController::parameters(Session& s, const Args& args) {
+  const auto value = [this](long long id) -> std::string {
+    switch (id) {
+      case 0x0E000200:
+        return fmt::format("{:.9g}", servo_cycle_s_);
+      case 0x16000200:
+        return fmt::format("{}", DataRecorder::kTables * DataRecorder::kPoints);
+      case 0x16000300:
+        return fmt::format("{}", DataRecorder::kTables);
+      case 0x13000004:
+        return fmt::format("{}", WaveTables::kPoints);
+      default:
+        return {};
+    }
+  };
+  std::vector<std::string> lines;
+  if (args.empty()) {
+    for (const Parameter& p : kParameters)
+      lines.push_back(fmt::format("1 0x{:08X}={}", p.id, value(p.id)));
+    return framed(lines);
+  }
+  if (args.size() % 2 != 0) {
+    fail(s, GcsError::kParamCount);
+    return {};
+  }
+  for (std::size_t i = 0; i < args.size(); i += 2) {
+    long long id = 0;
+    if (!parse_integer(args[i + 1], id)) {
+      fail(s, GcsError::kParamSyntax);
+      return {};
+    }
+    const std::string v = value(id);
+    if (v.empty()) {
+      fail(s, GcsError::kUnknownParameter);
+      return {};
+    }
+    lines.push_back(fmt::format("{} 0x{:08X}={}", args[i], id, v));
+  }
+  return framed(lines);
+}
+
+std::string GcsController::velocity(Session& s, const Args& args) {
+  std::vector<AxisValue> pairs;
+  if (!accepted(s, parse_pairs(args, pairs)))
+    return {};
+  for (const AxisValue& p : pairs) {
+    if (!(p.value > 0.0)) {
+      fail(s, GcsError::kVelocityOutOfLimits);
+      return {};
+    }
+  }
+  for (const AxisValue& p : pairs)
+    velocity_[p.axis] = p.value;
+  return {};
+}
+
+std::string GcsController::wave_define(Session& s, const Args& args) {
+  if (args.size() < 3) {
+    fail(s, GcsError::kParamCount);
+    return {};
+  }
+  long long table = 0;
+  if (!parse_integer(args[0], table)) {
+    fail(s, GcsError::kParamSyntax);
+    return {};
+  }
+  const int t = static_cast<int>(std::clamp<long long>(table, -1, 1000));
+  for (std::size_t g = 0; g < kGenerators; ++g) {
+    if (wave_running_[g] && wave_table_[g] == t) {
+      fail(s, GcsError::kWaveGeneratorActive);  // its copy plays on; still, PI refuses it
+      return {};
+    }
+  }
+  accepted(s, waves_.define(t, Args(args.begin() + 1, args.end())));
+  return {};
+}
+
+std::string GcsController::wave_query(Session& s, const Args& args) {
+  std::vector<std::string> lines;
+  const auto line = [&](int t) {
+    lines.push_back(fmt::format("{} 1={}", t, waves_.values(t).size()));
+  };
+  if (args.empty()) {
+    for (int t = 1; t <= WaveTables::kTables; ++t)
+      line(t);
+    return framed(lines);
+  }
+  if (args.size() % 2 != 0) {
+    fail(s, GcsError::kParamCount);
+    return {};
+  }
+  for (std::size_t i = 0; i < args.size(); i += 2) {
+    long long t = 0;
+    long long param = 0;
+    if (!parse_integer(args[i], t) || !parse_integer(args[i + 1], param)) {
+      fail(s, GcsError::kParamSyntax);
+      return {};
+    }
+    if (t < 1 || t > WaveTables::kTables) {
+      fail(s, GcsError::kWaveIndex);
+      return {};
+    }
+    if (param != 1) {  // 1: the number of points, the one parameter PI defines for WAV?
+      fail(s, GcsError::kParamOutOfRange);
+      return {};
+    }
+    line(static_cast<int>(t));
+  }
+  return framed(lines);
+}
+
+namespace {
+
+// "{generator} {integer} ..." pairs with generators 1..n; kNone on success.
+GcsError generator_pairs(const std::vector<std::string_view>& args, std::size_t n,
+                         std::vector<std::pair<std::size_t, long long>>& out) {
+  if (args.empty() || args.size() % 2 != 0)
+    return GcsError::kParamCount;
+  for (std::size_t i = 0; i < args.size(); i += 2) {
+    long long g = 0;
+    long long v = 0;
+    if (!parse_integer(args[i], g) || !parse_integer(args[i + 1], v))
+      return GcsError::kParamSyntax;
+    if (g < 1 || g > static_cast<long long>(n))
+      return GcsError::kWaveIndex;
+    out.emplace_back(static_cast<std::size_t>(g - 1), v);
+  }
+  return GcsError::kNone;
+}
+
+}  // namespace
+
+std::string GcsController::wave_start(Session& s, const Args& args) {
+  std::vector<std::pair<std::size_t, long long>> pairs;
+  if (!accepted(s, generator_pairs(args, kGenerators, pairs)))
+    return {};
+  std::array<bool, kGenerators> start{};
+  for (const auto& [g, mode] : pairs) {
+    if (mode != 0 && mode != 1) {  // 1: start now; PI's other bits (triggers, offsets) are not here
+      fail(s, GcsError::kWgoBitNotSupported);
+      return {};
+    }
+    start[g] = mode == 1;
+  }
+  const bool any_start = std::find(start.begin(), start.end(), true) != start.end();
+  if (any_start) {
+    if (!servo_on_ || faulted_) {
+      fail(s, GcsError::kServoOff);
+      return {};
+    }
+    // The range each generator will span, and the poses at the corners of that box: a move
+    // checked as a whole pose, as MOV is (the supervisor's limits hold whatever the check).
+    std::array<double, kGenerators> lo{};
+    std::array<double, kGenerators> hi{};
+    const AxisValues now = commanded();
+    for (std::size_t g = 0; g < kGenerators; ++g) {
+      lo[g] = hi[g] = target_[g];
+      if (start[g]) {
+        const int t = wave_table_[g];
+        if (t < 1 || waves_.values(t).empty()) {
+          fail(s, GcsError::kWaveNotDefined);
+          return {};
+        }
+        const auto [mn, mx] = std::minmax_element(waves_.values(t).begin(), waves_.values(t).end());
+        lo[g] = *mn;
+        hi[g] = *mx;
+      } else if (wave_running_[g]) {
+        lo[g] = wave_min_[g];
+        hi[g] = wave_max_[g];
+      } else {
+        lo[g] = hi[g] = now[g];
+      }
+    }
+    for (unsigned corner = 0; corner < 8; ++corner) {
+      AxisValues pose{};
+      for (std::size_t g = 0; g < kGenerators; ++g)
+        pose[g] = ((corner >> g) & 1u) != 0 ? hi[g] : lo[g];
+      if (!model_.reachable(pose)) {
+        fail(s, GcsError::kPositionOutOfLimits);
+        return {};
+      }
+    }
+  }
+  for (const auto& [g, mode] : pairs) {
+    if (mode == 0) {
+      if ((wave_running_[g] || wave_mode_[g] != 0) && !stop_wave(s, g))
+        return {};
+      wave_mode_[g] = 0;
+      continue;
+    }
+    // The slot the loop does not read: the other one of this generator's pair, once the loop
+    // has applied this generator's last start or stop.
+    if (!slot_free(g)) {
+      fail(s, GcsError::kCommunication);
+      return {};
+    }
+    const int slot = wave_slot_[g] == static_cast<int>(2 * g) ? static_cast<int>(2 * g + 1)
+                                                              : static_cast<int>(2 * g);
+    const std::vector<double>& values = waves_.values(wave_table_[g]);
+    Slot& storage = (*slots_)[static_cast<std::size_t>(slot)];
+    std::copy(values.begin(), values.end(), storage.begin());
+    AxisValues unit{};
+    unit[g] = 1.0;
+    const Vec3 zero = model_.points_for(AxisValues{});
+    const Vec3 column = model_.points_for(unit);
+    HostCommand c{};
+    c.kind = HostCommand::Kind::kWave;
+    c.wave.action = runtime::WaveCommand::Action::kStart;
+    c.wave.generator = static_cast<std::uint8_t>(g);
+    c.wave.values = storage.data();
+    c.wave.length = static_cast<std::uint32_t>(values.size());
+    c.wave.rate = static_cast<std::uint32_t>(wave_rate_[g]);
+    c.wave.cycles = static_cast<std::uint32_t>(wave_cycles_[g]);
+    for (std::size_t i = 0; i < 3; ++i)
+      c.wave.points_per_unit[i] = column[i] - zero[i];
+    c.wave.reference = target_[g];
+    if (!send(s, c))
+      return {};
+    wave_slot_[g] = slot;
+    wave_sequence_[g] = sequence_;
+    wave_mode_[g] = mode;
+    wave_running_[g] = true;
+    const auto [mn, mx] = std::minmax_element(values.begin(), values.end());
+    wave_min_[g] = *mn;
+    wave_max_[g] = *mx;
+  }
+  if (any_start) {
+    settled_ = {};
+    motion_trigger();
+  }
+  return {};
+}
+
+std::string GcsController::wave_setting(Session& s, std::string_view name, const Args& args) {
+  if (name == "WTR") {
+    // "{generator} {rate} {interpolation}" triples; generator 0: all.
+    if (args.empty() || args.size() % 3 != 0) {
+      fail(s, GcsError::kParamCount);
+      return {};
+    }
+    std::vector<std::pair<std::size_t, long long>> set;
+    for (std::size_t i = 0; i < args.size(); i += 3) {
+      long long g = 0;
+      long long rate = 0;
+      long long interpolation = 0;
+      if (!parse_integer(args[i], g) || !parse_integer(args[i + 1], rate) ||
+          !parse_integer(args[i + 2], interpolation)) {
+        fail(s, GcsError::kParamSyntax);
+        return {};
+      }
+      if (g < 0 || g > static_cast<long long>(kGenerators)) {
+        fail(s, GcsError::kWaveIndex);
+        return {};
+      }
+      if (rate < 1 || rate > 1000000 || interpolation != 0) {
+        fail(s, GcsError::kParamOutOfRange);
+        return {};
+      }
+      for (std::size_t k = 0; k < kGenerators; ++k)
+        if (g == 0 || static_cast<std::size_t>(g - 1) == k)
+          set.emplace_back(k, rate);
+    }
+    for (const auto& [g, rate] : set)
+      wave_rate_[g] = rate;
+    return {};
+  }
+  std::vector<std::pair<std::size_t, long long>> pairs;
+  if (!accepted(s, generator_pairs(args, kGenerators, pairs)))
+    return {};
+  for (const auto& [g, v] : pairs) {
+    if (name == "WSL" && (v < 0 || v > WaveTables::kTables)) {
+      fail(s, GcsError::kWaveIndex);
+      return {};
+    }
+    if (name == "WGC" && (v < 0 || v > 0xFFFFFFFFLL)) {
+      fail(s, GcsError::kParamOutOfRange);
+      return {};
+    }
+    if (name == "WSL" && wave_running_[g]) {
+      fail(s, GcsError::kWaveGeneratorActive);
+      return {};
+    }
+  }
+  for (const auto& [g, v] : pairs) {
+    if (name == "WSL")
+      wave_table_[g] = static_cast<int>(v);
+    else
+      wave_cycles_[g] = v;
+  }
+  return {};
+}
+
+std::string GcsController::wave_setting_query(Session& s, std::string_view name, const Args& args) {
+  std::string answer;
+  const auto value = [&](int g) -> std::string {
+    const auto i = static_cast<std::size_t>(g - 1);
+    if (name == "WSL?")
+      return fmt::format("{}", wave_table_[i]);
+    if (name == "WGC?")
+      return fmt::format("{}", wave_cycles_[i]);
+    if (name == "WTR?")
+      return fmt::format("{} 0", wave_rate_[i]);
+    return fmt::format("{}", wave_mode_[i]);
+  };
+  return reply(s,
+               id_lines(args, static_cast<int>(kGenerators), GcsError::kWaveIndex, value, answer),
+               answer);
+}
+
+std::string GcsController::wave_record_restart(Session& s, const Args& args) {
+  if (!args.empty()) {
+    fail(s, GcsError::kParamCount);
+    return {};
+  }
+  recorder_.restart();
+  record_from_sequence_ = sequence_;
+  return {};
 }
 
 }  // namespace piezoshift::host

@@ -16,6 +16,8 @@ const char* describe(GcsError error) noexcept {
       return "Move attempted with servo off";
     case GcsError::kPositionOutOfLimits:
       return "Position out of limits";
+    case GcsError::kVelocityOutOfLimits:
+      return "Velocity out of limits";
     case GcsError::kStopped:
       return "Controller was stopped by command";
     case GcsError::kInvalidAxis:
@@ -30,6 +32,8 @@ const char* describe(GcsError error) noexcept {
       return "Invalid floating point number";
     case GcsError::kCommunication:
       return "Controller detected communication error";
+    case GcsError::kUnknownParameter:
+      return "Unknown parameter";
     case GcsError::kNoRecordTable:
       return "Data record table does not exist";
     case GcsError::kNoRecordOption:
@@ -40,6 +44,22 @@ const char* describe(GcsError error) noexcept {
       return "Data record table does not hold enough recorded data";
     case GcsError::kTableDeactivated:
       return "Data record table is not configured for recording";
+    case GcsError::kWaveGeneratorActive:
+      return "Motion commands are not allowed when the wave generator is active";
+    case GcsError::kWaveIndex:
+      return "Wave generator index error";
+    case GcsError::kWaveNotDefined:
+      return "Wave table not defined";
+    case GcsError::kWaveTypeNotSupported:
+      return "Wave type not supported";
+    case GcsError::kWaveTooLong:
+      return "Wave length exceeds limit";
+    case GcsError::kWaveParamCount:
+      return "Wave parameter number error";
+    case GcsError::kWaveParamOutOfRange:
+      return "Wave parameter out of range";
+    case GcsError::kWgoBitNotSupported:
+      return "WGO command bit not supported";
     case GcsError::kOpenLoopWithServoOn:
       return "Open-loop commands are not allowed when servo is on";
     case GcsError::kMotionError:

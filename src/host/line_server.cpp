@@ -270,6 +270,13 @@ void LineServer::consume(Client& c, std::string_view data) {
       data.remove_prefix(lf + 1);
       continue;
     }
+    // A single-character command (GCS: #5, #7, ... sent as the control byte alone, no LF) is
+    // recognised where a line would start; inside a line the byte belongs to the line.
+    if (c.input.empty() && handler_.is_immediate(data.front())) {
+      queue(c, handler_.on_immediate(c.id, data.front()));
+      data.remove_prefix(1);
+      continue;
+    }
     if (lf == std::string_view::npos) {
       c.input.append(data);
       // One byte of slack: the last byte may be the CR of a CRLF that does not count.

@@ -78,6 +78,8 @@ LoopResult ControlLoop::run() noexcept {
   HostLink* const host = config_.host;
   if (host == nullptr)
     cycle_.drive(DriveMode::kPoints, profile_.at(0.0));
+  Vec3 host_zd{};
+  WaveGenerator wave;  // fixed-size; the tables are the host's (wave_generator.hpp)
   std::uint64_t applied_sequence = 0;
   const auto clear_latched_fault = [&]() noexcept {
     if (cycle_.clear_fault() && stop_requested)
@@ -115,12 +117,13 @@ LoopResult ControlLoop::run() noexcept {
       switch (cmd.kind) {
         case HostCommand::Kind::kMoveTo:
           if (closed_loop)
-            cycle_.drive(DriveMode::kPoints, cmd.zd_um);
+            host_zd = cmd.zd_um;
           break;
         case HostCommand::Kind::kServoOn:
           clear_latched_fault();
           // Bumpless: each PID resumes from the command the output already holds.
-          cycle_.drive(DriveMode::kPoints, cmd.zd_um);
+          host_zd = cmd.zd_um;
+          cycle_.drive(DriveMode::kPoints, host_zd);
           cycle_.restart_from_outputs();
           break;
         case HostCommand::Kind::kServoOff:
@@ -131,10 +134,21 @@ LoopResult ControlLoop::run() noexcept {
           if (!closed_loop)
             cycle_.drive(DriveMode::kOpenLoop, cmd.ao_V);
           break;
+        case HostCommand::Kind::kWave:
+          wave.apply(cmd.wave, host_zd);
+          break;
       }
     }
-    if (host == nullptr)
+    if (host == nullptr) {
       cycle_.drive(DriveMode::kPoints, profile_.at(static_cast<double>(ct.since_start_ns) * 1e-9));
+    } else {
+      // The host's set-point plus its running wave generators (stopped while open loop or
+      // faulted).
+      const bool closed = cycle_.mode() != DriveMode::kOpenLoop;
+      const Vec3 zd = wave.next(host_zd, closed && !supervisor.faulted());
+      if (closed)
+        cycle_.drive(DriveMode::kPoints, zd);
+    }
 
     const CycleSample& cs = cycle_.step(daq_, ct, previous_overran);
     const SupervisorOutput& s = cs.supervisor;
@@ -206,6 +220,7 @@ LoopResult ControlLoop::run() noexcept {
       h.state = static_cast<std::uint8_t>(s.state);
       h.fault_reason = static_cast<std::uint8_t>(supervisor.fault().reason);
       h.fault_channel = static_cast<std::int8_t>(supervisor.fault().channel);
+      h.wave_running = wave.running_mask();
       if (!host->samples.try_push(h))
         ++result.host_samples_dropped;
     }

@@ -44,6 +44,12 @@ bool framed(const std::string& answer) {
   return true;
 }
 
+// What a failed command answers: nothing for a set command, one empty line for a query.
+std::string failed_answer(std::string_view line) {
+  const std::string_view name = line.substr(0, line.find(' '));
+  return name.back() == '?' ? "\n" : "";
+}
+
 class GcsControllerTest : public ::testing::Test {
  protected:
   explicit GcsControllerTest(const GcsOptions& options = GcsOptions{})
@@ -128,11 +134,11 @@ TEST_F(GcsControllerTest, IdentificationAndSyntaxQueries) {
     EXPECT_NE(help.find(c), std::string::npos) << c;
   EXPECT_EQ(err(), 0);
   // Surplus arguments: 24; a bad SAI? argument: 1.
-  EXPECT_EQ(cmd("*IDN? 1"), "");
+  EXPECT_EQ(cmd("*IDN? 1"), "\n");
   EXPECT_EQ(err(), 24);
-  EXPECT_EQ(cmd("SAI? Z"), "");
+  EXPECT_EQ(cmd("SAI? Z"), "\n");
   EXPECT_EQ(err(), 1);
-  EXPECT_EQ(cmd("PUN? W"), "");
+  EXPECT_EQ(cmd("PUN? W"), "\n");
   EXPECT_EQ(err(), 15);
   EXPECT_EQ(err(), 0);
 }
@@ -171,7 +177,7 @@ TEST_F(GcsControllerTest, PositionComesFromTheGauges) {
   EXPECT_EQ(cmd("POS? V Z"), "V=-8.000000 \nZ=3.000000\n");
   EXPECT_EQ(cmd("SVO?"), "Z=0 \nU=0 \nV=0\n");
   EXPECT_EQ(cmd("ONT?"), "Z=0 \nU=0 \nV=0\n");
-  EXPECT_EQ(cmd("POS? Z W"), "");
+  EXPECT_EQ(cmd("POS? Z W"), "\n");
   EXPECT_EQ(err(), 15);
 }
 
@@ -309,7 +315,7 @@ TEST_F(GcsControllerTest, MoveErrors) {
         Case{"MOV Z", 24}, Case{"MOV", 24}, Case{"MOV Z 1 U", 24}, Case{"MOV Z abc", 25},
         Case{"MOV Z 1.5x", 25}, Case{"MOV Z nan", 25}, Case{"MOV Z inf", 25},
         Case{"MOV Z 1e400", 25}, Case{"MOV Z 1 Z 2", 22}, Case{"MVR U 1 U 1", 22}}) {
-    EXPECT_EQ(cmd(k.line), "") << k.line;
+    EXPECT_EQ(cmd(k.line), failed_answer(k.line)) << k.line;
     EXPECT_EQ(err(), k.error) << k.line;
     EXPECT_EQ(err(), 0) << k.line;
   }
@@ -375,11 +381,11 @@ TEST_F(GcsControllerTest, VoltageQuery) {
   feed(s);
   EXPECT_EQ(cmd("VOL?"), "1=15.0000 \n2=30.0000 \n3=45.0000\n");
   EXPECT_EQ(cmd("VOL? 3 1"), "3=45.0000 \n1=15.0000\n");
-  EXPECT_EQ(cmd("VOL? 4"), "");
+  EXPECT_EQ(cmd("VOL? 4"), "\n");
   EXPECT_EQ(err(), 17);
-  EXPECT_EQ(cmd("VOL? 0"), "");
+  EXPECT_EQ(cmd("VOL? 0"), "\n");
   EXPECT_EQ(err(), 17);
-  EXPECT_EQ(cmd("VOL? Z"), "");
+  EXPECT_EQ(cmd("VOL? Z"), "\n");
   EXPECT_EQ(err(), 1);
 }
 
@@ -588,7 +594,7 @@ TEST_F(GcsControllerTest, RecorderSetUpCommands) {
         Case{"DRC 1 Z y", 1}, Case{"DRC? 9", 57}, Case{"DRC? a", 1}, Case{"RTR 0", 17},
         Case{"RTR", 24}, Case{"RTR 1.5", 1}, Case{"RTR? 1", 24}, Case{"TNR? 1", 24},
         Case{"DRL? 9", 57}}) {
-    EXPECT_EQ(cmd(k.line), "") << k.line;
+    EXPECT_EQ(cmd(k.line), failed_answer(k.line)) << k.line;
     EXPECT_EQ(err(), k.error) << k.line;
   }
   EXPECT_EQ(err(), 0);
@@ -646,13 +652,167 @@ TEST_F(GcsControllerTest, RecorderRecordsTheLoopsSamples) {
   for (const Case& k :
        {Case{"DRR? 0", 17}, Case{"DRR? 1 -1", 17}, Case{"DRR? 1 4", 77}, Case{"DRR? 5", 77},
         Case{"DRR? 1 1 6", 78}, Case{"DRR? 1 1 9", 57}, Case{"DRR? a", 1}}) {
-    EXPECT_EQ(cmd(k.line), "") << k.line;
+    EXPECT_EQ(cmd(k.line), failed_answer(k.line)) << k.line;
     EXPECT_EQ(err(), k.error) << k.line;
   }
   // A motion command restarts the recording.
   EXPECT_EQ(cmd("MVR Z 0.5"), "");
   EXPECT_EQ(cmd("DRL? 1"), "1=0\n");
   EXPECT_EQ(err(), 0);
+}
+
+TEST_F(GcsControllerTest, AFailedQueryAnswersOneEmptyLineAndASetCommandNothing) {
+  EXPECT_EQ(cmd("FOO?"), "\n");
+  EXPECT_EQ(cmd("POS? W"), "\n");
+  EXPECT_EQ(cmd("FOO"), "");
+  EXPECT_EQ(err(), 2);
+  EXPECT_EQ(err(), 15);
+  EXPECT_EQ(err(), 2);
+  EXPECT_EQ(err(), 0);
+}
+
+TEST_F(GcsControllerTest, SingleCharacterCommands) {
+  for (char c : {'\x05', '\x07', '\x08', '\x09', '\x18'})
+    EXPECT_TRUE(gcs_.is_immediate(c)) << int(c);
+  EXPECT_FALSE(gcs_.is_immediate('M'));
+  EXPECT_EQ(gcs_.on_immediate(1, 7), "\xB1\n");
+  EXPECT_EQ(gcs_.on_immediate(1, 8), "0\n");
+  EXPECT_EQ(gcs_.on_immediate(1, 9), "0\n");
+  EXPECT_EQ(gcs_.on_immediate(1, 5), "0\n");  // servo off: nothing moves
+  const std::uint64_t on = servo_on_at({3.0, 12.0, -8.0});
+  // Just switched on: not settled yet, so all three axes count as moving (bits 0..2).
+  EXPECT_EQ(gcs_.on_immediate(1, 5), "7\n");
+  feed(at({3.0, 12.0, -8.0}, on, true), 10);
+  EXPECT_EQ(gcs_.on_immediate(1, 5), "0\n");
+  EXPECT_EQ(cmd("MOV U 20"), "");
+  const HostCommand m = only_command();
+  feed(at({3.0, 12.0, -8.0}, m.sequence, true), 10);
+  EXPECT_EQ(gcs_.on_immediate(1, 5), "2\n");  // U only: Z and V have settled again
+  // #24 stops like STP: error 10 for the client that sent it, nothing answered.
+  EXPECT_EQ(gcs_.on_immediate(1, 24), "");
+  EXPECT_EQ(only_command().kind, Kind::kMoveTo);
+  EXPECT_EQ(err(), 10);
+  EXPECT_EQ(err(2), 0);
+}
+
+TEST_F(GcsControllerTest, StageParametersAndRecorderHelp) {
+  EXPECT_EQ(cmd("CST?"), "Z=PIEZOSHIFT_TRIPOD \nU=PIEZOSHIFT_TRIPOD \nV=PIEZOSHIFT_TRIPOD\n");
+  EXPECT_EQ(cmd("SPA? 1 0x0E000200"), "1 0x0E000200=0.001\n");
+  EXPECT_EQ(cmd("SPA? Z 0x16000200 Z 0x16000300"), "Z 0x16000200=65536 \nZ 0x16000300=8\n");
+  EXPECT_EQ(cmd("SEP? 1 0x13000004"), "1 0x13000004=8192\n");
+  EXPECT_EQ(cmd("SPA? 1 0x7000000"), "\n");
+  EXPECT_EQ(err(), 54);
+  const std::string hpa = cmd("HPA?");
+  EXPECT_TRUE(framed(hpa)) << hpa;
+  EXPECT_NE(hpa.find("0x16000200=\t0\t1\tINT\t"), std::string::npos) << hpa;
+  const std::string hdr = cmd("HDR?");
+  EXPECT_TRUE(framed(hdr)) << hdr;
+  for (const char* line : {"#RecordOptions \n", "2=Actual position of axis \n",
+                           "#TriggerOptions \n", "8192 datapoints per table \n"})
+    EXPECT_NE(hdr.find(line), std::string::npos) << line;
+  EXPECT_EQ(cmd("VEL?"), "Z=0.000000 \nU=0.000000 \nV=0.000000\n");
+  EXPECT_EQ(cmd("VEL Z 100"), "");
+  EXPECT_EQ(cmd("VEL? Z"), "Z=100.000000\n");
+  EXPECT_EQ(cmd("VEL Z -1"), "");
+  EXPECT_EQ(err(), 8);
+  EXPECT_EQ(cmd("VCO? Z"), "Z=0\n");
+  EXPECT_EQ(cmd("DRT 0 4"), "");
+  EXPECT_EQ(cmd("DRT? 1"), "1=4 0\n");
+  EXPECT_EQ(cmd("DRT 1 3 0"), "");
+  EXPECT_EQ(err(), 17);
+  EXPECT_EQ(err(), 0);
+}
+
+TEST_F(GcsControllerTest, WaveTablesAndGeneratorSettings) {
+  EXPECT_EQ(cmd("WAV 1 X PNT 1 3 0.5 1.5 2.5"), "");
+  EXPECT_EQ(cmd("WAV 1 & PNT 1 2 3.5 4.5"), "");
+  EXPECT_EQ(cmd("WAV? 1 1"), "1 1=5\n");
+  EXPECT_EQ(cmd("WAV 2 X LIN 10 2 1 10 0 0"), "");
+  EXPECT_EQ(cmd("WAV 3 X SIN_P 100 4 1 100 0 50"), "");
+  EXPECT_EQ(cmd("WAV? 2 1 3 1"), "2 1=10 \n3 1=100\n");
+  EXPECT_EQ(cmd("WSL? 1"), "1=1\n");
+  EXPECT_EQ(cmd("WSL 1 3"), "");
+  EXPECT_EQ(cmd("WGC 1 2"), "");
+  EXPECT_EQ(cmd("WTR 0 5 0"), "");
+  EXPECT_EQ(cmd("WSL? 1 2"), "1=3 \n2=2\n");
+  EXPECT_EQ(cmd("WGC? 1"), "1=2\n");
+  EXPECT_EQ(cmd("WTR?"), "1=5 0 \n2=5 0 \n3=5 0\n");
+  EXPECT_EQ(cmd("TWG?"), "3\n");
+  EXPECT_EQ(err(), 0);
+  struct Case {
+    const char* line;
+    int error;
+  };
+  for (const Case& k :
+       {Case{"WAV 9 X PNT 1 1 0", 400}, Case{"WAV 1 X SQR 1 1 0", 402},
+        Case{"WAV 1 Y PNT 1 1 0", 1}, Case{"WAV 1 X PNT 1 2 0", 404},
+        Case{"WAV 1 X PNT 2 1 0", 405}, Case{"WAV 1 X PNT 1 1 x", 25},
+        Case{"WAV 1 X LIN 9000 1 0 10 0 0", 403}, Case{"WAV 1 X LIN 10 1 0 20 0 0", 405},
+        Case{"WAV 1 X LIN 10 1 0", 404}, Case{"WSL 4 1", 400}, Case{"WSL 1 9", 400},
+        Case{"WTR 1 0 0", 17}, Case{"WTR 1 1 1", 17}, Case{"WGO 1 2", 406}, Case{"WGO 1 1", 5},
+        Case{"WAV? 1 2", 17}, Case{"WSL? 4", 400}}) {
+    EXPECT_EQ(cmd(k.line), failed_answer(k.line)) << k.line;
+    EXPECT_EQ(err(), k.error) << k.line;
+  }
+  EXPECT_EQ(cmd("WAV? 1 1"), "1 1=5\n");  // the failed definitions left it as it was
+}
+
+TEST_F(GcsControllerTest, WaveGeneratorHandsAFixedSlotToTheLoopAndFollowsItsSamples) {
+  const std::uint64_t on = servo_on_at({3.0, 0.0, 0.0});
+  EXPECT_EQ(cmd("WAV 1 X PNT 1 4 3 3.5 4 4.5"), "");
+  EXPECT_EQ(cmd("WGC 1 1"), "");
+  EXPECT_EQ(cmd("WGO 1 1"), "");
+  EXPECT_EQ(err(), 0);
+  const HostCommand c = only_command();
+  ASSERT_EQ(c.kind, Kind::kWave);
+  EXPECT_EQ(c.wave.action, runtime::WaveCommand::Action::kStart);
+  EXPECT_EQ(c.wave.generator, 0);
+  ASSERT_NE(c.wave.values, nullptr);
+  EXPECT_EQ(c.wave.length, 4u);
+  EXPECT_EQ(c.wave.values[3], 4.5);
+  EXPECT_EQ(c.wave.cycles, 1u);
+  EXPECT_EQ(c.wave.reference, 3.0);
+  // Z moves the three points alike: d Z_d / d Z = (1, 1, 1).
+  expect_near(c.wave.points_per_unit, Vec3{1.0, 1.0, 1.0}, 1e-12);
+  EXPECT_EQ(cmd("WGO? 1"), "1=1\n");
+  EXPECT_EQ(gcs_.on_immediate(1, 9), "1\n");
+  EXPECT_EQ(cmd("MOV Z 4"), "");  // its generator runs
+  EXPECT_EQ(err(), 73);
+  // The loop plays 4.0 now: MOV? follows the wave.
+  HostSample s = at({4.0, 0.0, 0.0}, c.sequence, true);
+  s.zd_um = model_.points_for({4.0, 0.0, 0.0});
+  s.wave_running = 1;
+  feed(s);
+  EXPECT_NEAR(std::stod(cmd("MOV? Z").substr(2)), 4.0, 1e-12);
+  EXPECT_EQ(cmd("ONT? Z"), "Z=0\n");
+  // Done: the loop holds 4.5, and so does the target.
+  s.zd_um = model_.points_for({4.5, 0.0, 0.0});
+  s.wave_running = 0;
+  feed(s);
+  EXPECT_EQ(gcs_.on_immediate(1, 9), "0\n");
+  EXPECT_NEAR(std::stod(cmd("MOV? Z").substr(2)), 4.5, 1e-12);
+  // A second start takes the other slot of the pair, so the loop never reads a slot being written.
+  EXPECT_EQ(cmd("WGO 1 1"), "");
+  const HostCommand c2 = only_command();
+  EXPECT_NE(c2.wave.values, c.wave.values);
+  EXPECT_EQ(c2.wave.reference, 4.5);
+  // A table beyond the travel is refused as a whole (7), and STP stops a running generator.
+  EXPECT_EQ(cmd("WAV 2 X PNT 1 2 1 50"), "");
+  EXPECT_EQ(cmd("WGO 2 1"), "");  // generator 2 plays table 2 into U: 50 urad is reachable
+  EXPECT_EQ(err(), 0);
+  EXPECT_EQ(only_command().wave.generator, 1);
+  EXPECT_EQ(cmd("WAV 3 X PNT 1 1 1000"), "");
+  EXPECT_EQ(cmd("WGO 3 1"), "");
+  EXPECT_EQ(err(), 7);
+  EXPECT_EQ(cmd("STP"), "");
+  const std::vector<HostCommand> stops = commands();
+  ASSERT_EQ(stops.size(), 3u);  // generators 1 and 2, then the hold
+  EXPECT_EQ(stops[0].kind, Kind::kWave);
+  EXPECT_EQ(stops[0].wave.action, runtime::WaveCommand::Action::kStop);
+  EXPECT_EQ(stops[1].wave.generator, 1);
+  EXPECT_EQ(stops[2].kind, Kind::kMoveTo);
+  EXPECT_EQ(err(), 10);
+  (void)on;
 }
 
 TEST_F(GcsControllerTest, CountsSamplesAndDrops) {

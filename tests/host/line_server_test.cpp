@@ -43,6 +43,11 @@ class TestHandler final : public LineHandler {
     ++overlongs;
     return "OVERLONG\n";
   }
+  // 0x05 is a single-character command, as GCS's #5.
+  bool is_immediate(char byte) const override { return byte == 5; }
+  std::string on_immediate(ClientId, char byte) override {
+    return "IMMEDIATE " + std::to_string(int(byte)) + "\n";
+  }
   std::string on_line(ClientId id, std::string_view line) override {
     {
       std::lock_guard lock(mutex_);
@@ -124,6 +129,25 @@ bool eventually(const std::function<bool()>& condition, double timeout_s = 5.0) 
     std::this_thread::sleep_for(std::chrono::milliseconds(1));
   }
   return true;
+}
+
+TEST(LineServerFraming, ASingleCharacterCommandNeedsNoLfWhereALineWouldStart) {
+  TestHandler handler;
+  ServerThread st(handler);
+  auto c = st.connect();
+  c->send_raw("\x05");  // no LF: answered at once
+  EXPECT_EQ(c->read_answer(), "IMMEDIATE 5\n");
+  // Twice in a row, then a line: three answers in order.
+  c->send_raw(
+      "\x05\x05"
+      "ECHO a\n");
+  EXPECT_EQ(c->read_answer(), "IMMEDIATE 5\n");
+  EXPECT_EQ(c->read_answer(), "IMMEDIATE 5\n");
+  EXPECT_EQ(c->read_answer(), "a\n");
+  // Inside a line the byte belongs to the line (ECHO x<05>y is 8 bytes long).
+  c->send_raw("ECHO x\x05y\n");
+  EXPECT_EQ(c->read_answer(), "x\x05y\n");
+  EXPECT_EQ(handler.lines().size(), 2u);
 }
 
 TEST(LineServerFraming, MultiLineAnswerIsReadWholeWithItsLines) {

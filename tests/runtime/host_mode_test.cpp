@@ -1,5 +1,6 @@
 // ControlLoop in host mode (`piezoshift serve`): set-points and servo state from HostCommands,
 // one HostSample back per tick. On the closed-form FakeBackend plant and a simulated clock.
+#include <algorithm>
 #include <cmath>
 #include <vector>
 
@@ -125,6 +126,84 @@ TEST(HostMode, ServoOffHoldsTheAppliedVolts) {
   EXPECT_EQ(after.applied_sequence, 3u);
   for (std::size_t i = 0; i < 3; ++i)
     EXPECT_NEAR(after.ao_V[i], before.ao_V[i], 1e-3) << i;
+}
+
+HostCommand wave_start(std::uint64_t sequence, const double* values, std::uint32_t length,
+                       std::uint32_t rate, std::uint32_t cycles, double reference) {
+  HostCommand c;
+  c.kind = HostCommand::Kind::kWave;
+  c.sequence = sequence;
+  c.wave.action = WaveCommand::Action::kStart;
+  c.wave.generator = 0;
+  c.wave.values = values;
+  c.wave.length = length;
+  c.wave.rate = rate;
+  c.wave.cycles = cycles;
+  c.wave.points_per_unit = Vec3{1.0, 0.5, 0.25};
+  c.wave.reference = reference;
+  return c;
+}
+
+TEST(HostMode, AWaveTablePlaysOnePointEveryRateTicksThenHoldsItsLastPoint) {
+  // 10 points, 2 ticks each, one cycle: ticks 0..19 play them (the start is applied at tick 0,
+  // before the set-point of that tick), from tick 20 on the set-point holds the last point.
+  std::vector<double> table(10);
+  for (std::size_t i = 0; i < table.size(); ++i)
+    table[i] = 2.0 + 0.1 * static_cast<double>(i);
+  const HostRun r = run_host({command(HostCommand::Kind::kServoOn, 1, control::filled(2.0)),
+                              wave_start(2, table.data(), 10, 2, 1, 2.0)},
+                             0.05);
+  EXPECT_FALSE(r.result.fault_detected) << to_string(r.result.fault.reason);
+  ASSERT_GE(r.samples.size(), 30u);
+  for (std::size_t k = 0; k < 30; ++k) {
+    const double w = table[std::min<std::size_t>(k / 2, 9)] - 2.0;
+    EXPECT_DOUBLE_EQ(r.samples[k].zd_um[0], 2.0 + 1.0 * w) << k;
+    EXPECT_DOUBLE_EQ(r.samples[k].zd_um[1], 2.0 + 0.5 * w) << k;
+    EXPECT_DOUBLE_EQ(r.samples[k].zd_um[2], 2.0 + 0.25 * w) << k;
+    EXPECT_EQ(r.samples[k].wave_running, k < 19 ? 1 : 0) << k;  // done with the 20th tick
+  }
+}
+
+TEST(HostMode, AWaveStopsWhereItIsOnAStopAndWhenTheServoGoesOff) {
+  std::vector<double> table{1.0, 2.0, 3.0, 4.0};
+  HostCommand stop{};
+  stop.kind = HostCommand::Kind::kWave;
+  stop.sequence = 3;
+  stop.wave.action = WaveCommand::Action::kStop;
+  // Endless (cycles 0); the stop, pushed during tick 6, is applied at tick 7, which then plays
+  // no point: the set-point keeps tick 6's value, table[6 % 4] = 3.
+  const HostCommand start = wave_start(2, table.data(), 4, 1, 0, 0.0);
+  const HostRun r = run_host({command(HostCommand::Kind::kServoOn, 1, control::filled(0.0)), start},
+                             0.02, &stop, 6);
+  ASSERT_GE(r.samples.size(), 10u);
+  EXPECT_DOUBLE_EQ(r.samples[5].zd_um[0], 2.0);
+  EXPECT_DOUBLE_EQ(r.samples[6].zd_um[0], 3.0);
+  EXPECT_EQ(r.samples[6].wave_running, 1);
+  for (std::size_t k = 7; k < 10; ++k) {
+    EXPECT_DOUBLE_EQ(r.samples[k].zd_um[0], 3.0) << k;
+    EXPECT_EQ(r.samples[k].wave_running, 0) << k;
+  }
+  // Servo off stops it too.
+  HostCommand off = command(HostCommand::Kind::kServoOff, 3);
+  const HostRun o = run_host({command(HostCommand::Kind::kServoOn, 1, control::filled(0.0)), start},
+                             0.02, &off, 6);
+  EXPECT_EQ(o.samples[6].wave_running, 1);
+  EXPECT_EQ(o.samples[7].wave_running, 0);
+}
+
+TEST(HostMode, ARestartedWaveKeepsTheReferenceItsSetPointHolds) {
+  // The host's target stays the first start's reference while the generator runs, so a restart
+  // (whose own reference is ignored) plays the new table on the same base.
+  std::vector<double> first{1.0, 2.0};
+  std::vector<double> second{5.0};
+  const HostCommand start = wave_start(2, first.data(), 2, 1, 0, 0.0);
+  const HostCommand restart = wave_start(3, second.data(), 1, 1, 0, 99.0);
+  const HostRun r = run_host({command(HostCommand::Kind::kServoOn, 1, control::filled(0.0)), start},
+                             0.02, &restart, 3);
+  ASSERT_GE(r.samples.size(), 8u);
+  EXPECT_DOUBLE_EQ(r.samples[3].zd_um[0], 2.0);
+  for (std::size_t k = 4; k < 8; ++k)
+    EXPECT_DOUBLE_EQ(r.samples[k].zd_um[0], 5.0) << k;
 }
 
 TEST(HostMode, CommandsAndSamplesMakeNoHeapAllocation) {

@@ -7,6 +7,8 @@
 //   handler.on_poll()
 //   poll(wake-up fd, listening socket, every client; POLLOUT only while its output is pending)
 //   for each client: recv() one chunk -> split at LF -> handler.on_line() -> queue the answer
+//                    (a byte for which handler.is_immediate() holds, where a line would start:
+//                    handler.on_immediate() at once, no LF needed)
 //                    send() queued output (MSG_NOSIGNAL: a vanished peer is an error, not SIGPIPE)
 //   accept() new connections (beyond max_clients: accepted and closed at once)
 //   disconnect idle clients, slow readers, failed or finished connections ->
@@ -65,6 +67,11 @@ class LineHandler {
   virtual std::string on_line(ClientId, std::string_view line) = 0;
   //! A line longer than LineServerLimits::max_line_bytes; returns the bytes to send back.
   virtual std::string on_overlong_line(ClientId) { return {}; }
+  //! True for a byte that is a whole command by itself when it starts a line (GCS's
+  //! single-character commands, e.g. 0x05 for #5); such a byte is passed to on_immediate().
+  virtual bool is_immediate(char) const { return false; }
+  //! One single-character command; returns the bytes to send back.
+  virtual std::string on_immediate(ClientId, char) { return {}; }
   //! Every turn of the loop, before input is handled: at least every poll interval.
   virtual void on_poll() {}
 };

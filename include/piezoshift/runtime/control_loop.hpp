@@ -7,8 +7,10 @@
 //     clear requested (request_clear())                  -> supervisor.clear_fault(),
 //                                                           controller reset (bumpless from 0 V)
 //     host mode: apply the host's commands (host_link.hpp)
-//     Z_d = profile(k T), or the host's last move        (host mode with the servo off: the
-//                                                         host's open-loop volts)
+//     Z_d = profile(k T), or the host's last move plus   (host mode with the servo off: the
+//           its running wave generators               host's open-loop volts; the generators
+//           (wave_generator.hpp)                      stop when the servo is off or a fault is
+//                                                     latched)
 //     cycle.step(daq, k, overrun(k-1))                   the one control tick (control_cycle.hpp):
 //                                                        read, controller, supervisor, write
 //                                                        E_k = end of work

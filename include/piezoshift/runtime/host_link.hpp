@@ -14,23 +14,27 @@
 //   kServoOff    clears a latched fault, then opens the loop: the open-loop outputs start at the
 //                volts already applied, so nothing moves
 //   kOpenLoop    servo off: the DAQ outputs := ao_V (through the safety supervisor's limits)
+//   kWave        starts or stops one wave generator (wave_generator.hpp); it plays into Z_d while
+//                the servo is on and no fault is latched, and stops otherwise
 // Every sample carries the sequence number of the last command applied, so the host knows when
 // its command has reached the loop.
 #include <cstdint>
 
 #include "piezoshift/control/vec3.hpp"
 #include "piezoshift/runtime/spsc_ring.hpp"
+#include "piezoshift/runtime/wave_generator.hpp"
 
 namespace piezoshift::runtime {
 
 using control::Vec3;
 
 struct HostCommand {
-  enum class Kind : std::uint8_t { kMoveTo, kServoOn, kServoOff, kOpenLoop };
+  enum class Kind : std::uint8_t { kMoveTo, kServoOn, kServoOff, kOpenLoop, kWave };
   Kind kind = Kind::kMoveTo;
   std::uint64_t sequence = 0;  //!< set by the host, increasing
   Vec3 zd_um{};                //!< kMoveTo, kServoOn: Z_d of P1..P3
   Vec3 ao_V{};                 //!< kOpenLoop: DAQ volts per channel
+  WaveCommand wave{};          //!< kWave
 };
 
 struct HostSample {
@@ -50,6 +54,7 @@ struct HostSample {
   std::uint8_t state = 0;              //!< SupervisorState as a number
   std::uint8_t fault_reason = 0;       //!< FaultReason as a number (0 = none)
   std::int8_t fault_channel = -1;
+  std::uint8_t wave_running = 0;  //!< bit g: wave generator g runs (WaveGenerator::running_mask)
 };
 
 struct HostLink {
