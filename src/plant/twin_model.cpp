@@ -199,9 +199,36 @@ TwinModel make_twin_model(const design::DesignInputs& d, const TwinParams& p) {
         m.geometry.sgs_gain[i] / (1.0 + km / m.contact_stiffness_N_per_um);
   }
   m.sgs_nominal_um_per_V = d.actuator.nominal_stroke_um / sgs.full_scale_V;
+  // Gauge creep: the stack's chain, scaled so a step creeps by the stated fraction in the
+  // stated time (creep.hpp: the step response is linear in the per-decade fraction).
+  require(std::isfinite(sgs.gauge_creep_fraction) && sgs.gauge_creep_fraction >= 0.0 &&
+              sgs.gauge_creep_fraction <= 0.1,
+          "twin.sgs.gauge_creep_fraction must be in [0, 0.1]");
+  require(positive(sgs.gauge_creep_time_s), "twin.sgs.gauge_creep_time_s must be positive");
   CreepParams gauge = p.piezo.creep;
-  gauge.per_decade_fraction = sgs.gauge_creep_per_decade;
+  gauge.per_decade_fraction = 1.0;
+  const double unit_creep = built("twin.sgs", [&] {
+                              return CreepChain(gauge, m.control_period_s);
+                            }).step_response(sgs.gauge_creep_time_s);
+  gauge.per_decade_fraction = sgs.gauge_creep_fraction / unit_creep;
   m.gauge_creep = built("twin.sgs", [&] { return CreepChain(gauge, m.control_period_s); });
+  // Flicker: the zero's 1/f level A = S_white f_corner, S_white = sigma^2 / (f_s / 2); the
+  // excitation's level from its rms over the stated window (flicker.hpp).
+  require(positive(sgs.flicker_corner_Hz) || sgs.flicker_corner_Hz == 0.0,
+          "twin.sgs.flicker_corner_Hz must be >= 0");
+  require(std::isfinite(sgs.excitation_drift_ppm_rms) && sgs.excitation_drift_ppm_rms >= 0.0,
+          "twin.sgs.excitation_drift_ppm_rms must be >= 0");
+  require(positive(sgs.excitation_drift_window_s),
+          "twin.sgs.excitation_drift_window_s must be positive");
+  const double white_psd_nm2_per_Hz =
+      sgs.noise_nm_rms * sgs.noise_nm_rms / (0.5 / m.control_period_s);
+  m.sgs_zero_flicker =
+      FlickerNoise(white_psd_nm2_per_Hz * sgs.flicker_corner_Hz, kSgsZeroFlickerShortestS,
+                   kSgsFlickerLongestS, 1, m.control_period_s);
+  m.sgs_excitation_drift = FlickerNoise(
+      flicker_psd_for_window_rms(sgs.excitation_drift_ppm_rms * 1e-6, sgs.excitation_drift_window_s,
+                                 kSgsExcitationShortestS, kSgsFlickerLongestS, 1),
+      kSgsExcitationShortestS, kSgsFlickerLongestS, 1, m.control_period_s);
 
   // Interferometer and lab
   const InterferometerParams& ifm = p.interferometer;
@@ -215,17 +242,18 @@ TwinModel make_twin_model(const design::DesignInputs& d, const TwinParams& p) {
           "twin.interferometer.cyclic_error_nm must be >= 0");
   const LabParams& lab = p.lab;
   require(std::isfinite(lab.temperature_C), "twin.lab.temperature_C must be finite");
-  require(std::isfinite(lab.temperature_amplitude_K) && lab.temperature_amplitude_K >= 0.0,
-          "twin.lab.temperature_amplitude_K must be >= 0");
-  require(positive(lab.temperature_period_s), "twin.lab.temperature_period_s must be positive");
+  require(std::isfinite(lab.temperature_rms_K) && lab.temperature_rms_K >= 0.0,
+          "twin.lab.temperature_rms_K must be >= 0");
+  require(positive(lab.temperature_correlation_time_s),
+          "twin.lab.temperature_correlation_time_s must be positive");
   require(positive(lab.structure_time_constant_s),
           "twin.lab.structure_time_constant_s must be positive");
   require(std::isfinite(lab.metrology_loop_length_m) && lab.metrology_loop_length_m >= 0.0,
           "twin.lab.metrology_loop_length_m must be >= 0");
   require(std::isfinite(lab.metrology_loop_cte_per_K),
           "twin.lab.metrology_loop_cte_per_K must be finite");
-  require(std::isfinite(lab.uncompensated_air_path_m) && lab.uncompensated_air_path_m >= 0.0,
-          "twin.lab.uncompensated_air_path_m must be >= 0");
+  require(std::isfinite(lab.dead_path_m) && lab.dead_path_m >= 0.0,
+          "twin.lab.dead_path_m must be >= 0");
   require(std::isfinite(lab.air_index_per_K), "twin.lab.air_index_per_K must be finite");
 
   // Dynamics

@@ -21,6 +21,7 @@
 #include "piezoshift/design/design_inputs.hpp"
 #include "piezoshift/plant/amplifier.hpp"
 #include "piezoshift/plant/creep.hpp"
+#include "piezoshift/plant/flicker.hpp"
 #include "piezoshift/plant/geometry.hpp"
 #include "piezoshift/plant/hysteresis.hpp"
 #include "piezoshift/plant/mechanics.hpp"
@@ -77,6 +78,8 @@ struct TwinModel {
   PrandtlIshlinskii hysteresis{};
   CreepChain creep{};
   CreepChain gauge_creep{};
+  FlickerNoise sgs_zero_flicker{};      //!< z_i [nm]
+  FlickerNoise sgs_excitation_drift{};  //!< delta [relative]
   LinearMechanics mechanics{};
   control::Mat3 legs_to_pose{};  //!< (Z [um], theta_x [urad], theta_y [urad]) = this x
 };
