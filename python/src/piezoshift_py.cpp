@@ -296,7 +296,9 @@ PYBIND11_MODULE(_piezoshift, m) {
       .def(py::init<>())
       .PS_RW(pl::ContactParams, open_loop_travel_um)
       .PS_RW(pl::ContactParams, open_loop_time_s)
-      .PS_RW(pl::ContactParams, stiffness_N_per_um);
+      .PS_RW(pl::ContactParams, stiffness_N_per_um)
+      .PS_RW(pl::ContactParams, ball_radius_m)
+      .PS_RW(pl::ContactParams, preload_N);
   py::class_<pl::MechanicsParams>(m, "MechanicsParams")
       .def(py::init<>())
       .PS_RW(pl::MechanicsParams, mechanism_damping_ratio)

@@ -77,6 +77,9 @@ void read_twin_sections(const ConfigFile& file, const design::DesignInputs& desi
   contact.read("open_loop_time_s", t.contact.open_loop_time_s, positive);
   if (double k = 0.0; contact.read("stiffness_N_per_um", k, positive))
     t.contact.stiffness_N_per_um = k;
+  contact.read("ball_radius_m", t.contact.ball_radius_m, non_negative);
+  if (double f = 0.0; contact.read("preload_N", f, positive))
+    t.contact.preload_N = f;
 
   const ConfigSection mech = file.section("twin.mechanics");
   mech.read("mechanism_damping_ratio", t.mechanics.mechanism_damping_ratio, ratio);

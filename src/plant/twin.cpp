@@ -32,6 +32,8 @@ Twin::Twin(const design::DesignInputs& design, const TwinParams& params, std::ui
     sgs_gain_[i] = model_.sgs_gain_per_elongation[i];
   }
   sgs_beta_ = 1.0 - std::exp(-2.0 * std::numbers::pi * p.sgs.bandwidth_Hz * model_.physics_step_s);
+  sgs_beta_tick_ =
+      1.0 - std::exp(-2.0 * std::numbers::pi * p.sgs.bandwidth_Hz * model_.control_period_s);
   ai_noise_V_ =
       std::hypot(p.sgs.noise_nm_rms * 1e-3 / model_.sgs_nominal_um_per_V, p.daq.ai_noise_V_rms);
   lsb_V_ = daq_lsb_V(p.daq);
@@ -89,7 +91,7 @@ void Twin::advance() noexcept {
     const double in = faults_[c].amplifier_failed ? 0.0 : ao_V_[c];
     double v = amp_V_[c];
     PlaySweep sweep(m.hysteresis, play_[c], gain_V * in > v);
-    const double g = m.stroke_gain_um[c], creep = creep_out_[c], k = ks_[c];
+    const double g = m.stroke_gain_um[c], creep = creep_out_[c], k = ks_[c], r = hertz_r_um_[c];
     double y_sum = 0.0, xf = free_um_[c], f = filtered_free_um_[c];
     for (std::size_t s = 0; s < n; ++s) {
       v = amp.step(v, in);
@@ -97,7 +99,7 @@ void Twin::advance() noexcept {
       y_sum += y;
       xf = g * (y + creep);
       f += beta * (xf - f);
-      force_N_[s][c] = k * xf;
+      force_N_[s][c] = k * (xf - r);
     }
     sweep.commit(play_[c]);
     amp_V_[c] = v;
@@ -134,8 +136,18 @@ void Twin::advance() noexcept {
   filtered_modes_[4] = fm2;
   ifm_countdown_ = countdown;
   const Vec3 x = mechanics_.displacement_um(mech_);
-  for (std::size_t i = 0; i < 3; ++i)
-    elongation_um_[i] = free_um_[i] - ks_over_ka_[i] * (free_um_[i] - x[i]);
+  for (std::size_t i = 0; i < 3; ++i) {
+    const double r = hertz_r_um_[i];
+    const double f = ks_[i] * (free_um_[i] - r - x[i]);  // the contact's force increment
+    elongation_um_[i] = free_um_[i] - ks_over_ka_[i] * (free_um_[i] - r - x[i]);
+    filtered_hertz_r_um_[i] += sgs_beta_tick_ * (r - filtered_hertz_r_um_[i]);
+    truth_.contact_force_N[i] = m.contact_preload_N + f;
+    truth_.contact_residual_um[i] = r;
+    // For the next period, from the mechanism's force k_m x (the contact's force in statics):
+    // the leg moves smoothly, while k_s (x_free - r - x) rings with every amplifier step.
+    if (m.contact_hertz)
+      hertz_r_um_[i] = m.hertz(m.mechanism_stiffness_N_per_um * x[i]);
+  }
   ++tick_;
   for (std::size_t i = 0; i < 3; ++i) {
     creep_out_[i] = m.creep.update(creep_[i], y_mean[i]);
@@ -170,7 +182,8 @@ void Twin::sample_ai(double structure_change_K) noexcept {
   }
   for (std::size_t i = 0; i < 3; ++i) {
     const double filtered_e =
-        filtered_free_um_[i] - ks_over_ka_[i] * (filtered_free_um_[i] - fx[i]);
+        filtered_free_um_[i] -
+        ks_over_ka_[i] * (filtered_free_um_[i] - filtered_hertz_r_um_[i] - fx[i]);
     const double r_um = sgs_gain_[i] * (1.0 + delta) * (filtered_e - gauge_out_[i]) + drift_um +
                         1e-3 * truth_.sgs_zero_flicker_nm[i];
     const double v_lin = r_um * inv_scale;

@@ -5,6 +5,7 @@
 #include <cmath>
 #include <complex>
 #include <numbers>
+#include <stdexcept>
 #include <vector>
 
 #include <gtest/gtest.h>
@@ -13,6 +14,7 @@
 #include "piezoshift/plant/interferometer.hpp"
 #include "piezoshift/plant/lab_environment.hpp"
 #include "piezoshift/plant/random.hpp"
+#include "piezoshift/plant/twin.hpp"
 #include "piezoshift/plant/twin_model.hpp"
 
 namespace piezoshift::plant {
@@ -35,8 +37,8 @@ double welch_psd(const std::vector<double>& x, std::size_t n, std::size_t k, dou
       mean += x[s * n + i];
     mean /= static_cast<double>(n);
     // the twiddle factor by rotation (its rounding stays far below the estimate's spread)
-    const std::complex<double> rot = std::polar(
-        1.0, -2.0 * std::numbers::pi * static_cast<double>(k) / static_cast<double>(n));
+    const std::complex<double> rot =
+        std::polar(1.0, -2.0 * std::numbers::pi * static_cast<double>(k) / static_cast<double>(n));
     std::complex<double> tw{1.0, 0.0};
     for (std::size_t i = 0; i < n; ++i) {
       const double w = 0.5 - 0.5 * std::cos(2.0 * std::numbers::pi * static_cast<double>(i) /
@@ -214,6 +216,63 @@ TEST(Lab, AirAndStructureHaveTheirStationaryVariances) {
   EXPECT_NEAR(std::sqrt(ax / n), 0.03, 0.0015);
   // The discrete lag (forward step of 10 s on 1800 s) adds < 0.3 %.
   EXPECT_NEAR(std::sqrt(ay / n), 0.03 * std::sqrt(600.0 / 2400.0), 0.001);
+}
+
+}  // namespace
+}  // namespace piezoshift::plant
+
+namespace piezoshift::plant {
+namespace {
+
+TEST(HertzContact, DeflectionAndItsLinearizationAreTheClosedForms) {
+  const double e = hertz_contact_modulus_Pa(2.1e11, 0.28);  // Table 2
+  EXPECT_NEAR(e, 2.1e11 / (2.0 * (1.0 - 0.28 * 0.28)), 1.0);
+  EXPECT_NEAR(e / 1e9, 113.9, 0.1);
+  const double r = 0.005, f = 150.0;
+  // d = (9 F^2 / (16 E*^2 R))^(1/3)
+  EXPECT_NEAR(hertz_deflection_um(f, r, e), 1e6 * std::cbrt(9.0 * f * f / (16.0 * e * e * r)),
+              1e-12);
+  // k = dF/dd = (6 E*^2 R F)^(1/3) = 3 F / (2 d): against a central difference
+  const double h = 1e-3;
+  const double dd = hertz_deflection_um(f + h, r, e) - hertz_deflection_um(f - h, r, e);
+  EXPECT_NEAR(hertz_stiffness_N_per_um(f, r, e), 2.0 * h / dd, 1e-6);
+  EXPECT_NEAR(hertz_stiffness_N_per_um(f, r, e), 1.5 * f / hertz_deflection_um(f, r, e), 1e-9);
+  // the residual beyond the linearization: zero with zero slope at the preload, <= 0 elsewhere
+  const HertzResidual res = make_hertz_residual(f, r, e);
+  EXPECT_NEAR(res(0.0), 0.0, 1e-12);
+  EXPECT_NEAR((res(h) - res(-h)) / (2.0 * h), 0.0, 1e-8);
+  for (const double df : {-100.0, -20.0, 20.0, 90.0})
+    EXPECT_LT(res(df), 0.0) << df;
+  EXPECT_NEAR(res(90.0),
+              hertz_deflection_um(240.0, r, e) - hertz_deflection_um(150.0, r, e) -
+                  90.0 / hertz_stiffness_N_per_um(150.0, r, e),
+              1e-12);
+}
+
+TEST(HertzContact, PreloadIdentificationInvertsTheLegStatics) {
+  const double e = hertz_contact_modulus_Pa(2.1e11, 0.28), ka = 70.0, km = 6.7763;
+  const double f0 = identify_hertz_preload_N(12.931, 16.276, ka, km, 0.005, e);
+  EXPECT_NEAR(hertz_static_leg_um(16.276, ka, km, f0, 0.005, e), 12.931, 1e-9);
+  // a stroke the rigid contact cannot deliver has no preload
+  EXPECT_THROW(identify_hertz_preload_N(14.7, 16.0, ka, km, 0.005, e), std::invalid_argument);
+}
+
+TEST(HertzContact, TwinStaticsAreTheExactHertzSolution) {
+  // Open loop, held: the residual lagged by one period converges to the exact statics.
+  Twin twin({}, {}, 1);
+  const TwinModel& m = twin.model();
+  for (const double volts : {10.0, 4.0}) {
+    for (int k = 0; k < 500; ++k)
+      twin.step({volts, volts, volts});
+    for (std::size_t i = 0; i < 3; ++i) {
+      const double exact =
+          hertz_static_leg_um(twin.truth().free_elongation_um[i], m.actuator_stiffness_N_per_um,
+                              m.mechanism_stiffness_N_per_um, m.contact_preload_N,
+                              m.params.contact.ball_radius_m, m.contact_modulus_Pa);
+      // creep still moves x_free by ~0.1 nm per period after 0.5 s
+      EXPECT_NEAR(twin.truth().leg_um[i], exact, 2e-4) << volts << " V, leg " << i;
+    }
+  }
 }
 
 }  // namespace

@@ -66,6 +66,8 @@ struct TwinTruth {
   Vec3 sgs_zero_flicker_nm{};             //!< z_i
   Vec3 gauge_creep_um{};                  //!< d_i, in um of stack elongation
   double interferometer_drift_nm = 0.0;   //!< d(t), the lab's drift of every reading
+  Vec3 contact_force_N{};                 //!< F0 + f, the ball contact's force (contact.hpp)
+  Vec3 contact_residual_um{};             //!< r(f): Hertz beyond its linearization
 };
 
 struct InterferometerReading {
@@ -161,6 +163,9 @@ class Twin {
   // (k_s/k_a) x separately: on x_free and on the modal coordinates (x = Phi eta), which spares
   // forming x at every physics step.
   Vec3 filtered_free_um_{};
+  Vec3 hertz_r_um_{};           // r, held over the period (contact.hpp)
+  Vec3 filtered_hertz_r_um_{};  // r through the conditioner's filter
+  double sgs_beta_tick_ = 0.0;  // the conditioner filter over one control period
   MechanicsState filtered_modes_{};
   Vec3 sgs_last_V_{};
   Vec3 ai_V_{};
