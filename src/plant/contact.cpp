@@ -65,6 +65,16 @@ double hertz_free_stroke_um(double x_um, double ka, double km, double f0, double
 
 }  // namespace
 
+bool hertz_preload_reachable(double travel_um, double free_stroke_um, double ka, double km,
+                             double radius_m, double modulus_Pa) {
+  try {
+    (void)identify_hertz_preload_N(travel_um, free_stroke_um, ka, km, radius_m, modulus_Pa);
+  } catch (const std::invalid_argument&) {
+    return false;
+  }
+  return true;
+}
+
 double identify_hertz_preload_N(double travel_um, double free_stroke_um, double ka, double km,
                                 double radius_m, double modulus_Pa) {
   // the contact's share of the stroke, d_H(F0 + f) - d_H(F0), falls with F0

@@ -148,7 +148,10 @@ TwinModel make_twin_model(const design::DesignInputs& d, const TwinParams& p) {
     const double kc = *p.contact.stiffness_N_per_um;
     require(kc > 0.0 && !std::isnan(kc), "twin.contact.stiffness_N_per_um must be positive");
     m.contact_stiffness_N_per_um = kc;
-  } else if (p.contact.ball_radius_m > 0.0) {
+  } else if (p.contact.ball_radius_m > 0.0 &&
+             (p.contact.preload_N.has_value() ||
+              hertz_preload_reachable(travel, free_at_measurement, ka, km, p.contact.ball_radius_m,
+                                      m.contact_modulus_Pa))) {
     const double r = p.contact.ball_radius_m, e = m.contact_modulus_Pa;
     m.contact_hertz = true;
     if (p.contact.preload_N.has_value()) {
@@ -167,6 +170,9 @@ TwinModel make_twin_model(const design::DesignInputs& d, const TwinParams& p) {
                                 (hertz_deflection_um(m.contact_preload_N + km * travel, r, e) -
                                  hertz_deflection_um(m.contact_preload_N, r, e));
   } else {
+    // ball_radius_m = 0, or a design whose mechanism is so soft that no preload's Hertz contact
+    // gives up enough stroke (a design study with another hinge): the linear contact
+    // identified from the same travel.
     m.contact_stiffness_N_per_um = built("twin.contact", [&] {
       return identify_contact_stiffness_N_per_um(travel, free_at_measurement, ka, km);
     });

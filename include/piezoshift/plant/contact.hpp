@@ -83,6 +83,12 @@ struct HertzResidual {
 };
 HertzResidual make_hertz_residual(double preload_N, double radius_m, double modulus_Pa);
 
+//! Whether some preload solves the Hertz identification (the contact can give up the stroke
+//! Eq. 1 leaves over: with a very soft mechanism even F0 -> 0 cannot, and the twin falls back to
+//! the linear identification).
+bool hertz_preload_reachable(double travel_um, double free_stroke_um, double actuator_N_per_um,
+                             double mechanism_N_per_um, double radius_m, double modulus_Pa);
+
 //! Solves the Hertz identification above for F0 [N]. Throws std::invalid_argument when no
 //! preload reaches the travel.
 double identify_hertz_preload_N(double travel_um, double free_stroke_um, double actuator_N_per_um,
