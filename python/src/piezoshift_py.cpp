@@ -302,7 +302,9 @@ PYBIND11_MODULE(_piezoshift, m) {
       .def(py::init<>())
       .PS_RW(pl::ContactParams, open_loop_travel_um)
       .PS_RW(pl::ContactParams, open_loop_time_s)
-      .PS_RW(pl::ContactParams, stiffness_N_per_um);
+      .PS_RW(pl::ContactParams, stiffness_N_per_um)
+      .PS_RW(pl::ContactParams, ball_radius_m)
+      .PS_RW(pl::ContactParams, preload_N);
   py::class_<pl::MechanicsParams>(m, "MechanicsParams")
       .def(py::init<>())
       .PS_RW(pl::MechanicsParams, mechanism_damping_ratio)
@@ -331,7 +333,11 @@ PYBIND11_MODULE(_piezoshift, m) {
       .PS_RW(pl::SgsParams, bandwidth_Hz)
       .PS_V3(pl::SgsParams, offset_V)
       .PS_RW(pl::SgsParams, zero_drift_nm_per_K)
-      .PS_RW(pl::SgsParams, gauge_creep_per_decade);
+      .PS_RW(pl::SgsParams, gauge_creep_fraction)
+      .PS_RW(pl::SgsParams, gauge_creep_time_s)
+      .PS_RW(pl::SgsParams, flicker_corner_Hz)
+      .PS_RW(pl::SgsParams, excitation_drift_ppm_rms)
+      .PS_RW(pl::SgsParams, excitation_drift_window_s);
   py::class_<pl::InterferometerParams>(m, "InterferometerParams")
       .def(py::init<>())
       .PS_RW(pl::InterferometerParams, wavelength_nm)
@@ -344,12 +350,12 @@ PYBIND11_MODULE(_piezoshift, m) {
   py::class_<pl::LabParams>(m, "LabParams")
       .def(py::init<>())
       .PS_RW(pl::LabParams, temperature_C)
-      .PS_RW(pl::LabParams, temperature_amplitude_K)
-      .PS_RW(pl::LabParams, temperature_period_s)
+      .PS_RW(pl::LabParams, temperature_rms_K)
+      .PS_RW(pl::LabParams, temperature_correlation_time_s)
       .PS_RW(pl::LabParams, structure_time_constant_s)
       .PS_RW(pl::LabParams, metrology_loop_length_m)
       .PS_RW(pl::LabParams, metrology_loop_cte_per_K)
-      .PS_RW(pl::LabParams, uncompensated_air_path_m)
+      .PS_RW(pl::LabParams, dead_path_m)
       .PS_RW(pl::LabParams, air_index_per_K);
   py::class_<pl::TwinParams>(m, "TwinParams")
       .def(py::init<>())
@@ -395,7 +401,11 @@ PYBIND11_MODULE(_piezoshift, m) {
       .PS_V3(Tr, points_um)
       .PS_V3(Tr, sgs_V)
       .PS_RO(Tr, air_temperature_C)
-      .PS_RO(Tr, structure_temperature_C);
+      .PS_RO(Tr, structure_temperature_C)
+      .PS_RO(Tr, sgs_excitation_drift_ppm)
+      .PS_V3(Tr, sgs_zero_flicker_nm)
+      .PS_V3(Tr, gauge_creep_um)
+      .PS_RO(Tr, interferometer_drift_nm);
 
   using Ifm = pl::InterferometerReading;
   py::class_<Ifm>(m, "InterferometerReading")

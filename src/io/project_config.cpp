@@ -77,6 +77,9 @@ void read_twin_sections(const ConfigFile& file, const design::DesignInputs& desi
   contact.read("open_loop_time_s", t.contact.open_loop_time_s, positive);
   if (double k = 0.0; contact.read("stiffness_N_per_um", k, positive))
     t.contact.stiffness_N_per_um = k;
+  contact.read("ball_radius_m", t.contact.ball_radius_m, non_negative);
+  if (double f = 0.0; contact.read("preload_N", f, positive))
+    t.contact.preload_N = f;
 
   const ConfigSection mech = file.section("twin.mechanics");
   mech.read("mechanism_damping_ratio", t.mechanics.mechanism_damping_ratio, ratio);
@@ -113,7 +116,11 @@ void read_twin_sections(const ConfigFile& file, const design::DesignInputs& desi
   sgs.read("bandwidth_Hz", t.sgs.bandwidth_Hz, positive);
   sgs.read("offset_V", t.sgs.offset_V);
   sgs.read("zero_drift_nm_per_K", t.sgs.zero_drift_nm_per_K);
-  sgs.read("gauge_creep_per_decade", t.sgs.gauge_creep_per_decade, Bounds::closed(0.0, 0.2));
+  sgs.read("gauge_creep_fraction", t.sgs.gauge_creep_fraction, Bounds::closed(0.0, 0.1));
+  sgs.read("gauge_creep_time_s", t.sgs.gauge_creep_time_s, positive);
+  sgs.read("flicker_corner_Hz", t.sgs.flicker_corner_Hz, non_negative);
+  sgs.read("excitation_drift_ppm_rms", t.sgs.excitation_drift_ppm_rms, non_negative);
+  sgs.read("excitation_drift_window_s", t.sgs.excitation_drift_window_s, positive);
 
   const ConfigSection ifm = file.section("twin.interferometer");
   ifm.read("wavelength_nm", t.interferometer.wavelength_nm, positive);
@@ -126,12 +133,12 @@ void read_twin_sections(const ConfigFile& file, const design::DesignInputs& desi
 
   const ConfigSection lab = file.section("twin.lab");
   lab.read("temperature_C", t.lab.temperature_C);
-  lab.read("temperature_amplitude_K", t.lab.temperature_amplitude_K, non_negative);
-  lab.read("temperature_period_s", t.lab.temperature_period_s, positive);
+  lab.read("temperature_rms_K", t.lab.temperature_rms_K, non_negative);
+  lab.read("temperature_correlation_time_s", t.lab.temperature_correlation_time_s, positive);
   lab.read("structure_time_constant_s", t.lab.structure_time_constant_s, positive);
   lab.read("metrology_loop_length_m", t.lab.metrology_loop_length_m, non_negative);
   lab.read("metrology_loop_cte_per_K", t.lab.metrology_loop_cte_per_K);
-  lab.read("uncompensated_air_path_m", t.lab.uncompensated_air_path_m, non_negative);
+  lab.read("dead_path_m", t.lab.dead_path_m, non_negative);
   lab.read("air_index_per_K", t.lab.air_index_per_K);
 
   // What one key's bounds cannot say (rates that must divide, the contact identification, A).

@@ -8,6 +8,7 @@
 #include <Eigen/LU>
 
 #include "piezoshift/plant/daq.hpp"
+#include "piezoshift/plant/interferometer.hpp"
 #include "piezoshift/plant/sgs.hpp"
 
 namespace piezoshift::plant {
@@ -15,10 +16,15 @@ namespace piezoshift::plant {
 Twin::Twin(const design::DesignInputs& design, const TwinParams& params, std::uint64_t seed)
     : model_(make_twin_model(design, params)), seed_(seed), rng_(seed) {
   const TwinParams& p = model_.params;
-  // The run's draws at construction, in this order: the lab cycle's phase, the interferometer's
-  // scale error.
-  lab_ = LabEnvironment(p.lab, 2.0 * std::numbers::pi * rng_.uniform());
+  // The run's draws at construction, in this order: the lab's start (2 deviates), the
+  // interferometer's scale error, the excitation drift's terms, each channel's zero flicker terms
+  // (all stationary starts).
+  lab_ = LabEnvironment(p.lab, model_.control_period_s);
+  lab_.start(lab_state_, rng_);
   ifm_scale_ = 1.0 + p.interferometer.accuracy_ppm * 1e-6 * (2.0 * rng_.uniform() - 1.0);
+  model_.sgs_excitation_drift.start(excitation_, rng_);
+  for (std::size_t i = 0; i < 3; ++i)
+    model_.sgs_zero_flicker.start(zero_flicker_[i], rng_);
 
   for (std::size_t i = 0; i < 3; ++i) {
     ks_[i] = model_.series_stiffness_N_per_um;
@@ -26,24 +32,21 @@ Twin::Twin(const design::DesignInputs& design, const TwinParams& params, std::ui
     sgs_gain_[i] = model_.sgs_gain_per_elongation[i];
   }
   sgs_beta_ = 1.0 - std::exp(-2.0 * std::numbers::pi * p.sgs.bandwidth_Hz * model_.physics_step_s);
+  sgs_beta_tick_ =
+      1.0 - std::exp(-2.0 * std::numbers::pi * p.sgs.bandwidth_Hz * model_.control_period_s);
   ai_noise_V_ =
       std::hypot(p.sgs.noise_nm_rms * 1e-3 / model_.sgs_nominal_um_per_V, p.daq.ai_noise_V_rms);
   lsb_V_ = daq_lsb_V(p.daq);
   inv_lsb_V_ = 1.0 / lsb_V_;  // cheaper than dividing; can differ only at an exact midpoint
   code_max_ = std::ldexp(1.0, static_cast<int>(p.daq.resolution_bits) - 1) - 1.0;
   code_min_ = -code_max_ - 1.0;
-  lab_sin_ = std::sin(lab_.phase_at(0.0));
-  lab_cos_ = std::cos(lab_.phase_at(0.0));
-  const double step_rad = lab_.angular_rate_rad_per_s() * model_.control_period_s;
-  lab_rot_sin_ = std::sin(step_rad);
-  lab_rot_cos_ = std::cos(step_rad);
   mechanics_ = model_.mechanics;
   update_mean_point_weights();
   force_N_.assign(model_.substeps, {0.0, 0.0, 0.0});  // the one allocation, at set-up
   ifm_countdown_ = model_.interferometer_every;
   for (std::size_t i = 0; i < 3; ++i)
     sgs_last_V_[i] = p.sgs.offset_V[i];
-  update_truth(Vec3{0.0, 0.0, 0.0}, lab_.air_C(0.0), lab_.structure_C(0.0));
+  update_truth(Vec3{0.0, 0.0, 0.0});
 }
 
 // daq_quantize_V with the constants kept (a product for the quotient: the same code except, at
@@ -89,7 +92,7 @@ void Twin::advance() noexcept {
     const double in = faults_[c].amplifier_failed ? 0.0 : ao_V_[c];
     double v = amp_V_[c];
     PlaySweep sweep(m.hysteresis, play_[c], gain_V * in > v);
-    const double g = m.stroke_gain_um[c], creep = creep_out_[c], k = ks_[c];
+    const double g = m.stroke_gain_um[c], creep = creep_out_[c], k = ks_[c], r = hertz_r_um_[c];
     double y_sum = 0.0, xf = free_um_[c], f = filtered_free_um_[c];
     for (std::size_t s = 0; s < n; ++s) {
       v = amp.step(v, in);
@@ -97,7 +100,7 @@ void Twin::advance() noexcept {
       y_sum += y;
       xf = g * (y + creep);
       f += beta * (xf - f);
-      force_N_[s][c] = k * xf;
+      force_N_[s][c] = k * (xf - r);
     }
     sweep.commit(play_[c]);
     amp_V_[c] = v;
@@ -130,7 +133,7 @@ void Twin::advance() noexcept {
         pending_end_sample = true;  // at the period's end: sampled below, temperatures shared
       } else {
         const double t = t0 + static_cast<double>(s + 1) * m.physics_step_s;
-        sample_interferometer(mech.displacement_um(ms), t, lab_.interferometer_drift_um(t));
+        sample_interferometer(mech.displacement_um(ms), t, lab_.drift_um(lab_state_));
       }
     }
   }
@@ -140,29 +143,34 @@ void Twin::advance() noexcept {
   filtered_modes_[4] = fm2;
   ifm_countdown_ = countdown;
   const Vec3 x = mechanics_.displacement_um(mech_);
-  for (std::size_t i = 0; i < 3; ++i)
-    elongation_um_[i] = free_um_[i] - ks_over_ka_[i] * (free_um_[i] - x[i]);
+  for (std::size_t i = 0; i < 3; ++i) {
+    const double r = hertz_r_um_[i];
+    const double f = ks_[i] * (free_um_[i] - r - x[i]);  // the contact's force increment
+    elongation_um_[i] = free_um_[i] - ks_over_ka_[i] * (free_um_[i] - r - x[i]);
+    filtered_hertz_r_um_[i] += sgs_beta_tick_ * (r - filtered_hertz_r_um_[i]);
+    truth_.contact_force_N[i] = m.contact_preload_N + f;
+    truth_.contact_residual_um[i] = r;
+    // For the next period, from the mechanism's force k_m x (the contact's force in statics):
+    // the leg moves smoothly, while k_s (x_free - r - x) rings with every amplifier step.
+    if (m.contact_hertz)
+      hertz_r_um_[i] = m.hertz(m.mechanism_stiffness_N_per_um * x[i]);
+  }
   ++tick_;
   for (std::size_t i = 0; i < 3; ++i) {
     creep_out_[i] = m.creep.update(creep_[i], y_mean[i]);
-    if (m.params.sgs.gauge_creep_per_decade != 0.0)
+    if (m.params.sgs.gauge_creep_fraction != 0.0)
       gauge_out_[i] = m.gauge_creep.update(gauge_creep_[i], elongation_um_[i]);
   }
   const double t = static_cast<double>(tick_) * m.control_period_s;
-  if (tick_ % kLabResync == 0) {
-    lab_sin_ = std::sin(lab_.phase_at(t));
-    lab_cos_ = std::cos(lab_.phase_at(t));
-  } else {
-    const double s_new = lab_sin_ * lab_rot_cos_ + lab_cos_ * lab_rot_sin_;
-    lab_cos_ = lab_cos_ * lab_rot_cos_ - lab_sin_ * lab_rot_sin_;
-    lab_sin_ = s_new;
-  }
-  double air = 0.0, structure = 0.0;
-  lab_.temperatures_C(lab_sin_, lab_cos_, air, structure);
+  // Per tick, in this order: the lab (1 deviate), the interferometer (3 per sample), the
+  // excitation drift and each channel's zero flicker (the terms due), the AI (3).
+  lab_.update(lab_state_, rng_);
+  const double drift_um = lab_.drift_um(lab_state_);
   if (pending_end_sample)
-    sample_interferometer(x, t, lab_.drift_um(air, structure));
-  sample_ai(structure - lab_.structure_at_start_C());
-  update_truth(x, air, structure);
+    sample_interferometer(x, t, drift_um);
+  truth_.interferometer_drift_nm = 1e3 * drift_um;
+  sample_ai(lab_.structure_change_K(lab_state_));
+  update_truth(x);
   truth_.period_max_mean_points_um = z_max;
   truth_.period_min_mean_points_um = z_min;
 }
@@ -188,10 +196,19 @@ void Twin::sample_ai(double structure_change_K) noexcept {
   const double nl_V = sgs.nonlinearity_fraction * sgs.full_scale_V;
   const double inv_scale = 1.0 / model_.sgs_nominal_um_per_V;
   const Vec3 fx = mechanics_.displacement_um(filtered_modes_);  // the filtered x
+  const double delta = model_.sgs_excitation_drift.update(excitation_, tick_, rng_);
+  truth_.sgs_excitation_drift_ppm = 1e6 * delta;
+  for (std::size_t i = 0; i < 3; ++i) {
+    const double z_nm = model_.sgs_zero_flicker.update(zero_flicker_[i], tick_, rng_);
+    truth_.sgs_zero_flicker_nm[i] = z_nm;
+    truth_.gauge_creep_um[i] = gauge_out_[i];
+  }
   for (std::size_t i = 0; i < 3; ++i) {
     const double filtered_e =
-        filtered_free_um_[i] - ks_over_ka_[i] * (filtered_free_um_[i] - fx[i]);
-    const double r_um = sgs_gain_[i] * (filtered_e - gauge_out_[i]) + drift_um;
+        filtered_free_um_[i] -
+        ks_over_ka_[i] * (filtered_free_um_[i] - filtered_hertz_r_um_[i] - fx[i]);
+    const double r_um = sgs_gain_[i] * (1.0 + delta) * (filtered_e - gauge_out_[i]) + drift_um +
+                        1e-3 * truth_.sgs_zero_flicker_nm[i];
     const double v_lin = r_um * inv_scale;
     double v = sgs.offset_V[i] + v_lin +
                nl_V * sgs_nonlinearity_shape(sgs.nonlinearity_shape, v_lin / sgs.full_scale_V);
@@ -224,14 +241,16 @@ void Twin::sample_interferometer(const Vec3& x_um, double t_s, double drift_um) 
     double m = ifm_scale_ * z + drift_um + p.noise_nm_rms * 1e-3 * rng_.normal();
     if (cyclic_um != 0.0)
       m += cyclic_um * std::sin(k_cyclic * z);
-    ifm_.dynamic_um[j] = std::nearbyint(m / res_um) * res_um;
-    static_sum_[j] += m;
+    // The XL-80 counts in whole resolution steps: each sample is quantized, and the static mode
+    // averages the quantized samples (then rounds the mean to the resolution again).
+    ifm_.dynamic_um[j] = interferometer_quantize(m, res_um);
+    static_sum_[j] += ifm_.dynamic_um[j];
   }
   ifm_.dynamic_time_s = t_s;
   if (++static_n_ == model_.interferometer_static_samples) {
     for (std::size_t j = 0; j < 3; ++j) {
       ifm_.static_um[j] =
-          std::nearbyint(static_sum_[j] / static_cast<double>(static_n_) / res_um) * res_um;
+          interferometer_static_reading(static_sum_[j], static_cast<double>(static_n_), res_um);
       static_sum_[j] = 0.0;
     }
     static_n_ = 0;
@@ -240,7 +259,7 @@ void Twin::sample_interferometer(const Vec3& x_um, double t_s, double drift_um) 
   }
 }
 
-void Twin::update_truth(const Vec3& x_um, double air_C, double structure_C) noexcept {
+void Twin::update_truth(const Vec3& x_um) noexcept {
   const TwinModel& m = model_;
   TwinTruth& t = truth_;
   t.time_s = static_cast<double>(tick_) * m.control_period_s;
@@ -254,8 +273,8 @@ void Twin::update_truth(const Vec3& x_um, double air_C, double structure_C) noex
   t.theta_x_urad = pose[1];
   t.theta_y_urad = pose[2];
   t.points_um = control::multiply(m.geometry.barycentric, x_um);
-  t.air_temperature_C = air_C;
-  t.structure_temperature_C = structure_C;
+  t.air_temperature_C = lab_.air_C(lab_state_);
+  t.structure_temperature_C = lab_.structure_C(lab_state_);
 }
 
 void Twin::set_fault(std::size_t channel, const ChannelFault& fault) {

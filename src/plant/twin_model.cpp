@@ -135,26 +135,60 @@ TwinModel make_twin_model(const design::DesignInputs& d, const TwinParams& p) {
   const double km = m.mechanism_stiffness_N_per_um, ka = m.actuator_stiffness_N_per_um;
   require(positive(p.contact.open_loop_time_s), "twin.contact.open_loop_time_s must be positive");
   m.open_loop_creep_factor = (1.0 + m.creep.step_response(p.contact.open_loop_time_s)) / f_ref;
+  require(std::isfinite(p.contact.ball_radius_m) && p.contact.ball_radius_m >= 0.0,
+          "twin.contact.ball_radius_m must be >= 0");
+  require(positive(p.contact.open_loop_travel_um),
+          "twin.contact.open_loop_travel_um must be positive");
+  const double free_at_measurement =
+      d.actuator.nominal_stroke_um * scale_sum / 3.0 * m.open_loop_creep_factor;
+  const double travel = p.contact.open_loop_travel_um;
+  m.contact_modulus_Pa =
+      hertz_contact_modulus_Pa(d.material.elastic_modulus_Pa, d.material.poisson_ratio);
   if (p.contact.stiffness_N_per_um.has_value()) {
     const double kc = *p.contact.stiffness_N_per_um;
     require(kc > 0.0 && !std::isnan(kc), "twin.contact.stiffness_N_per_um must be positive");
     m.contact_stiffness_N_per_um = kc;
+  } else if (p.contact.ball_radius_m > 0.0 &&
+             (p.contact.preload_N.has_value() ||
+              hertz_preload_reachable(travel, free_at_measurement, ka, km, p.contact.ball_radius_m,
+                                      m.contact_modulus_Pa))) {
+    const double r = p.contact.ball_radius_m, e = m.contact_modulus_Pa;
+    m.contact_hertz = true;
+    if (p.contact.preload_N.has_value()) {
+      require(positive(*p.contact.preload_N), "twin.contact.preload_N must be positive");
+      m.contact_preload_N = *p.contact.preload_N;
+    } else {
+      m.contact_preload_N = built("twin.contact", [&] {
+        return identify_hertz_preload_N(travel, free_at_measurement, ka, km, r, e);
+      });
+      m.contact_preload_identified = true;
+    }
+    m.contact_identified = m.contact_preload_identified;
+    m.contact_stiffness_N_per_um = hertz_stiffness_N_per_um(m.contact_preload_N, r, e);
+    m.hertz = make_hertz_residual(m.contact_preload_N, r, e);
+    m.contact_secant_N_per_um = km * travel /
+                                (hertz_deflection_um(m.contact_preload_N + km * travel, r, e) -
+                                 hertz_deflection_um(m.contact_preload_N, r, e));
   } else {
-    require(positive(p.contact.open_loop_travel_um),
-            "twin.contact.open_loop_travel_um must be positive");
-    const double free_at_measurement =
-        d.actuator.nominal_stroke_um * scale_sum / 3.0 * m.open_loop_creep_factor;
+    // ball_radius_m = 0, or a design whose mechanism is so soft that no preload's Hertz contact
+    // gives up enough stroke (a design study with another hinge): the linear contact
+    // identified from the same travel.
     m.contact_stiffness_N_per_um = built("twin.contact", [&] {
-      return identify_contact_stiffness_N_per_um(p.contact.open_loop_travel_um, free_at_measurement,
-                                                 ka, km);
+      return identify_contact_stiffness_N_per_um(travel, free_at_measurement, ka, km);
     });
     m.contact_identified = true;
   }
+  if (!m.contact_hertz)
+    m.contact_secant_N_per_um = m.contact_stiffness_N_per_um;
   m.series_stiffness_N_per_um = series_stiffness_N_per_um(ka, m.contact_stiffness_N_per_um);
   const double ks = m.series_stiffness_N_per_um;
   m.equation1_um = design::available_displacement_um(d.actuator, km);
-  for (std::size_t i = 0; i < 3; ++i)
-    m.leg_static_um[i] = m.free_stroke_um[i] * ks / (ks + km);
+  for (std::size_t i = 0; i < 3; ++i) {
+    m.leg_static_um[i] = m.contact_hertz
+                             ? hertz_static_leg_um(m.free_stroke_um[i], ka, km, m.contact_preload_N,
+                                                   p.contact.ball_radius_m, m.contact_modulus_Pa)
+                             : m.free_stroke_um[i] * ks / (ks + km);
+  }
 
   // Masses
   m.mechanism_mass_kg = d.mechanism.moving_mass_kg;
@@ -195,13 +229,39 @@ TwinModel make_twin_model(const design::DesignInputs& d, const TwinParams& p) {
   require(std::isfinite(sgs.zero_drift_nm_per_K), "twin.sgs.zero_drift_nm_per_K must be finite");
   for (std::size_t i = 0; i < 3; ++i) {
     require(std::isfinite(sgs.offset_V[i]), fmt::format("twin.sgs.offset_V[{}] must be finite", i));
-    m.sgs_gain_per_elongation[i] =
-        m.geometry.sgs_gain[i] / (1.0 + km / m.contact_stiffness_N_per_um);
+    m.sgs_gain_per_elongation[i] = m.geometry.sgs_gain[i] / (1.0 + km / m.contact_secant_N_per_um);
   }
   m.sgs_nominal_um_per_V = d.actuator.nominal_stroke_um / sgs.full_scale_V;
+  // Gauge creep: the stack's chain, scaled so a step creeps by the stated fraction in the
+  // stated time (creep.hpp: the step response is linear in the per-decade fraction).
+  require(std::isfinite(sgs.gauge_creep_fraction) && sgs.gauge_creep_fraction >= 0.0 &&
+              sgs.gauge_creep_fraction <= 0.1,
+          "twin.sgs.gauge_creep_fraction must be in [0, 0.1]");
+  require(positive(sgs.gauge_creep_time_s), "twin.sgs.gauge_creep_time_s must be positive");
   CreepParams gauge = p.piezo.creep;
-  gauge.per_decade_fraction = sgs.gauge_creep_per_decade;
+  gauge.per_decade_fraction = 1.0;
+  const double unit_creep = built("twin.sgs", [&] {
+                              return CreepChain(gauge, m.control_period_s);
+                            }).step_response(sgs.gauge_creep_time_s);
+  gauge.per_decade_fraction = sgs.gauge_creep_fraction / unit_creep;
   m.gauge_creep = built("twin.sgs", [&] { return CreepChain(gauge, m.control_period_s); });
+  // Flicker: the zero's 1/f level A = S_white f_corner, S_white = sigma^2 / (f_s / 2); the
+  // excitation's level from its rms over the stated window (flicker.hpp).
+  require(positive(sgs.flicker_corner_Hz) || sgs.flicker_corner_Hz == 0.0,
+          "twin.sgs.flicker_corner_Hz must be >= 0");
+  require(std::isfinite(sgs.excitation_drift_ppm_rms) && sgs.excitation_drift_ppm_rms >= 0.0,
+          "twin.sgs.excitation_drift_ppm_rms must be >= 0");
+  require(positive(sgs.excitation_drift_window_s),
+          "twin.sgs.excitation_drift_window_s must be positive");
+  const double white_psd_nm2_per_Hz =
+      sgs.noise_nm_rms * sgs.noise_nm_rms / (0.5 / m.control_period_s);
+  m.sgs_zero_flicker =
+      FlickerNoise(white_psd_nm2_per_Hz * sgs.flicker_corner_Hz, kSgsZeroFlickerShortestS,
+                   kSgsFlickerLongestS, 1, m.control_period_s);
+  m.sgs_excitation_drift = FlickerNoise(
+      flicker_psd_for_window_rms(sgs.excitation_drift_ppm_rms * 1e-6, sgs.excitation_drift_window_s,
+                                 kSgsExcitationShortestS, kSgsFlickerLongestS, 1),
+      kSgsExcitationShortestS, kSgsFlickerLongestS, 1, m.control_period_s);
 
   // Interferometer and lab
   const InterferometerParams& ifm = p.interferometer;
@@ -215,17 +275,18 @@ TwinModel make_twin_model(const design::DesignInputs& d, const TwinParams& p) {
           "twin.interferometer.cyclic_error_nm must be >= 0");
   const LabParams& lab = p.lab;
   require(std::isfinite(lab.temperature_C), "twin.lab.temperature_C must be finite");
-  require(std::isfinite(lab.temperature_amplitude_K) && lab.temperature_amplitude_K >= 0.0,
-          "twin.lab.temperature_amplitude_K must be >= 0");
-  require(positive(lab.temperature_period_s), "twin.lab.temperature_period_s must be positive");
+  require(std::isfinite(lab.temperature_rms_K) && lab.temperature_rms_K >= 0.0,
+          "twin.lab.temperature_rms_K must be >= 0");
+  require(positive(lab.temperature_correlation_time_s),
+          "twin.lab.temperature_correlation_time_s must be positive");
   require(positive(lab.structure_time_constant_s),
           "twin.lab.structure_time_constant_s must be positive");
   require(std::isfinite(lab.metrology_loop_length_m) && lab.metrology_loop_length_m >= 0.0,
           "twin.lab.metrology_loop_length_m must be >= 0");
   require(std::isfinite(lab.metrology_loop_cte_per_K),
           "twin.lab.metrology_loop_cte_per_K must be finite");
-  require(std::isfinite(lab.uncompensated_air_path_m) && lab.uncompensated_air_path_m >= 0.0,
-          "twin.lab.uncompensated_air_path_m must be >= 0");
+  require(std::isfinite(lab.dead_path_m) && lab.dead_path_m >= 0.0,
+          "twin.lab.dead_path_m must be >= 0");
   require(std::isfinite(lab.air_index_per_K), "twin.lab.air_index_per_K must be finite");
 
   // Dynamics

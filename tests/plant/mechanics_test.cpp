@@ -117,7 +117,9 @@ TEST(Fidelity4, LoadedPistonModeInASimulatedResponseMatchesTheModel) {
   const double peak = simulated_peak_Hz(model.mechanics, model.physics_step_s, f_model - 200.0,
                                         f_model + 200.0, {1.0, 1.0, 1.0});
   EXPECT_NEAR(peak, f_model, 3.0);
-  EXPECT_NEAR(f_model, 1449.0, 5.0);  // 1.035 kg plate, three legs of 32.97 N/um
+  // 1.035 kg plate, three legs of 6.78 + 24.88 N/um: the Hertz contact linearized at its preload
+  // (38.53 N/um; the linear contact of 41.86 N/um gave 1449 Hz)
+  EXPECT_NEAR(f_model, 1419.0, 5.0);
 }
 
 }  // namespace

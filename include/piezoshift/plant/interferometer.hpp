@@ -11,8 +11,12 @@
 //   c          periodic (cyclic) nonlinearity, period lambda / 2 of displacement (one fringe of a
 //              retroreflector pair); 0 by default, the paper gives none
 //   dynamic    one sample every 1 / f_dyn (Section 4.1: 1 kHz), rounded to the resolution
-//   static     the mean of the samples of each averaging window (Section 4.2: 1 s), rounded to
-//              the resolution, published at the end of its window
+//   static     the mean of the quantized samples of each averaging window (Section 4.2: 1 s),
+//              rounded to the resolution again, published at the end of its window: the
+//              XL-80 counts whole resolution steps, so it averages counts, not the analogue
+//              position (without noise, a position 0.45 nm for 60 % of a window and 0.9 nm for
+//              40 % reads 0 nm; averaging first would read 1 nm)
+#include <cmath>
 #include <cstdint>
 
 namespace piezoshift::plant {
@@ -30,5 +34,16 @@ struct InterferometerParams {
 
   bool operator==(const InterferometerParams&) const = default;
 };
+
+//! One reading quantized to the resolution (both in the same unit).
+inline double interferometer_quantize(double value, double resolution) noexcept {
+  return std::nearbyint(value / resolution) * resolution;
+}
+
+//! The static mode's reading from the sum of n quantized samples.
+inline double interferometer_static_reading(double quantized_sum, double n,
+                                            double resolution) noexcept {
+  return interferometer_quantize(quantized_sum / n, resolution);
+}
 
 }  // namespace piezoshift::plant

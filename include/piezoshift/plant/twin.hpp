@@ -29,6 +29,7 @@
 #include "piezoshift/control/vec3.hpp"
 #include "piezoshift/design/design_inputs.hpp"
 #include "piezoshift/plant/creep.hpp"
+#include "piezoshift/plant/flicker.hpp"
 #include "piezoshift/plant/hysteresis.hpp"
 #include "piezoshift/plant/lab_environment.hpp"
 #include "piezoshift/plant/mechanics.hpp"
@@ -64,6 +65,13 @@ struct TwinTruth {
   Vec3 sgs_V{};  //!< conditioner outputs before the ADC (noise included)
   double air_temperature_C = 0.0;
   double structure_temperature_C = 0.0;
+  // The sensor path's slow errors at the last AI sample (sgs.hpp, lab_environment.hpp):
+  double sgs_excitation_drift_ppm = 0.0;  //!< delta, common to the three channels
+  Vec3 sgs_zero_flicker_nm{};             //!< z_i
+  Vec3 gauge_creep_um{};                  //!< d_i, in um of stack elongation
+  double interferometer_drift_nm = 0.0;   //!< d(t), the lab's drift of every reading
+  Vec3 contact_force_N{};                 //!< F0 + f, the ball contact's force (contact.hpp)
+  Vec3 contact_residual_um{};             //!< r(f): Hertz beyond its linearization
 };
 
 struct InterferometerReading {
@@ -120,7 +128,7 @@ class Twin {
  private:
   void sample_interferometer(const Vec3& x_um, double t_s, double drift_um) noexcept;
   void sample_ai(double structure_change_K) noexcept;
-  void update_truth(const Vec3& x_um, double air_C, double structure_C) noexcept;
+  void update_truth(const Vec3& x_um) noexcept;
   //! mean(P1..P3) = this . (eta_1, eta_2, eta_3), the modal displacements.
   void update_mean_point_weights();
   double quantize_V(double v) const noexcept;
@@ -129,12 +137,8 @@ class Twin {
   std::uint64_t seed_;
   Rng rng_;
   LabEnvironment lab_;
+  LabState lab_state_{};
   double ifm_scale_ = 1.0;  // 1 + eps
-  // sin and cos of the lab cycle's phase at the current tick, stepped by a rotation of w T_s per
-  // tick and recomputed from the time every kLabResync ticks (the rotation's rounding stays far
-  // below a picokelvin)
-  static constexpr std::uint64_t kLabResync = 1024;
-  double lab_sin_ = 0.0, lab_cos_ = 1.0, lab_rot_sin_ = 0.0, lab_rot_cos_ = 1.0;
 
   // Per-channel constants (copied from the model for locality; changed by faults)
   std::array<double, 3> ks_{};  // k_s [N/um]
@@ -157,6 +161,8 @@ class Twin {
   Vec3 creep_out_{};
   std::array<CreepState, 3> gauge_creep_{};
   Vec3 gauge_out_{};
+  FlickerState excitation_{};                   // delta's terms
+  std::array<FlickerState, 3> zero_flicker_{};  // z_i's terms [nm]
   MechanicsState mech_{};
   Vec3 free_um_{};
   Vec3 elongation_um_{};
@@ -164,6 +170,9 @@ class Twin {
   // (k_s/k_a) x separately: on x_free and on the modal coordinates (x = Phi eta), which spares
   // forming x at every physics step.
   Vec3 filtered_free_um_{};
+  Vec3 hertz_r_um_{};           // r, held over the period (contact.hpp)
+  Vec3 filtered_hertz_r_um_{};  // r through the conditioner's filter
+  double sgs_beta_tick_ = 0.0;  // the conditioner filter over one control period
   MechanicsState filtered_modes_{};
   Vec3 sgs_last_V_{};
   Vec3 ai_V_{};

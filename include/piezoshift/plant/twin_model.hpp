@@ -10,7 +10,7 @@
 //   k_s      1 / (1 / k_a + 1 / k_c)
 //   m_leg    mechanism moving mass (design, 1839 Hz fit) + stack mass k_a / (2 pi f_a)^2
 //   x_nom,i  nominal stroke s_i; the stroke gain x_nom s_i / (1 + C_step(t_ref)) multiplies y + C
-//   g'_i     g_i / (1 + k_m / k_c)  (sgs.hpp)
+//   g'_i     g_i / (1 + k_m / k_c,secant)  (sgs.hpp)
 //   modes    LinearMechanics of the loaded legs + plate; also the unloaded mechanism
 //            sqrt(k_m / m_mech) / 2 pi (1839 Hz) and one leg with its stack, no plate
 #include <array>
@@ -20,7 +20,9 @@
 #include "piezoshift/control/vec3.hpp"
 #include "piezoshift/design/design_inputs.hpp"
 #include "piezoshift/plant/amplifier.hpp"
+#include "piezoshift/plant/contact.hpp"
 #include "piezoshift/plant/creep.hpp"
+#include "piezoshift/plant/flicker.hpp"
 #include "piezoshift/plant/geometry.hpp"
 #include "piezoshift/plant/hysteresis.hpp"
 #include "piezoshift/plant/mechanics.hpp"
@@ -46,6 +48,14 @@ struct TwinModel {
   double contact_stiffness_N_per_um = 0.0;    //!< k_c
   bool contact_identified = false;            //!< k_c from the open-loop travel (not given)
   double series_stiffness_N_per_um = 0.0;     //!< k_s
+  bool contact_hertz = false;                 //!< the Hertz contact (contact.hpp)
+  double contact_preload_N = 0.0;             //!< F0 (Hertz)
+  bool contact_preload_identified = false;    //!< F0 from the open-loop travel (not given)
+  double contact_modulus_Pa = 0.0;            //!< E* (Hertz)
+  //! k_m x / (d_H(F0 + k_m x) - d_H(F0)) at x = the open-loop travel (Hertz; else k_c): the
+  //! secant stiffness that sets the gauges' mean elongation per um of leg motion
+  double contact_secant_N_per_um = 0.0;
+  HertzResidual hertz{};  //!< r(f) (Hertz)
   double mechanism_mass_kg = 0.0;
   double stack_mass_kg = 0.0;
   double leg_mass_kg = 0.0;
@@ -55,7 +65,7 @@ struct TwinModel {
   std::array<double, 3> free_stroke_um{};  //!< x_nom s_i
   std::array<double, 3> stroke_gain_um{};  //!< x_nom s_i / (1 + C_step(t_ref))
   double equation1_um = 0.0;               //!< Eq. 1 with the nominal stack, rigid contact
-  std::array<double, 3> leg_static_um{};   //!< x_i at 150 V, t_ref: free stroke k_s / (k_s + k_m)
+  std::array<double, 3> leg_static_um{};   //!< x_i at 150 V, t_ref (Eq. 1 generalized; Hertz)
   double open_loop_creep_factor = 0.0;     //!< (1 + C(t_m)) / (1 + C(t_ref)) at open_loop_time_s
 
   // Electrical
@@ -77,6 +87,8 @@ struct TwinModel {
   PrandtlIshlinskii hysteresis{};
   CreepChain creep{};
   CreepChain gauge_creep{};
+  FlickerNoise sgs_zero_flicker{};      //!< z_i [nm]
+  FlickerNoise sgs_excitation_drift{};  //!< delta [relative]
   LinearMechanics mechanics{};
   control::Mat3 legs_to_pose{};  //!< (Z [um], theta_x [urad], theta_y [urad]) = this x
 };
