@@ -6,6 +6,7 @@
 #include <CLI/CLI.hpp>
 
 #include "command.hpp"
+#include "piezoshift/experiments/validity.hpp"
 #include "piezoshift/io/input_error.hpp"
 
 int main(int argc, char** argv) {
@@ -43,6 +44,9 @@ int main(int argc, char** argv) {
   } catch (const piezoshift::io::InputError& e) {
     fmt::print(stderr, "piezoshift: error: {}\n", e.what());
     return piezoshift::io::kExitBadInput;
+  } catch (const piezoshift::experiments::ProcedureFailed& e) {
+    fmt::print(stderr, "piezoshift: not valid: {}\n", e.what());
+    return piezoshift::experiments::kExitNotValid;
   } catch (const std::exception& e) {
     fmt::print(stderr, "piezoshift: internal error: {}\n", e.what());
     return 1;

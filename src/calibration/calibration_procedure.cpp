@@ -26,7 +26,7 @@ CalibrationWithTravel calibrate_with_travel(const io::ProjectConfig& config, std
   out.travel =
       experiments::run_travel_range(config, out.calibration.controller, seed + 3, options.travel);
   if (!(out.travel.single_move_um > 0.0))
-    throw io::InputError(
+    throw experiments::ProcedureFailed(
         fmt::format("calibration: the calibrated loop has no semi-closed-loop travel: {}",
                     out.travel.validity.reason));
   return out;
@@ -46,15 +46,27 @@ CalibrationOutcome calibrate(const io::ProjectConfig& config,
   // Stage 2: A, identity feedforward not involved (inner loops only).
   out.controller.polynomial = control::CubicPolynomial::identity();
   out.controller.matrix = control::TransmissionMatrix::identity();
+  // A stage whose supervisor tripped measured nothing: the calibration cannot go on.
+  const auto check = [](const experiments::Bench& bench, const char* stage) {
+    if (bench.faulted()) {
+      const runtime::FaultRecord& f = bench.fault();
+      throw experiments::ProcedureFailed(
+          fmt::format("calibration {}: the safety supervisor tripped ({}, channel {}, at {:.3f} s)",
+                      stage, runtime::to_string(f.reason), f.channel + 1,
+                      static_cast<double>(f.tick) * bench.sample_time_s()));
+    }
+  };
   {
     experiments::Bench bench(config, out.controller, seed + 1);
     out.matrix = identify_matrix(bench, options.matrix, progress);
+    check(bench, "stage 2 (matrix A)");
   }
   out.controller.matrix = out.matrix.fit.a;
   // Stage 3: p, with the gains and A in place.
   {
     experiments::Bench bench(config, out.controller, seed + 2);
     out.polynomial = identify_polynomial(bench, options.polynomial, progress);
+    check(bench, "stage 3 (polynomial p)");
   }
   out.controller.polynomial = out.polynomial.fit.p;
   return out;

@@ -1,6 +1,7 @@
 #include "piezoshift/psi/stage.hpp"
 
 #include <algorithm>
+#include <array>
 #include <cmath>
 
 #include "piezoshift/experiments/bench.hpp"
@@ -41,18 +42,35 @@ void BenchStage::move(double piston_nm) {
 }
 
 bool BenchStage::wait_on_target(const OnTarget& c) {
+  // Each channel's error |S - feedback| averaged over the last hold_s: single samples carry the
+  // gauges' white and flicker noise (docs/twin.md, ~1.5 nm rms each), which a band of a few nm
+  // on raw samples would mistake for motion.
   const double t0 = bench_.time_s(), dt = bench_.sample_time_s();
-  double inside_since = -1.0;
+  const auto n = static_cast<std::size_t>(std::max(1L, std::lround(c.hold_s / dt)));
+  std::vector<std::array<double, 3>> window;
+  window.reserve(n);
+  std::size_t next = 0;
   while (bench_.time_s() - t0 < c.timeout_s) {
     tick();
-    const bool inside = log_.back().gauge_error_nm <= c.band_nm;
-    if (!inside) {
-      inside_since = -1.0;
+    const control::ControllerOutput& out = bench_.last_output();
+    std::array<double, 3> e{};
+    for (std::size_t i = 0; i < 3; ++i)
+      e[i] = 1000.0 * (out.target_um[i] - out.feedback_um[i]);
+    if (window.size() < n)
+      window.push_back(e);
+    else
+      window[next] = e;
+    next = (next + 1) % n;
+    if (window.size() < n)
       continue;
+    bool inside = true;
+    for (std::size_t i = 0; i < 3; ++i) {
+      double sum = 0.0;
+      for (const auto& w : window)
+        sum += w[i];
+      inside = inside && std::fabs(sum / static_cast<double>(n)) <= c.band_nm;
     }
-    if (inside_since < 0.0)
-      inside_since = bench_.time_s();
-    if (bench_.time_s() - inside_since >= c.hold_s - 0.5 * dt)
+    if (inside)
       return true;
   }
   return false;

@@ -18,7 +18,9 @@ namespace piezoshift::calibration {
 
 struct MatrixIdentificationOptions {
   double base_um = 2.0;   //!< common SGS target of the three actuators between moves
-  double move_um = 8.0;   //!< the "certain displacement" of each actuator alone
+  double move_um = 7.0;   //!< the "certain displacement" of each actuator alone (base + move
+                          //!< stays below the stroke a leg alone reaches while the other two
+                          //!< hold the plate: 10 um saturates a stack on the twin)
   int repeats = 3;        //!< the paper: "repeated many times to attain average values"
   double settle_s = 0.5;  //!< after each move, before reading
 };

@@ -6,10 +6,11 @@
 // BenchStage:
 //   move(piston_nm)          drive_points(Z_d) with Z_d = base_um + piston_nm / 1000 on P1..P3
 //                            (equal point displacements: a pure piston of the plate)
-//   wait_on_target(band)     runs ticks until every channel's gauge feedback has stayed within
-//                            band_nm of its target (the controller's S, in the controller's
-//                            nominal micrometres) for hold_s, as a controller's on-target flag
-//                            would: judged on what the hardware sees, never on the twin's truth
+//   wait_on_target(band)     runs ticks until every channel's gauge error (target S minus
+//                            feedback, in the controller's nominal micrometres), averaged over
+//                            the last hold_s, is within band_nm, as a controller's on-target
+//                            flag would: judged on what the hardware sees, never on the twin's
+//                            truth (averaged, because single samples carry the gauges' noise)
 //   expose(T)                runs the ticks of the exposure and returns the TRUE plate pose
 //                            (twin().truth(): plate_z_um, theta_x_urad, theta_y_urad, relative to
 //                            the pose at construction) at its start and after every tick
@@ -25,7 +26,7 @@ class Bench;
 namespace piezoshift::psi {
 
 struct OnTarget {
-  double band_nm = 2.0;    //!< |S - feedback| on every channel (twin SGS noise ~0.3 nm rms)
+  double band_nm = 2.0;    //!< |mean(S - feedback)| over hold_s on every channel
   double hold_s = 0.005;   //!< for this long (5 ticks at 1 kHz)
   double timeout_s = 1.0;  //!< give up (the frame is then taken anyway and flagged)
 };

@@ -51,9 +51,8 @@ struct Schedule {
   static Schedule quick();  //!< shortened steps, same procedure
 };
 
-//! Exit status of `reproduce` when a Table 4 experiment is not valid (documented in
-//! docs/experiments.md; 2 stays bad input, 3 a supervisor fault of `run`).
-inline constexpr int kExitInvalidExperiment = 4;
+//! Exit status of `reproduce` when a Table 4 experiment is not valid.
+inline constexpr int kExitInvalidExperiment = experiments::kExitNotValid;
 
 //! Table 4's experiments and the two extra linearity sweeps, for one controller.
 struct ExperimentSet {
