@@ -4,7 +4,6 @@
 #include <netinet/in.h>
 #include <netinet/tcp.h>
 #include <poll.h>
-#include <sys/eventfd.h>
 #include <sys/socket.h>
 #include <unistd.h>
 
@@ -238,62 +237,26 @@ HttpServer::HttpServer(const HttpServerOptions& options, HttpHandler& handler)
   if (options.max_clients < 1 || options.max_request_bytes < 256 || options.max_body_bytes < 1 ||
       !(options.request_timeout_s > 0.0) || options.max_pending_output_bytes < 1)
     fail("invalid limits");
-  in_addr ip{};
-  const std::string numeric = options.host == "localhost" ? "127.0.0.1" : options.host;
-  if (::inet_pton(AF_INET, numeric.c_str(), &ip) != 1)
-    fail(fmt::format("'{}' is not a numeric IPv4 address (nor localhost)", options.host));
-  const bool loopback = (ntohl(ip.s_addr) >> 24) == 127;
-  if (!loopback && options.token.empty())
+  const Ipv4Host ip = parse_ipv4_host(options.host, "HTTP server", where);
+  if (!ip.loopback && options.token.empty())
     fail(
         fmt::format("refuses non-loopback address {} without an access token (--http-token or "
                     "--http-token-file): anyone who reaches the port could move the stage",
                     options.host));
-
-  try {
-    wake_fd_ = ::eventfd(0, EFD_NONBLOCK | EFD_CLOEXEC);
-    if (wake_fd_ < 0)
-      throw std::runtime_error(fmt::format("HTTP server: eventfd: {}", std::strerror(errno)));
-    listen_fd_ = ::socket(AF_INET, SOCK_STREAM | SOCK_NONBLOCK | SOCK_CLOEXEC, 0);
-    if (listen_fd_ < 0)
-      throw std::runtime_error(fmt::format("HTTP server: socket: {}", std::strerror(errno)));
-    const int one = 1;
-    ::setsockopt(listen_fd_, SOL_SOCKET, SO_REUSEADDR, &one, sizeof one);
-    sockaddr_in sa{};
-    sa.sin_family = AF_INET;
-    sa.sin_port = htons(options.port);
-    sa.sin_addr = ip;
-    if (::bind(listen_fd_, reinterpret_cast<const sockaddr*>(&sa), sizeof sa) != 0)
-      fail(fmt::format("cannot bind: {}", std::strerror(errno)));
-    if (::listen(listen_fd_, SOMAXCONN) != 0)
-      fail(fmt::format("cannot listen: {}", std::strerror(errno)));
-    socklen_t len = sizeof sa;
-    if (::getsockname(listen_fd_, reinterpret_cast<sockaddr*>(&sa), &len) != 0)
-      throw std::runtime_error(fmt::format("HTTP server: getsockname: {}", std::strerror(errno)));
-    port_ = ntohs(sa.sin_port);
-  } catch (...) {
-    close_fd(listen_fd_);
-    close_fd(wake_fd_);
-    throw;
-  }
+  listener_ = std::make_unique<TcpListener>(ip, options.port, "HTTP server", where);
+  const std::string numeric = options.host == "localhost" ? "127.0.0.1" : options.host;
   for (const std::string& h : {std::string("127.0.0.1"), std::string("localhost"), numeric})
-    allowed_hosts_.push_back(fmt::format("{}:{}", h, port_));
+    allowed_hosts_.push_back(fmt::format("{}:{}", h, listener_->port()));
 }
 
 HttpServer::~HttpServer() {
   for (Client& c : clients_)
     close_fd(c.fd);
-  close_fd(listen_fd_);
-  close_fd(wake_fd_);
 }
 
 void HttpServer::stop() noexcept {
-  const int saved_errno = errno;
   stop_requested_.store(true);
-  const std::uint64_t one = 1;
-  if (::write(wake_fd_, &one, sizeof one) < 0) {
-    // EAGAIN: already signalled.
-  }
-  errno = saved_errno;
+  listener_->wake();
 }
 
 HttpServerStats HttpServer::stats() const {
@@ -323,8 +286,8 @@ void HttpServer::run(const std::atomic<int>* stop_flag, int poll_interval_ms) {
   while (!stopping()) {
     handler_.on_poll(*this);
     fds.clear();
-    fds.push_back({wake_fd_, POLLIN, 0});
-    fds.push_back({listen_fd_, POLLIN, 0});
+    fds.push_back({listener_->wake_fd(), POLLIN, 0});
+    fds.push_back({listener_->fd(), POLLIN, 0});
     for (const Client& c : clients_) {
       short events = c.answered ? 0 : POLLIN;
       if (c.pending() > 0)
@@ -339,12 +302,8 @@ void HttpServer::run(const std::atomic<int>* stop_flag, int poll_interval_ms) {
         continue;
       throw std::runtime_error(fmt::format("HTTP server: poll: {}", std::strerror(errno)));
     }
-    if (fds[0].revents != 0) {
-      std::uint64_t count = 0;
-      if (::read(wake_fd_, &count, sizeof count) < 0) {
-        // EAGAIN: drained.
-      }
-    }
+    if (fds[0].revents != 0)
+      listener_->drain_wake();
     for (std::size_t i = 0; i + 2 < fds.size(); ++i) {
       Client& c = clients_[i];
       const short revents = fds[i + 2].revents;
@@ -380,7 +339,7 @@ void HttpServer::run(const std::atomic<int>* stop_flag, int poll_interval_ms) {
 
 void HttpServer::accept_clients() {
   for (;;) {
-    const int fd = ::accept4(listen_fd_, nullptr, nullptr, SOCK_NONBLOCK | SOCK_CLOEXEC);
+    const int fd = ::accept4(listener_->fd(), nullptr, nullptr, SOCK_NONBLOCK | SOCK_CLOEXEC);
     if (fd < 0) {
       if (errno == EINTR || errno == ECONNABORTED)
         continue;

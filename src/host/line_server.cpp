@@ -4,7 +4,6 @@
 #include <netinet/in.h>
 #include <netinet/tcp.h>
 #include <poll.h>
-#include <sys/eventfd.h>
 #include <sys/socket.h>
 #include <unistd.h>
 
@@ -61,69 +60,23 @@ LineServer::LineServer(const ListenAddress& address, const LineServerLimits& lim
   const std::string where = fmt::format("{}:{}", address.host, address.port);
   check_limits(limits, where);
 
-  in_addr ip{};
-  const std::string numeric = address.host == "localhost" ? "127.0.0.1" : address.host;
-  if (::inet_pton(AF_INET, numeric.c_str(), &ip) != 1)
-    throw io::InputError(
-        fmt::format("TCP server on {}: '{}' is not a numeric IPv4 address (nor localhost)", where,
-                    address.host));
-  const bool loopback = (ntohl(ip.s_addr) >> 24) == 127;
-  if (!loopback && !address.allow_remote)
+  const Ipv4Host ip = parse_ipv4_host(address.host, "TCP server", where);
+  if (!ip.loopback && !address.allow_remote)
     throw io::InputError(fmt::format(
         "TCP server on {} refuses non-loopback address {} without --allow-remote (GCS has no "
         "authentication: anyone who reaches the port moves the stage)",
         where, address.host));
-
-  try {
-    wake_fd_ = ::eventfd(0, EFD_NONBLOCK | EFD_CLOEXEC);
-    if (wake_fd_ < 0)
-      throw std::runtime_error(
-          fmt::format("TCP server on {}: eventfd: {}", where, std::strerror(errno)));
-    listen_fd_ = ::socket(AF_INET, SOCK_STREAM | SOCK_NONBLOCK | SOCK_CLOEXEC, 0);
-    if (listen_fd_ < 0)
-      throw std::runtime_error(
-          fmt::format("TCP server on {}: socket: {}", where, std::strerror(errno)));
-    // A restarted server can bind again while old connections are still in TIME_WAIT.
-    const int one = 1;
-    ::setsockopt(listen_fd_, SOL_SOCKET, SO_REUSEADDR, &one, sizeof one);
-
-    sockaddr_in sa{};
-    sa.sin_family = AF_INET;
-    sa.sin_port = htons(address.port);
-    sa.sin_addr = ip;
-    if (::bind(listen_fd_, reinterpret_cast<const sockaddr*>(&sa), sizeof sa) != 0)
-      throw io::InputError(
-          fmt::format("TCP server cannot bind {}: {}", where, std::strerror(errno)));
-    if (::listen(listen_fd_, SOMAXCONN) != 0)
-      throw io::InputError(
-          fmt::format("TCP server cannot listen on {}: {}", where, std::strerror(errno)));
-    socklen_t len = sizeof sa;
-    if (::getsockname(listen_fd_, reinterpret_cast<sockaddr*>(&sa), &len) != 0)
-      throw std::runtime_error(
-          fmt::format("TCP server on {}: getsockname: {}", where, std::strerror(errno)));
-    port_ = ntohs(sa.sin_port);
-  } catch (...) {
-    close_fd(listen_fd_);
-    close_fd(wake_fd_);
-    throw;
-  }
+  listener_ = std::make_unique<TcpListener>(ip, address.port, "TCP server", where);
 }
 
 LineServer::~LineServer() {
   for (Client& c : clients_)
     close_fd(c.fd);
-  close_fd(listen_fd_);
-  close_fd(wake_fd_);
 }
 
 void LineServer::stop() noexcept {
-  const int saved_errno = errno;  // a signal handler must leave errno as it found it
   stop_requested_.store(true);
-  const std::uint64_t one = 1;
-  if (::write(wake_fd_, &one, sizeof one) < 0) {
-    // EAGAIN: the counter is already non-zero, so poll() wakes anyway.
-  }
-  errno = saved_errno;
+  listener_->wake();
 }
 
 LineServerStats LineServer::stats() const {
@@ -157,9 +110,9 @@ void LineServer::run(const std::atomic<int>* stop_flag, int poll_interval_ms) {
       // [0] wake-up, [1] listener, [2 + i] clients_[i] (clients accepted later in this turn are
       // polled from the next turn on).
       fds.clear();
-      fds.push_back({wake_fd_, POLLIN, 0});
+      fds.push_back({listener_->wake_fd(), POLLIN, 0});
       const bool accepting = Clock::now() >= accept_paused_until_;
-      fds.push_back({accepting ? listen_fd_ : -1, POLLIN, 0});  // fd -1: ignored by poll()
+      fds.push_back({accepting ? listener_->fd() : -1, POLLIN, 0});  // fd -1: ignored by poll()
       for (const Client& c : clients_) {
         short events = c.input_ended ? 0 : POLLIN;
         if (c.pending() > 0)
@@ -172,12 +125,8 @@ void LineServer::run(const std::atomic<int>* stop_flag, int poll_interval_ms) {
         throw std::runtime_error(fmt::format("TCP server: poll: {}", std::strerror(errno)));
       }
 
-      if (fds[0].revents != 0) {
-        std::uint64_t count = 0;
-        if (::read(wake_fd_, &count, sizeof count) < 0) {
-          // EAGAIN: already drained.
-        }
-      }
+      if (fds[0].revents != 0)
+        listener_->drain_wake();
       for (std::size_t i = 0; i + 2 < fds.size(); ++i) {
         Client& c = clients_[i];
         const short revents = fds[i + 2].revents;
@@ -214,7 +163,7 @@ void LineServer::run(const std::atomic<int>* stop_flag, int poll_interval_ms) {
 
 void LineServer::accept_clients() {
   for (;;) {
-    const int fd = ::accept4(listen_fd_, nullptr, nullptr, SOCK_NONBLOCK | SOCK_CLOEXEC);
+    const int fd = ::accept4(listener_->fd(), nullptr, nullptr, SOCK_NONBLOCK | SOCK_CLOEXEC);
     if (fd < 0) {
       if (errno == EINTR || errno == ECONNABORTED)  // ECONNABORTED: that one left already
         continue;

@@ -25,9 +25,12 @@
 #include <cstddef>
 #include <cstdint>
 #include <map>
+#include <memory>
 #include <string>
 #include <string_view>
 #include <vector>
+
+#include "piezoshift/host/tcp_listener.hpp"
 
 namespace piezoshift::host {
 
@@ -96,7 +99,7 @@ class HttpServer {
   HttpServer(const HttpServer&) = delete;
   HttpServer& operator=(const HttpServer&) = delete;
 
-  std::uint16_t port() const noexcept { return port_; }
+  std::uint16_t port() const noexcept { return listener_->port(); }
   //! Serves until stop() or *stop_flag != 0, then closes every connection.
   void run(const std::atomic<int>* stop_flag = nullptr, int poll_interval_ms = 5);
   //! Thread-safe and async-signal-safe.
@@ -134,9 +137,7 @@ class HttpServer {
   HttpServerOptions options_;
   HttpHandler& handler_;
   std::vector<std::string> allowed_hosts_;  // Host header values naming this server
-  int listen_fd_ = -1;
-  int wake_fd_ = -1;
-  std::uint16_t port_ = 0;
+  std::unique_ptr<TcpListener> listener_;
   std::vector<Client> clients_;
   std::atomic<bool> stop_requested_{false};
   struct AtomicStats {

@@ -19,9 +19,12 @@
 #include <chrono>
 #include <cstddef>
 #include <cstdint>
+#include <memory>
 #include <string>
 #include <string_view>
 #include <vector>
+
+#include "piezoshift/host/tcp_listener.hpp"
 
 namespace piezoshift::host {
 
@@ -99,7 +102,7 @@ class LineServer {
   LineServer& operator=(const LineServer&) = delete;
 
   //! The bound port (the kernel's choice when ListenAddress::port was 0).
-  std::uint16_t port() const noexcept { return port_; }
+  std::uint16_t port() const noexcept { return listener_->port(); }
   //! Connections currently served. Thread-safe.
   std::size_t client_count() const noexcept { return client_count_.load(); }
 
@@ -139,9 +142,7 @@ class LineServer {
 
   LineServerLimits limits_;
   LineHandler& handler_;
-  int listen_fd_ = -1;
-  int wake_fd_ = -1;
-  std::uint16_t port_ = 0;
+  std::unique_ptr<TcpListener> listener_;
   ClientId next_id_ = 1;
   Clock::time_point accept_paused_until_{};  // after EMFILE & co: do not spin on the listener
   std::vector<Client> clients_;

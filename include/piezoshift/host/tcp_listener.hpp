@@ -1,0 +1,53 @@
+#pragma once
+// The listening end both network servers share (the GCS line server, line_server.hpp, and the
+// dashboard's HTTP server, http_server.hpp): an IPv4 TCP socket, non-blocking, bound and
+// listening, and an eventfd that wakes the server's poll() from any thread or a signal handler.
+//
+//   parse_ipv4_host(host)   "localhost" or a numeric IPv4 address; says whether it is loopback
+//                           (127.0.0.0/8), so a server can refuse a remote bind before binding
+//   TcpListener(host, port) socket, SO_REUSEADDR (a restarted server binds again while old
+//                           connections sit in TIME_WAIT), bind, listen; port 0 takes a free port
+//   wake()                  async-signal-safe: makes wake_fd() readable; errno is kept
+//   drain_wake()            after poll() reports wake_fd() readable
+//
+// Errors name the server and the address: io::InputError for what the user chose (an address
+// that is not IPv4, a port that cannot be bound), std::runtime_error for the system refusing a
+// descriptor.
+#include <netinet/in.h>
+
+#include <cstdint>
+#include <string>
+
+namespace piezoshift::host {
+
+struct Ipv4Host {
+  in_addr address{};
+  bool loopback = false;
+};
+
+//! server and where ("TCP server", "127.0.0.1:50000") name the error's source.
+Ipv4Host parse_ipv4_host(const std::string& host, const std::string& server,
+                         const std::string& where);
+
+class TcpListener {
+ public:
+  TcpListener(const Ipv4Host& host, std::uint16_t port, const std::string& server,
+              const std::string& where);
+  ~TcpListener();
+  TcpListener(const TcpListener&) = delete;
+  TcpListener& operator=(const TcpListener&) = delete;
+
+  int fd() const noexcept { return listen_fd_; }
+  int wake_fd() const noexcept { return wake_fd_; }
+  std::uint16_t port() const noexcept { return port_; }
+
+  void wake() const noexcept;
+  void drain_wake() const noexcept;
+
+ private:
+  int listen_fd_ = -1;
+  int wake_fd_ = -1;
+  std::uint16_t port_ = 0;
+};
+
+}  // namespace piezoshift::host
