@@ -31,6 +31,7 @@
 #include "piezoshift/io/input_error.hpp"
 #include "piezoshift/io/project_config.hpp"
 #include "piezoshift/plant/twin.hpp"
+#include "piezoshift/runtime/safety_supervisor.hpp"
 
 namespace piezoshift::app {
 namespace {
@@ -117,17 +118,20 @@ int run_simulate(const SimulateOptions& opt) {
   io::ProjectConfig config;
   if (!opt.config_path.empty())
     config = io::load_project_config(opt.config_path);
-  const double range_V = config.twin.daq.range_V;
   const double period_s = config.twin.daq.sample_time_s;
 
+  // The supervisor (the bench's, as `run`'s) passes 0 to 10 DAQ volts (0 to 150 V at the stacks);
+  // anything else would be clamped there, so it is refused here.
   const bool closed_loop = opt.open_loop_volts.empty();
+  const runtime::SafetyLimits limits;
   Vec3 open_loop{};
   if (!closed_loop) {
     for (std::size_t i = 0; i < 3; ++i) {
       const double v = opt.open_loop_volts[i];
-      if (!std::isfinite(v) || v < -range_V || v > range_V) {
-        throw io::InputError(fmt::format("--open-loop-volts: V{} = {} is outside the DAQ's +-{} V",
-                                         i + 1, v, range_V));
+      if (!std::isfinite(v) || v < limits.output_min_V || v > limits.output_max_V) {
+        throw io::InputError(
+            fmt::format("--open-loop-volts: V{} = {} is outside the supervisor's {} to {} V", i + 1,
+                        v, limits.output_min_V, limits.output_max_V));
       }
       open_loop[i] = v;
     }

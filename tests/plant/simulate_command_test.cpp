@@ -89,6 +89,10 @@ TEST_F(SimulateCommand, BadInputExitsTwoWithAClearMessage) {
   RunResult r = run("--open-loop-volts 10,12,10 --duration-s 0.1");
   EXPECT_EQ(r.status, 2);
   EXPECT_NE(r.err.find("--open-loop-volts"), std::string::npos) << r.err;
+  // Below the supervisor's 0 V the bench would clamp: refused, never clamped in silence.
+  r = run("--open-loop-volts 5,-1,5 --duration-s 0.1");
+  EXPECT_EQ(r.status, 2);
+  EXPECT_NE(r.err.find("V2 = -1"), std::string::npos) << r.err;
   r = run("--step-um 5 --duration-s -1");
   EXPECT_EQ(r.status, 2);
   EXPECT_NE(r.err.find("--duration-s"), std::string::npos) << r.err;
