@@ -159,15 +159,10 @@ Json write_analysis(const psi::Analysis& a, psi::Algorithm alg, double wavelengt
          {"surface_pv_nm", a.figures.pv},         {"surface_pvr_nm", a.figures.pvr},
          {"colour_scale_nm", {lo, hi}},           {"zernike_nm", a.zernike_nm}};
   if (!a.phase.shifts.empty()) {
-    std::vector<double> piston, tip, tilt;
-    for (const psi::FrameShift& s : a.phase.shifts) {
-      piston.push_back(s.piston_rad);
-      tip.push_back(s.tip_rad);
-      tilt.push_back(s.tilt_rad);
-    }
-    j["piston_rad"] = piston;
-    j["tip_rad"] = tip;
-    j["tilt_rad"] = tilt;
+    const psi::FrameShiftColumns c = psi::shift_columns(a.phase.shifts);
+    j["piston_rad"] = c.piston_rad;
+    j["tip_rad"] = c.tip_rad;
+    j["tilt_rad"] = c.tilt_rad;
   }
   io::write_file_atomically((fs::path(out) / "analysis.json").string(), j.dump(2) + "\n");
   return j;

@@ -77,15 +77,10 @@ py::dict analysis_dict(const psi::Analysis& a, psi::Algorithm alg) {
   d["surface_pvr_nm"] = a.figures.pvr;
   d["zernike_nm"] = a.zernike_nm;
   if (!a.phase.shifts.empty()) {
-    std::vector<double> piston, tip, tilt;
-    for (const psi::FrameShift& s : a.phase.shifts) {
-      piston.push_back(s.piston_rad);
-      tip.push_back(s.tip_rad);
-      tilt.push_back(s.tilt_rad);
-    }
-    d["piston_rad"] = piston;
-    d["tip_rad"] = tip;
-    d["tilt_rad"] = tilt;
+    const psi::FrameShiftColumns c = psi::shift_columns(a.phase.shifts);
+    d["piston_rad"] = c.piston_rad;
+    d["tip_rad"] = c.tip_rad;
+    d["tilt_rad"] = c.tilt_rad;
   }
   return d;
 }

@@ -244,8 +244,7 @@ HttpServer::HttpServer(const HttpServerOptions& options, HttpHandler& handler)
                     "--http-token-file): anyone who reaches the port could move the stage",
                     options.host));
   listener_ = std::make_unique<TcpListener>(ip, options.port, "HTTP server", where);
-  const std::string numeric = options.host == "localhost" ? "127.0.0.1" : options.host;
-  for (const std::string& h : {std::string("127.0.0.1"), std::string("localhost"), numeric})
+  for (const std::string& h : {std::string("127.0.0.1"), std::string("localhost"), ip.numeric})
     allowed_hosts_.push_back(fmt::format("{}:{}", h, listener_->port()));
 }
 

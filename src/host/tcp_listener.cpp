@@ -27,8 +27,8 @@ void close_fd(int& fd) noexcept {
 Ipv4Host parse_ipv4_host(const std::string& host, const std::string& server,
                          const std::string& where) {
   Ipv4Host h;
-  const std::string numeric = host == "localhost" ? "127.0.0.1" : host;
-  if (::inet_pton(AF_INET, numeric.c_str(), &h.address) != 1)
+  h.numeric = host == "localhost" ? "127.0.0.1" : host;
+  if (::inet_pton(AF_INET, h.numeric.c_str(), &h.address) != 1)
     throw io::InputError(fmt::format("{} on {}: '{}' is not a numeric IPv4 address (nor localhost)",
                                      server, where, host));
   h.loopback = (ntohl(h.address.s_addr) >> 24) == 127;

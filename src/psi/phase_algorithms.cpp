@@ -501,4 +501,14 @@ PhaseResult wrapped_phase(std::span<const Map> frames, const Mask& mask, const P
   }
 }
 
+FrameShiftColumns shift_columns(const std::vector<FrameShift>& shifts) {
+  FrameShiftColumns c;
+  for (const FrameShift& s : shifts) {
+    c.piston_rad.push_back(s.piston_rad);
+    c.tip_rad.push_back(s.tip_rad);
+    c.tilt_rad.push_back(s.tilt_rad);
+  }
+  return c;
+}
+
 }  // namespace piezoshift::psi

@@ -22,6 +22,7 @@ namespace piezoshift::host {
 
 struct Ipv4Host {
   in_addr address{};
+  std::string numeric;  //!< dotted quad ("localhost" becomes 127.0.0.1)
   bool loopback = false;
 };
 

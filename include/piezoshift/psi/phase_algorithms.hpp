@@ -113,6 +113,13 @@ struct FrameShift {
   double tilt_rad = 0.0;
 };
 
+//! The per-frame shifts as three columns (the JSON and Python outputs' piston_rad, tip_rad,
+//! tilt_rad).
+struct FrameShiftColumns {
+  std::vector<double> piston_rad, tip_rad, tilt_rad;
+};
+FrameShiftColumns shift_columns(const std::vector<FrameShift>& shifts);
+
 struct PhaseResult {
   Map phase_rad;                   //!< wrapped to (-pi, pi], NaN outside the mask
   Map modulation;                  //!< B estimate (frame units), NaN outside the mask
