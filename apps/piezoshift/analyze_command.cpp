@@ -1,9 +1,11 @@
 // `piezoshift analyze linearity|repeatability|step --data FILE.csv [--json] [--plot FIG.png]`:
 // the performance metrics of the paper's Section 4 computed from recorded data (bench or twin).
-//   linearity      columns desired_um,measured_um (one row per point of the sweep)
+//   linearity      columns zd_um,measured_um (one row per point of the sweep)
 //   repeatability  column measured_um (one row per repeated move)
-//   step           columns time_s,measured_um (one row per sample)
-// Column order is free and other columns are ignored. Bad data exits with status 2 and a message
+//   step           columns t_s,measured_um (one row per sample)
+// The column vocabulary is docs/files.md's; --column NAME reads the measured values from another
+// column (interferometer1_um of a `run` or `simulate` log). Column order is free and other
+// columns are ignored. Bad data exits with status 2 and a message
 // naming the file and, where one applies, the line and column. --plot draws the matching figure
 // with gnuplot (PNG, or SVG for a .svg name) and keeps its .gp script and .dat data beside it.
 #include <cmath>
@@ -31,6 +33,7 @@ struct AnalyzeOptions {
   std::string data_path;
   bool json = false;
   std::string plot_path;  // empty: no figure
+  std::string column = "measured_um";
   experiments::StepResponseOptions step;
   std::int64_t median_window = 5;
 };
@@ -72,9 +75,9 @@ Json number_or_null(double v) {
 
 int run_linearity(const AnalyzeOptions& o) {
   const io::CsvTable t = io::CsvTable::load(o.data_path);
-  t.require_columns({"desired_um", "measured_um"});
-  const std::vector<double> x = t.column("desired_um");
-  const std::vector<double> y = t.column("measured_um");
+  t.require_columns({"zd_um", o.column});
+  const std::vector<double> x = t.column("zd_um");
+  const std::vector<double> y = t.column(o.column);
   const experiments::LinearityMetrics m =
       with_file(o.data_path, [&] { return experiments::linearity_metrics(x, y); });
   if (o.json) {
@@ -104,8 +107,8 @@ int run_linearity(const AnalyzeOptions& o) {
 
 int run_repeatability(const AnalyzeOptions& o) {
   const io::CsvTable t = io::CsvTable::load(o.data_path);
-  t.require_columns({"measured_um"});
-  const std::vector<double> z = t.column("measured_um");
+  t.require_columns({o.column});
+  const std::vector<double> z = t.column(o.column);
   const experiments::RepeatabilityMetrics r =
       with_file(o.data_path, [&] { return experiments::repeatability_metrics(z); });
   if (o.json) {
@@ -129,9 +132,9 @@ int run_step(const AnalyzeOptions& o_in) {
         fmt::format("--median-window {}: must be an odd number >= 1", o.median_window));
   o.step.median_window = static_cast<std::size_t>(o.median_window);
   const io::CsvTable t = io::CsvTable::load(o.data_path);
-  t.require_columns({"time_s", "measured_um"});
-  const std::vector<double> ts = t.column("time_s");
-  const std::vector<double> y = t.column("measured_um");
+  t.require_columns({"t_s", o.column});
+  const std::vector<double> ts = t.column("t_s");
+  const std::vector<double> y = t.column(o.column);
   const experiments::StepResponseMetrics m =
       with_file(o.data_path, [&] { return experiments::step_response_metrics(ts, y, o.step); });
   if (o.json) {
@@ -175,16 +178,20 @@ void add_analyze_command(CLI::App& app, Action& action) {
   auto o = std::make_shared<AnalyzeOptions>();
 
   CLI::App* lin = analyze->add_subcommand(
-      "linearity", "Zero-end and best-fit linearity (columns desired_um, measured_um)");
+      "linearity", "Zero-end and best-fit linearity (columns zd_um, measured_um)");
   CLI::App* rep =
       analyze->add_subcommand("repeatability", "Eq. 9 repeatability (column measured_um)");
   CLI::App* step = analyze->add_subcommand(
-      "step", "Rise time, overshoot, settling times (columns time_s, measured_um)");
+      "step", "Rise time, overshoot, settling times (columns t_s, measured_um)");
   for (CLI::App* sub : {lin, rep, step}) {
     sub->add_option("--data", o->data_path, "CSV file with a header row")->required();
     sub->add_flag("--json", o->json, "Machine-readable output");
     sub->add_option("--plot", o->plot_path,
                     "Draw the figure with gnuplot to this .png (or .svg) file");
+    sub->add_option("--column", o->column,
+                    "Column of the measured values (e.g. interferometer1_um of a run or simulate "
+                    "log; docs/files.md)")
+        ->capture_default_str();
   }
   step->add_option("--step-time-s", o->step.step_time_s, "When the step was commanded [s]")
       ->capture_default_str();

@@ -165,19 +165,19 @@ void write_data(const ReproductionResult& r, const fs::path& dir, ReportFiles& f
     return std::make_unique<io::CsvWriter>((dir / name).string(), std::move(columns), decimals);
   };
   {
-    auto w = csv("step_response.csv", {"time_s", "desired_um", "measured_um"}, 6);
+    auto w = csv("step_response.csv", {"t_s", "zd_um", "measured_um"}, 6);
     for (std::size_t k = 0; k < r.step.time_s.size(); ++k) {
       w->row({r.step.time_s[k], r.step.desired_um[k], r.step.measured_um[k]});
     }
     w->close();
   }
   {
-    auto w = csv("linearity.csv", {"desired_um", "measured_um"}, 6);
+    auto w = csv("linearity.csv", {"zd_um", "measured_um"}, 6);
     for (std::size_t k = 0; k < r.linearity.desired_um.size(); ++k) {
       w->row({r.linearity.desired_um[k], r.linearity.measured_um[k]});
     }
     w->close();
-    auto s = csv("linearity_samples.csv", {"time_s", "desired_um", "measured_um"}, 6);
+    auto s = csv("linearity_samples.csv", {"t_s", "zd_um", "measured_um"}, 6);
     for (std::size_t k = 0; k < r.linearity.sample_time_s.size(); ++k) {
       s->row({r.linearity.sample_time_s[k], r.linearity.sample_desired_um[k],
               r.linearity.sample_measured_um[k]});
@@ -187,7 +187,7 @@ void write_data(const ReproductionResult& r, const fs::path& dir, ReportFiles& f
   for (const auto& [name, lin] : {std::pair{"linearity_grid.csv", &r.linearity_grid},
                                   std::pair{"linearity_down.csv", &r.linearity_down},
                                   std::pair{"oracle_linearity.csv", &r.oracle.linearity}}) {
-    auto w = csv(name, {"desired_um", "measured_um"}, 6);
+    auto w = csv(name, {"zd_um", "measured_um"}, 6);
     for (std::size_t k = 0; k < lin->desired_um.size(); ++k)
       w->row({lin->desired_um[k], lin->measured_um[k]});
     w->close();
@@ -201,7 +201,7 @@ void write_data(const ReproductionResult& r, const fs::path& dir, ReportFiles& f
     w->close();
   }
   {
-    auto w = csv("travel_range.csv", {"desired_um", "measured_um", "saturated_mask"}, 6);
+    auto w = csv("travel_range.csv", {"zd_um", "measured_um", "saturated_mask"}, 6);
     for (std::size_t k = 0; k < r.travel.desired_um.size(); ++k) {
       w->row({r.travel.desired_um[k], r.travel.measured_um[k],
               static_cast<double>(r.travel.saturated_mask[k])});

@@ -73,7 +73,7 @@ TEST_F(SimulateCommand, SameSeedGivesTheSameLogAndAnotherSeedDoesNot) {
   EXPECT_NE(read_text(a), read_text(c));
 }
 
-TEST_F(SimulateCommand, ProfileIsFollowedAsAStaircase) {
+TEST_F(SimulateCommand, ProfileIsFollowedAsRunFollowsIt) {
   const std::string profile = write("p.csv", "t_s,zd_um\n0.0,2.0\n0.3,6.0\n");
   const RunResult r = run("--profile '" + profile + "' --duration-s 0.6 --json");
   ASSERT_EQ(r.status, 0) << r.err;
