@@ -2,12 +2,14 @@
 // the performance metrics of the paper's Section 4 computed from recorded data (bench or twin).
 //   linearity      columns zd_um,measured_um (one row per point of the sweep)
 //   repeatability  column measured_um (one row per repeated move)
-//   step           columns t_s,measured_um (one row per sample)
+//   step           columns t_s,measured_um (one row per sample; in a file with a state column,
+//                  a `run` log, the rows before the first with state != 0: the controlled part)
 // The column vocabulary is docs/files.md's; --column NAME reads the measured values from another
 // column (interferometer1_um of a `run` or `simulate` log). Column order is free and other
 // columns are ignored. Bad data exits with status 2 and a message
 // naming the file and, where one applies, the line and column. --plot draws the matching figure
 // with gnuplot (PNG, or SVG for a .svg name) and keeps its .gp script and .dat data beside it.
+#include <algorithm>
 #include <cmath>
 #include <memory>
 #include <string>
@@ -133,8 +135,18 @@ int run_step(const AnalyzeOptions& o_in) {
   o.step.median_window = static_cast<std::size_t>(o.median_window);
   const io::CsvTable t = io::CsvTable::load(o.data_path);
   t.require_columns({"t_s", o.column});
-  const std::vector<double> ts = t.column("t_s");
-  const std::vector<double> y = t.column(o.column);
+  std::vector<double> ts = t.column("t_s");
+  std::vector<double> y = t.column(o.column);
+  // A `run` log goes on through the ramp to 0 V after its controlled part (state 1, stopping)
+  // or a fault: the step is the part where the supervisor was running (state 0).
+  if (t.has_column("state")) {
+    const std::vector<double> state = t.column("state");
+    const auto end = static_cast<std::size_t>(
+        std::find_if(state.begin(), state.end(), [](double v) { return v != 0.0; }) -
+        state.begin());
+    ts.resize(end);
+    y.resize(end);
+  }
   const experiments::StepResponseMetrics m =
       with_file(o.data_path, [&] { return experiments::step_response_metrics(ts, y, o.step); });
   if (o.json) {
