@@ -186,4 +186,31 @@ TEST_F(GuidedCalibrateCli, BadOptionsExitTwoNamingTheOption) {
   EXPECT_NE(c.err.find("none.csv"), std::string::npos) << c.err;
 }
 
+TEST_F(GuidedCalibrateCli, ASessionOfOtherOptionsOrMalformedIsRefusedNamingIt) {
+  // The first run's session is for seed 3: another seed does not resume it.
+  const std::string out = path("sim/cal.toml");
+  const CliResult other =
+      run("calibrate --daq sim --interferometer sim --seed 4 --out '" + out + "'");
+  EXPECT_EQ(other.status, 2);
+  EXPECT_NE(other.err.find("cal.session.json: this session was recorded for"), std::string::npos)
+      << other.err;
+  EXPECT_NE(other.err.find("--restart"), std::string::npos);
+  // --restart discards it: seed 4 gives other readings than seed 3.
+  const CliResult restarted =
+      run("calibrate --daq sim --interferometer sim --seed 4 --restart --json --out '" + out + "'");
+  ASSERT_EQ(restarted.status, 0) << restarted.err;
+  EXPECT_GT(max_difference(fit_of(restarted.out), sim_fit_), 1e-6);
+
+  std::filesystem::create_directories(path("m"));
+  write("m/cal.session.json", "{\"format\": \"piezoshift guided calibration session 1\", \"pl");
+  const CliResult bad =
+      run("calibrate --daq sim --interferometer sim --seed 3 --out '" + path("m/cal.toml") + "'");
+  EXPECT_EQ(bad.status, 2);
+  EXPECT_NE(bad.err.find("m/cal.session.json: not a session file"), std::string::npos) << bad.err;
+  const CliResult search =
+      run("calibrate --daq sim --interferometer sim --pid search --out '" + path("s.toml") + "'");
+  EXPECT_EQ(search.status, 2);
+  EXPECT_NE(search.err.find("--pid search"), std::string::npos) << search.err;
+}
+
 }  // namespace

@@ -59,9 +59,9 @@ TEST_F(SimulateCommand, StepWithThePapersControllerLogsEveryTickWithUnits) {
       ++rows;
   }
   EXPECT_EQ(rows, 500);
-  EXPECT_EQ(header.rfind("t_s,zd_um,s1_um", 0), 0u) << header;
+  EXPECT_EQ(header.rfind("t_s,zd1_um,zd2_um,zd3_um,s1_um", 0), 0u) << header;
   EXPECT_NE(header.find("plate_z_um"), std::string::npos);
-  EXPECT_NE(header.find("ifm3_um"), std::string::npos);
+  EXPECT_NE(header.find(",truth3_um,interferometer1_um,"), std::string::npos);
 }
 
 TEST_F(SimulateCommand, SameSeedGivesTheSameLogAndAnotherSeedDoesNot) {
