@@ -129,16 +129,11 @@ int run_guided(const Options& o) {
   } else if (ifm == "sim") {
     source = std::make_unique<calibration::TwinSource>();
   } else {
-    calibration::LogFileOptions lo;
-    lo.wait = !sim;  // the twin's times are simulated: the log is complete already
-    source = std::make_unique<calibration::LogFileSource>(ifm.substr(5), lo);
+    source = std::make_unique<calibration::LogFileSource>(ifm.substr(5));
   }
-  calibration::GuidedIo gio{*source,
-                            say,
-                            [&session_file](const calibration::GuidedSession& s) {
+  calibration::GuidedIo gio{*source, say, [&session_file](const calibration::GuidedSession& s) {
                               calibration::save_guided_session(session_file, s);
-                            },
-                            {}};
+                            }};
   // Written before the stage moves: a folder that cannot take the session is found now.
   calibration::save_guided_session(session_file, session);
   const calibration::GuidedOutcome r =

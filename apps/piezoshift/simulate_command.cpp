@@ -62,30 +62,15 @@ std::vector<std::string> log_columns(bool closed_loop) {
          {"zd1_um", "zd2_um", "zd3_um", "s1_um", "s2_um", "s3_um", "u1_um", "u2_um", "u3_um"})
       c.emplace_back(n);
   }
-  for (const char* n : {"ao1_V",
-                        "ao2_V",
-                        "ao3_V",
-                        "amp1_V",
-                        "amp2_V",
-                        "amp3_V",
-                        "sgs1_V",
-                        "sgs2_V",
-                        "sgs3_V",
-                        "stack1_um",
-                        "stack2_um",
-                        "stack3_um",
-                        "leg1_um",
-                        "leg2_um",
-                        "leg3_um",
-                        "plate_z_um",
-                        "theta_x_urad",
-                        "theta_y_urad",
-                        "truth1_um",
-                        "truth2_um",
-                        "truth3_um",
-                        "interferometer1_um",
-                        "interferometer2_um",
-                        "interferometer3_um"})
+  // clang-format off
+  static constexpr const char* kTwinColumns[] = {
+      "ao1_V",     "ao2_V",     "ao3_V",     "amp1_V",     "amp2_V",       "amp3_V",
+      "sgs1_V",    "sgs2_V",    "sgs3_V",    "stack1_um",  "stack2_um",    "stack3_um",
+      "leg1_um",   "leg2_um",   "leg3_um",   "plate_z_um", "theta_x_urad", "theta_y_urad",
+      "truth1_um", "truth2_um", "truth3_um",
+      "interferometer1_um", "interferometer2_um", "interferometer3_um"};
+  // clang-format on
+  for (const char* n : kTwinColumns)
     c.emplace_back(n);
   if (closed_loop)
     c.emplace_back("saturated_mask_bits");

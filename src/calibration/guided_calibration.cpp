@@ -209,11 +209,8 @@ GuidedOutcome run_guided_calibration(GuidedRig& stage2, GuidedRig& stage3,
     if (!taking && !rig.replays())
       continue;
     const bool new_position = k == 0 || plan[k - 1].optics != s.optics || k == recorded;
-    if (taking && new_position) {
+    if (taking && new_position)
       io.say(instruction(s));
-      if (io.confirm && !io.confirm(fmt::format("optics at {}", to_string(s.optics))))
-        return out;
-    }
     if (first_of_stage3)
       rig.rest(o.polynomial.settle_s);
     if (s.stage == 2)

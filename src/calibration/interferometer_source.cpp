@@ -1,10 +1,10 @@
 #include "piezoshift/calibration/interferometer_source.hpp"
 
-#include <chrono>
+#include <algorithm>
 #include <filesystem>
+#include <limits>
 #include <stdexcept>
 #include <string_view>
-#include <thread>
 #include <vector>
 
 #include <fmt/core.h>
@@ -91,40 +91,31 @@ void PromptSource::refuse(const std::string& why) {
 }
 
 std::optional<double> LogFileSource::read(const ReadingRequest& r) {
-  const auto started = std::chrono::steady_clock::now();
-  for (;;) {
-    std::error_code ec;
-    const auto size = std::filesystem::file_size(path_, ec);
-    if (!ec && size > o_.max_bytes)
-      throw io::InputError(fmt::format("{}: the log is larger than {} bytes", path_, o_.max_bytes));
-    const io::CsvTable t = io::CsvTable::load(path_);
-    t.require_columns({"t_s", "displacement_um"});
-    const std::vector<double> time = t.column("t_s");
-    const std::vector<double> z = t.column("displacement_um");
-    double sum = 0.0, last = -std::numeric_limits<double>::infinity();
-    std::size_t n = 0;
-    for (std::size_t i = 0; i < time.size(); ++i) {
-      last = std::max(last, time[i]);
-      if (time[i] >= r.window.start_s && time[i] <= r.window.end_s) {
-        sum += z[i];
-        ++n;
-      }
+  std::error_code ec;
+  const auto size = std::filesystem::file_size(path_, ec);
+  if (!ec && size > max_bytes_)
+    throw io::InputError(fmt::format("{}: the log is larger than {} bytes", path_, max_bytes_));
+  const io::CsvTable t = io::CsvTable::load(path_);
+  t.require_columns({"t_s", "displacement_um"});
+  const std::vector<double> time = t.column("t_s");
+  const std::vector<double> z = t.column("displacement_um");
+  double sum = 0.0, last = -std::numeric_limits<double>::infinity();
+  std::size_t n = 0;
+  for (std::size_t i = 0; i < time.size(); ++i) {
+    last = std::max(last, time[i]);
+    if (time[i] >= r.window.start_s && time[i] <= r.window.end_s) {
+      sum += z[i];
+      ++n;
     }
-    if (last >= r.window.end_s) {
-      if (n == 0)
-        throw io::InputError(fmt::format("{}: no row with t_s between {:.3f} and {:.3f} s ({})",
-                                         path_, r.window.start_s, r.window.end_s, r.what));
-      return sum / static_cast<double>(n);
-    }
-    const double waited =
-        std::chrono::duration<double>(std::chrono::steady_clock::now() - started).count();
-    if (!o_.wait || waited > o_.wait_timeout_s)
-      throw io::InputError(fmt::format(
-          "{}: the log ends at t_s {:.3f}, before the end of the window {:.3f} s ({}){}", path_,
-          last, r.window.end_s, r.what,
-          o_.wait ? fmt::format(" after waiting {:.0f} s", waited) : std::string()));
-    std::this_thread::sleep_for(std::chrono::milliseconds(200));
   }
+  if (last < r.window.end_s)
+    throw io::InputError(
+        fmt::format("{}: the log ends at t_s {:.3f}, before the end of the window {:.3f} s ({})",
+                    path_, last, r.window.end_s, r.what));
+  if (n == 0)
+    throw io::InputError(fmt::format("{}: no row with t_s between {:.3f} and {:.3f} s ({})", path_,
+                                     r.window.start_s, r.window.end_s, r.what));
+  return sum / static_cast<double>(n);
 }
 
 std::optional<double> TwinSource::read(const ReadingRequest& r) {

@@ -184,6 +184,15 @@ TEST_F(GuidedCalibrateCli, BadOptionsExitTwoNamingTheOption) {
                           "' --out '" + path("c.toml") + "'");
   EXPECT_EQ(c.status, 2);
   EXPECT_NE(c.err.find("none.csv"), std::string::npos) << c.err;
+  // A log that stops before the first window ends: refused naming the file and the window.
+  const std::string shortlog = write("short.csv", "t_s,displacement_um\n0.5,0.001\n");
+  const CliResult d = run("calibrate --daq sim --interferometer 'file:" + shortlog + "' --out '" +
+                          path("d.toml") + "'");
+  EXPECT_EQ(d.status, 2);
+  EXPECT_NE(
+      d.err.find("short.csv: the log ends at t_s 0.500, before the end of the window 2.000 s"),
+      std::string::npos)
+      << d.err;
 }
 
 TEST_F(GuidedCalibrateCli, ASessionOfOtherOptionsOrMalformedIsRefusedNamingIt) {

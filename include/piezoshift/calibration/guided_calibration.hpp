@@ -66,10 +66,6 @@ struct GuidedIo {
   InterferometerSource& source;
   std::function<void(const std::string&)> say;       //!< instructions, to the operator
   std::function<void(const GuidedSession&)> record;  //!< after every reading
-  //! When set, called after each change of the optics' position, before the stage is driven
-  //! (an interferometer log file needs the optics in place before the window); false ends the
-  //! run as an ended source does.
-  std::function<bool(const std::string&)> confirm;
 };
 
 struct GuidedOutcome {

@@ -5,8 +5,8 @@
 //   PromptSource    typed by the operator (a line per reading on an input stream); a line that is
 //                   not a number, or a reading the plausibility checks refuse, is asked again
 //   LogFileSource   read from the CSV the interferometer software writes, columns t_s (on the
-//                   rig's clock: Unix time on hardware) and displacement_um: the mean of the rows
-//                   inside the window (docs/files.md)
+//                   rig's clock) and displacement_um: the mean of the rows inside the window
+//                   (docs/files.md); the log must already reach past the window's end
 //   TwinSource      the twin's own interferometer (`--daq sim` only)
 // read() returns nothing when the source has ended (the operator closed the input): the session
 // so far is recorded and a later run resumes it.
@@ -63,19 +63,13 @@ class PromptSource final : public InterferometerSource {
   std::function<void(const std::string&)> say_;
 };
 
-struct LogFileOptions {
-  //! How long to wait for the software to write a row past the window's end before giving up.
-  double wait_timeout_s = 30.0;
-  //! false on the twin: the file is complete already, waiting cannot help.
-  bool wait = true;
-  std::size_t max_bytes = 64u << 20;  //!< bounded memory: a larger log is refused
-};
-
 class LogFileSource final : public InterferometerSource {
  public:
-  LogFileSource(std::string path, const LogFileOptions& options)
-      : path_(std::move(path)), o_(options) {}
-  //! Throws io::InputError naming the file for a bad file, no row in the window, or a timeout.
+  //! The log is read whole at each reading; a file larger than max_bytes is refused.
+  explicit LogFileSource(std::string path, std::size_t max_bytes = std::size_t{64} << 20)
+      : path_(std::move(path)), max_bytes_(max_bytes) {}
+  //! Throws io::InputError naming the file for a bad file, a log that ends before the window
+  //! does, or no row inside the window.
   std::optional<double> read(const ReadingRequest& request) override;
   bool can_retry() const override { return false; }
   void refuse(const std::string&) override {}
@@ -83,7 +77,7 @@ class LogFileSource final : public InterferometerSource {
 
  private:
   std::string path_;
-  LogFileOptions o_;
+  std::size_t max_bytes_;
 };
 
 class TwinSource final : public InterferometerSource {
