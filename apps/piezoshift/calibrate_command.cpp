@@ -242,8 +242,9 @@ void add_calibrate_command(CLI::App& app, Action& action) {
          "paper: keep 0.6/0.2/0.001 (default); search: grid-search the gains on the full loop")
       ->check(CLI::IsMember({"paper", "search"}));
   cmd->add_flag("--json", o->json, "print a JSON summary");
-  cmd->add_option("--daq", o->daq,
-                  "guided calibration on a bench: sim (the twin) or comedi:/dev/comediN");
+  cmd->add_option(
+      "--daq", o->daq,
+      "guided calibration on a bench: sim (the twin; comedi:/dev/comediN is not built yet)");
   cmd->add_option("--interferometer", o->interferometer,
                   "guided: prompt (readings typed on stdin), file:PATH (the interferometer "
                   "software's CSV log, t_s,displacement_um) or sim (the twin's, --daq sim)");

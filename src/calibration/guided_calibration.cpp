@@ -197,7 +197,7 @@ GuidedOutcome run_guided_calibration(GuidedRig& stage2, GuidedRig& stage3,
   for (std::size_t k = 0; k < plan.size(); ++k) {
     const GuidedStep& s = plan[k];
     GuidedRig& rig = s.stage == 2 ? stage2 : stage3;
-    const bool first_of_stage3 = s.stage == 3 && (k == 0 || plan[k - 1].stage == 2);
+    const bool first_of_stage3 = s.stage == 3 && plan[k - 1].stage == 2;  // stage 2 comes first
     if (first_of_stage3) {
       out.matrix = fit_stage2(session, o);
       out.controller.matrix = out.matrix.fit.a;
@@ -255,10 +255,6 @@ GuidedOutcome run_guided_calibration(GuidedRig& stage2, GuidedRig& stage3,
     session.readings.push_back(e);
     ++out.taken;
     io.record(session);
-  }
-  if (out.matrix.ds_um.empty()) {  // a plan without stage 3 steps (not made by guided_plan)
-    out.matrix = fit_stage2(session, o);
-    out.controller.matrix = out.matrix.fit.a;
   }
   PolynomialIdentificationResult& pr = out.polynomial;
   for (std::size_t k = 0; k < plan.size(); ++k) {
