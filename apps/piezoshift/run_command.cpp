@@ -187,18 +187,16 @@ int run(const RunOptions& o) {
   StopSignals signals;
   if (logger)
     logger->start();  // before the real-time request: the logging thread stays a normal thread
+  std::optional<LiveStatus> status_line;  // likewise: it must not inherit the loop's priority
+  if (show_live)
+    status_line.emplace(live);
   RealtimeReport rt;
   if (clock->real_time())
     rt = request_realtime_or_warn(o.cpu);
 
   daq->activate();
-  LoopResult r;
-  {
-    std::optional<LiveStatus> status_line;
-    if (show_live)
-      status_line.emplace(live);
-    r = loop.run();
-  }
+  const LoopResult r = loop.run();
+  status_line.reset();  // clears its line before the summary
   daq->deactivate();
   if (logger)
     logger->stop();
