@@ -105,15 +105,20 @@ ReproductionResult reproduce(const io::ProjectConfig& config, const ReproduceOpt
   base.sample_time_s = config.twin.daq.sample_time_s;  // the controller runs at the DAQ's rate
   r.calibration = calibration::calibrate(config, base, seed, s.calibration, progress);
   run_set(r, config, r.calibration.controller, seed, s, progress);
+  control::SemiClosedLoopParams without_cubic = r.calibration.controller;
+  without_cubic.polynomial = control::CubicPolynomial::identity();
+  r.linearity_without_cubic =
+      experiments::run_linearity(config, without_cubic, seed + 30, s.linearity, progress);
   // The oracle: the same loop, gains and A, fed the plate's truth; nothing left for p to correct.
   r.oracle_controller = r.calibration.controller;
   r.oracle_controller.polynomial = control::CubicPolynomial::identity();
   Schedule so = s;
   with_feedback(so, experiments::Feedback::kOracle);
   run_set(r.oracle, config, r.oracle_controller, seed, so, progress);
-  r.simulated_time_s = r.calibration.pid.simulated_time_s + r.calibration.matrix.simulated_time_s +
-                       r.calibration.polynomial.simulated_time_s +
-                       r.experiments_simulated_time_s() + r.oracle.experiments_simulated_time_s();
+  r.simulated_time_s =
+      r.calibration.pid.simulated_time_s + r.calibration.matrix.simulated_time_s +
+      r.calibration.polynomial.simulated_time_s + r.experiments_simulated_time_s() +
+      r.linearity_without_cubic.simulated_time_s + r.oracle.experiments_simulated_time_s();
   r.wall_time_s = std::chrono::duration<double>(std::chrono::steady_clock::now() - start).count();
   return r;
 }

@@ -83,6 +83,10 @@ nlohmann::json summary_json(const ReproductionResult& r) {
   j["pid"] = r.options.pid == calibration::PidChoice::kPaper ? "paper" : "search";
   set_json(j, "", r);
   set_json(j, "oracle_", r.oracle);
+  const auto& raw = r.linearity_without_cubic;
+  j["linearity_without_cubic_zero_end_pct"] = raw.metrics.linearity_zero_end_pct;
+  j["linearity_without_cubic_best_fit_pct"] = raw.metrics.linearity_best_fit_pct;
+  j["linearity_without_cubic_valid"] = raw.validity.valid;
   j["identified_A"] = matrix_json(cal.controller.matrix.a);
   j["identified_A_condition_number"] = cal.matrix.fit.condition_number;
   j["identified_A_rms_residual_um"] = cal.matrix.fit.rms_residual_um;
