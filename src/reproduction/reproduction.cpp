@@ -46,6 +46,7 @@ void with_feedback(Schedule& s, experiments::Feedback f) {
   s.linearity.bench.feedback = f;
   s.linearity_grid.bench.feedback = f;
   s.linearity_down.bench.feedback = f;
+  s.phase_step.bench.feedback = f;
   s.repeat_5um.bench.feedback = f;
   s.repeat_10um.bench.feedback = f;
 }
@@ -61,6 +62,7 @@ void run_set(ExperimentSet& r, const io::ProjectConfig& config,
   r.repeat_10um = ex::run_repeatability(config, c, seed + 50, s.repeat_10um, progress);
   r.linearity_grid = ex::run_linearity(config, c, seed + 60, s.linearity_grid, progress);
   r.linearity_down = ex::run_linearity(config, c, seed + 70, s.linearity_down, progress);
+  r.phase_step = ex::run_phase_step(config, c, seed + 80, s.phase_step, progress);
 }
 
 }  // namespace
@@ -68,7 +70,7 @@ void run_set(ExperimentSet& r, const io::ProjectConfig& config,
 double ExperimentSet::experiments_simulated_time_s() const {
   return travel.simulated_time_s + step.simulated_time_s + linearity.simulated_time_s +
          linearity_grid.simulated_time_s + linearity_down.simulated_time_s +
-         repeat_5um.simulated_time_s + repeat_10um.simulated_time_s;
+         repeat_5um.simulated_time_s + repeat_10um.simulated_time_s + phase_step.simulated_time_s;
 }
 
 bool ExperimentSet::table4_valid() const {
@@ -89,6 +91,7 @@ std::vector<std::string> ExperimentSet::invalid_reasons() const {
   add("repeatability 10 um", repeat_10um.validity);
   add("linearity (0.25 um grid)", linearity_grid.validity);
   add("linearity (downwards)", linearity_down.validity);
+  add("phase step", phase_step.validity);
   return out;
 }
 

@@ -59,6 +59,10 @@ void set_json(nlohmann::json& j, const std::string& prefix, const ExperimentSet&
   j[prefix + "repeatability_10um_nm"] = e.repeat_10um.metrics.repeatability_nm;
   j[prefix + "repeatability_5um_n"] = e.repeat_5um.metrics.n;
   j[prefix + "repeatability_10um_n"] = e.repeat_10um.metrics.n;
+  j[prefix + "phase_step_nm"] = e.phase_step.step_nm;
+  j[prefix + "phase_step_hold_jitter_nm_rms"] = e.phase_step.hold_jitter_nm_rms;
+  j[prefix + "phase_step_settling_time_s"] = time_or_null(e.phase_step.settling_time_s);
+  j[prefix + "phase_step_final_error_nm"] = e.phase_step.final_error_nm;
   j[prefix + "valid"] = e.table4_valid();
   j[prefix + "invalid_reasons"] = e.invalid_reasons();
   const auto validity = [](const experiments::Validity& v) {
@@ -70,7 +74,8 @@ void set_json(nlohmann::json& j, const std::string& prefix, const ExperimentSet&
                             {"linearity_grid", validity(e.linearity_grid.validity)},
                             {"linearity_down", validity(e.linearity_down.validity)},
                             {"repeatability_5um", validity(e.repeat_5um.validity)},
-                            {"repeatability_10um", validity(e.repeat_10um.validity)}};
+                            {"repeatability_10um", validity(e.repeat_10um.validity)},
+                            {"phase_step", validity(e.phase_step.validity)}};
 }
 
 }  // namespace

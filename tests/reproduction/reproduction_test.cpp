@@ -105,7 +105,9 @@ TEST(Reproduction, SummaryHasTheIssuesKeys) {
   const nlohmann::json j = summary_json(quick_run());
   for (const char* key : {"travel_open_loop_um", "travel_semi_closed_um", "step_settling_time_s",
                           "linearity_zero_end_pct", "repeatability_5um_nm", "repeatability_10um_nm",
-                          "identified_A", "fitted_p", "simulated_time_s", "wall_time_s"}) {
+                          "identified_A", "fitted_p", "simulated_time_s", "wall_time_s",
+                          "linearity_without_cubic_zero_end_pct", "phase_step_hold_jitter_nm_rms",
+                          "phase_step_settling_time_s", "oracle_phase_step_hold_jitter_nm_rms"}) {
     EXPECT_TRUE(j.contains(key)) << key;
   }
   EXPECT_EQ(j["identified_A"].size(), 3U);
@@ -120,7 +122,7 @@ TEST(Reproduction, ReportHasTable4FiguresAndData) {
   const auto dir = std::filesystem::temp_directory_path() / "piezoshift_report_test";
   std::filesystem::remove_all(dir);
   const ReportFiles files = write_report(quick_run(), dir, "built-in defaults");
-  ASSERT_EQ(files.figures.size(), 3U);
+  ASSERT_EQ(files.figures.size(), 4U);  // Figures 10 to 12 and the phase step
   for (const auto& f : files.figures)
     EXPECT_GT(std::filesystem::file_size(f), 5000U) << f;
   std::ifstream md(files.markdown);
@@ -129,9 +131,13 @@ TEST(Reproduction, ReportHasTable4FiguresAndData) {
   EXPECT_NE(text.find("| S315.10 (PI)"), std::string::npos);
   EXPECT_NE(text.find("| NPS-Z-15H (Queensgate)"), std::string::npos);
   EXPECT_NE(text.find("![Figure 10"), std::string::npos);
+  EXPECT_NE(text.find("![Phase step](phase_step.png)"), std::string::npos);
+  EXPECT_NE(text.find("| hold jitter, 1 ms exposure means (rms) |"), std::string::npos);
   EXPECT_TRUE(std::filesystem::exists(dir / "report.html"));
   EXPECT_TRUE(std::filesystem::exists(dir / "calibration.toml"));
   EXPECT_TRUE(std::filesystem::exists(dir / "linearity.csv"));
+  EXPECT_TRUE(std::filesystem::exists(dir / "phase_step.csv"));
+  EXPECT_TRUE(std::filesystem::exists(dir / "linearity_without_cubic.csv"));
   std::filesystem::remove_all(dir);
 }
 

@@ -9,6 +9,7 @@
 //   linearity, 0.25 um grid seed + 60   (levels the calibration never saw)
 //   linearity, downwards    seed + 70
 //   linearity without the cubic  seed + 30 (the paper's protocol, p = identity: what p corrects)
+//   phase step (lambda/8)   seed + 80   (beyond the paper: experiments/phase_step.hpp)
 // all with the calibrated controller (the paper's structure: PID, A, p), through the loop `run`
 // and `serve` ship (experiments/bench.hpp), supervisor included. Then the same experiments, same
 // seeds, with the oracle (runtime/oracle_backend.hpp): the same loop fed the plate's true point
@@ -28,6 +29,7 @@
 
 #include "piezoshift/calibration/calibration_procedure.hpp"
 #include "piezoshift/experiments/paper_experiments.hpp"
+#include "piezoshift/experiments/phase_step.hpp"
 #include "piezoshift/io/project_config.hpp"
 
 namespace piezoshift::reproduction {
@@ -47,6 +49,7 @@ struct Schedule {
   experiments::RepeatabilityOptions repeat_10um;
   experiments::LinearityOptions linearity_grid;  //!< the unseen 0.25 um grid
   experiments::LinearityOptions linearity_down;  //!< the paper's levels, downwards
+  experiments::PhaseStepOptions phase_step;      //!< lambda/8 at mid-travel
 
   static Schedule paper();  //!< the full schedule (Section 4)
   static Schedule quick();  //!< shortened steps, same procedure
@@ -64,11 +67,12 @@ struct ExperimentSet {
   experiments::LinearityResult linearity_down;  //!< the paper's levels, downwards
   experiments::RepeatabilityResult repeat_5um;
   experiments::RepeatabilityResult repeat_10um;
+  experiments::PhaseStepResult phase_step;  //!< beyond the paper: lambda/8, 1 ms exposures
 
   double experiments_simulated_time_s() const;
   //! Every Table 4 row (travel, step, linearity by the paper's protocol, repeatability) valid.
   bool table4_valid() const;
-  //! "name: reason" for every experiment that is not valid (the extra sweeps included).
+  //! "name: reason" for every experiment that is not valid (the extra ones included).
   std::vector<std::string> invalid_reasons() const;
 };
 
