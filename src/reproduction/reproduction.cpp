@@ -40,6 +40,8 @@ Schedule Schedule::quick() {
 
 namespace {
 
+constexpr double kFastSampleTime_s = 1e-4;  // 10 kHz, the second loop rate
+
 void with_feedback(Schedule& s, experiments::Feedback f) {
   s.travel.bench.feedback = f;
   s.step.bench.feedback = f;
@@ -112,6 +114,16 @@ ReproductionResult reproduce(const io::ProjectConfig& config, const ReproduceOpt
   without_cubic.polynomial = control::CubicPolynomial::identity();
   r.linearity_without_cubic =
       experiments::run_linearity(config, without_cubic, seed + 30, s.linearity, progress);
+  for (std::size_t i = 0; i < r.inner_loop.size(); ++i) {
+    io::ProjectConfig at = config;
+    control::SemiClosedLoopParams c = r.calibration.controller;
+    if (i == 1)
+      at.twin.daq.sample_time_s = c.sample_time_s = kFastSampleTime_s;
+    InnerLoopAnalysis& a = r.inner_loop[i];
+    a.sample_time_s = c.sample_time_s;
+    a.plant = calibration::identify_loop(at, c, seed + 90 + i);
+    a.margins = calibration::pid_margins(a.plant, c.pid_params());
+  }
   // The oracle: the same loop, gains and A, fed the plate's truth; nothing left for p to correct.
   r.oracle_controller = r.calibration.controller;
   r.oracle_controller.polynomial = control::CubicPolynomial::identity();

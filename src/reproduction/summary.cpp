@@ -1,6 +1,9 @@
 #include "piezoshift/reproduction/summary.hpp"
 
+#include <algorithm>
 #include <cmath>
+
+#include <fmt/core.h>
 
 namespace piezoshift::reproduction {
 namespace {
@@ -92,6 +95,22 @@ nlohmann::json summary_json(const ReproductionResult& r) {
   j["linearity_without_cubic_zero_end_pct"] = raw.metrics.linearity_zero_end_pct;
   j["linearity_without_cubic_best_fit_pct"] = raw.metrics.linearity_best_fit_pct;
   j["linearity_without_cubic_valid"] = raw.validity.valid;
+  // The calibrated PID's stability margins on the identified loop, the worst of the channels.
+  for (const InnerLoopAnalysis& a : r.inner_loop) {
+    const std::string at = fmt::format("pid_margins_{:g}kHz_", 1e-3 / a.sample_time_s);
+    double gm = a.margins[0].gain_margin_dB, pm = a.margins[0].phase_margin_deg;
+    double fc = a.margins[0].gain_crossover_Hz;
+    for (const auto& m : a.margins) {
+      gm = std::min(gm, m.gain_margin_dB);
+      if (m.phase_margin_deg < pm) {
+        pm = m.phase_margin_deg;
+        fc = m.gain_crossover_Hz;
+      }
+    }
+    j[at + "gain_margin_dB"] = std::isfinite(gm) ? nlohmann::json(gm) : nlohmann::json();
+    j[at + "phase_margin_deg"] = std::isfinite(pm) ? nlohmann::json(pm) : nlohmann::json();
+    j[at + "gain_crossover_Hz"] = std::isfinite(fc) ? nlohmann::json(fc) : nlohmann::json();
+  }
   j["identified_A"] = matrix_json(cal.controller.matrix.a);
   j["identified_A_condition_number"] = cal.matrix.fit.condition_number;
   j["identified_A_rms_residual_um"] = cal.matrix.fit.rms_residual_um;

@@ -103,11 +103,13 @@ TEST(Reproduction, IdentifiedMatrixIsThePapersAndCalibrationIsDeterministic) {
 
 TEST(Reproduction, SummaryHasTheIssuesKeys) {
   const nlohmann::json j = summary_json(quick_run());
-  for (const char* key : {"travel_open_loop_um", "travel_semi_closed_um", "step_settling_time_s",
-                          "linearity_zero_end_pct", "repeatability_5um_nm", "repeatability_10um_nm",
-                          "identified_A", "fitted_p", "simulated_time_s", "wall_time_s",
-                          "linearity_without_cubic_zero_end_pct", "phase_step_hold_jitter_nm_rms",
-                          "phase_step_settling_time_s", "oracle_phase_step_hold_jitter_nm_rms"}) {
+  for (const char* key :
+       {"travel_open_loop_um", "travel_semi_closed_um", "step_settling_time_s",
+        "linearity_zero_end_pct", "repeatability_5um_nm", "repeatability_10um_nm", "identified_A",
+        "fitted_p", "simulated_time_s", "wall_time_s", "linearity_without_cubic_zero_end_pct",
+        "phase_step_hold_jitter_nm_rms", "phase_step_settling_time_s",
+        "oracle_phase_step_hold_jitter_nm_rms", "pid_margins_1kHz_gain_margin_dB",
+        "pid_margins_10kHz_phase_margin_deg"}) {
     EXPECT_TRUE(j.contains(key)) << key;
   }
   EXPECT_EQ(j["identified_A"].size(), 3U);
@@ -122,7 +124,7 @@ TEST(Reproduction, ReportHasTable4FiguresAndData) {
   const auto dir = std::filesystem::temp_directory_path() / "piezoshift_report_test";
   std::filesystem::remove_all(dir);
   const ReportFiles files = write_report(quick_run(), dir, "built-in defaults");
-  ASSERT_EQ(files.figures.size(), 4U);  // Figures 10 to 12 and the phase step
+  ASSERT_EQ(files.figures.size(), 5U);  // Figures 10 to 12, the phase step, the Bode plot
   for (const auto& f : files.figures)
     EXPECT_GT(std::filesystem::file_size(f), 5000U) << f;
   std::ifstream md(files.markdown);

@@ -10,6 +10,8 @@
 //   linearity, downwards    seed + 70
 //   linearity without the cubic  seed + 30 (the paper's protocol, p = identity: what p corrects)
 //   phase step (lambda/8)   seed + 80   (beyond the paper: experiments/phase_step.hpp)
+//   inner loop identified   seed + 90 at the DAQ's rate, seed + 91 at 10 kHz, with the margins
+//                           of the calibrated PID on it (calibration/loop_identification.hpp)
 // all with the calibrated controller (the paper's structure: PID, A, p), through the loop `run`
 // and `serve` ship (experiments/bench.hpp), supervisor included. Then the same experiments, same
 // seeds, with the oracle (runtime/oracle_backend.hpp): the same loop fed the plate's true point
@@ -28,6 +30,7 @@
 #include <vector>
 
 #include "piezoshift/calibration/calibration_procedure.hpp"
+#include "piezoshift/calibration/loop_identification.hpp"
 #include "piezoshift/experiments/paper_experiments.hpp"
 #include "piezoshift/experiments/phase_step.hpp"
 #include "piezoshift/io/project_config.hpp"
@@ -76,6 +79,13 @@ struct ExperimentSet {
   std::vector<std::string> invalid_reasons() const;
 };
 
+//! The inner loop's identified plant at one sample time and the calibrated PID's margins on it.
+struct InnerLoopAnalysis {
+  double sample_time_s = 0.0;
+  calibration::LoopIdentification plant;
+  std::array<calibration::StabilityMargins, 3> margins{};
+};
+
 //! The paper's controller's set (the base, so result.travel, result.step, ... are it) and the
 //! oracle's.
 struct ReproductionResult : ExperimentSet {
@@ -88,6 +98,9 @@ struct ReproductionResult : ExperimentSet {
   //! `linearity`: the semi-closed loop's own nonlinearity (SGS conditioner, ball contact), which
   //! the cubic is there to remove. Not a Table 4 row, so it does not count in valid().
   experiments::LinearityResult linearity_without_cubic;
+  //! The calibrated PID's loop at the DAQ's rate (the paper's 1 kHz) and at 10 kHz (the same
+  //! gains re-expressed per sample, the twin's DAQ at 0.1 ms).
+  std::array<InnerLoopAnalysis, 2> inner_loop{};
   double simulated_time_s = 0.0;  //!< twin time over every stage and experiment
   double wall_time_s = 0.0;
 
