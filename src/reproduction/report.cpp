@@ -1,5 +1,6 @@
 #include "piezoshift/reproduction/report.hpp"
 
+#include <algorithm>
 #include <cmath>
 #include <complex>
 #include <fstream>
@@ -179,6 +180,8 @@ io::Figure inner_loop_figure(const ReproductionResult& r) {
   mag.markers.push_back({false, 0.0, "0 dB"});
   ph.markers.push_back({false, -180.0, "-180 deg"});
   for (const InnerLoopAnalysis& a : r.inner_loop) {
+    if (!a.validity.valid)
+      continue;
     const control::PidParams pid = [&] {
       control::SemiClosedLoopParams c = r.calibration.controller;
       c.sample_time_s = a.sample_time_s;
@@ -361,14 +364,16 @@ ReportFiles write_report(const ReproductionResult& r, const fs::path& dir,
                                                         {"10 um", r.repeat_10um.measured_um}};
   io::Figure f12 = experiments::repeatability_figure(sets, 1.0, "Repeatability (twin)");
   io::Figure fps = phase_step_figure(r);
-  io::Figure fil = inner_loop_figure(r);
   for (const auto& [fig, stem] :
        {std::pair{&f10, "fig10_step_response"}, std::pair{&f11, "fig11_linearity"},
-        std::pair{&f12, "fig12_repeatability"}, std::pair{&fps, "phase_step"},
-        std::pair{&fil, "inner_loop_bode"}}) {
+        std::pair{&f12, "fig12_repeatability"}, std::pair{&fps, "phase_step"}}) {
     const io::PlotFiles pf = io::render(*fig, dir / stem);
     files.figures.push_back(*pf.png);
   }
+  const bool any_loop = std::any_of(r.inner_loop.begin(), r.inner_loop.end(),
+                                    [](const InnerLoopAnalysis& a) { return a.validity.valid; });
+  if (any_loop)
+    files.figures.push_back(*io::render(inner_loop_figure(r), dir / "inner_loop_bode").png);
 
   const auto& cal = r.calibration;
   const auto& step = r.step.metrics;
@@ -512,6 +517,11 @@ ReportFiles write_report(const ReproductionResult& r, const fs::path& dir,
                                 : std::string("none (no crossover)");
   };
   for (const InnerLoopAnalysis& a : r.inner_loop) {
+    if (!a.validity.valid) {
+      loop_rows.push_back({fmt::format("{:g} kHz", 1e-3 / a.sample_time_s), "-",
+                           "not available: " + a.validity.reason, "", "", ""});
+      continue;
+    }
     for (std::size_t i = 0; i < 3; ++i) {
       const auto& m = a.margins[i];
       const auto& model = a.plant.channel[i];
@@ -528,7 +538,8 @@ ReportFiles write_report(const ReproductionResult& r, const fs::path& dir,
     "through the loop that ships, so its delays are the real ones; the 10 kHz row runs the twin's "
     "DAQ at 0.1 ms with the same gains re-expressed per sample. The margins are those of the "
     "calibrated PID on that model (calibration/stability_margins.hpp).");
-  image("Inner loop Bode plot", "inner_loop_bode.png");
+  if (any_loop)
+    image("Inner loop Bode plot", "inner_loop_bode.png");
 
   h(2, "Calibration");
   h(3, "Stage 1: PID gains");

@@ -1,6 +1,7 @@
 #include "piezoshift/reproduction/reproduction.hpp"
 
 #include <chrono>
+#include <stdexcept>
 
 namespace piezoshift::reproduction {
 
@@ -114,15 +115,23 @@ ReproductionResult reproduce(const io::ProjectConfig& config, const ReproduceOpt
   without_cubic.polynomial = control::CubicPolynomial::identity();
   r.linearity_without_cubic =
       experiments::run_linearity(config, without_cubic, seed + 30, s.linearity, progress);
-  for (std::size_t i = 0; i < r.inner_loop.size(); ++i) {
+  std::vector<double> rates{config.twin.daq.sample_time_s};
+  if (config.twin.daq.sample_time_s != kFastSampleTime_s)
+    rates.push_back(kFastSampleTime_s);
+  for (std::size_t i = 0; i < rates.size(); ++i) {
     io::ProjectConfig at = config;
     control::SemiClosedLoopParams c = r.calibration.controller;
-    if (i == 1)
-      at.twin.daq.sample_time_s = c.sample_time_s = kFastSampleTime_s;
-    InnerLoopAnalysis& a = r.inner_loop[i];
+    at.twin.daq.sample_time_s = c.sample_time_s = rates[i];
+    InnerLoopAnalysis& a = r.inner_loop.emplace_back();
     a.sample_time_s = c.sample_time_s;
-    a.plant = calibration::identify_loop(at, c, seed + 90 + i);
-    a.margins = calibration::pid_margins(a.plant, c.pid_params());
+    try {
+      a.plant = calibration::identify_loop(at, c, seed + 90 + i);
+      a.margins = calibration::pid_margins(a.plant, c.pid_params());
+    } catch (const std::invalid_argument& e) {  // e.g. a physics rate 10 kHz does not divide
+      a.validity.fail(e.what());
+    } catch (const experiments::ProcedureFailed& e) {
+      a.validity.fail(e.what());
+    }
   }
   // The oracle: the same loop, gains and A, fed the plate's truth; nothing left for p to correct.
   r.oracle_controller = r.calibration.controller;

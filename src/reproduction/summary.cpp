@@ -98,6 +98,11 @@ nlohmann::json summary_json(const ReproductionResult& r) {
   // The calibrated PID's stability margins on the identified loop, the worst of the channels.
   for (const InnerLoopAnalysis& a : r.inner_loop) {
     const std::string at = fmt::format("pid_margins_{:g}kHz_", 1e-3 / a.sample_time_s);
+    j[at + "valid"] = a.validity.valid;
+    if (!a.validity.valid) {
+      j[at + "reason"] = a.validity.reason;
+      continue;
+    }
     double gm = a.margins[0].gain_margin_dB, pm = a.margins[0].phase_margin_deg;
     double fc = a.margins[0].gain_crossover_Hz;
     for (const auto& m : a.margins) {

@@ -84,6 +84,9 @@ struct InnerLoopAnalysis {
   double sample_time_s = 0.0;
   calibration::LoopIdentification plant;
   std::array<calibration::StabilityMargins, 3> margins{};
+  //! Not valid when the twin cannot run at this rate (its physics rate is not a whole multiple)
+  //! or the identification tripped the supervisor; plant and margins are then empty.
+  experiments::Validity validity;
 };
 
 //! The paper's controller's set (the base, so result.travel, result.step, ... are it) and the
@@ -99,8 +102,8 @@ struct ReproductionResult : ExperimentSet {
   //! the cubic is there to remove. Not a Table 4 row, so it does not count in valid().
   experiments::LinearityResult linearity_without_cubic;
   //! The calibrated PID's loop at the DAQ's rate (the paper's 1 kHz) and at 10 kHz (the same
-  //! gains re-expressed per sample, the twin's DAQ at 0.1 ms).
-  std::array<InnerLoopAnalysis, 2> inner_loop{};
+  //! gains re-expressed per sample, the twin's DAQ at 0.1 ms) unless that is the DAQ's rate.
+  std::vector<InnerLoopAnalysis> inner_loop;
   double simulated_time_s = 0.0;  //!< twin time over every stage and experiment
   double wall_time_s = 0.0;
 
