@@ -1,11 +1,15 @@
 // `piezoshift analyze linearity|repeatability|step --data FILE.csv [--json] [--plot FIG.png]`:
 // the performance metrics of the paper's Section 4 computed from recorded data (bench or twin).
-//   linearity      columns desired_um,measured_um (one row per point of the sweep)
+//   linearity      columns zd_um,measured_um (one row per point of the sweep)
 //   repeatability  column measured_um (one row per repeated move)
-//   step           columns time_s,measured_um (one row per sample)
-// Column order is free and other columns are ignored. Bad data exits with status 2 and a message
+//   step           columns t_s,measured_um (one row per sample; in a file with a state column,
+//                  a `run` log, the rows before the first with state != 0: the controlled part)
+// The column vocabulary is docs/files.md's; --column NAME reads the measured values from another
+// column (interferometer1_um of a `run` or `simulate` log). Column order is free and other
+// columns are ignored. Bad data exits with status 2 and a message
 // naming the file and, where one applies, the line and column. --plot draws the matching figure
 // with gnuplot (PNG, or SVG for a .svg name) and keeps its .gp script and .dat data beside it.
+#include <algorithm>
 #include <cmath>
 #include <memory>
 #include <string>
@@ -31,6 +35,7 @@ struct AnalyzeOptions {
   std::string data_path;
   bool json = false;
   std::string plot_path;  // empty: no figure
+  std::string column = "measured_um";
   experiments::StepResponseOptions step;
   std::int64_t median_window = 5;
 };
@@ -72,9 +77,9 @@ Json number_or_null(double v) {
 
 int run_linearity(const AnalyzeOptions& o) {
   const io::CsvTable t = io::CsvTable::load(o.data_path);
-  t.require_columns({"desired_um", "measured_um"});
-  const std::vector<double> x = t.column("desired_um");
-  const std::vector<double> y = t.column("measured_um");
+  t.require_columns({"zd_um", o.column});
+  const std::vector<double> x = t.column("zd_um");
+  const std::vector<double> y = t.column(o.column);
   const experiments::LinearityMetrics m =
       with_file(o.data_path, [&] { return experiments::linearity_metrics(x, y); });
   if (o.json) {
@@ -104,8 +109,8 @@ int run_linearity(const AnalyzeOptions& o) {
 
 int run_repeatability(const AnalyzeOptions& o) {
   const io::CsvTable t = io::CsvTable::load(o.data_path);
-  t.require_columns({"measured_um"});
-  const std::vector<double> z = t.column("measured_um");
+  t.require_columns({o.column});
+  const std::vector<double> z = t.column(o.column);
   const experiments::RepeatabilityMetrics r =
       with_file(o.data_path, [&] { return experiments::repeatability_metrics(z); });
   if (o.json) {
@@ -129,9 +134,19 @@ int run_step(const AnalyzeOptions& o_in) {
         fmt::format("--median-window {}: must be an odd number >= 1", o.median_window));
   o.step.median_window = static_cast<std::size_t>(o.median_window);
   const io::CsvTable t = io::CsvTable::load(o.data_path);
-  t.require_columns({"time_s", "measured_um"});
-  const std::vector<double> ts = t.column("time_s");
-  const std::vector<double> y = t.column("measured_um");
+  t.require_columns({"t_s", o.column});
+  std::vector<double> ts = t.column("t_s");
+  std::vector<double> y = t.column(o.column);
+  // A `run` log goes on through the ramp to 0 V after its controlled part (state 1, stopping)
+  // or a fault: the step is the part where the supervisor was running (state 0).
+  if (t.has_column("state")) {
+    const std::vector<double> state = t.column("state");
+    const auto end = static_cast<std::size_t>(
+        std::find_if(state.begin(), state.end(), [](double v) { return v != 0.0; }) -
+        state.begin());
+    ts.resize(end);
+    y.resize(end);
+  }
   const experiments::StepResponseMetrics m =
       with_file(o.data_path, [&] { return experiments::step_response_metrics(ts, y, o.step); });
   if (o.json) {
@@ -175,16 +190,20 @@ void add_analyze_command(CLI::App& app, Action& action) {
   auto o = std::make_shared<AnalyzeOptions>();
 
   CLI::App* lin = analyze->add_subcommand(
-      "linearity", "Zero-end and best-fit linearity (columns desired_um, measured_um)");
+      "linearity", "Zero-end and best-fit linearity (columns zd_um, measured_um)");
   CLI::App* rep =
       analyze->add_subcommand("repeatability", "Eq. 9 repeatability (column measured_um)");
   CLI::App* step = analyze->add_subcommand(
-      "step", "Rise time, overshoot, settling times (columns time_s, measured_um)");
+      "step", "Rise time, overshoot, settling times (columns t_s, measured_um)");
   for (CLI::App* sub : {lin, rep, step}) {
     sub->add_option("--data", o->data_path, "CSV file with a header row")->required();
     sub->add_flag("--json", o->json, "Machine-readable output");
     sub->add_option("--plot", o->plot_path,
                     "Draw the figure with gnuplot to this .png (or .svg) file");
+    sub->add_option("--column", o->column,
+                    "Column of the measured values (e.g. interferometer1_um of a run or simulate "
+                    "log; docs/files.md)")
+        ->capture_default_str();
   }
   step->add_option("--step-time-s", o->step.step_time_s, "When the step was commanded [s]")
       ->capture_default_str();

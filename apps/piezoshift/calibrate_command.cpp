@@ -1,6 +1,10 @@
-// `piezoshift calibrate`: the paper's three calibration stages on the twin, written as a
-// calibration file that `piezoshift run --calibration` loads.
+// `piezoshift calibrate`: the paper's three calibration stages on the twin, or guided on a bench
+// (--daq, --interferometer: calibration/guided_calibration.hpp), written as a calibration file
+// that `piezoshift run --calibration` loads.
 #include <algorithm>
+#include <cstdio>
+#include <filesystem>
+#include <iostream>
 #include <memory>
 #include <string>
 
@@ -10,7 +14,9 @@
 #include "command.hpp"
 #include "piezoshift/calibration/calibration_file.hpp"
 #include "piezoshift/calibration/calibration_procedure.hpp"
+#include "piezoshift/calibration/guided_calibration.hpp"
 #include "piezoshift/experiments/paper_experiments.hpp"
+#include "piezoshift/io/input_error.hpp"
 #include "piezoshift/io/project_config.hpp"
 #include "progress_bar.hpp"
 
@@ -23,6 +29,10 @@ struct Options {
   std::string config;
   std::string pid = "paper";
   bool json = false;
+  std::string daq;             //!< guided: sim or comedi[:DEVICE]
+  std::string interferometer;  //!< guided: prompt, file:PATH or sim
+  bool restart = false;
+  double max_zero_drift_um = calibration::GuidedOptions{}.max_zero_drift_um;
 };
 
 nlohmann::json matrix_json(const control::Mat3& a) {
@@ -32,7 +42,141 @@ nlohmann::json matrix_json(const control::Mat3& a) {
   return rows;
 }
 
+std::string session_path(const std::string& out) {
+  return std::filesystem::path(out).replace_extension(".session.json").string();
+}
+
+void print_fits(const control::SemiClosedLoopParams& controller,
+                const calibration::MatrixIdentificationResult& matrix,
+                const calibration::PolynomialIdentificationResult& polynomial) {
+  fmt::print("stage 2  matrix A   rms residual {:.4f} um, cond(A) {:.3f}\n",
+             matrix.fit.rms_residual_um, matrix.fit.condition_number);
+  for (const auto& row : controller.matrix.a) {
+    fmt::print("           [{:8.4f} {:8.4f} {:8.4f}]\n", row[0], row[1], row[2]);
+  }
+  const auto& p = controller.polynomial;
+  fmt::print("stage 3  cubic p    p3 {:.4e}, p2 {:.4e}, p1 {:.5f}, p0 {:.4f} um (rms {:.4f} um)\n",
+             p.p3, p.p2, p.p1, p.p0, polynomial.fit.rms_residual_um);
+}
+
+// The guided calibration: the poses through the one control tick, the readings from the
+// operator, a log file or the twin's interferometer, the session recorded beside --out.
+int run_guided(const Options& o) {
+  if (o.pid != "paper")
+    throw io::InputError(
+        "--pid search: the guided calibration keeps the paper's gains (the search scores the "
+        "plate's motion between the ticks, which a bench does not see)");
+  const bool sim = o.daq == "sim";
+  if (!sim && o.daq.rfind("comedi", 0) == 0)
+    throw io::InputError(fmt::format(
+        "--daq {}: the guided calibration on hardware is not built yet (only --daq sim); see "
+        "docs/calibration.md",
+        o.daq));
+  if (!sim)
+    throw io::InputError(fmt::format("--daq {}: expected sim or comedi:/dev/comediN", o.daq));
+  const std::string& ifm = o.interferometer;
+  if (ifm.empty())
+    throw io::InputError("--daq needs --interferometer prompt, file:PATH or sim");
+  if (ifm != "prompt" && ifm != "sim" && !(ifm.rfind("file:", 0) == 0 && ifm.size() > 5))
+    throw io::InputError(
+        fmt::format("--interferometer {}: expected prompt, file:PATH or sim", ifm));
+  if (!(o.max_zero_drift_um > 0.0))
+    throw io::InputError(
+        fmt::format("--max-zero-drift-um {}: must be a positive length", o.max_zero_drift_um));
+
+  const io::ProjectConfig config =
+      o.config.empty() ? io::ProjectConfig{} : io::load_project_config(o.config);
+  calibration::GuidedOptions go;
+  go.max_zero_drift_um = o.max_zero_drift_um;
+  const std::vector<calibration::GuidedStep> plan = calibration::guided_plan(go);
+  const std::string session_file = session_path(o.out);
+  const std::string plan_text = fmt::format(
+      "daq {}, seed {}, configuration {}, stage 2: {} repeats, base {:g} um, move {:g} um; stage "
+      "3: {} commands to {:g} um",
+      o.daq, o.seed, o.config.empty() ? "built-in defaults" : o.config, go.matrix.repeats,
+      go.matrix.base_um, go.matrix.move_um, go.polynomial.points, go.polynomial.max_um);
+  calibration::GuidedSession session{plan_text, plan.size(), {}};
+  if (!o.restart) {
+    if (auto loaded = calibration::load_guided_session(session_file)) {
+      if (loaded->plan != plan_text || loaded->steps != plan.size())
+        throw io::InputError(fmt::format(
+            "{}: this session was recorded for \"{}\", not \"{}\": give --restart to discard it",
+            session_file, loaded->plan, plan_text));
+      session = std::move(*loaded);
+      fmt::print(stderr, "resuming {}: {} of {} steps recorded\n", session_file,
+                 session.readings.size(), plan.size());
+    }
+  }
+
+  // The controller the twin calibration starts from: the DAQ's rate, the paper's gains.
+  control::SemiClosedLoopParams base;
+  base.sample_time_s = config.twin.daq.sample_time_s;
+  base.gains_sample_time_s = base.sample_time_s;
+  // Stage 2 on seed + 1, stage 3 on seed + 2, as `calibrate` on the twin.
+  experiments::Bench bench2(config, base, o.seed + 1);
+  experiments::Bench bench3(config, base, o.seed + 2);
+  const double window_s = config.twin.interferometer.static_average_s;
+  calibration::BenchRig rig2(bench2, window_s);
+  calibration::BenchRig rig3(bench3, window_s, &rig2);
+
+  const auto say = [](const std::string& text) {
+    fmt::print(stderr, "{}", text);
+    std::fflush(stderr);
+  };
+  std::unique_ptr<calibration::InterferometerSource> source;
+  if (ifm == "prompt") {
+    source = std::make_unique<calibration::PromptSource>(std::cin, say);
+  } else if (ifm == "sim") {
+    source = std::make_unique<calibration::TwinSource>();
+  } else {
+    source = std::make_unique<calibration::LogFileSource>(ifm.substr(5));
+  }
+  calibration::GuidedIo gio{*source, say, [&session_file](const calibration::GuidedSession& s) {
+                              calibration::save_guided_session(session_file, s);
+                            }};
+  // Written before the stage moves: a folder that cannot take the session is found now.
+  calibration::save_guided_session(session_file, session);
+  const calibration::GuidedOutcome r =
+      calibration::run_guided_calibration(rig2, rig3, base, session, gio, go);
+  if (!r.complete)
+    throw io::InputError(fmt::format(
+        "{} ended: {} of {} steps are recorded in {}; run the same command again to resume",
+        source->name(), session.readings.size(), plan.size(), session_file));
+
+  calibration::write_calibration_file(
+      o.out, r.controller,
+      fmt::format("piezoshift calibration, identified by the guided `piezoshift calibrate` on {} "
+                  "with the interferometer from {}\nseed {}, configuration: {}, session: {}",
+                  o.daq, ifm, o.seed, o.config.empty() ? "built-in defaults" : o.config,
+                  session_file));
+  const auto& p = r.controller.polynomial;
+  if (o.json) {
+    nlohmann::json j;
+    j["calibration_file"] = o.out;
+    j["session_file"] = session_file;
+    j["readings_taken"] = r.taken;
+    j["steps"] = plan.size();
+    const auto& g = r.controller.gains;
+    j["pid_gains"] = {{"kp", g.kp}, {"ki", g.ki}, {"kd", g.kd}};
+    j["A"] = matrix_json(r.controller.matrix.a);
+    j["p"] = {p.p3, p.p2, p.p1, p.p0};
+    j["A_rms_residual_um"] = r.matrix.fit.rms_residual_um;
+    j["condition_number"] = r.matrix.fit.condition_number;
+    j["p_rms_residual_um"] = r.polynomial.fit.rms_residual_um;
+    j["p_skipped_commands"] = r.polynomial.saturated_points;
+    fmt::print("{}\n", j.dump(2));
+    return 0;
+  }
+  print_fits(r.controller, r.matrix, r.polynomial);
+  fmt::print("written: {} (session: {})\n", o.out, session_file);
+  return 0;
+}
+
 int run(const Options& o) {
+  if (!o.daq.empty())
+    return run_guided(o);
+  if (!o.interferometer.empty())
+    throw io::InputError("--interferometer needs --daq (the guided calibration)");
   const io::ProjectConfig config =
       o.config.empty() ? io::ProjectConfig{} : io::load_project_config(o.config);
   calibration::CalibrationOptions co;
@@ -75,13 +219,7 @@ int run(const Options& o) {
              std::count_if(c.pid.trials.begin(), c.pid.trials.end(),
                            [](const auto& t) { return t.acceptable; }),
              c.pid.trials.size());
-  fmt::print("stage 2  matrix A   rms residual {:.4f} um, cond(A) {:.3f}\n",
-             c.matrix.fit.rms_residual_um, c.matrix.fit.condition_number);
-  for (const auto& row : c.controller.matrix.a) {
-    fmt::print("           [{:8.4f} {:8.4f} {:8.4f}]\n", row[0], row[1], row[2]);
-  }
-  fmt::print("stage 3  cubic p    p3 {:.4e}, p2 {:.4e}, p1 {:.5f}, p0 {:.4f} um (rms {:.4f} um)\n",
-             p.p3, p.p2, p.p1, p.p0, c.polynomial.fit.rms_residual_um);
+  print_fits(c.controller, c.matrix, c.polynomial);
   fmt::print(
       "travel   semi-closed loop {:.2f} um (Section 4.1); one move reaches {:.2f} to "
       "{:.2f} um (written as z_min_um, z_max_um)\n",
@@ -104,6 +242,16 @@ void add_calibrate_command(CLI::App& app, Action& action) {
          "paper: keep 0.6/0.2/0.001 (default); search: grid-search the gains on the full loop")
       ->check(CLI::IsMember({"paper", "search"}));
   cmd->add_flag("--json", o->json, "print a JSON summary");
+  cmd->add_option(
+      "--daq", o->daq,
+      "guided calibration on a bench: sim (the twin; comedi:/dev/comediN is not built yet)");
+  cmd->add_option("--interferometer", o->interferometer,
+                  "guided: prompt (readings typed on stdin), file:PATH (the interferometer "
+                  "software's CSV log, t_s,displacement_um) or sim (the twin's, --daq sim)");
+  cmd->add_flag("--restart", o->restart,
+                "guided: discard the session recorded beside --out instead of resuming it");
+  cmd->add_option("--max-zero-drift-um", o->max_zero_drift_um,
+                  "guided: largest change between repeated base readings at one point [um]");
   cmd->callback([o, &action] { action = [o] { return run(*o); }; });
 }
 

@@ -5,7 +5,10 @@
 // Column order is free and other columns are ignored. Bad data (missing column, text or NaN in a
 // cell, too few rows, a rank-deficient design, a missing file) exits with status 2 and a message
 // naming the file and, where one applies, the line and column. Text for people, --json for
-// programs.
+// programs. --out FILE writes the fitted A or p into a calibration file that `run` and `serve`
+// load: an existing one keeps its other values (so `fit matrix` then `fit poly` into the same
+// file gives both), a new one takes the paper's for them (docs/calibration.md).
+#include <filesystem>
 #include <memory>
 #include <string>
 #include <vector>
@@ -14,6 +17,7 @@
 #include <nlohmann/json.hpp>
 
 #include "command.hpp"
+#include "piezoshift/calibration/calibration_file.hpp"
 #include "piezoshift/calibration/matrix_fit.hpp"
 #include "piezoshift/calibration/poly_fit.hpp"
 #include "piezoshift/io/csv_table.hpp"
@@ -26,7 +30,27 @@ using Json = nlohmann::ordered_json;
 struct FitOptions {
   std::string data_path;
   bool json = false;
+  std::string out;  //!< calibration file to write, empty: none
 };
+
+// Replaces A or p (set) in the calibration file o.out, keeping everything else it holds.
+template <class Set>
+void write_into_calibration(const FitOptions& o, const char* what, Set&& set) {
+  control::SemiClosedLoopParams params;
+  std::optional<double> z_max, z_min;
+  std::error_code ec;
+  const bool existing = std::filesystem::exists(o.out, ec);
+  if (existing)
+    params = calibration::load_calibration_file(o.out, &z_max, &z_min);
+  set(params);
+  calibration::write_calibration_file(
+      o.out, params,
+      fmt::format("piezoshift calibration: {} fitted by `piezoshift fit` from {}\n{}", what,
+                  o.data_path,
+                  existing ? "the other values kept from the file this replaced"
+                           : "the other values the paper's (Section 4)"),
+      z_max, z_min);
+}
 
 // Runs a fit; a FitError (which does not know the file) gets the file name in front.
 template <class F>
@@ -55,17 +79,21 @@ int run_matrix(const FitOptions& o) {
   const calibration::MatrixFitResult r =
       with_file(o.data_path, [&] { return calibration::fit_transmission_matrix(s, z); });
   const auto& a = r.a.a;
+  if (!o.out.empty())
+    write_into_calibration(o, "A", [&](control::SemiClosedLoopParams& p) { p.matrix = r.a; });
   if (o.json) {
     Json rows = Json::array();
     for (const auto& row : a)
       rows.push_back(Json{row[0], row[1], row[2]});
-    const Json out{{"data", o.data_path},
-                   {"poses", r.poses},
-                   {"A", rows},
-                   {"rms_residual_um", r.rms_residual_um},
-                   {"rms_residual_per_s_um", r.rms_residual_per_s_um},
-                   {"condition_number", r.condition_number},
-                   {"design_condition_number", r.design_condition_number}};
+    Json out{{"data", o.data_path},
+             {"poses", r.poses},
+             {"A", rows},
+             {"rms_residual_um", r.rms_residual_um},
+             {"rms_residual_per_s_um", r.rms_residual_per_s_um},
+             {"condition_number", r.condition_number},
+             {"design_condition_number", r.design_condition_number}};
+    if (!o.out.empty())
+      out["calibration_file"] = o.out;
     fmt::print("{}\n", out.dump(2));
     return 0;
   }
@@ -79,6 +107,8 @@ int run_matrix(const FitOptions& o) {
   fmt::print("condition number of Z     {:.4g}\n", r.design_condition_number);
   if (r.poses == calibration::kMatrixFitMinPoses)
     fmt::print("note: 3 poses determine A exactly; the residual is 0 by construction\n");
+  if (!o.out.empty())
+    fmt::print("written: {} (A)\n", o.out);
   return 0;
 }
 
@@ -89,14 +119,18 @@ int run_poly(const FitOptions& o) {
   const std::vector<double> m = t.column("measured_um");
   const calibration::PolyFitResult r =
       with_file(o.data_path, [&] { return calibration::fit_cubic_polynomial(m, c); });
+  if (!o.out.empty())
+    write_into_calibration(o, "p", [&](control::SemiClosedLoopParams& p) { p.polynomial = r.p; });
   if (o.json) {
-    const Json out{{"data", o.data_path},
-                   {"points", r.points},
-                   {"p", {r.p.p3, r.p.p2, r.p.p1, r.p.p0}},
-                   {"rms_residual_um", r.rms_residual_um},
-                   {"max_abs_residual_um", r.max_abs_residual_um},
-                   {"condition_number", r.condition_number},
-                   {"condition_number_unscaled", r.condition_number_unscaled}};
+    Json out{{"data", o.data_path},
+             {"points", r.points},
+             {"p", {r.p.p3, r.p.p2, r.p.p1, r.p.p0}},
+             {"rms_residual_um", r.rms_residual_um},
+             {"max_abs_residual_um", r.max_abs_residual_um},
+             {"condition_number", r.condition_number},
+             {"condition_number_unscaled", r.condition_number_unscaled}};
+    if (!o.out.empty())
+      out["calibration_file"] = o.out;
     fmt::print("{}\n", out.dump(2));
     return 0;
   }
@@ -108,6 +142,8 @@ int run_poly(const FitOptions& o) {
              r.max_abs_residual_um);
   fmt::print("condition number          {:.4g} (centred and scaled design; raw {:.4g})\n",
              r.condition_number, r.condition_number_unscaled);
+  if (!o.out.empty())
+    fmt::print("written: {} (p)\n", o.out);
   return 0;
 }
 
@@ -126,6 +162,9 @@ void add_fit_command(CLI::App& app, Action& action) {
   for (CLI::App* sub : {matrix, poly}) {
     sub->add_option("--data", options->data_path, "CSV file with a header row")->required();
     sub->add_flag("--json", options->json, "Machine-readable output");
+    sub->add_option("--out", options->out,
+                    "calibration file to write the fit into (TOML; an existing one keeps its "
+                    "other values)");
   }
   matrix->callback([&action, options] { action = [options] { return run_matrix(*options); }; });
   poly->callback([&action, options] { action = [options] { return run_poly(*options); }; });

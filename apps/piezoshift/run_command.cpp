@@ -4,10 +4,19 @@
 // Exit status: 0 the run completed (duration, SIGINT or SIGTERM) without a fault; 3 the safety
 // supervisor latched a fault (the outputs were ramped to 0 V); 2 bad input, including a DAQ
 // device that cannot be opened; 1 internal error.
+#include <unistd.h>
+
+#include <algorithm>
+#include <atomic>
+#include <cmath>
+#include <condition_variable>
 #include <cstdint>
+#include <cstdio>
 #include <memory>
+#include <mutex>
 #include <optional>
 #include <string>
+#include <thread>
 #include <vector>
 
 #include <fmt/core.h>
@@ -17,6 +26,7 @@
 #include "loop_setup.hpp"
 #include "piezoshift/calibration/calibration_file.hpp"
 #include "piezoshift/io/input_error.hpp"
+#include "piezoshift/io/project_config.hpp"
 #include "piezoshift/runtime/control_loop.hpp"
 #include "piezoshift/runtime/csv_logger.hpp"
 #include "piezoshift/runtime/fault_injection.hpp"
@@ -35,6 +45,7 @@ struct RunOptions {
   std::string daq = "sim";
   double rate_Hz = 1000.0;
   std::string calibration;
+  std::string config;
   std::optional<double> step_um;
   std::string profile;
   double duration_s = 0.0;
@@ -51,6 +62,61 @@ double us(std::int64_t ns) {
   return static_cast<double>(ns) * 1e-3;
 }
 
+// One status line on stderr, rewritten a few times a second from a thread of its own (never the
+// loop's): time, Z_d, the SGS position, the worst tracking error S - SGS, the supervisor.
+class LiveStatus {
+ public:
+  explicit LiveStatus(const LoopStatus& status) : status_(status), thread_([this] { loop(); }) {}
+  ~LiveStatus() {
+    {
+      std::lock_guard<std::mutex> lock(mutex_);
+      done_ = true;
+    }
+    wake_.notify_one();
+    thread_.join();
+    fmt::print(stderr, "\r\033[K");
+    std::fflush(stderr);
+  }
+  LiveStatus(const LiveStatus&) = delete;
+  LiveStatus& operator=(const LiveStatus&) = delete;
+
+ private:
+  void loop() {
+    std::unique_lock<std::mutex> lock(mutex_);
+    while (!wake_.wait_for(lock, std::chrono::milliseconds(250), [this] { return done_; })) {
+      if (status_.ticks.load(std::memory_order_relaxed) == 0)
+        continue;
+      const Vec3 zd = LoopStatus::load_vec(status_.zd_um);
+      const Vec3 s = LoopStatus::load_vec(status_.target_um);
+      const Vec3 fb = LoopStatus::load_vec(status_.feedback_um);
+      double worst = 0.0;
+      for (std::size_t i = 0; i < 3; ++i)
+        worst = std::max(worst, std::fabs(s[i] - fb[i]));
+      const auto reason = static_cast<FaultReason>(status_.fault_reason.load());
+      fmt::print(stderr,
+                 "\r\033[Kt {:8.2f} s  Z_d {:.3f} {:.3f} {:.3f} um  SGS {:.3f} {:.3f} {:.3f} um  "
+                 "error max {:.1f} nm  {}{}",
+                 status_.t_s.load(), zd[0], zd[1], zd[2], fb[0], fb[1], fb[2], worst * 1e3,
+                 to_string(static_cast<SupervisorState>(status_.state.load())),
+                 reason != FaultReason::kNone ? fmt::format(" FAULT {}", to_string(reason)) : "");
+      std::fflush(stderr);
+    }
+  }
+
+  const LoopStatus& status_;
+  std::mutex mutex_;
+  std::condition_variable wake_;
+  bool done_ = false;
+  std::thread thread_;
+};
+
+nlohmann::json vec_json(const Vec3& v) {
+  nlohmann::json a = nlohmann::json::array();
+  for (double x : v)
+    a.push_back(std::isfinite(x) ? nlohmann::json(x) : nlohmann::json(nullptr));
+  return a;
+}
+
 int run(const RunOptions& o) {
   check_loop_rate(o.rate_Hz);
   if (!(o.duration_s > 0.0) || o.duration_s > 1e6)
@@ -62,8 +128,9 @@ int run(const RunOptions& o) {
   for (const std::string& f : o.faults)
     faults.push_back(parse_fault_spec(f));
 
-  const LoopCalibration cal =
-      resolve_calibration(o.calibration, o.daq, io::ProjectConfig{}, o.seed);
+  const io::ProjectConfig project =
+      o.config.empty() ? io::ProjectConfig{} : io::load_project_config(o.config);
+  const LoopCalibration cal = resolve_calibration(o.calibration, o.daq, project, o.seed);
   const control::SemiClosedLoopParams& params = cal.params;
   if (o.step_um && cal.travel_z_max_um && *o.step_um > *cal.travel_z_max_um)
     throw io::InputError(
@@ -77,7 +144,7 @@ int run(const RunOptions& o) {
     throw io::InputError("--fault needs --daq sim (faults are injected into the twin)");
   if (comedi && o.free_run)
     throw io::InputError("--free-run needs --daq sim (hardware runs in real time)");
-  ChosenBackend chosen = make_backend(o.daq, io::ProjectConfig{}, o.seed, o.rate_Hz);
+  ChosenBackend chosen = make_backend(o.daq, project, o.seed, o.rate_Hz);
   std::unique_ptr<DaqBackend> hardware = std::move(chosen.backend);
   SimBackend* sim = chosen.sim;
   hardware->configure();  // comedi: names the device it cannot open (exit 2)
@@ -109,6 +176,10 @@ int run(const RunOptions& o) {
   config.rate_Hz = o.rate_Hz;
   config.duration_s = o.duration_s;
   config.stop_signal = &g_stop_signal;
+  LoopStatus live;
+  const bool show_live = ::isatty(STDERR_FILENO) == 1 && !o.free_run;
+  if (show_live)
+    config.status = &live;
   const SafetyLimits limits = loop_safety_limits(o.max_overruns);
   ControlLoop loop(config, params, limits, *daq, *clock, std::move(profile),
                    logger ? &logger->ring() : nullptr);
@@ -116,12 +187,16 @@ int run(const RunOptions& o) {
   StopSignals signals;
   if (logger)
     logger->start();  // before the real-time request: the logging thread stays a normal thread
+  std::optional<LiveStatus> status_line;  // likewise: it must not inherit the loop's priority
+  if (show_live)
+    status_line.emplace(live);
   RealtimeReport rt;
   if (clock->real_time())
     rt = request_realtime_or_warn(o.cpu);
 
   daq->activate();
   const LoopResult r = loop.run();
+  status_line.reset();  // clears its line before the summary
   daq->deactivate();
   if (logger)
     logger->stop();
@@ -187,6 +262,26 @@ int run(const RunOptions& o) {
   j["max_output_V"] = r.max_output_V;
   j["min_output_V"] = r.min_output_V;
   j["max_output_slew_V_per_ms"] = r.max_output_slew_V_per_ms;
+  // Where the controlled part ended (before the ramp to 0 V): the position the SGS report, the
+  // tracking error S - SGS the PIDs saw, and on the twin its interferometer.
+  Vec3 tracking{};
+  double worst_tracking_um = 0.0;
+  for (std::size_t i = 0; i < 3; ++i) {
+    tracking[i] = r.end_target_um[i] - r.end_feedback_um[i];
+    worst_tracking_um = std::max(worst_tracking_um, std::fabs(tracking[i]));
+  }
+  const bool has_end = r.controlled_end_tick > 0;
+  const auto or_null = [has_end](const Vec3& v) {
+    return has_end ? vec_json(v) : nlohmann::json(nullptr);
+  };
+  j["final_time_s"] = has_end ? nlohmann::json(static_cast<double>(r.controlled_end_tick) *
+                                               static_cast<double>(period_ns) * 1e-9)
+                              : nlohmann::json(nullptr);
+  j["final_setpoint_um"] = or_null(r.end_zd_um);
+  j["final_target_um"] = or_null(r.end_target_um);
+  j["final_sgs_um"] = or_null(r.end_feedback_um);
+  j["final_tracking_error_um"] = or_null(tracking);
+  j["final_interferometer_um"] = or_null(r.end_interferometer_um);
   j["log"] = {{"path", o.log.empty() ? nlohmann::json(nullptr) : nlohmann::json(o.log)},
               {"records_written", logger ? logger->records_written() : 0},
               {"records_dropped", r.telemetry_dropped},
@@ -207,6 +302,18 @@ int run(const RunOptions& o) {
     fmt::print("overruns       {} (longest run {})\n", st.overruns, st.max_consecutive_overruns);
     fmt::print("outputs        max {:.3f} V, max slew {:.3f} V/ms\n", r.max_output_V,
                r.max_output_slew_V_per_ms);
+    if (has_end) {
+      fmt::print(
+          "final position Z_d {:.4f} {:.4f} {:.4f} um, SGS {:.4f} {:.4f} {:.4f} um{}\n",
+          r.end_zd_um[0], r.end_zd_um[1], r.end_zd_um[2], r.end_feedback_um[0],
+          r.end_feedback_um[1], r.end_feedback_um[2],
+          std::isfinite(r.end_interferometer_um[0])
+              ? fmt::format(", interferometer {:.4f} {:.4f} {:.4f} um", r.end_interferometer_um[0],
+                            r.end_interferometer_um[1], r.end_interferometer_um[2])
+              : std::string());
+      fmt::print("tracking error S - SGS {:+.1f} {:+.1f} {:+.1f} nm (worst {:.1f} nm)\n",
+                 tracking[0] * 1e3, tracking[1] * 1e3, tracking[2] * 1e3, worst_tracking_um * 1e3);
+    }
     if (r.fault_detected) {
       fmt::print(
           "FAULT          {} at tick {}{} (value {:.4g}, limit {:.4g}){}\n",
@@ -239,9 +346,13 @@ void add_run_command(CLI::App& app, Action& action) {
       ->capture_default_str();
   cmd->add_option("--calibration", o->calibration,
                   "TOML with [controller] kp, ki, kd, gains_sample_time_s, p, A");
+  cmd->add_option("--config", o->config,
+                  "TOML configuration (configs/paper.toml's sections): the twin's, and what the "
+                  "twin calibration without --calibration runs on");
   auto* step = cmd->add_option("--step-um", o->step_um, "step Z_d1 = Z_d2 = Z_d3 to Z (um)");
-  auto* prof = cmd->add_option("--profile", o->profile,
-                               "CSV with t_s and z_um (or z1_um, z2_um, z3_um), piecewise linear");
+  auto* prof =
+      cmd->add_option("--profile", o->profile,
+                      "CSV with t_s and zd_um (or zd1_um, zd2_um, zd3_um), piecewise linear");
   step->excludes(prof);
   prof->excludes(step);
   cmd->add_option("--duration-s", o->duration_s, "controlled time (s); a ramp to 0 V follows")

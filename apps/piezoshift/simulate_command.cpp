@@ -6,12 +6,13 @@
 //
 //   piezoshift simulate --open-loop-volts 10,10,10 --duration-s 2
 //   piezoshift simulate --step-um 11 --duration-s 1 --log step.csv --json
-//   piezoshift simulate --profile staircase.csv --duration-s 120 --seed 7 --config my.toml
+//   piezoshift simulate --profile profile.csv --duration-s 120 --seed 7 --config my.toml
 //
-// Per tick: Z_d from the mode, then the shipping tick. The profile is a staircase: from each
-// row's t_s on, Z_d = zd_um (0 before the first row). The log has one row per control tick: the
-// AI read and the AO written in it, and the truth and the interferometer's dynamic reading at the
-// end of the period the AI closes.
+// Per tick: Z_d from the mode, then the shipping tick. The profile is `run`'s
+// (runtime/setpoint_profile.hpp: t_s and zd_um or zd1_um..zd3_um, piecewise linear). The log has
+// one row per control tick, in the column vocabulary of docs/files.md: the AI read and the AO
+// written in it, and the truth and the interferometer's dynamic reading at the end of the period
+// the AI closes.
 #include <cmath>
 #include <cstdint>
 #include <initializer_list>
@@ -32,6 +33,7 @@
 #include "piezoshift/io/project_config.hpp"
 #include "piezoshift/plant/twin.hpp"
 #include "piezoshift/runtime/safety_supervisor.hpp"
+#include "piezoshift/runtime/setpoint_profile.hpp"
 
 namespace piezoshift::app {
 namespace {
@@ -53,47 +55,22 @@ struct SimulateOptions {
   bool json = false;
 };
 
-// A staircase Z_d(t): the last row with t_s <= t, 0 before the first row.
-struct Profile {
-  std::vector<double> t_s, zd_um;
-  std::size_t next = 0;
-  double current = 0.0;
-
-  double at(double t) {
-    while (next < t_s.size() && t_s[next] <= t)
-      current = zd_um[next++];
-    return current;
-  }
-};
-
-Profile load_profile(const std::string& path) {
-  const io::CsvTable table = io::CsvTable::load(path);
-  table.require_columns({"t_s", "zd_um"});
-  Profile p{table.column("t_s"), table.column("zd_um")};
-  if (p.t_s.empty())
-    throw io::InputError(fmt::format("{}: the profile has no rows", path));
-  for (std::size_t r = 0; r < p.t_s.size(); ++r) {
-    if (p.t_s[r] < 0.0 || (r > 0 && p.t_s[r] < p.t_s[r - 1])) {
-      throw io::InputError(
-          fmt::format("{}:{}: t_s = {} must be >= 0 and not less than the row before", path,
-                      table.line_of_row(r), p.t_s[r]));
-    }
-  }
-  return p;
-}
-
 std::vector<std::string> log_columns(bool closed_loop) {
   std::vector<std::string> c{"t_s"};
   if (closed_loop) {
-    c.push_back("zd_um");
-    for (const char* n : {"s1_um", "s2_um", "s3_um", "u1_um", "u2_um", "u3_um"})
+    for (const char* n :
+         {"zd1_um", "zd2_um", "zd3_um", "s1_um", "s2_um", "s3_um", "u1_um", "u2_um", "u3_um"})
       c.emplace_back(n);
   }
-  for (const char* n :
-       {"ao1_V",   "ao2_V",   "ao3_V",   "amp1_V",     "amp2_V",       "amp3_V",
-        "ai1_V",   "ai2_V",   "ai3_V",   "stack1_um",  "stack2_um",    "stack3_um",
-        "leg1_um", "leg2_um", "leg3_um", "plate_z_um", "theta_x_urad", "theta_y_urad",
-        "p1_um",   "p2_um",   "p3_um",   "ifm1_um",    "ifm2_um",      "ifm3_um"})
+  // clang-format off
+  static constexpr const char* kTwinColumns[] = {
+      "ao1_V",     "ao2_V",     "ao3_V",     "amp1_V",     "amp2_V",       "amp3_V",
+      "sgs1_V",    "sgs2_V",    "sgs3_V",    "stack1_um",  "stack2_um",    "stack3_um",
+      "leg1_um",   "leg2_um",   "leg3_um",   "plate_z_um", "theta_x_urad", "theta_y_urad",
+      "truth1_um", "truth2_um", "truth3_um",
+      "interferometer1_um", "interferometer2_um", "interferometer3_um"};
+  // clang-format on
+  for (const char* n : kTwinColumns)
     c.emplace_back(n);
   if (closed_loop)
     c.emplace_back("saturated_mask_bits");
@@ -138,9 +115,9 @@ int run_simulate(const SimulateOptions& opt) {
   }
   if (opt.step_um && !std::isfinite(*opt.step_um))
     throw io::InputError("--step-um must be a finite number");
-  Profile profile;
+  std::optional<runtime::SetpointProfile> profile;
   if (!opt.profile_path.empty())
-    profile = load_profile(opt.profile_path);
+    profile = runtime::SetpointProfile::load_csv(opt.profile_path);
 
   control::SemiClosedLoopParams cp;
   cp.sample_time_s = period_s;  // the paper's gains, re-expressed at the twin's DAQ period
@@ -170,12 +147,17 @@ int run_simulate(const SimulateOptions& opt) {
   std::vector<double> row;
   for (std::uint64_t k = 0; k < ticks; ++k) {
     const double t = static_cast<double>(k) * period_s;
-    double zd = 0.0;
+    Vec3 zd{};
     if (!closed_loop) {
       bench.drive_open_loop(open_loop);
     } else {
-      zd = opt.step_um ? (t >= opt.step_at_s ? *opt.step_um : 0.0) : profile.at(t);
-      bench.drive_points(Vec3{zd, zd, zd});
+      if (opt.step_um) {
+        const double z = t >= opt.step_at_s ? *opt.step_um : 0.0;
+        zd = Vec3{z, z, z};
+      } else {
+        zd = profile->at(t);
+      }
+      bench.drive_points(zd);
     }
     bench.run(period_s);
     const runtime::CycleSample& c = bench.last_cycle();
@@ -188,7 +170,7 @@ int run_simulate(const SimulateOptions& opt) {
       row.clear();
       row.push_back(s.time_s);
       if (closed_loop) {
-        row.push_back(zd);
+        row.insert(row.end(), zd.begin(), zd.end());
         row.insert(row.end(), out.target_um.begin(), out.target_um.end());
         row.insert(row.end(), out.command_um.begin(), out.command_um.end());
       }
@@ -296,8 +278,9 @@ void add_simulate_command(CLI::App& app, Action& action) {
   cmd->add_option("--step-um", opt->step_um,
                   "closed loop: step of the three points' desired displacement Z_d [um]");
   cmd->add_option("--step-at-s", opt->step_at_s, "when the step is applied [s] (default 0)");
-  cmd->add_option("--profile", opt->profile_path,
-                  "closed loop: CSV with columns t_s,zd_um (a staircase of Z_d)");
+  cmd->add_option(
+      "--profile", opt->profile_path,
+      "closed loop: CSV t_s and zd_um (or zd1_um..zd3_um), piecewise linear, as `run` reads");
   cmd->add_option("--log", opt->log_path, "CSV log, one row per control tick");
   cmd->add_flag("--json", opt->json, "print a JSON summary instead of the text one");
   cmd->callback([&action, opt] { action = [opt] { return run_simulate(*opt); }; });

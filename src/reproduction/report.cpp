@@ -245,19 +245,19 @@ void write_data(const ReproductionResult& r, const fs::path& dir, ReportFiles& f
     return std::make_unique<io::CsvWriter>((dir / name).string(), std::move(columns), decimals);
   };
   {
-    auto w = csv("step_response.csv", {"time_s", "desired_um", "measured_um"}, 6);
+    auto w = csv("step_response.csv", {"t_s", "zd_um", "measured_um"}, 6);
     for (std::size_t k = 0; k < r.step.time_s.size(); ++k) {
       w->row({r.step.time_s[k], r.step.desired_um[k], r.step.measured_um[k]});
     }
     w->close();
   }
   {
-    auto w = csv("linearity.csv", {"desired_um", "measured_um"}, 6);
+    auto w = csv("linearity.csv", {"zd_um", "measured_um"}, 6);
     for (std::size_t k = 0; k < r.linearity.desired_um.size(); ++k) {
       w->row({r.linearity.desired_um[k], r.linearity.measured_um[k]});
     }
     w->close();
-    auto s = csv("linearity_samples.csv", {"time_s", "desired_um", "measured_um"}, 6);
+    auto s = csv("linearity_samples.csv", {"t_s", "zd_um", "measured_um"}, 6);
     for (std::size_t k = 0; k < r.linearity.sample_time_s.size(); ++k) {
       s->row({r.linearity.sample_time_s[k], r.linearity.sample_desired_um[k],
               r.linearity.sample_measured_um[k]});
@@ -269,14 +269,14 @@ void write_data(const ReproductionResult& r, const fs::path& dir, ReportFiles& f
         std::pair{"linearity_down.csv", &r.linearity_down},
         std::pair{"linearity_without_cubic.csv", &r.linearity_without_cubic},
         std::pair{"oracle_linearity.csv", &r.oracle.linearity}}) {
-    auto w = csv(name, {"desired_um", "measured_um"}, 6);
+    auto w = csv(name, {"zd_um", "measured_um"}, 6);
     for (std::size_t k = 0; k < lin->desired_um.size(); ++k)
       w->row({lin->desired_um[k], lin->measured_um[k]});
     w->close();
   }
   {
     // Both controllers' records have the same ticks (same schedule and sample time).
-    auto w = csv("phase_step.csv", {"time_s", "paper_nm", "oracle_nm"}, 6);
+    auto w = csv("phase_step.csv", {"t_s", "paper_nm", "oracle_nm"}, 6);
     const auto& a = r.phase_step;
     const auto& b = r.oracle.phase_step;
     for (std::size_t k = 0; k < std::min(a.time_s.size(), b.time_s.size()); ++k)
@@ -292,7 +292,7 @@ void write_data(const ReproductionResult& r, const fs::path& dir, ReportFiles& f
     w->close();
   }
   {
-    auto w = csv("travel_range.csv", {"desired_um", "measured_um", "saturated_mask"}, 6);
+    auto w = csv("travel_range.csv", {"zd_um", "measured_um", "saturated_mask"}, 6);
     for (std::size_t k = 0; k < r.travel.desired_um.size(); ++k) {
       w->row({r.travel.desired_um[k], r.travel.measured_um[k],
               static_cast<double>(r.travel.saturated_mask[k])});

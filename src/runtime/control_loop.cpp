@@ -172,6 +172,28 @@ LoopResult ControlLoop::run() noexcept {
     }
     previous_ao = s.ao_V;
     result.last_sgs_V = cs.ai_V;
+    if (config_.status != nullptr) {
+      LoopStatus& st = *config_.status;
+      st.t_s.store(static_cast<double>(ct.since_start_ns) * 1e-9, std::memory_order_relaxed);
+      st.publish_vec(st.zd_um, zd);
+      st.publish_vec(st.target_um, c.target_um);
+      st.publish_vec(st.feedback_um, c.feedback_um);
+      st.state.store(static_cast<std::uint8_t>(s.state), std::memory_order_relaxed);
+      st.fault_reason.store(static_cast<std::uint8_t>(supervisor.fault().reason),
+                            std::memory_order_relaxed);
+      st.ticks.store(tick + 1, std::memory_order_relaxed);
+    }
+    if (!stop_requested && closed_loop && !supervisor.faulted()) {
+      result.controlled_end_tick = tick + 1;
+      result.end_zd_um = zd;
+      result.end_target_um = c.target_um;
+      result.end_feedback_um = c.feedback_um;
+      Vec3 truth{};
+      if (!daq_.truth(truth, result.end_interferometer_um)) {
+        const double nan = std::numeric_limits<double>::quiet_NaN();
+        result.end_interferometer_um = Vec3{nan, nan, nan};
+      }
+    }
 
     const std::int64_t end = clock_.now_ns();
     previous_overran = stats_.record(deadline, wake, end, previous_wake, period_ns_);

@@ -48,17 +48,18 @@ SetpointProfile SetpointProfile::load_csv(const std::string& path, double max_z_
     throw io::InputError(fmt::format("{}: the profile has no data rows", path));
   const std::vector<double> t = table.column("t_s");
   std::vector<Vec3> z(t.size());
-  if (table.has_column("z_um")) {
-    if (table.has_column("z1_um"))
-      throw io::InputError(fmt::format("{}: give either z_um or z1_um..z3_um, not both", path));
-    const std::vector<double> c = table.column("z_um");
+  // The column vocabulary of docs/files.md: zd_um for all three points, or zd1_um..zd3_um.
+  if (table.has_column("zd_um")) {
+    if (table.has_column("zd1_um"))
+      throw io::InputError(fmt::format("{}: give either zd_um or zd1_um..zd3_um, not both", path));
+    const std::vector<double> c = table.column("zd_um");
     for (std::size_t i = 0; i < c.size(); ++i)
       z[i] = Vec3{c[i], c[i], c[i]};
   } else {
-    table.require_columns({"z1_um", "z2_um", "z3_um"});
-    const std::vector<double> c1 = table.column("z1_um");
-    const std::vector<double> c2 = table.column("z2_um");
-    const std::vector<double> c3 = table.column("z3_um");
+    table.require_columns({"zd1_um", "zd2_um", "zd3_um"});
+    const std::vector<double> c1 = table.column("zd1_um");
+    const std::vector<double> c2 = table.column("zd2_um");
+    const std::vector<double> c3 = table.column("zd3_um");
     for (std::size_t i = 0; i < c1.size(); ++i)
       z[i] = Vec3{c1[i], c2[i], c3[i]};
   }
@@ -72,8 +73,8 @@ SetpointProfile SetpointProfile::load_csv(const std::string& path, double max_z_
           fmt::format("{}: t_s = {} does not increase (previous row: {})", where, t[i], t[i - 1]));
     for (double v : z[i]) {
       if (!(v >= 0.0 && v <= max_z_um))
-        throw io::InputError(fmt::format("{}: z = {} um is outside [0, {}] um (the nominal stroke)",
-                                         where, v, max_z_um));
+        throw io::InputError(fmt::format(
+            "{}: Z_d = {} um is outside [0, {}] um (the nominal stroke)", where, v, max_z_um));
     }
   }
   return from_samples(t, std::move(z), path, max_z_um);

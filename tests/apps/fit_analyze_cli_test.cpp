@@ -24,7 +24,7 @@ const piezoshift::control::CubicPolynomial kPaperP;
 // Poses with Z on a small grid and S = A Z exactly (17 significant digits survive the CSV),
 // columns in a scrambled order with two extra columns and comments.
 std::string matrix_csv(int poses) {
-  std::string s = "# recorded poses\nz3_um,s1_um,note,z1_um,s2_um,time_s,s3_um,z2_um\n";
+  std::string s = "# recorded poses\nz3_um,s1_um,note,z1_um,s2_um,t_s,s3_um,z2_um\n";
   for (int i = 0; i < poses; ++i) {
     const double z[3] = {1.0 + (i % 3), 2.0 + 0.5 * ((i / 3) % 3), 0.5 + 1.5 * (i % 4)};
     double sv[3];
@@ -133,7 +133,7 @@ TEST_F(FitAnalyzeCli, FitBadInputExitsTwoNamingFileLineAndColumn) {
 TEST_F(FitAnalyzeCli, AnalyzeLinearityHandCalculation) {
   // See tests/experiments/metrics_linearity_test.cpp: zero-end 0.75 %, best-fit 0.45 %.
   const std::string f = write("lin.csv",
-                              "measured_um,comment,desired_um\n0,a,0\n1.01,b,1\n2.03,c,2\n"
+                              "measured_um,comment,zd_um\n0,a,0\n1.01,b,1\n2.03,c,2\n"
                               "3.02,d,3\n4.00,e,4\n\n");
   const CliResult r = run("analyze linearity --data '" + f + "' --json");
   ASSERT_EQ(r.status, 0) << r.err;
@@ -156,7 +156,7 @@ TEST_F(FitAnalyzeCli, AnalyzeRepeatabilityHandCalculation) {
 
 TEST_F(FitAnalyzeCli, AnalyzeStepFirstOrderAndItsFigure) {
   // 11 um, tau = 10 ms, sampled at 10 kHz for 0.2 s: rise tau ln 9, 2 % settling tau ln 50.
-  std::string csv = "time_s,measured_um\n";
+  std::string csv = "t_s,measured_um\n";
   for (int k = 0; k <= 2000; ++k)
     csv += fmt::format("{:.4f},{:.12f}\n", k * 1e-4, 11.0 * (1 - std::exp(-k * 1e-4 / 0.01)));
   const std::string f = write("step.csv", csv);
@@ -176,15 +176,15 @@ TEST_F(FitAnalyzeCli, AnalyzeStepFirstOrderAndItsFigure) {
 }
 
 TEST_F(FitAnalyzeCli, AnalyzeBadInputExitsTwo) {
-  const std::string f1 = write("nan.csv", "desired_um,measured_um\n0,0\n1,NaN\n2,2\n");
+  const std::string f1 = write("nan.csv", "zd_um,measured_um\n0,0\n1,NaN\n2,2\n");
   expect_refused("analyze linearity --data '" + f1 + "'",
                  {f1 + ":3: column 'measured_um' (field 2): 'NaN' is not a finite number"});
   const std::string f2 = write("one.csv", "measured_um\n5.0\n");
   expect_refused("analyze repeatability --data '" + f2 + "'",
                  {f2 + ": repeatability: 1 value; Eq. 9 needs at least 2"});
   const std::string f3 = write("cols.csv", "desired,measured_um\n0,0\n");
-  expect_refused("analyze linearity --data '" + f3 + "'", {f3 + ":1: missing column 'desired_um'"});
-  const std::string f4 = write("short.csv", "desired_um,measured_um\n0,0\n1\n");
+  expect_refused("analyze linearity --data '" + f3 + "'", {f3 + ":1: missing column 'zd_um'"});
+  const std::string f4 = write("short.csv", "zd_um,measured_um\n0,0\n1\n");
   expect_refused("analyze linearity --data '" + f4 + "'",
                  {f4 + ":3: 1 fields, but the header (line 1) has 2"});
 }

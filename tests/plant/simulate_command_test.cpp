@@ -59,9 +59,9 @@ TEST_F(SimulateCommand, StepWithThePapersControllerLogsEveryTickWithUnits) {
       ++rows;
   }
   EXPECT_EQ(rows, 500);
-  EXPECT_EQ(header.rfind("t_s,zd_um,s1_um", 0), 0u) << header;
+  EXPECT_EQ(header.rfind("t_s,zd1_um,zd2_um,zd3_um,s1_um", 0), 0u) << header;
   EXPECT_NE(header.find("plate_z_um"), std::string::npos);
-  EXPECT_NE(header.find("ifm3_um"), std::string::npos);
+  EXPECT_NE(header.find(",truth3_um,interferometer1_um,"), std::string::npos);
 }
 
 TEST_F(SimulateCommand, SameSeedGivesTheSameLogAndAnotherSeedDoesNot) {
@@ -73,7 +73,7 @@ TEST_F(SimulateCommand, SameSeedGivesTheSameLogAndAnotherSeedDoesNot) {
   EXPECT_NE(read_text(a), read_text(c));
 }
 
-TEST_F(SimulateCommand, ProfileIsFollowedAsAStaircase) {
+TEST_F(SimulateCommand, ProfileIsFollowedAsRunFollowsIt) {
   const std::string profile = write("p.csv", "t_s,zd_um\n0.0,2.0\n0.3,6.0\n");
   const RunResult r = run("--profile '" + profile + "' --duration-s 0.6 --json");
   ASSERT_EQ(r.status, 0) << r.err;

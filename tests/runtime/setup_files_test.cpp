@@ -24,7 +24,8 @@ using ControllerConfigTest = TempDir;
 using AtomicFileTest = TempDir;
 
 TEST_F(SetpointProfileTest, PiecewiseLinearBetweenRowsHeldOutside) {
-  SetpointProfile p = SetpointProfile::load_csv(write("p.csv", "t_s,z_um\n0.1,0\n0.2,10\n0.4,4\n"));
+  SetpointProfile p =
+      SetpointProfile::load_csv(write("p.csv", "t_s,zd_um\n0.1,0\n0.2,10\n0.4,4\n"));
   EXPECT_EQ(p.at(0.0)[0], 0.0);
   EXPECT_NEAR(p.at(0.15)[1], 5.0, 1e-12);
   EXPECT_NEAR(p.at(0.3)[2], 7.0, 1e-12);
@@ -34,7 +35,7 @@ TEST_F(SetpointProfileTest, PiecewiseLinearBetweenRowsHeldOutside) {
 
 TEST_F(SetpointProfileTest, ThreePointColumns) {
   SetpointProfile p =
-      SetpointProfile::load_csv(write("p.csv", "t_s,z1_um,z2_um,z3_um\n0,1,2,3\n1,3,2,1\n"));
+      SetpointProfile::load_csv(write("p.csv", "t_s,zd1_um,zd2_um,zd3_um\n0,1,2,3\n1,3,2,1\n"));
   const Vec3 z = p.at(0.5);
   EXPECT_NEAR(z[0], 2.0, 1e-12);
   EXPECT_NEAR(z[1], 2.0, 1e-12);
@@ -42,7 +43,7 @@ TEST_F(SetpointProfileTest, ThreePointColumns) {
 }
 
 TEST_F(SetpointProfileTest, RefusesOutOfStrokeAndNonIncreasingTimesWithLine) {
-  const std::string a = write("a.csv", "t_s,z_um\n0,1\n0.1,17\n");
+  const std::string a = write("a.csv", "t_s,zd_um\n0,1\n0.1,17\n");
   EXPECT_THROW(
       {
         try {
@@ -53,7 +54,7 @@ TEST_F(SetpointProfileTest, RefusesOutOfStrokeAndNonIncreasingTimesWithLine) {
         }
       },
       io::InputError);
-  const std::string b = write("b.csv", "t_s,z_um\n0,1\n0,2\n");
+  const std::string b = write("b.csv", "t_s,zd_um\n0,1\n0,2\n");
   EXPECT_THROW(SetpointProfile::load_csv(b), io::InputError);
   EXPECT_THROW(SetpointProfile::step(-0.1), io::InputError);
   EXPECT_THROW(SetpointProfile::step(16.5), io::InputError);

@@ -32,6 +32,7 @@
 #include "piezoshift/runtime/daq_backend.hpp"
 #include "piezoshift/runtime/host_link.hpp"
 #include "piezoshift/runtime/loop_clock.hpp"
+#include "piezoshift/runtime/loop_status.hpp"
 #include "piezoshift/runtime/period_stats.hpp"
 #include "piezoshift/runtime/safety_supervisor.hpp"
 #include "piezoshift/runtime/setpoint_profile.hpp"
@@ -49,6 +50,8 @@ struct LoopConfig {
   bool stop_when_safe_after_fault = true;
   //! Host mode: set-points and servo state from this link (host_link.hpp), samples back to it.
   HostLink* host = nullptr;
+  //! When set, the latest tick is published here for a display (loop_status.hpp).
+  LoopStatus* status = nullptr;
 };
 
 enum class StopReason : std::uint8_t { kDuration, kSignal, kFault };
@@ -67,6 +70,15 @@ struct LoopResult {
   std::uint64_t host_samples_dropped = 0;
   std::uint64_t host_commands_applied = 0;
   Vec3 last_sgs_V{};
+  //! The last closed-loop tick of the controlled part, before the ramp to 0 V and before any
+  //! fault: Z_d, the actuator targets S, the SGS feedback (tracking error = S - feedback) and,
+  //! on the twin, its interferometer at P1..P3 (NaN on hardware). controlled_end_tick: that
+  //! tick + 1 (0: there was none).
+  std::uint64_t controlled_end_tick = 0;
+  Vec3 end_zd_um{};
+  Vec3 end_target_um{};
+  Vec3 end_feedback_um{};
+  Vec3 end_interferometer_um{};
 };
 
 class ControlLoop {

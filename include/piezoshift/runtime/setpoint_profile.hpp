@@ -2,7 +2,8 @@
 // The desired displacements Z_d of P1..P3 over time for a run:
 //   step(Z)          Z_d(t) = [Z, Z, Z] for t >= 0  (the paper's Section 4.1 step, Z_d1 = Z_d2 =
 //                    Z_d3 so the stage moves along z only)
-//   from CSV         columns t_s and either z_um (all three points) or z1_um, z2_um, z3_um;
+//   from CSV         columns t_s and either zd_um (all three points) or zd1_um, zd2_um, zd3_um
+//                    (docs/files.md; `run` and `simulate` read the same files);
 //                    piecewise linear between rows, the first row's value before it, the last
 //                    row's after it. Times strictly increasing.
 // Every value must lie in [0, max_z_um] (default: the 16 um nominal stroke, Section 2.1): a value
