@@ -12,6 +12,7 @@
 #include <filesystem>
 #include <fstream>
 #include <iterator>
+#include <ostream>
 #include <string>
 #include <vector>
 
@@ -37,6 +38,15 @@ std::string read(const fs::path& path) {
   std::ifstream in(path, std::ios::binary);
   return {std::istreambuf_iterator<char>(in), std::istreambuf_iterator<char>()};
 }
+
+}  // namespace
+
+// Test names and messages show the target's name.
+void PrintTo(const Target& target, std::ostream* os) {
+  *os << target.name;
+}
+
+namespace {
 
 // The subcommands' reports (JSON on stdout) go nowhere while it lives, as with libFuzzer's
 // -close_fd_mask=1 in `make fuzz`.
