@@ -58,7 +58,7 @@ struct LineServerLimits {
   std::size_t max_pending_output_bytes = std::size_t{16} << 20;
   //! Throttle: while this much output waits for a client, its further lines are not handled (nor
   //! read), so that answers nobody reads cost no work and other clients no time.
-  std::size_t output_high_water_bytes = std::size_t{64} << 10;
+  std::size_t output_high_water_bytes = std::size_t{16} << 10;
   //! A client whose queued output its socket takes nothing of for this long [s] is disconnected.
   double send_timeout_s = 10.0;
   //! A client from which no byte arrives for this long [s] is disconnected; +inf: never.
