@@ -398,7 +398,7 @@ TEST(LineServerClients, NonReadingDrrFloodDoesNotDelayAnotherClientsPos) {
   runtime::HostLink link;
   GcsController gcs(model, link, 1e-3, GcsOptions{});
   // 2048 ticks recorded in tables 1 and 2 (the defaults), pushed as the loop would: each DRR? is
-  // ~28 kB, made in ~0.5 ms (~5 ms under ASan).
+  // ~28 kB, made in ~0.5 ms (several ms under ASan).
   for (std::uint64_t k = 0; k < 2048; ++k) {
     runtime::HostSample s{};
     s.tick = k;
