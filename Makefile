@@ -6,7 +6,7 @@ BUILD_DIR = build/$(PRESET)
 PIEZOSHIFT = $(BUILD_DIR)/apps/piezoshift/piezoshift
 DEMO_OUT ?= out/demo
 
-.PHONY: all deps configure build test demo mcu python python-install sanitize bench format format-check clean
+.PHONY: all deps configure build test demo mcu python python-install sanitize fuzz bench format format-check clean
 
 all: build
 
@@ -45,6 +45,11 @@ python-install: python
 
 sanitize:
 	@$(MAKE) --no-print-directory test PRESET=sanitize
+
+# libFuzzer targets under ASan + UBSan (preset fuzz, clang; docs/fuzzing.md), FUZZ_SECONDS each.
+FUZZ_SECONDS ?= 60
+fuzz: deps
+	@FUZZ_SECONDS=$(FUZZ_SECONDS) JOBS=$(JOBS) scripts/fuzz
 
 bench: build
 	@$(BUILD_DIR)/bench/piezoshift_bench

@@ -10,21 +10,9 @@
 #include "piezoshift/io/input_error.hpp"
 
 int main(int argc, char** argv) {
-  CLI::App app{"piezoshift: design, simulate, calibrate, run and validate a piezo phase shifter"};
-  app.require_subcommand(1);
-  app.set_version_flag("--version", "piezoshift 0.1.0");
-
+  CLI::App app;
   piezoshift::app::Action action;
-  piezoshift::app::add_design_command(app, action);
-  piezoshift::app::add_simulate_command(app, action);
-  piezoshift::app::add_fit_command(app, action);
-  piezoshift::app::add_analyze_command(app, action);
-  piezoshift::app::add_run_command(app, action);
-  piezoshift::app::add_calibrate_command(app, action);
-  piezoshift::app::add_serve_command(app, action);
-  piezoshift::app::add_gcs_command(app, action);
-  piezoshift::app::add_reproduce_command(app, action);
-  piezoshift::app::add_psi_command(app, action);
+  piezoshift::app::build_program(app, action);
 
   try {
     app.parse(argc, argv);

@@ -48,8 +48,12 @@ void check_limits(const LineServerLimits& limits, const std::string& where) {
     fail("max_line_bytes must be at least 1");
   if (limits.max_pending_output_bytes < 1)
     fail("max_pending_output_bytes must be at least 1");
+  if (limits.output_high_water_bytes < 1)
+    fail("output_high_water_bytes must be at least 1");
   if (!(limits.idle_timeout_s > 0.0))  // also rejects NaN
     fail("idle_timeout_s must be > 0 (+inf: no timeout)");
+  if (!(limits.send_timeout_s > 0.0))
+    fail("send_timeout_s must be > 0 (+inf: no timeout)");
 }
 
 }  // namespace
@@ -98,9 +102,14 @@ void LineServer::run(const std::atomic<int>* stop_flag, int poll_interval_ms) {
   const auto stopping = [&] {
     return stop_requested_.load() || (stop_flag != nullptr && stop_flag->load() != 0);
   };
+  const auto limit = [](double s) {
+    return std::chrono::duration_cast<Clock::duration>(
+        std::chrono::duration<double>(std::isfinite(s) ? s : 0.0));
+  };
   const bool idle_limited = std::isfinite(limits_.idle_timeout_s);
-  const auto idle_limit = std::chrono::duration_cast<Clock::duration>(
-      std::chrono::duration<double>(idle_limited ? limits_.idle_timeout_s : 0.0));
+  const auto idle_limit = limit(limits_.idle_timeout_s);
+  const bool send_limited = std::isfinite(limits_.send_timeout_s);
+  const auto send_limit = limit(limits_.send_timeout_s);
 
   std::vector<pollfd> fds;
   try {
@@ -113,13 +122,15 @@ void LineServer::run(const std::atomic<int>* stop_flag, int poll_interval_ms) {
       fds.push_back({listener_->wake_fd(), POLLIN, 0});
       const bool accepting = Clock::now() >= accept_paused_until_;
       fds.push_back({accepting ? listener_->fd() : -1, POLLIN, 0});  // fd -1: ignored by poll()
+      bool work_left = false;  // lines received but beyond last turn's budget: do not sleep
       for (const Client& c : clients_) {
-        short events = c.input_ended ? 0 : POLLIN;
+        short events = wants_input(c) ? POLLIN : 0;
         if (c.pending() > 0)
           events |= POLLOUT;
         fds.push_back({c.fd, events, 0});
+        work_left = work_left || (!c.unread.empty() && !throttled(c));
       }
-      if (::poll(fds.data(), fds.size(), poll_interval_ms) < 0) {
+      if (::poll(fds.data(), fds.size(), work_left ? 0 : poll_interval_ms) < 0) {
         if (errno == EINTR)
           continue;
         throw std::runtime_error(fmt::format("TCP server: poll: {}", std::strerror(errno)));
@@ -130,24 +141,28 @@ void LineServer::run(const std::atomic<int>* stop_flag, int poll_interval_ms) {
       for (std::size_t i = 0; i + 2 < fds.size(); ++i) {
         Client& c = clients_[i];
         const short revents = fds[i + 2].revents;
-        if (revents == 0)
-          continue;
         if (revents & POLLNVAL) {
           c.close = Client::Close::kNow;
           continue;
         }
         // POLLHUP/POLLERR: recv() or send() reports what happened.
-        if (!c.input_ended && (revents & (POLLIN | POLLHUP | POLLERR)))
+        if (wants_input(c) && (revents & (POLLIN | POLLHUP | POLLERR)))
           read_from(c);
+        if (c.close == Client::Close::kNo && !c.unread.empty() && !throttled(c))
+          serve_lines(c);
         if (c.close == Client::Close::kNo && c.pending() > 0)
           flush(c);
       }
 
-      if (idle_limited) {
-        const auto now = Clock::now();
-        for (Client& c : clients_)
-          if (c.close == Client::Close::kNo && now - c.last_input > idle_limit)
-            c.close = Client::Close::kIdle;
+      const auto now = Clock::now();
+      for (Client& c : clients_) {
+        if (c.close != Client::Close::kNo)
+          continue;
+        // A throttled client's input waits unread by our choice: the send timeout judges it.
+        if (idle_limited && !throttled(c) && now - c.last_input > idle_limit)
+          c.close = Client::Close::kIdle;
+        else if (send_limited && c.pending() > 0 && now - c.last_output > send_limit)
+          c.close = Client::Close::kSlow;
       }
       close_marked_clients();
       // Accept after closing, so that a slot freed in this turn is available at once.
@@ -191,34 +206,53 @@ void LineServer::accept_clients() {
   }
 }
 
+bool LineServer::throttled(const Client& c) const {
+  return c.pending() >= limits_.output_high_water_bytes;
+}
+
+bool LineServer::wants_input(const Client& c) const {
+  return !c.input_ended && c.unread.empty() && !throttled(c);
+}
+
 void LineServer::read_from(Client& c) {
   char* const buffer = read_buffer_.data();
   const ssize_t n = ::recv(c.fd, buffer, read_buffer_.size(), 0);
   if (n > 0) {
     stats_.bytes_in.fetch_add(static_cast<std::uint64_t>(n), std::memory_order_relaxed);
     c.last_input = Clock::now();
-    consume(c, std::string_view(buffer, static_cast<std::size_t>(n)));
+    c.unread.assign(buffer, static_cast<std::size_t>(n));
   } else if (n == 0) {
     // EOF: the peer may have only shut down its sending side (`printf '*IDN?\n' | nc -N ...`),
-    // so its pending answers are still sent; a partial last line without LF is dropped.
+    // so its lines already received are handled and its answers still sent; a partial last line
+    // without LF is dropped.
     c.input_ended = true;
-    if (c.pending() == 0)
-      c.close = Client::Close::kNow;
+    close_if_done(c);
   } else if (errno != EINTR && !would_block(errno)) {
     c.close = Client::Close::kNow;  // ECONNRESET and the like
   }
 }
 
-void LineServer::consume(Client& c, std::string_view data) {
-  while (!data.empty() && c.close == Client::Close::kNo) {
+void LineServer::close_if_done(Client& c) {
+  if (c.input_ended && c.unread.empty() && c.pending() == 0 && c.close == Client::Close::kNo)
+    c.close = Client::Close::kNow;
+}
+
+void LineServer::serve_lines(Client& c) {
+  std::string_view data = c.unread;
+  std::size_t handled = 0;
+  while (!data.empty() && c.close == Client::Close::kNo && handled < kLinesPerTurn &&
+         !throttled(c)) {
     const std::size_t lf = data.find('\n');
     if (c.discarding) {  // the rest of an overlong line, already reported
-      if (lf == std::string_view::npos)
-        return;
+      if (lf == std::string_view::npos) {
+        data = {};
+        break;
+      }
       c.discarding = false;
       data.remove_prefix(lf + 1);
       continue;
     }
+    ++handled;
     // A single-character command (GCS: #5, #7, ... sent as the control byte alone, no LF) is
     // recognised where a line would start; inside a line the byte belongs to the line.
     if (c.input.empty() && handler_.is_immediate(data.front())) {
@@ -228,6 +262,7 @@ void LineServer::consume(Client& c, std::string_view data) {
     }
     if (lf == std::string_view::npos) {
       c.input.append(data);
+      data = {};
       // One byte of slack: the last byte may be the CR of a CRLF that does not count.
       if (c.input.size() > limits_.max_line_bytes + 1) {
         c.input.clear();
@@ -235,7 +270,7 @@ void LineServer::consume(Client& c, std::string_view data) {
         stats_.overlong_lines.fetch_add(1, std::memory_order_relaxed);
         queue(c, handler_.on_overlong_line(c.id));
       }
-      return;
+      break;
     }
     // A complete line: straight from the chunk when nothing was buffered before.
     std::string_view line = data.substr(0, lf);
@@ -254,6 +289,8 @@ void LineServer::consume(Client& c, std::string_view data) {
     c.input.clear();
     data.remove_prefix(lf + 1);
   }
+  c.unread.erase(0, c.unread.size() - data.size());
+  close_if_done(c);
 }
 
 void LineServer::queue(Client& c, std::string&& answer) {
@@ -262,10 +299,11 @@ void LineServer::queue(Client& c, std::string&& answer) {
   if (c.pending() == 0) {
     c.output = std::move(answer);
     c.output_sent = 0;
+    c.last_output = Clock::now();  // the send timeout runs from here
   } else {
     c.output += answer;
   }
-  // Sending is normally left to the end of the read (one send() for several answers); only when
+  // Sending is normally left to the end of the turn (one send() for several answers); only when
   // the limit is crossed do we try to send now, and disconnect if the socket takes too little.
   if (c.pending() > limits_.max_pending_output_bytes) {
     flush(c);
@@ -280,6 +318,7 @@ void LineServer::flush(Client& c) {
     const ssize_t n = ::send(c.fd, c.output.data() + c.output_sent, c.pending(), MSG_NOSIGNAL);
     if (n > 0) {
       c.output_sent += static_cast<std::size_t>(n);
+      c.last_output = Clock::now();
       stats_.bytes_out.fetch_add(static_cast<std::uint64_t>(n), std::memory_order_relaxed);
     } else if (n < 0 && errno == EINTR) {
       continue;
@@ -296,8 +335,7 @@ void LineServer::flush(Client& c) {
       std::string().swap(c.output);
     c.output.clear();
     c.output_sent = 0;
-    if (c.input_ended)
-      c.close = Client::Close::kNow;
+    close_if_done(c);
   } else if (c.output_sent > kReadChunkBytes && c.output_sent > c.output.size() / 2) {
     // Drop what is sent once it is most of the buffer: amortised O(1) per byte.
     c.output.erase(0, c.output_sent);

@@ -1,9 +1,11 @@
 // The TCP transport of `piezoshift serve` (LineServer) and the GCS client, over loopback: framing,
 // several clients, resource limits (clients, line length, pending output, idle time), hostile
-// input and peers that vanish mid-answer, address checks. SIGPIPE is deliberately NOT ignored in
+// input and peers that vanish mid-answer, a non-reading client that must not delay another (with
+// the real GCS interpreter), address checks. SIGPIPE is deliberately NOT ignored in
 // this process: a send() without MSG_NOSIGNAL to a vanished peer would kill the test.
 #include <gtest/gtest.h>
 
+#include <algorithm>
 #include <atomic>
 #include <chrono>
 #include <exception>
@@ -17,8 +19,11 @@
 #include <vector>
 
 #include "piezoshift/host/gcs_client.hpp"
+#include "piezoshift/host/gcs_controller.hpp"
 #include "piezoshift/host/line_server.hpp"
+#include "piezoshift/host/locked_line_handler.hpp"
 #include "piezoshift/io/input_error.hpp"
+#include "piezoshift/plant/geometry.hpp"
 
 namespace piezoshift::host {
 namespace {
@@ -148,6 +153,18 @@ TEST(LineServerFraming, ASingleCharacterCommandNeedsNoLfWhereALineWouldStart) {
   c->send_raw("ECHO x\x05y\n");
   EXPECT_EQ(c->read_answer(), "x\x05y\n");
   EXPECT_EQ(handler.lines().size(), 2u);
+}
+
+// `serve --http-port` puts the interpreter behind a mutex: single-character commands must pass.
+TEST(LineServerFraming, ALockedHandlerPassesSingleCharacterCommandsOn) {
+  TestHandler handler;
+  std::mutex mutex;
+  LockedLineHandler locked(handler, mutex);
+  ServerThread st(locked);
+  auto client = st.connect();
+  client->send_raw("\x05");
+  EXPECT_EQ(client->read_answer(), "IMMEDIATE 5\n");
+  EXPECT_EQ(client->query("ECHO x"), "x\n");
 }
 
 TEST(LineServerFraming, MultiLineAnswerIsReadWholeWithItsLines) {
@@ -345,6 +362,7 @@ TEST(LineServerLimits, SlowReaderIsDisconnectedWhileOthersAreServed) {
   TestHandler handler;
   LineServerLimits limits;
   limits.max_pending_output_bytes = 1u << 20;
+  limits.send_timeout_s = 0.3;
   ServerThread server(handler, limits);
   auto slow = server.connect();
   auto fast = server.connect();
@@ -366,9 +384,72 @@ TEST(LineServerLimits, SlowReaderIsDisconnectedWhileOthersAreServed) {
   EXPECT_TRUE(slow->wait_closed(5.0));
   ASSERT_TRUE(eventually([&] { return handler.disconnects == 1; }));
   EXPECT_EQ(server.server().client_count(), 1u);
-  // Cut off long before the end: the server never held the 64 MiB.
-  EXPECT_LT(handler.big_lines, 256);
-  EXPECT_LT(server.server().stats().bytes_out, 64u << 20);
+  // Throttled, then cut off: answers were made only while its queue was short (a few socket
+  // buffers' worth), never the 64 MiB.
+  EXPECT_LT(handler.big_lines, 64);
+  EXPECT_LT(server.server().stats().bytes_out, 32u << 20);
+}
+
+// Issue 17: one client sends 100 DRR? (each a full table of the recorder) and reads nothing; the
+// POS? of another client right after must not wait for those answers to be made. Before the
+// per-client throttle the server made every answer of the burst in one turn (~50 ms here).
+TEST(LineServerClients, NonReadingDrrFloodDoesNotDelayAnotherClientsPos) {
+  const StageModel model(stage_model_params(plant::GeometryParams{}));
+  runtime::HostLink link;
+  GcsController gcs(model, link, 1e-3, GcsOptions{});
+  // 2048 ticks recorded in tables 1 and 2 (the defaults), pushed as the loop would: each DRR? is
+  // ~28 kB, made in ~0.5 ms (several ms under ASan).
+  for (std::uint64_t k = 0; k < 2048; ++k) {
+    runtime::HostSample s{};
+    s.tick = k;
+    s.t_s = 1e-3 * static_cast<double>(k);
+    s.sgs_V = {1.0 + 1e-4 * static_cast<double>(k), 2.0, 3.0};
+    ASSERT_TRUE(link.samples.try_push(s));
+  }
+  gcs.drain();
+  LineServerLimits limits;
+  limits.send_timeout_s = 1.0;
+  ServerThread server(gcs, limits);
+  auto reader = server.connect();
+  ASSERT_EQ(reader->query("DRL? 1"), "1=2048\n");
+  const std::size_t drr_bytes = reader->query("DRR?").size();
+  ASSERT_GT(drr_bytes, 25'000u);  // each answer of the flood costs real formatting work
+
+  std::string flood;
+  for (int i = 0; i < 100; ++i)
+    flood += "DRR?\n";
+  constexpr int kRounds = 7;
+  std::vector<double> latency_ms;
+  for (int round = 0; round < kRounds; ++round) {
+    auto flooder = server.connect();
+    ASSERT_TRUE(eventually([&] { return server.server().client_count() == 2; }));
+    flooder->send_raw(flood);
+    // Let the server take the burst first (ordering only; the assert is on the POS? below).
+    std::this_thread::sleep_for(std::chrono::milliseconds(2));
+    const auto start = std::chrono::steady_clock::now();
+    const std::string pos = reader->query("POS?");
+    latency_ms.push_back(
+        std::chrono::duration<double, std::milli>(std::chrono::steady_clock::now() - start)
+            .count());
+    EXPECT_TRUE(pos.starts_with("Z=")) << pos;
+    if (round + 1 < kRounds) {  // the last one stays, unread, for the send timeout
+      flooder.reset();
+      ASSERT_TRUE(eventually([&] { return server.server().client_count() == 1; }));
+    } else {
+      // 500 more: more answers than the sockets' buffers hold, so its queue stops draining.
+      for (int i = 0; i < 5; ++i)
+        flooder->send_raw(flood);
+      EXPECT_TRUE(eventually([&] { return server.server().client_count() == 1; }));
+    }
+  }
+  // The median of the rounds: robust against a round the shared machine happened to stall.
+  std::nth_element(latency_ms.begin(), latency_ms.begin() + kRounds / 2, latency_ms.end());
+  EXPECT_LT(latency_ms[kRounds / 2], 10.0);
+  const LineServerStats stats = server.server().stats();
+  server.join();
+  EXPECT_EQ(stats.disconnected_slow, 1u);  // the flooder left unread, after send_timeout_s
+  // Throttled: of the 1200 DRR? sent, only what the sockets' buffers took was made.
+  EXPECT_LT(gcs.stats().lines, 1100u);
 }
 
 TEST(LineServerLimits, IdleClientIsDisconnected) {

@@ -5,16 +5,23 @@
 //
 // One turn of run():
 //   handler.on_poll()
-//   poll(wake-up fd, listening socket, every client; POLLOUT only while its output is pending)
-//   for each client: recv() one chunk -> split at LF -> handler.on_line() -> queue the answer
-//                    (a byte for which handler.is_immediate() holds, where a line would start:
-//                    handler.on_immediate() at once, no LF needed)
+//   poll(wake-up fd, listening socket, every client: POLLIN only while it has no unhandled input
+//        and is not throttled, POLLOUT only while its output is pending)
+//   for each client: recv() one chunk into its input; handle its complete lines, at most
+//                    kLinesPerTurn and none once its queued output reaches
+//                    output_high_water_bytes: split at LF -> handler.on_line() -> queue the
+//                    answer (a byte for which handler.is_immediate() holds, where a line would
+//                    start: handler.on_immediate() at once, no LF needed)
 //                    send() queued output (MSG_NOSIGNAL: a vanished peer is an error, not SIGPIPE)
-//   accept() new connections (beyond max_clients: accepted and closed at once)
 //   disconnect idle clients, slow readers, failed or finished connections ->
 //   handler.on_disconnect()
-// Nothing blocks on one client: all sockets are non-blocking, each client has its own input and
-// output buffer. Not real-time code (heap, exceptions); it talks to the loop through its handler.
+//   accept() new connections (beyond max_clients: accepted and closed at once)
+// Nothing blocks on one client, and no client's work delays another's by more than one answer:
+// all sockets are non-blocking, each client has its own input and output queue, a turn handles a
+// bounded number of each client's lines, and a client that does not read its answers is
+// throttled (its further lines wait, in its own socket, until it reads) and, if it reads nothing
+// for send_timeout_s, disconnected. Not real-time code (heap, exceptions); it talks to the loop
+// through its handler.
 #include <atomic>
 #include <chrono>
 #include <cstddef>
@@ -46,9 +53,14 @@ struct LineServerLimits {
   //! Longest line in bytes (without LF and trailing CR); a longer one gives on_overlong_line()
   //! once and the rest of it, up to the next LF, is discarded.
   std::size_t max_line_bytes = 4096;
-  //! Output queued for one client beyond what its socket takes; a client that reads so slowly
-  //! that more is queued (or one answer is larger than this) is disconnected.
+  //! Output queued for one client beyond what its socket takes; an answer that would queue more
+  //! (one larger than this) disconnects the client.
   std::size_t max_pending_output_bytes = std::size_t{16} << 20;
+  //! Throttle: while this much output waits for a client, its further lines are not handled (nor
+  //! read), so that answers nobody reads cost no work and other clients no time.
+  std::size_t output_high_water_bytes = std::size_t{16} << 10;
+  //! A client whose queued output its socket takes nothing of for this long [s] is disconnected.
+  double send_timeout_s = 10.0;
   //! A client from which no byte arrives for this long [s] is disconnected; +inf: never.
   double idle_timeout_s = 600.0;
 };
@@ -83,15 +95,20 @@ class LineHandler {
 struct LineServerStats {
   std::uint64_t accepted = 0;             //!< connections served (on_connect calls)
   std::uint64_t refused_max_clients = 0;  //!< closed at once: max_clients already connected
-  std::uint64_t disconnected_slow = 0;    //!< output beyond max_pending_output_bytes
-  std::uint64_t disconnected_idle = 0;    //!< nothing received for idle_timeout_s
-  std::uint64_t overlong_lines = 0;       //!< lines longer than max_line_bytes
-  std::uint64_t bytes_in = 0;             //!< received from all clients
-  std::uint64_t bytes_out = 0;            //!< sent (accepted by the kernel) to all clients
+  //! output beyond max_pending_output_bytes, or none of it taken for send_timeout_s
+  std::uint64_t disconnected_slow = 0;
+  std::uint64_t disconnected_idle = 0;  //!< nothing received for idle_timeout_s
+  std::uint64_t overlong_lines = 0;     //!< lines longer than max_line_bytes
+  std::uint64_t bytes_in = 0;           //!< received from all clients
+  std::uint64_t bytes_out = 0;          //!< sent (accepted by the kernel) to all clients
 };
 
 class LineServer {
  public:
+  //! Lines (and single-character commands) of one client handled per turn at most: a client that
+  //! sends many cheap commands at once delays the others' by at most this many.
+  static constexpr std::size_t kLinesPerTurn = 32;
+
   //! Binds and listens (SO_REUSEADDR, non-blocking). Throws io::InputError naming host:port for an
   //! unparsable address, a non-loopback address without allow_remote, invalid limits, or a failed
   //! bind/listen (with the system's reason, e.g. "Address already in use").
@@ -122,19 +139,26 @@ class LineServer {
   struct Client {
     int fd = -1;
     ClientId id = 0;
+    std::string unread;        // received, not handled yet (at most one read chunk)
     std::string input;         // the partial line received so far (at most max_line_bytes + 1)
     bool discarding = false;   // inside an overlong line: drop bytes up to the next LF
     bool input_ended = false;  // EOF received: no more reading, close once output is sent
     std::string output;        // queued answers; output[output_sent..] still to send
     std::size_t output_sent = 0;
     Clock::time_point last_input;
+    Clock::time_point last_output;  // output queued on an empty queue, or taken by the socket
     enum class Close { kNo, kNow, kSlow, kIdle } close = Close::kNo;
     std::size_t pending() const { return output.size() - output_sent; }
   };
 
   void accept_clients();
   void read_from(Client& client);
-  void consume(Client& client, std::string_view data);
+  //! Handles the client's complete lines in unread, within the turn's budget (see the top).
+  void serve_lines(Client& client);
+  bool throttled(const Client& client) const;
+  bool wants_input(const Client& client) const;
+  //! Marks for closing a client whose input has ended and whose lines and answers are done.
+  void close_if_done(Client& client);
   void queue(Client& client, std::string&& answer);
   void flush(Client& client);
   void close_marked_clients();

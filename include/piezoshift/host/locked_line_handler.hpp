@@ -31,6 +31,13 @@ class LockedLineHandler final : public LineHandler {
     const std::lock_guard lock(mutex_);
     return inner_.on_overlong_line(id);
   }
+  // Without these two, GCS's single-character commands (#5, #7, #24, ...) would reach the
+  // interpreter as line content whenever the dashboard runs.
+  bool is_immediate(char byte) const override { return inner_.is_immediate(byte); }
+  std::string on_immediate(ClientId id, char byte) override {
+    const std::lock_guard lock(mutex_);
+    return inner_.on_immediate(id, byte);
+  }
   void on_poll() override {
     const std::lock_guard lock(mutex_);
     inner_.on_poll();

@@ -1,0 +1,80 @@
+// The entry points that read files or a command line (the GCS one is gcs_entry.cpp).
+#include "entry_points.hpp"
+
+#include <array>
+#include <string>
+#include <vector>
+
+#include "piezoshift/calibration/calibration_file.hpp"
+#include "piezoshift/io/input_error.hpp"
+#include "piezoshift/io/project_config.hpp"
+#include "program.hpp"
+#include "scratch_file.hpp"
+
+namespace piezoshift::fuzz {
+namespace {
+
+bool always(const CLI::App&) {
+  return true;
+}
+
+// `design` is the one subcommand quick enough to run on every input: the others would simulate,
+// serve or connect; --search ranks a whole grid and --config reads whatever path the input names.
+bool quick_design(const CLI::App& app) {
+  for (const CLI::App* sub : app.get_subcommands())
+    if (sub->get_name() == "design")
+      return sub->count("--search") == 0 && sub->count("--config") == 0;
+  return false;
+}
+
+}  // namespace
+
+void config_input(std::string_view data) {
+  try {
+    io::load_project_config(scratch_file("config.toml", data));
+  } catch (const io::InputError&) {
+  }
+}
+
+void calibration_input(std::string_view data) {
+  try {
+    std::optional<double> z_max, z_min;
+    calibration::load_calibration_file(scratch_file("calibration.toml", data), &z_max, &z_min);
+  } catch (const io::InputError&) {
+  }
+}
+
+void csv_input(std::string_view data) {
+  const std::string path = scratch_file("data.csv", data);
+  static constexpr std::array<std::array<const char*, 2>, 5> kPaths{{{"analyze", "linearity"},
+                                                                     {"analyze", "repeatability"},
+                                                                     {"analyze", "step"},
+                                                                     {"fit", "matrix"},
+                                                                     {"fit", "poly"}}};
+  // One app per path, built once: 5 apps per input would cost more than the work itself, and
+  // each is given the same options every time.
+  static Program programs[kPaths.size()];
+  for (std::size_t i = 0; i < kPaths.size(); ++i)
+    programs[i].run({"piezoshift", kPaths[i][0], kPaths[i][1], "--data", path, "--json"}, always);
+}
+
+void command_line_input(std::string_view data) {
+  std::vector<std::string> args{"piezoshift"};
+  while (!data.empty()) {
+    const std::size_t lf = data.find('\n');
+    args.emplace_back(data.substr(0, lf));
+    data.remove_prefix(lf == std::string_view::npos ? data.size() : lf + 1);
+  }
+  Program().run(args, quick_design);  // a fresh app: options must not keep an earlier input's
+}
+
+std::span<const Target> targets() {
+  static constexpr std::array<Target, 5> kTargets{{{"config", config_input},
+                                                   {"csv", csv_input},
+                                                   {"calibration", calibration_input},
+                                                   {"gcs", gcs_input},
+                                                   {"command_line", command_line_input}}};
+  return kTargets;
+}
+
+}  // namespace piezoshift::fuzz
