@@ -14,25 +14,6 @@
 
 namespace piezoshift::io {
 
-bool Bounds::contains(double v) const {
-  if (!std::isfinite(v))
-    return false;
-  const bool above = lo_open ? v > lo : v >= lo;
-  const bool below = hi_open ? v < hi : v <= hi;
-  return above && below;
-}
-
-std::string Bounds::describe() const {
-  const bool no_lo = lo <= -1e308, no_hi = hi >= 1e308;
-  if (no_lo && no_hi)
-    return "a finite number";
-  if (no_hi)
-    return fmt::format("{} {}", lo_open ? ">" : ">=", lo);
-  if (no_lo)
-    return fmt::format("{} {}", hi_open ? "<" : "<=", hi);
-  return fmt::format("in {}{}, {}{}", lo_open ? "(" : "[", lo, hi, hi_open ? ")" : "]");
-}
-
 struct ConfigFileImpl {
   std::string source;
   toml::table root;
