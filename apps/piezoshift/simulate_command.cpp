@@ -30,6 +30,7 @@
 #include "piezoshift/io/csv_writer.hpp"
 #include "piezoshift/io/input_error.hpp"
 #include "piezoshift/io/project_config.hpp"
+#include "piezoshift/plant/simulation_cost.hpp"
 #include "piezoshift/plant/twin.hpp"
 #include "piezoshift/runtime/safety_supervisor.hpp"
 
@@ -51,6 +52,7 @@ struct SimulateOptions {
   std::string profile_path;
   std::string log_path;
   bool json = false;
+  double max_physics_steps = plant::kDefaultPhysicsStepBudget;
 };
 
 // A staircase Z_d(t): the last row with t_s <= t, 0 before the first row.
@@ -112,6 +114,9 @@ int run_simulate(const SimulateOptions& opt) {
   }
   if (!std::isfinite(opt.duration_s) || !(opt.duration_s > 0.0))
     throw io::InputError(fmt::format("--duration-s = {} must be positive", opt.duration_s));
+  if (!(opt.max_physics_steps >= 1.0 && opt.max_physics_steps <= 1e15))
+    throw io::InputError(
+        fmt::format("--max-physics-steps = {} must be in [1, 1e15]", opt.max_physics_steps));
   if (!std::isfinite(opt.step_at_s) || opt.step_at_s < 0.0)
     throw io::InputError(fmt::format("--step-at-s = {} must be >= 0", opt.step_at_s));
 
@@ -141,6 +146,17 @@ int run_simulate(const SimulateOptions& opt) {
   Profile profile;
   if (!opt.profile_path.empty())
     profile = load_profile(opt.profile_path);
+
+  // The cost before the start: the duration and the config's rates together.
+  const plant::SimulationCost cost = plant::estimate_simulation_cost(config.twin, opt.duration_s);
+  if (const std::string p =
+          plant::simulation_budget_problem(cost, opt.max_physics_steps, "--max-physics-steps");
+      !p.empty()) {
+    throw io::InputError(fmt::format(
+        "--duration-s {} with physics_rate_Hz {} and sample_time_s {} ({}): {}", opt.duration_s,
+        config.twin.physics_rate_Hz, period_s,
+        opt.config_path.empty() ? "built-in configuration" : opt.config_path, p));
+  }
 
   control::SemiClosedLoopParams cp;
   cp.sample_time_s = period_s;  // the paper's gains, re-expressed at the twin's DAQ period
@@ -299,6 +315,8 @@ void add_simulate_command(CLI::App& app, Action& action) {
   cmd->add_option("--profile", opt->profile_path,
                   "closed loop: CSV with columns t_s,zd_um (a staircase of Z_d)");
   cmd->add_option("--log", opt->log_path, "CSV log, one row per control tick");
+  cmd->add_option("--max-physics-steps", opt->max_physics_steps,
+                  "refuse a run estimated above this many physics steps (default 1e9, about a minute)");
   cmd->add_flag("--json", opt->json, "print a JSON summary instead of the text one");
   cmd->callback([&action, opt] { action = [opt] { return run_simulate(*opt); }; });
 }

@@ -52,6 +52,10 @@ DaqStatus SimBackend::read(const CycleTime& t, Vec3& ai_V) noexcept {
   std::int64_t n = (t.period_ns + period_ns_ / 2) / period_ns_;
   if (n < 1)
     n = 1;
+  // A tick that took longer than its period must not make the next one longer still: the twin
+  // falls behind the clock instead (the supervisor's overrun rule trips on such a loop anyway).
+  if (n > kMaxCatchUpPeriods)
+    n = kMaxCatchUpPeriods;
   for (std::int64_t i = 0; i < n; ++i)
     twin_->advance();
   ai_V = twin_->read_ai();

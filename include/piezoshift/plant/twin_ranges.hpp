@@ -17,7 +17,7 @@
 namespace piezoshift::plant {
 
 //! physics_rate_Hz * daq.sample_time_s, the physics steps in one control tick, at most this: the
-//! default is 20, 10 000 steps of about 40 ns are 0.4 ms of work per tick (docs/performance.md).
+//! default is 20; 10 000 steps of about 60 ns are 0.6 ms of work per tick.
 inline constexpr double kMaxPhysicsStepsPerTick = 10000.0;
 
 //! Calls visit(section, key, value, bounds) for each value of twin (const or not) that has a

@@ -2,7 +2,7 @@
 // The `sim` backend: the digital twin (plant::Twin) behind the DAQ interface, advanced in step
 // with the loop's clock. Per tick, keeping the board's timing contract (daq_backend.hpp):
 //
-//   read(t):   n = period_ns / T (1, or more after skipped slots)
+//   read(t):   n = period_ns / T (1, or more after skipped slots; at most kMaxCatchUpPeriods)
 //              n x twin.advance()      physics over the elapsed periods with the AO held that
 //                                      went out at the previous tick; ends with the AI sample
 //              ai = twin.read_ai()
@@ -46,6 +46,10 @@ class SimBackend final : public DaqBackend, public PlantFaultHooks {
   void configure() override;
   void activate() override;
   void deactivate() noexcept override;
+  //! Periods one read() advances at most after skipped slots: so a twin slower than real time
+  //! (the heaviest physics the ranges accept) cannot make each tick longer than the one before.
+  static constexpr std::int64_t kMaxCatchUpPeriods = 10;
+
   DaqStatus read(const CycleTime& t, Vec3& ai_V) noexcept override;
   DaqStatus write(const CycleTime& t, const Vec3& ao_V) noexcept override;
   std::string name() const override { return "sim"; }
