@@ -472,6 +472,45 @@ TEST_F(Serve, TheGcsCommandSendsCommandsAndPrintsTheAnswersOfQueries) {
       << slurp(path("gcs2_err.txt"));
 }
 
+// Waits for s to exit, at most limit_s (a hang guard, not a timing assertion: the cases below end
+// in about 2 s); -2 and SIGKILL when it did not.
+int wait_exit_or_kill(const Spawned& s, int limit_s) {
+  for (int i = 0; i < limit_s * 100; ++i) {
+    int status = 0;
+    if (waitpid(s.pid, &status, WNOHANG) == s.pid)
+      return WIFEXITED(status) ? WEXITSTATUS(status) : -1;
+    std::this_thread::sleep_for(std::chrono::milliseconds(10));
+  }
+  kill(s.pid, SIGKILL);
+  wait_exit(s);
+  return -2;
+}
+
+// Issue 17: a twin of 2e10 Hz physics spun for minutes past --duration-s and SIGTERM. Such a rate
+// is refused by file and key; the heaviest accepted one (1e7 Hz, 10 000 physics steps per 1 ms
+// tick) honours both.
+TEST_F(Serve, HeaviestAcceptedTwinHonoursDurationAndSigterm) {
+  const std::string too_fast = write("too_fast.toml", "[twin]\nphysics_rate_Hz = 2e10\n");
+  const Spawned refused = spawn({"serve", "--port", "0", "--config", too_fast, "--duration-s", "1"},
+                                path("o.txt"), path("e.txt"));
+  EXPECT_EQ(wait_exit_or_kill(refused, 60), 2);
+  EXPECT_NE(slurp(path("e.txt")).find(too_fast + ":2:19: twin.physics_rate_Hz"), std::string::npos)
+      << slurp(path("e.txt"));
+
+  const std::string heavy = write("heavy.toml", "[twin]\nphysics_rate_Hz = 1e7\n");
+  ASSERT_NE(start({"--config", heavy, "--duration-s", "1"}), 0);
+  EXPECT_EQ(wait_exit_or_kill(server_, 120), 0) << slurp(path("err.txt"));
+  server_.pid = -1;
+  const std::string out = slurp(path("out.txt"));
+  EXPECT_NE(out.find("\"stop_reason\": \"duration\""), std::string::npos) << out;
+
+  ASSERT_NE(start({"--config", heavy}), 0);
+  kill(server_.pid, SIGTERM);
+  EXPECT_EQ(wait_exit_or_kill(server_, 120), 0) << slurp(path("err.txt"));
+  server_.pid = -1;
+  EXPECT_NE(slurp(path("out.txt")).find("\"stop_reason\": \"SIGTERM\""), std::string::npos);
+}
+
 TEST_F(Serve, RefusesARemoteAddressWithoutAllowRemoteAndBadInputWithExit2) {
   const auto refused = [&](std::vector<std::string> args, const std::string& piece) {
     const Spawned s = spawn(args, path("o.txt"), path("e.txt"));
