@@ -15,6 +15,7 @@
 #include <nlohmann/json.hpp>
 
 #include "command.hpp"
+#include "whole_number.hpp"
 #include "piezoshift/experiments/metrics_figures.hpp"
 #include "piezoshift/experiments/metrics_linearity.hpp"
 #include "piezoshift/experiments/metrics_repeatability.hpp"
@@ -124,9 +125,13 @@ int run_repeatability(const AnalyzeOptions& o) {
 
 int run_step(const AnalyzeOptions& o_in) {
   AnalyzeOptions o = o_in;
-  if (o.median_window < 1 || o.median_window % 2 == 0)
+  if (o.median_window < 1 || o.median_window % 2 == 0 ||
+      o.median_window > static_cast<std::int64_t>(experiments::kMaxMedianWindow))
+    throw io::InputError(fmt::format("--median-window {}: must be an odd number in [1, {}]",
+                                     o.median_window, experiments::kMaxMedianWindow));
+  if (!std::isfinite(o.step.step_time_s))
     throw io::InputError(
-        fmt::format("--median-window {}: must be an odd number >= 1", o.median_window));
+        fmt::format("--step-time-s {}: must be a finite number", o.step.step_time_s));
   o.step.median_window = static_cast<std::size_t>(o.median_window);
   const io::CsvTable t = io::CsvTable::load(o.data_path);
   t.require_columns({"time_s", "measured_um"});
@@ -196,7 +201,8 @@ void add_analyze_command(CLI::App& app, Action& action) {
       ->check(CLI::PositiveNumber);
   step->add_option("--median-window", o->median_window,
                    "Running-median length against spikes [samples, odd; 1: off]")
-      ->capture_default_str();
+      ->capture_default_str()
+      ->check(whole_number(1, experiments::kMaxMedianWindow));
 
   lin->callback([&action, o] { action = [o] { return run_linearity(*o); }; });
   rep->callback([&action, o] { action = [o] { return run_repeatability(*o); }; });

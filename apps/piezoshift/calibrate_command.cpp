@@ -8,6 +8,7 @@
 #include <nlohmann/json.hpp>
 
 #include "command.hpp"
+#include "whole_number.hpp"
 #include "piezoshift/calibration/calibration_file.hpp"
 #include "piezoshift/calibration/calibration_procedure.hpp"
 #include "piezoshift/experiments/paper_experiments.hpp"
@@ -97,7 +98,8 @@ void add_calibrate_command(CLI::App& app, Action& action) {
   CLI::App* cmd = app.add_subcommand(
       "calibrate", "The paper's three calibration stages on the twin; writes a calibration file");
   cmd->add_option("--out", o->out, "calibration file to write (TOML, replaced atomically)");
-  cmd->add_option("--seed", o->seed, "seed of the twin's random numbers");
+  cmd->add_option("--seed", o->seed, "seed of the twin's random numbers")
+      ->check(whole_number(0, kAnyUnsigned));
   cmd->add_option("--config", o->config, "TOML configuration (configs/paper.toml's sections)");
   cmd->add_option(
          "--pid", o->pid,

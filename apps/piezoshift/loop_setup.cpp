@@ -1,8 +1,6 @@
 #include "loop_setup.hpp"
 
-#include <algorithm>
 #include <csignal>
-#include <limits>
 
 #include <fmt/core.h>
 
@@ -28,11 +26,11 @@ void check_loop_rate(double rate_Hz) {
 }
 
 runtime::SafetyLimits loop_safety_limits(std::int64_t max_overruns) {
-  if (max_overruns < 1)
-    throw io::InputError(fmt::format("--max-overruns {}: must be >= 1", max_overruns));
+  if (max_overruns < 1 || static_cast<std::uint64_t>(max_overruns) > kMaxOverrunsOption)
+    throw io::InputError(fmt::format("--max-overruns {}: must be in [1, {}]", max_overruns,
+                                     kMaxOverrunsOption));
   runtime::SafetyLimits limits;
-  limits.max_consecutive_overruns = static_cast<std::uint32_t>(
-      std::min<std::int64_t>(max_overruns, std::numeric_limits<std::uint32_t>::max()));
+  limits.max_consecutive_overruns = static_cast<std::uint32_t>(max_overruns);
   return limits;
 }
 

@@ -26,8 +26,11 @@ struct ChosenBackend {
 //! the DAQ's practical limit, docs/runtime.md).
 void check_loop_rate(double rate_Hz);
 
+//! Largest --max-overruns: a million consecutive overruns (17 min at 1 kHz) is "never".
+inline constexpr std::uint64_t kMaxOverrunsOption = 1000000;
+
 //! The built-in safety limits with --max-overruns consecutive overruns; throws io::InputError
-//! when it is < 1.
+//! when it is not in [1, kMaxOverrunsOption].
 runtime::SafetyLimits loop_safety_limits(std::int64_t max_overruns);
 
 //! "sim" (the twin of config, at rate_Hz, with seed) or "comedi[:DEVICE]". Throws io::InputError

@@ -17,6 +17,7 @@
 #include <nlohmann/json.hpp>
 
 #include "command.hpp"
+#include "whole_number.hpp"
 #include "piezoshift/io/atomic_file.hpp"
 #include "piezoshift/io/input_error.hpp"
 #include "piezoshift/io/project_config.hpp"
@@ -395,7 +396,9 @@ void add_psi_command(CLI::App& app, Action& action) {
   sim->add_option("--frames", o->n_frames, "Frames (default: the algorithm's count, else 5)");
   sim->add_option("--algorithm", o->algorithm, "One of " + names + " (default hariharan5)");
   sim->add_option("--surface", o->surface, "Test surface, e.g. Z4=40,Z5=25,rough=0.5 (nm)");
-  sim->add_option("--seed", o->seed, "Random seed")->capture_default_str();
+  sim->add_option("--seed", o->seed, "Random seed")
+      ->capture_default_str()
+      ->check(whole_number(0, kAnyUnsigned));
   sim->add_option("--size", o->size_px, "Camera size [px], square")->capture_default_str();
   sim->add_option("--wavelength-nm", o->wavelength_nm, "Wavelength [nm]")->capture_default_str();
   sim->add_flag("!--no-budget", o->budget, "Skip the Monte Carlo error budget");

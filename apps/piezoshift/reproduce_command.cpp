@@ -8,6 +8,7 @@
 #include <fmt/core.h>
 
 #include "command.hpp"
+#include "whole_number.hpp"
 #include "piezoshift/io/input_error.hpp"
 #include "piezoshift/io/project_config.hpp"
 #include "piezoshift/reproduction/report.hpp"
@@ -104,7 +105,8 @@ void add_reproduce_command(CLI::App& app, Action& action) {
   CLI::App* cmd = app.add_subcommand(
       "reproduce", "Calibrate the twin, run the paper's four experiments, write the report");
   cmd->add_option("--out", o->out, "output folder for report.md, report.html, figures, CSVs");
-  cmd->add_option("--seed", o->seed, "seed of the twin's random numbers");
+  cmd->add_option("--seed", o->seed, "seed of the twin's random numbers")
+      ->check(whole_number(0, kAnyUnsigned));
   cmd->add_option("--config", o->config, "TOML configuration (configs/paper.toml's sections)");
   cmd->add_option("--pid", o->pid, "paper: the paper's gains; search: the stage-1 search's")
       ->check(CLI::IsMember({"paper", "search"}));

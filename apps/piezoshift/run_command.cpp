@@ -14,6 +14,7 @@
 #include <nlohmann/json.hpp>
 
 #include "command.hpp"
+#include "whole_number.hpp"
 #include "loop_setup.hpp"
 #include "piezoshift/calibration/calibration_file.hpp"
 #include "piezoshift/io/input_error.hpp"
@@ -53,8 +54,9 @@ double us(std::int64_t ns) {
 
 int run(const RunOptions& o) {
   check_loop_rate(o.rate_Hz);
-  if (!(o.duration_s > 0.0) || o.duration_s > 1e6)
-    throw io::InputError(fmt::format("--duration-s {}: must be > 0 s", o.duration_s));
+  if (!(o.duration_s > 0.0) || o.duration_s > kMaxRunDurationS)
+    throw io::InputError(
+        fmt::format("--duration-s {}: must be in (0, {}] s", o.duration_s, kMaxRunDurationS));
 
   SetpointProfile profile = !o.profile.empty() ? SetpointProfile::load_csv(o.profile)
                                                : SetpointProfile::step(o.step_um.value_or(0.0));
@@ -251,12 +253,15 @@ void add_run_command(CLI::App& app, Action& action) {
   cmd->add_option("--fault", o->faults,
                   "inject KIND@T_S[:CHANNEL] into the twin (sgs-open, sgs-stuck, adc-nan, "
                   "adc-spike, amplifier-fail, actuator-crack, overrun-burst); repeatable");
-  cmd->add_option("--seed", o->seed, "twin noise seed")->capture_default_str();
+  cmd->add_option("--seed", o->seed, "twin noise seed")
+      ->capture_default_str()
+      ->check(whole_number(0, kAnyUnsigned));
   cmd->add_flag("--free-run", o->free_run,
                 "sim only: simulated clock, as fast as possible (tests, benches)");
   cmd->add_option("--max-overruns", o->max_overruns,
                   "consecutive deadline overruns that trip the supervisor")
-      ->capture_default_str();
+      ->capture_default_str()
+      ->check(whole_number(1, kMaxOverrunsOption));
   cmd->add_option("--cpu", o->cpu, "CPU to pin the loop to (-1: the last one, -2: none)")
       ->capture_default_str();
   cmd->callback([&action, o] { action = [o] { return run(*o); }; });

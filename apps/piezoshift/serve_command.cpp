@@ -22,6 +22,7 @@
 #include <nlohmann/json.hpp>
 
 #include "command.hpp"
+#include "whole_number.hpp"
 #include "dashboard_page.hpp"
 #include "loop_setup.hpp"
 #include "piezoshift/calibration/calibration_file.hpp"
@@ -335,7 +336,9 @@ void add_serve_command(CLI::App& app, Action& action) {
                 "allow a --bind address other than loopback (GCS has no authentication)");
   cmd->add_option("--rate-hz", o->rate_Hz, "loop rate, 1000 (the paper) to 10000 Hz")
       ->capture_default_str();
-  cmd->add_option("--seed", o->seed, "twin noise seed")->capture_default_str();
+  cmd->add_option("--seed", o->seed, "twin noise seed")
+      ->capture_default_str()
+      ->check(whole_number(0, kAnyUnsigned));
   cmd->add_option("--duration-s", o->duration_s, "stop after this long (default: at SIGINT/TERM)");
   cmd->add_option("--max-clients", o->max_clients, "clients connected at once")
       ->capture_default_str();
@@ -352,7 +355,8 @@ void add_serve_command(CLI::App& app, Action& action) {
       ->capture_default_str();
   cmd->add_option("--max-overruns", o->max_overruns,
                   "consecutive deadline overruns that trip the supervisor")
-      ->capture_default_str();
+      ->capture_default_str()
+      ->check(whole_number(1, kMaxOverrunsOption));
   cmd->add_option("--cpu", o->cpu, "CPU to pin the loop to (-1: the last one, -2: none)")
       ->capture_default_str();
   cmd->add_option("--log", o->log, "CSV log of every tick (flushed every 0.25 s)");

@@ -24,6 +24,7 @@
 #include <nlohmann/json.hpp>
 
 #include "command.hpp"
+#include "whole_number.hpp"
 #include "piezoshift/control/semi_closed_loop.hpp"
 #include "piezoshift/experiments/bench.hpp"
 #include "piezoshift/io/csv_table.hpp"
@@ -303,7 +304,8 @@ void add_simulate_command(CLI::App& app, Action& action) {
   auto opt = std::make_shared<SimulateOptions>();
   cmd->add_option("--config", opt->config_path,
                   "TOML file (configs/paper.toml's sections; absent keys keep the paper's values)");
-  cmd->add_option("--seed", opt->seed, "seed of the twin's random numbers (default 1)");
+  cmd->add_option("--seed", opt->seed, "seed of the twin's random numbers (default 1)")
+      ->check(whole_number(0, kAnyUnsigned));
   cmd->add_option("--duration-s", opt->duration_s, "simulated time [s] (default 1)");
   cmd->add_option("--open-loop-volts", opt->open_loop_volts,
                   "open loop: the three DAQ output volts V1,V2,V3 (x15 at the stacks)")

@@ -11,6 +11,7 @@
 #include <toml++/toml.h>
 
 #include "piezoshift/io/input_error.hpp"
+#include "piezoshift/io/input_file.hpp"
 
 namespace piezoshift::io {
 
@@ -104,12 +105,11 @@ ConfigFile::~ConfigFile() = default;
 ConfigFile ConfigFile::load(const std::string& path) {
   auto impl = std::make_unique<ConfigFileImpl>();
   impl->source = path;
+  const std::string text = read_input_file(path, kMaxConfigFileBytes);
   try {
-    impl->root = toml::parse_file(path);
+    impl->root = toml::parse(text, path);
   } catch (const toml::parse_error& e) {
     const auto& b = e.source().begin;
-    if (b.line == 0)
-      throw InputError(fmt::format("{}: cannot read: {}", path, e.description()));
     throw InputError(
         fmt::format("{}:{}:{}: syntax error: {}", path, b.line, b.column, e.description()));
   }
