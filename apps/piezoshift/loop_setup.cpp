@@ -35,7 +35,7 @@ runtime::SafetyLimits loop_safety_limits(std::int64_t max_overruns) {
 }
 
 ChosenBackend make_backend(const std::string& daq, const io::ProjectConfig& config,
-                           std::uint64_t seed, double rate_Hz) {
+                           std::uint64_t seed, double rate_Hz, const std::string& config_path) {
   ChosenBackend chosen;
   if (daq == "sim") {
     runtime::SimOptions so;
@@ -43,6 +43,8 @@ ChosenBackend make_backend(const std::string& daq, const io::ProjectConfig& conf
     so.twin = config.twin;
     so.seed = seed;
     so.rate_Hz = rate_Hz;
+    if (!config_path.empty())
+      so.source = config_path;
     auto s = std::make_unique<runtime::SimBackend>(so);
     chosen.sim = s.get();
     chosen.backend = std::move(s);

@@ -34,9 +34,10 @@ inline constexpr std::uint64_t kMaxOverrunsOption = 1000000;
 runtime::SafetyLimits loop_safety_limits(std::int64_t max_overruns);
 
 //! "sim" (the twin of config, at rate_Hz, with seed) or "comedi[:DEVICE]". Throws io::InputError
-//! for anything else. Not configured yet.
+//! for anything else. Not configured yet. config_path: where config came from ("" built in), named
+//! in the sim backend's messages.
 ChosenBackend make_backend(const std::string& daq, const io::ProjectConfig& config,
-                           std::uint64_t seed, double rate_Hz);
+                           std::uint64_t seed, double rate_Hz, const std::string& config_path = {});
 
 //! The controller a loop runs with, and where it came from.
 struct LoopCalibration {

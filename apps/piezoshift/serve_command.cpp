@@ -114,8 +114,10 @@ host::StageModel make_stage_model(const ServeOptions& o, const io::ProjectConfig
     mp.channel_max_V = safety.output_max_V * mp.amplifier_gain;
     return host::StageModel(mp);
   } catch (const std::invalid_argument& e) {
+    // The calibration's A and the config's geometry meet here: name both.
     throw io::InputError(fmt::format(
-        "{}: {}", o.calibration.empty() ? "built-in calibration" : o.calibration, e.what()));
+        "{} with {}: {}", o.calibration.empty() ? "built-in calibration" : o.calibration,
+        o.config.empty() ? "the built-in configuration" : o.config, e.what()));
   }
 }
 
@@ -151,7 +153,7 @@ int serve(const ServeOptions& o) {
   const control::SemiClosedLoopParams& params = cal.params;
   const host::StageModel model = make_stage_model(o, config, params, cal, safety);
 
-  ChosenBackend chosen = make_backend(o.daq, config, o.seed, o.rate_Hz);
+  ChosenBackend chosen = make_backend(o.daq, config, o.seed, o.rate_Hz, o.config);
   check(faults.empty() || chosen.sim != nullptr,
         "--fault needs --daq sim (faults are injected into the twin)");
   runtime::MonotonicClock clock;

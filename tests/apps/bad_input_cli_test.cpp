@@ -38,6 +38,18 @@ TEST_F(BadInput, RepeatabilityOfDataSpreadOverMicronsIsComputedAndOverflowIsRefu
   refused("analyze repeatability --data '" + huge + "'", {huge + ": repeatability", "overflow"});
 }
 
+TEST_F(BadInput, LinearityThatOverflowsIsAFailureNotANan) {
+  const std::string lin =
+      write("lin.csv", "desired_um,measured_um\n1e308,1e308\n-1e308,-1e308\n0,1e300\n");
+  refused("analyze linearity --data '" + lin + "'", {lin + ": linearity", "overflow"});
+}
+
+// An output folder that cannot be made (a file system error on a path the user gave) is bad
+// input, not an internal error.
+TEST_F(BadInput, AnOutputFolderThatCannotBeMadeIsBadInput) {
+  refused("psi simulate --out /dev/null/x", {"/dev/null/x"});
+}
+
 TEST_F(BadInput, StepOptionsOutOfRangeNameTheOption) {
   const std::string step = write("step.csv", "time_s,measured_um\n0,0\n0.001,1\n0.002,1\n0.003,1\n");
   refused("analyze step --data '" + step + "' --median-window 18446744073709551615",

@@ -22,6 +22,7 @@
 // io::InputError for parameters that cannot make one).
 #include <cstdint>
 #include <memory>
+#include <string>
 
 #include "piezoshift/design/design_inputs.hpp"
 #include "piezoshift/plant/twin.hpp"
@@ -36,6 +37,8 @@ struct SimOptions {
   plant::TwinParams twin{};
   std::uint64_t seed = 1;
   double rate_Hz = 1000.0;  //!< the loop's rate; the twin's DAQ period is 1 / rate_Hz
+  //! Where design and twin came from (a configuration file), for messages.
+  std::string source = "the built-in configuration";
 };
 
 class SimBackend final : public DaqBackend, public PlantFaultHooks {
