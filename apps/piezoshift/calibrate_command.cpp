@@ -13,6 +13,7 @@
 #include "piezoshift/calibration/calibration_procedure.hpp"
 #include "piezoshift/experiments/paper_experiments.hpp"
 #include "piezoshift/io/project_config.hpp"
+#include "piezoshift/runtime/safety_ranges.hpp"
 #include "progress_bar.hpp"
 
 namespace piezoshift::app {
@@ -35,7 +36,7 @@ nlohmann::json matrix_json(const control::Mat3& a) {
 
 int run(const Options& o) {
   const io::ProjectConfig config =
-      o.config.empty() ? io::ProjectConfig{} : io::load_project_config(o.config);
+      o.config.empty() ? io::ProjectConfig{} : runtime::load_installation_config(o.config).project;
   calibration::CalibrationOptions co;
   co.pid = o.pid == "paper" ? calibration::PidChoice::kPaper : calibration::PidChoice::kSearch;
   calibration::CalibrationWithTravel ct;

@@ -8,6 +8,7 @@
 #include "piezoshift/calibration/calibration_procedure.hpp"
 #include "piezoshift/io/input_error.hpp"
 #include "piezoshift/runtime/comedi_backend.hpp"
+#include "piezoshift/runtime/safety_ranges.hpp"
 
 namespace piezoshift::app {
 
@@ -25,13 +26,23 @@ void check_loop_rate(double rate_Hz) {
         fmt::format("--rate-hz {}: supported rates are 1000 to 10000 Hz", rate_Hz));
 }
 
-runtime::SafetyLimits loop_safety_limits(std::int64_t max_overruns) {
-  if (max_overruns < 1 || static_cast<std::uint64_t>(max_overruns) > kMaxOverrunsOption)
-    throw io::InputError(fmt::format("--max-overruns {}: must be in [1, {}]", max_overruns,
+runtime::SafetyLimits loop_safety_limits(const runtime::SafetyLimits& installation,
+                                         std::optional<std::int64_t> max_overruns) {
+  runtime::SafetyLimits limits = installation;
+  if (!max_overruns)
+    return limits;
+  if (*max_overruns < 1 || static_cast<std::uint64_t>(*max_overruns) > kMaxOverrunsOption)
+    throw io::InputError(fmt::format("--max-overruns {}: must be in [1, {}]", *max_overruns,
                                      kMaxOverrunsOption));
-  runtime::SafetyLimits limits;
-  limits.max_consecutive_overruns = static_cast<std::uint32_t>(max_overruns);
+  limits.max_consecutive_overruns = static_cast<std::uint32_t>(*max_overruns);
   return limits;
+}
+
+nlohmann::json safety_json(const runtime::SafetyLimits& limits) {
+  nlohmann::json j = nlohmann::json::object();
+  runtime::visit_safety_limits(limits, [&](const char*, const char* key, const auto& value,
+                                           design::Bounds) { j[key] = value; });
+  return j;
 }
 
 ChosenBackend make_backend(const std::string& daq, const io::ProjectConfig& config,

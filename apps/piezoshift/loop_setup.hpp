@@ -8,6 +8,8 @@
 #include <optional>
 #include <string>
 
+#include <nlohmann/json.hpp>
+
 #include "piezoshift/control/semi_closed_loop.hpp"
 #include "piezoshift/io/project_config.hpp"
 #include "piezoshift/runtime/daq_backend.hpp"
@@ -26,12 +28,18 @@ struct ChosenBackend {
 //! the DAQ's practical limit, docs/runtime.md).
 void check_loop_rate(double rate_Hz);
 
-//! Largest --max-overruns: a million consecutive overruns (17 min at 1 kHz) is "never".
+//! Largest --max-overruns: a million consecutive overruns (17 min at 1 kHz) is "never", the
+//! range of [safety] max_consecutive_overruns (runtime/safety_ranges.hpp).
 inline constexpr std::uint64_t kMaxOverrunsOption = 1000000;
 
-//! The built-in safety limits with --max-overruns consecutive overruns; throws io::InputError
-//! when it is not in [1, kMaxOverrunsOption].
-runtime::SafetyLimits loop_safety_limits(std::int64_t max_overruns);
+//! The installation's limits (a config's [safety], or the built-in ones), with --max-overruns
+//! consecutive overruns instead when given; throws io::InputError when that is not in
+//! [1, kMaxOverrunsOption].
+runtime::SafetyLimits loop_safety_limits(const runtime::SafetyLimits& installation,
+                                         std::optional<std::int64_t> max_overruns);
+
+//! The limits as a JSON object, one member per [safety] key.
+nlohmann::json safety_json(const runtime::SafetyLimits& limits);
 
 //! "sim" (the twin of config, at rate_Hz, with seed) or "comedi[:DEVICE]". Throws io::InputError
 //! for anything else. Not configured yet. config_path: where config came from ("" built in), named

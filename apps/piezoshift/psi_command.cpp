@@ -21,6 +21,7 @@
 #include "piezoshift/io/atomic_file.hpp"
 #include "piezoshift/io/input_error.hpp"
 #include "piezoshift/io/project_config.hpp"
+#include "piezoshift/runtime/safety_ranges.hpp"
 #include "piezoshift/psi/analysis.hpp"
 #include "piezoshift/psi/error_budget.hpp"
 #include "piezoshift/psi/npy.hpp"
@@ -274,7 +275,7 @@ int run_calibrate(const PsiOptions& o) {
 int run_simulate(const PsiOptions& o) {
   io::ProjectConfig config;
   if (!o.config.empty())
-    config = io::load_project_config(o.config);
+    config = runtime::load_installation_config(o.config).project;  // [safety] allowed, unused
   psi::SimulationParams p;
   p.algorithm =
       o.algorithm.empty() ? psi::Algorithm::kHariharan5 : psi::parse_algorithm(o.algorithm);

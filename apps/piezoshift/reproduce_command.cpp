@@ -11,6 +11,7 @@
 #include "whole_number.hpp"
 #include "piezoshift/io/input_error.hpp"
 #include "piezoshift/io/project_config.hpp"
+#include "piezoshift/runtime/safety_ranges.hpp"
 #include "piezoshift/reproduction/report.hpp"
 #include "piezoshift/reproduction/reproduction.hpp"
 #include "piezoshift/reproduction/summary.hpp"
@@ -30,7 +31,7 @@ struct Options {
 
 int run(const Options& o) {
   const io::ProjectConfig config =
-      o.config.empty() ? io::ProjectConfig{} : io::load_project_config(o.config);
+      o.config.empty() ? io::ProjectConfig{} : runtime::load_installation_config(o.config).project;
   reproduction::ReproduceOptions ro;
   ro.seed = o.seed;
   ro.quick = o.quick;

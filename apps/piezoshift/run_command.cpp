@@ -22,6 +22,7 @@
 #include "piezoshift/runtime/csv_logger.hpp"
 #include "piezoshift/runtime/fault_injection.hpp"
 #include "piezoshift/runtime/loop_clock.hpp"
+#include "piezoshift/runtime/safety_ranges.hpp"
 #include "piezoshift/runtime/sim_backend.hpp"
 
 namespace piezoshift::app {
@@ -45,7 +46,7 @@ struct RunOptions {
   std::uint64_t seed = 1;
   bool free_run = false;
   int cpu = -1;
-  std::int64_t max_overruns = 3;
+  std::optional<std::int64_t> max_overruns;  // absent: the installation's (3 built in)
 };
 
 double us(std::int64_t ns) {
@@ -111,7 +112,9 @@ int run(const RunOptions& o) {
   config.rate_Hz = o.rate_Hz;
   config.duration_s = o.duration_s;
   config.stop_signal = &g_stop_signal;
-  const SafetyLimits limits = loop_safety_limits(o.max_overruns);
+  const SafetyLimits limits = loop_safety_limits(SafetyLimits{}, o.max_overruns);
+  if (!o.json)
+    fmt::print("safety: {}\n", describe(limits));
   ControlLoop loop(config, params, limits, *daq, *clock, std::move(profile),
                    logger ? &logger->ring() : nullptr);
 
@@ -186,6 +189,7 @@ int run(const RunOptions& o) {
   j["faults_injected"] = injected_list;
   j["detect_latency_ticks"] =
       has_latency ? nlohmann::json(r.fault.tick - injected) : nlohmann::json(nullptr);
+  j["safety"] = safety_json(limits);
   j["max_output_V"] = r.max_output_V;
   j["min_output_V"] = r.min_output_V;
   j["max_output_slew_V_per_ms"] = r.max_output_slew_V_per_ms;
@@ -259,8 +263,7 @@ void add_run_command(CLI::App& app, Action& action) {
   cmd->add_flag("--free-run", o->free_run,
                 "sim only: simulated clock, as fast as possible (tests, benches)");
   cmd->add_option("--max-overruns", o->max_overruns,
-                  "consecutive deadline overruns that trip the supervisor")
-      ->capture_default_str()
+                  "consecutive deadline overruns that trip the supervisor (default 3)")
       ->check(whole_number(1, kMaxOverrunsOption));
   cmd->add_option("--cpu", o->cpu, "CPU to pin the loop to (-1: the last one, -2: none)")
       ->capture_default_str();

@@ -31,6 +31,7 @@
 #include "piezoshift/io/csv_writer.hpp"
 #include "piezoshift/io/input_error.hpp"
 #include "piezoshift/io/project_config.hpp"
+#include "piezoshift/runtime/safety_ranges.hpp"
 #include "piezoshift/plant/simulation_cost.hpp"
 #include "piezoshift/plant/twin.hpp"
 #include "piezoshift/runtime/safety_supervisor.hpp"
@@ -121,15 +122,16 @@ int run_simulate(const SimulateOptions& opt) {
   if (!std::isfinite(opt.step_at_s) || opt.step_at_s < 0.0)
     throw io::InputError(fmt::format("--step-at-s = {} must be >= 0", opt.step_at_s));
 
-  io::ProjectConfig config;
+  runtime::InstallationConfig installation;
   if (!opt.config_path.empty())
-    config = io::load_project_config(opt.config_path);
+    installation = runtime::load_installation_config(opt.config_path);
+  const io::ProjectConfig& config = installation.project;
   const double period_s = config.twin.daq.sample_time_s;
 
-  // The supervisor (the bench's, as `run`'s) passes 0 to 10 DAQ volts (0 to 150 V at the stacks);
-  // anything else would be clamped there, so it is refused here.
+  // The supervisor (the bench's, as `run`'s, with the config's [safety]) passes 0 to 10 DAQ volts
+  // by default (0 to 150 V at the stacks); anything else would be clamped there, so it is refused.
   const bool closed_loop = opt.open_loop_volts.empty();
-  const runtime::SafetyLimits limits;
+  const runtime::SafetyLimits& limits = installation.safety;
   Vec3 open_loop{};
   if (!closed_loop) {
     for (std::size_t i = 0; i < 3; ++i) {
@@ -167,7 +169,9 @@ int run_simulate(const SimulateOptions& opt) {
                                      opt.duration_s, period_s));
   std::unique_ptr<experiments::Bench> made;
   try {
-    made = std::make_unique<experiments::Bench>(config, cp, opt.seed);
+    experiments::BenchOptions bo;
+    bo.limits = limits;
+    made = std::make_unique<experiments::Bench>(config, cp, opt.seed, bo);
   } catch (const std::invalid_argument& e) {
     throw io::InputError(fmt::format(
         "{}: {}", opt.config_path.empty() ? "configuration" : opt.config_path, e.what()));

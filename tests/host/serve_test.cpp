@@ -511,6 +511,21 @@ TEST_F(Serve, HeaviestAcceptedTwinHonoursDurationAndSigterm) {
   EXPECT_NE(slurp(path("out.txt")).find("\"stop_reason\": \"SIGTERM\""), std::string::npos);
 }
 
+// The installation's [safety] is applied and shown at start-up and in the summary; the command
+// line's --max-overruns (start() gives 1000000) overrides its overrun count.
+TEST_F(Serve, SafetySectionIsAppliedAndShown) {
+  const std::string site =
+      write("site.toml", "[safety]\noutput_max_V = 8.0\nmax_consecutive_overruns = 5\n");
+  ASSERT_NE(start({"--config", site, "--duration-s", "0.2"}), 0);
+  EXPECT_EQ(wait_exit_or_kill(server_, 120), 0) << slurp(path("err.txt"));
+  server_.pid = -1;
+  const std::string out = slurp(path("out.txt"));
+  EXPECT_NE(out.find("safety (" + site + " [safety]): outputs 0 to 8 V"), std::string::npos) << out;
+  const nlohmann::json j = nlohmann::json::parse(out.substr(out.find("\n{") + 1));
+  EXPECT_EQ(j.at("safety").at("output_max_V"), 8.0);
+  EXPECT_EQ(j.at("safety").at("max_consecutive_overruns"), 1000000);
+}
+
 TEST_F(Serve, RefusesARemoteAddressWithoutAllowRemoteAndBadInputWithExit2) {
   const auto refused = [&](std::vector<std::string> args, const std::string& piece) {
     const Spawned s = spawn(args, path("o.txt"), path("e.txt"));

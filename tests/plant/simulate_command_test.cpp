@@ -135,6 +135,15 @@ TEST_F(SimulateCommand, CostIsEstimatedAndRefusedAboveTheBudgetUnlessRaised) {
   EXPECT_NE(r.err.find("--max-physics-steps = 0 must be in [1, 1e15]"), std::string::npos) << r.err;
 }
 
+// The installation's [safety] is the supervisor's: 9 V passes the built-in 10 V limit, not 8 V.
+TEST_F(SimulateCommand, SafetySectionOfTheConfigIsTheSupervisors) {
+  const std::string site = write("site.toml", "[safety]\noutput_max_V = 8.0\n");
+  EXPECT_EQ(run("--open-loop-volts 9,9,9 --duration-s 0.01").status, 0);
+  const RunResult r = run("--open-loop-volts 9,9,9 --duration-s 0.01 --config '" + site + "'");
+  EXPECT_EQ(r.status, 2);
+  EXPECT_NE(r.err.find("V1 = 9 is outside the supervisor's 0 to 8 V"), std::string::npos) << r.err;
+}
+
 TEST_F(SimulateCommand, ConfigValuesThatUsedToExhaustOrHangAreRefusedByFileAndKey) {
   const struct {
     const char* toml;
