@@ -15,13 +15,13 @@
 #include <nlohmann/json.hpp>
 
 #include "command.hpp"
-#include "whole_number.hpp"
 #include "piezoshift/experiments/metrics_figures.hpp"
 #include "piezoshift/experiments/metrics_linearity.hpp"
 #include "piezoshift/experiments/metrics_repeatability.hpp"
 #include "piezoshift/experiments/metrics_step_response.hpp"
 #include "piezoshift/io/csv_table.hpp"
 #include "piezoshift/io/plot.hpp"
+#include "whole_number.hpp"
 
 namespace piezoshift::app {
 namespace {

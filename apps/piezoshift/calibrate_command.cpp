@@ -8,13 +8,13 @@
 #include <nlohmann/json.hpp>
 
 #include "command.hpp"
-#include "whole_number.hpp"
 #include "piezoshift/calibration/calibration_file.hpp"
 #include "piezoshift/calibration/calibration_procedure.hpp"
 #include "piezoshift/experiments/paper_experiments.hpp"
 #include "piezoshift/io/project_config.hpp"
 #include "piezoshift/runtime/safety_ranges.hpp"
 #include "progress_bar.hpp"
+#include "whole_number.hpp"
 
 namespace piezoshift::app {
 namespace {

@@ -32,8 +32,8 @@ runtime::SafetyLimits loop_safety_limits(const runtime::SafetyLimits& installati
   if (!max_overruns)
     return limits;
   if (*max_overruns < 1 || static_cast<std::uint64_t>(*max_overruns) > kMaxOverrunsOption)
-    throw io::InputError(fmt::format("--max-overruns {}: must be in [1, {}]", *max_overruns,
-                                     kMaxOverrunsOption));
+    throw io::InputError(
+        fmt::format("--max-overruns {}: must be in [1, {}]", *max_overruns, kMaxOverrunsOption));
   limits.max_consecutive_overruns = static_cast<std::uint32_t>(*max_overruns);
   return limits;
 }

@@ -17,11 +17,9 @@
 #include <nlohmann/json.hpp>
 
 #include "command.hpp"
-#include "whole_number.hpp"
 #include "piezoshift/io/atomic_file.hpp"
 #include "piezoshift/io/input_error.hpp"
 #include "piezoshift/io/project_config.hpp"
-#include "piezoshift/runtime/safety_ranges.hpp"
 #include "piezoshift/psi/analysis.hpp"
 #include "piezoshift/psi/error_budget.hpp"
 #include "piezoshift/psi/npy.hpp"
@@ -29,6 +27,8 @@
 #include "piezoshift/psi/simulation.hpp"
 #include "piezoshift/psi/step_calibration.hpp"
 #include "piezoshift/psi/zernike.hpp"
+#include "piezoshift/runtime/safety_ranges.hpp"
+#include "whole_number.hpp"
 
 namespace piezoshift::app {
 namespace {

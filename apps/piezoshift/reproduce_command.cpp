@@ -8,14 +8,14 @@
 #include <fmt/core.h>
 
 #include "command.hpp"
-#include "whole_number.hpp"
 #include "piezoshift/io/input_error.hpp"
 #include "piezoshift/io/project_config.hpp"
-#include "piezoshift/runtime/safety_ranges.hpp"
 #include "piezoshift/reproduction/report.hpp"
 #include "piezoshift/reproduction/reproduction.hpp"
 #include "piezoshift/reproduction/summary.hpp"
+#include "piezoshift/runtime/safety_ranges.hpp"
 #include "progress_bar.hpp"
+#include "whole_number.hpp"
 
 namespace piezoshift::app {
 namespace {

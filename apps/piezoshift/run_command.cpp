@@ -14,7 +14,6 @@
 #include <nlohmann/json.hpp>
 
 #include "command.hpp"
-#include "whole_number.hpp"
 #include "loop_setup.hpp"
 #include "piezoshift/calibration/calibration_file.hpp"
 #include "piezoshift/io/input_error.hpp"
@@ -24,6 +23,7 @@
 #include "piezoshift/runtime/loop_clock.hpp"
 #include "piezoshift/runtime/safety_ranges.hpp"
 #include "piezoshift/runtime/sim_backend.hpp"
+#include "whole_number.hpp"
 
 namespace piezoshift::app {
 

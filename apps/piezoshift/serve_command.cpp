@@ -22,7 +22,6 @@
 #include <nlohmann/json.hpp>
 
 #include "command.hpp"
-#include "whole_number.hpp"
 #include "dashboard_page.hpp"
 #include "loop_setup.hpp"
 #include "piezoshift/calibration/calibration_file.hpp"
@@ -34,11 +33,12 @@
 #include "piezoshift/host/stage_model.hpp"
 #include "piezoshift/io/input_error.hpp"
 #include "piezoshift/io/project_config.hpp"
-#include "piezoshift/runtime/safety_ranges.hpp"
 #include "piezoshift/runtime/control_loop.hpp"
 #include "piezoshift/runtime/csv_logger.hpp"
 #include "piezoshift/runtime/fault_injection.hpp"
 #include "piezoshift/runtime/loop_clock.hpp"
+#include "piezoshift/runtime/safety_ranges.hpp"
+#include "whole_number.hpp"
 
 namespace piezoshift::app {
 

@@ -24,17 +24,17 @@
 #include <nlohmann/json.hpp>
 
 #include "command.hpp"
-#include "whole_number.hpp"
 #include "piezoshift/control/semi_closed_loop.hpp"
 #include "piezoshift/experiments/bench.hpp"
 #include "piezoshift/io/csv_table.hpp"
 #include "piezoshift/io/csv_writer.hpp"
 #include "piezoshift/io/input_error.hpp"
 #include "piezoshift/io/project_config.hpp"
-#include "piezoshift/runtime/safety_ranges.hpp"
 #include "piezoshift/plant/simulation_cost.hpp"
 #include "piezoshift/plant/twin.hpp"
+#include "piezoshift/runtime/safety_ranges.hpp"
 #include "piezoshift/runtime/safety_supervisor.hpp"
+#include "whole_number.hpp"
 
 namespace piezoshift::app {
 namespace {
@@ -155,10 +155,10 @@ int run_simulate(const SimulateOptions& opt) {
   if (const std::string p =
           plant::simulation_budget_problem(cost, opt.max_physics_steps, "--max-physics-steps");
       !p.empty()) {
-    throw io::InputError(fmt::format(
-        "--duration-s {} with physics_rate_Hz {} and sample_time_s {} ({}): {}", opt.duration_s,
-        config.twin.physics_rate_Hz, period_s,
-        opt.config_path.empty() ? "built-in configuration" : opt.config_path, p));
+    throw io::InputError(
+        fmt::format("--duration-s {} with physics_rate_Hz {} and sample_time_s {} ({}): {}",
+                    opt.duration_s, config.twin.physics_rate_Hz, period_s,
+                    opt.config_path.empty() ? "built-in configuration" : opt.config_path, p));
   }
 
   control::SemiClosedLoopParams cp;
@@ -321,8 +321,9 @@ void add_simulate_command(CLI::App& app, Action& action) {
   cmd->add_option("--profile", opt->profile_path,
                   "closed loop: CSV with columns t_s,zd_um (a staircase of Z_d)");
   cmd->add_option("--log", opt->log_path, "CSV log, one row per control tick");
-  cmd->add_option("--max-physics-steps", opt->max_physics_steps,
-                  "refuse a run estimated above this many physics steps (default 1e9, about a minute)");
+  cmd->add_option(
+      "--max-physics-steps", opt->max_physics_steps,
+      "refuse a run estimated above this many physics steps (default 1e9, about a minute)");
   cmd->add_flag("--json", opt->json, "print a JSON summary instead of the text one");
   cmd->callback([&action, opt] { action = [opt] { return run_simulate(*opt); }; });
 }

@@ -32,12 +32,12 @@
 #include "piezoshift/experiments/paper_experiments.hpp"
 #include "piezoshift/io/input_error.hpp"
 #include "piezoshift/io/project_config.hpp"
-#include "piezoshift/runtime/safety_ranges.hpp"
 #include "piezoshift/plant/twin.hpp"
 #include "piezoshift/plant/twin_params.hpp"
 #include "piezoshift/reproduction/report.hpp"
 #include "piezoshift/reproduction/reproduction.hpp"
 #include "piezoshift/reproduction/summary.hpp"
+#include "piezoshift/runtime/safety_ranges.hpp"
 
 namespace py = pybind11;
 namespace ps = piezoshift;

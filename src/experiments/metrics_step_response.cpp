@@ -62,7 +62,8 @@ StepResponseMetrics step_response_metrics(std::span<const double> t_s, std::span
       !std::isfinite(o.band_nm))
     throw MetricsError("step response: the settling bands must be > 0");
   if (!std::isfinite(o.step_time_s))
-    throw MetricsError(fmt::format("step response: step_time_s = {} must be finite", o.step_time_s));
+    throw MetricsError(
+        fmt::format("step response: step_time_s = {} must be finite", o.step_time_s));
   const auto first_after = static_cast<std::size_t>(
       std::lower_bound(t_s.begin(), t_s.end(), o.step_time_s) - t_s.begin());
   if (n - first_after < 3) {

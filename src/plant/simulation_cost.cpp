@@ -7,8 +7,8 @@
 namespace piezoshift::plant {
 
 SimulationCost estimate_simulation_cost(const TwinParams& twin, double duration_s) {
-  const double per_tick = std::fmax(1.0, std::ceil(twin.physics_rate_Hz * twin.daq.sample_time_s -
-                                                   1e-9));
+  const double per_tick =
+      std::fmax(1.0, std::ceil(twin.physics_rate_Hz * twin.daq.sample_time_s - 1e-9));
   SimulationCost c;
   c.control_ticks = duration_s / twin.daq.sample_time_s;
   c.physics_steps = c.control_ticks * per_tick;

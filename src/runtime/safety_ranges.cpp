@@ -10,13 +10,13 @@ namespace piezoshift::runtime {
 
 std::string safety_limits_problem(const SafetyLimits& l) {
   std::string problem;
-  visit_safety_limits(l, [&](const char* section, const char* key, const auto& value,
-                             design::Bounds bounds) {
-    if (problem.empty()) {
-      problem = design::range_problem(fmt::format("{}.{}", section, key),
-                                      static_cast<double>(value), bounds);
-    }
-  });
+  visit_safety_limits(
+      l, [&](const char* section, const char* key, const auto& value, design::Bounds bounds) {
+        if (problem.empty()) {
+          problem = design::range_problem(fmt::format("{}.{}", section, key),
+                                          static_cast<double>(value), bounds);
+        }
+      });
   if (!problem.empty())
     return problem;
   if (!(l.output_min_V < l.output_max_V))
@@ -29,23 +29,22 @@ std::string safety_limits_problem(const SafetyLimits& l) {
     return fmt::format("safety.sgs_min_V = {} must be below safety.sgs_max_V = {}", l.sgs_min_V,
                        l.sgs_max_V);
   if (!(l.response_gain_min < l.response_gain_max))
-    return fmt::format(
-        "safety.response_gain_min = {} must be below safety.response_gain_max = {}",
-        l.response_gain_min, l.response_gain_max);
+    return fmt::format("safety.response_gain_min = {} must be below safety.response_gain_max = {}",
+                       l.response_gain_min, l.response_gain_max);
   return {};
 }
 
 void read_safety_section(const io::ConfigFile& file, SafetyLimits& limits) {
   const io::ConfigSection s = file.section("safety");
-  visit_safety_limits(limits, [&](const char*, const char* key, auto& value,
-                                  design::Bounds bounds) {
-    if constexpr (std::is_same_v<std::remove_reference_t<decltype(value)>, std::uint32_t>) {
-      if (std::int64_t v = 0; s.read(key, v, bounds))
-        value = static_cast<std::uint32_t>(v);  // within bounds, so within uint32
-    } else {
-      s.read(key, value, bounds);
-    }
-  });
+  visit_safety_limits(
+      limits, [&](const char*, const char* key, auto& value, design::Bounds bounds) {
+        if constexpr (std::is_same_v<std::remove_reference_t<decltype(value)>, std::uint32_t>) {
+          if (std::int64_t v = 0; s.read(key, v, bounds))
+            value = static_cast<std::uint32_t>(v);  // within bounds, so within uint32
+        } else {
+          s.read(key, value, bounds);
+        }
+      });
   if (const std::string problem = safety_limits_problem(limits); !problem.empty())
     throw io::InputError(fmt::format("{}: {}", file.source(), problem));
 }

@@ -63,7 +63,7 @@ TEST(MetricsFigures, LinearityAndRepeatabilityFiguresRender) {
 // the histogram's 10000 bins of 1 nm: the bin widens to 1, 2 or 5 x 10^k nm, named on the axis.
 TEST(MetricsFigures, RepeatabilityHistogramWidensItsBinForMicronSpreads) {
   EXPECT_EQ(histogram_bin_nm(4.0, 1.0), 1.0);
-  EXPECT_EQ(histogram_bin_nm(11000.0, 1.0), 50.0);  // 22 nm at least: 50 nm
+  EXPECT_EQ(histogram_bin_nm(11000.0, 1.0), 50.0);   // 22 nm at least: 50 nm
   EXPECT_EQ(histogram_bin_nm(60000.0, 1.0), 200.0);  // 120 nm at least: 200 nm
   std::vector<RepeatabilitySet> sets{{"sweep", {}}};
   for (int i = 0; i <= 11; ++i)

@@ -541,9 +541,9 @@ TEST_F(Serve, RefusesARemoteAddressWithoutAllowRemoteAndBadInputWithExit2) {
   // A config valid at its own 1 kHz but not at the loop's 3 kHz (21 kHz physics is no multiple of
   // the interferometer's 1 kHz): the message names the rate and the file, not only a key.
   const std::string cfg = write("twin.toml", "[twin]\nphysics_rate_Hz = 20000\n");
-  refused({"serve", "--port", "0", "--rate-hz", "3000", "--config", cfg, "--calibration",
-           calibration_},
-          "sim at 3000 Hz: the twin of " + cfg + " cannot be built");
+  refused(
+      {"serve", "--port", "0", "--rate-hz", "3000", "--config", cfg, "--calibration", calibration_},
+      "sim at 3000 Hz: the twin of " + cfg + " cannot be built");
 }
 
 }  // namespace

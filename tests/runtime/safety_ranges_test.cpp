@@ -59,8 +59,7 @@ TEST(SafetyRanges, TheSupervisorRefusesWhatTheReaderRefuses) {
     s.configure(l, 1e-3, {});
     ADD_FAILURE() << "no error";
   } catch (const std::invalid_argument& e) {
-    EXPECT_EQ(std::string(e.what()),
-              "SafetyLimits: safety.jump_factor = 1.5 must be in [2, 100]");
+    EXPECT_EQ(std::string(e.what()), "SafetyLimits: safety.jump_factor = 1.5 must be in [2, 100]");
   }
 }
 

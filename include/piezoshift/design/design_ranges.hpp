@@ -26,8 +26,7 @@ void visit_design_values(Inputs& in, Visit&& visit) {
   visit("material", "elastic_modulus_Pa", in.material.elastic_modulus_Pa, Bounds::above(0, 1e13));
   visit("material", "poisson_ratio", in.material.poisson_ratio, Bounds::open(0.0, 0.5));
   visit("material", "density_kg_per_m3", in.material.density_kg_per_m3, Bounds::above(0, 1e5));
-  visit("material", "allowable_stress_Pa", in.material.allowable_stress_Pa,
-        Bounds::above(0, 1e11));
+  visit("material", "allowable_stress_Pa", in.material.allowable_stress_Pa, Bounds::above(0, 1e11));
   visit("hinge", "width_m", in.hinge.width_m, Bounds::above(0, 1.0));
   visit("hinge", "thickness_m", in.hinge.thickness_m, Bounds::above(0, 1.0));
   visit("hinge", "radius_m", in.hinge.radius_m, Bounds::above(0, 1.0));

@@ -54,12 +54,10 @@ void visit_twin_values(Twin& t, Visit&& visit) {
   visit("twin.piezo", "creep_longest_time_constant_s", t.piezo.creep.longest_time_constant_s,
         B::closed(1e-6, 1e9));
   visit("twin.piezo", "creep_terms_per_decade", t.piezo.creep.terms_per_decade, B::closed(1, 10));
-  visit("twin.piezo", "creep_reference_time_s", t.piezo.creep_reference_time_s,
-        B::above(0.0, 1e9));
+  visit("twin.piezo", "creep_reference_time_s", t.piezo.creep_reference_time_s, B::above(0.0, 1e9));
   visit("twin.piezo", "free_stroke_scale", t.piezo.free_stroke_scale, B::above(0.0, 10.0));
 
-  visit("twin.contact", "open_loop_travel_um", t.contact.open_loop_travel_um,
-        B::above(0.0, 1e4));
+  visit("twin.contact", "open_loop_travel_um", t.contact.open_loop_travel_um, B::above(0.0, 1e4));
   visit("twin.contact", "open_loop_time_s", t.contact.open_loop_time_s, B::above(0.0, 1e9));
   visit("twin.contact", "stiffness_N_per_um", t.contact.stiffness_N_per_um, B::above(0.0, 1e6));
   visit("twin.contact", "ball_radius_m", t.contact.ball_radius_m, B::closed(0.0, 1.0));
@@ -96,10 +94,8 @@ void visit_twin_values(Twin& t, Visit&& visit) {
   visit("twin.sgs", "excitation_drift_window_s", t.sgs.excitation_drift_window_s,
         B::above(0.0, 1e9));
 
-  visit("twin.interferometer", "wavelength_nm", t.interferometer.wavelength_nm,
-        B::above(0.0, 1e5));
-  visit("twin.interferometer", "resolution_nm", t.interferometer.resolution_nm,
-        B::above(0.0, 1e6));
+  visit("twin.interferometer", "wavelength_nm", t.interferometer.wavelength_nm, B::above(0.0, 1e5));
+  visit("twin.interferometer", "resolution_nm", t.interferometer.resolution_nm, B::above(0.0, 1e6));
   visit("twin.interferometer", "accuracy_ppm", t.interferometer.accuracy_ppm, B::closed(0.0, 1e6));
   visit("twin.interferometer", "noise_nm_rms", t.interferometer.noise_nm_rms, B::closed(0.0, 1e6));
   visit("twin.interferometer", "cyclic_error_nm", t.interferometer.cyclic_error_nm,
