@@ -64,6 +64,14 @@ void validate(const Figure& f) {
     if (p.series.empty())
       throw std::invalid_argument(fmt::format("plot: panel '{}' has no series", p.title));
     for (const Series& s : p.series) {
+      if (p.x_log) {
+        for (const double x : s.x) {
+          if (!(x > 0.0))
+            throw std::invalid_argument(
+                fmt::format("plot: series '{}' of panel '{}' has x = {} on a logarithmic axis",
+                            s.title, p.title, x));
+        }
+      }
       const bool needs_w = s.style == SeriesStyle::kBoxes || s.style == SeriesStyle::kBand;
       if (s.x.empty() || s.x.size() != s.y.size() || (needs_w && s.w.size() != s.x.size()))
         throw std::invalid_argument(
@@ -107,6 +115,7 @@ std::string script_body(const Figure& f) {
     b += fmt::format("set title {}\nset xlabel {}\nset ylabel {}\n", gp_quote(p.title),
                      gp_quote(p.x_label), gp_quote(p.y_label));
     b += p.key == "off" ? "unset key\n" : fmt::format("set key {} opaque\n", p.key);
+    b += p.x_log ? "set logscale x\n" : "unset logscale x\n";
     b += fmt::format("set xrange {}\nset yrange {}\n", range(p.x_range), range(p.y_range));
     for (const Marker& m : p.markers) {
       if (m.vertical) {

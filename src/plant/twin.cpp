@@ -118,12 +118,14 @@ void Twin::advance() noexcept {
   const double w0 = mean_point_modal_[0], w1 = mean_point_modal_[1], w2 = mean_point_modal_[2];
   double z_max = -std::numeric_limits<double>::infinity();
   double z_min = std::numeric_limits<double>::infinity();
+  double z_sum = 0.0;
   const double t0 = static_cast<double>(tick_) * m.control_period_s;
   for (std::size_t s = 0; s < n; ++s) {
     mech.step(ms, force_N_[s]);
     const double z_mean = w0 * ms[0] + w1 * ms[2] + w2 * ms[4];
     z_max = z_mean > z_max ? z_mean : z_max;
     z_min = z_mean < z_min ? z_mean : z_min;
+    z_sum += z_mean;
     fm0 += beta * (ms[0] - fm0);
     fm1 += beta * (ms[2] - fm1);
     fm2 += beta * (ms[4] - fm2);
@@ -173,6 +175,7 @@ void Twin::advance() noexcept {
   update_truth(x);
   truth_.period_max_mean_points_um = z_max;
   truth_.period_min_mean_points_um = z_min;
+  truth_.period_avg_mean_points_um = z_sum / static_cast<double>(n);
 }
 
 void Twin::update_mean_point_weights() {

@@ -1,6 +1,7 @@
 #include "piezoshift/reproduction/reproduction.hpp"
 
 #include <chrono>
+#include <stdexcept>
 
 namespace piezoshift::reproduction {
 
@@ -40,12 +41,15 @@ Schedule Schedule::quick() {
 
 namespace {
 
+constexpr double kFastSampleTime_s = 1e-4;  // 10 kHz, the second loop rate
+
 void with_feedback(Schedule& s, experiments::Feedback f) {
   s.travel.bench.feedback = f;
   s.step.bench.feedback = f;
   s.linearity.bench.feedback = f;
   s.linearity_grid.bench.feedback = f;
   s.linearity_down.bench.feedback = f;
+  s.phase_step.bench.feedback = f;
   s.repeat_5um.bench.feedback = f;
   s.repeat_10um.bench.feedback = f;
 }
@@ -61,6 +65,7 @@ void run_set(ExperimentSet& r, const io::ProjectConfig& config,
   r.repeat_10um = ex::run_repeatability(config, c, seed + 50, s.repeat_10um, progress);
   r.linearity_grid = ex::run_linearity(config, c, seed + 60, s.linearity_grid, progress);
   r.linearity_down = ex::run_linearity(config, c, seed + 70, s.linearity_down, progress);
+  r.phase_step = ex::run_phase_step(config, c, seed + 80, s.phase_step, progress);
 }
 
 }  // namespace
@@ -68,7 +73,7 @@ void run_set(ExperimentSet& r, const io::ProjectConfig& config,
 double ExperimentSet::experiments_simulated_time_s() const {
   return travel.simulated_time_s + step.simulated_time_s + linearity.simulated_time_s +
          linearity_grid.simulated_time_s + linearity_down.simulated_time_s +
-         repeat_5um.simulated_time_s + repeat_10um.simulated_time_s;
+         repeat_5um.simulated_time_s + repeat_10um.simulated_time_s + phase_step.simulated_time_s;
 }
 
 bool ExperimentSet::table4_valid() const {
@@ -89,6 +94,7 @@ std::vector<std::string> ExperimentSet::invalid_reasons() const {
   add("repeatability 10 um", repeat_10um.validity);
   add("linearity (0.25 um grid)", linearity_grid.validity);
   add("linearity (downwards)", linearity_down.validity);
+  add("phase step", phase_step.validity);
   return out;
 }
 
@@ -105,15 +111,38 @@ ReproductionResult reproduce(const io::ProjectConfig& config, const ReproduceOpt
   base.sample_time_s = config.twin.daq.sample_time_s;  // the controller runs at the DAQ's rate
   r.calibration = calibration::calibrate(config, base, seed, s.calibration, progress);
   run_set(r, config, r.calibration.controller, seed, s, progress);
+  control::SemiClosedLoopParams without_cubic = r.calibration.controller;
+  without_cubic.polynomial = control::CubicPolynomial::identity();
+  r.linearity_without_cubic =
+      experiments::run_linearity(config, without_cubic, seed + 30, s.linearity, progress);
+  std::vector<double> rates{config.twin.daq.sample_time_s};
+  if (config.twin.daq.sample_time_s != kFastSampleTime_s)
+    rates.push_back(kFastSampleTime_s);
+  for (std::size_t i = 0; i < rates.size(); ++i) {
+    io::ProjectConfig at = config;
+    control::SemiClosedLoopParams c = r.calibration.controller;
+    at.twin.daq.sample_time_s = c.sample_time_s = rates[i];
+    InnerLoopAnalysis& a = r.inner_loop.emplace_back();
+    a.sample_time_s = c.sample_time_s;
+    try {
+      a.plant = calibration::identify_loop(at, c, seed + 90 + i);
+      a.margins = calibration::pid_margins(a.plant, c.pid_params());
+    } catch (const std::invalid_argument& e) {  // e.g. a physics rate 10 kHz does not divide
+      a.validity.fail(e.what());
+    } catch (const experiments::ProcedureFailed& e) {
+      a.validity.fail(e.what());
+    }
+  }
   // The oracle: the same loop, gains and A, fed the plate's truth; nothing left for p to correct.
   r.oracle_controller = r.calibration.controller;
   r.oracle_controller.polynomial = control::CubicPolynomial::identity();
   Schedule so = s;
   with_feedback(so, experiments::Feedback::kOracle);
   run_set(r.oracle, config, r.oracle_controller, seed, so, progress);
-  r.simulated_time_s = r.calibration.pid.simulated_time_s + r.calibration.matrix.simulated_time_s +
-                       r.calibration.polynomial.simulated_time_s +
-                       r.experiments_simulated_time_s() + r.oracle.experiments_simulated_time_s();
+  r.simulated_time_s =
+      r.calibration.pid.simulated_time_s + r.calibration.matrix.simulated_time_s +
+      r.calibration.polynomial.simulated_time_s + r.experiments_simulated_time_s() +
+      r.linearity_without_cubic.simulated_time_s + r.oracle.experiments_simulated_time_s();
   r.wall_time_s = std::chrono::duration<double>(std::chrono::steady_clock::now() - start).count();
   return r;
 }

@@ -1,6 +1,9 @@
 #include "piezoshift/reproduction/summary.hpp"
 
+#include <algorithm>
 #include <cmath>
+
+#include <fmt/core.h>
 
 namespace piezoshift::reproduction {
 namespace {
@@ -59,6 +62,10 @@ void set_json(nlohmann::json& j, const std::string& prefix, const ExperimentSet&
   j[prefix + "repeatability_10um_nm"] = e.repeat_10um.metrics.repeatability_nm;
   j[prefix + "repeatability_5um_n"] = e.repeat_5um.metrics.n;
   j[prefix + "repeatability_10um_n"] = e.repeat_10um.metrics.n;
+  j[prefix + "phase_step_nm"] = e.phase_step.step_nm;
+  j[prefix + "phase_step_hold_jitter_nm_rms"] = e.phase_step.hold_jitter_nm_rms;
+  j[prefix + "phase_step_settling_time_s"] = time_or_null(e.phase_step.settling_time_s);
+  j[prefix + "phase_step_final_error_nm"] = e.phase_step.final_error_nm;
   j[prefix + "valid"] = e.table4_valid();
   j[prefix + "invalid_reasons"] = e.invalid_reasons();
   const auto validity = [](const experiments::Validity& v) {
@@ -70,7 +77,8 @@ void set_json(nlohmann::json& j, const std::string& prefix, const ExperimentSet&
                             {"linearity_grid", validity(e.linearity_grid.validity)},
                             {"linearity_down", validity(e.linearity_down.validity)},
                             {"repeatability_5um", validity(e.repeat_5um.validity)},
-                            {"repeatability_10um", validity(e.repeat_10um.validity)}};
+                            {"repeatability_10um", validity(e.repeat_10um.validity)},
+                            {"phase_step", validity(e.phase_step.validity)}};
 }
 
 }  // namespace
@@ -83,6 +91,31 @@ nlohmann::json summary_json(const ReproductionResult& r) {
   j["pid"] = r.options.pid == calibration::PidChoice::kPaper ? "paper" : "search";
   set_json(j, "", r);
   set_json(j, "oracle_", r.oracle);
+  const auto& raw = r.linearity_without_cubic;
+  j["linearity_without_cubic_zero_end_pct"] = raw.metrics.linearity_zero_end_pct;
+  j["linearity_without_cubic_best_fit_pct"] = raw.metrics.linearity_best_fit_pct;
+  j["linearity_without_cubic_valid"] = raw.validity.valid;
+  // The calibrated PID's stability margins on the identified loop, the worst of the channels.
+  for (const InnerLoopAnalysis& a : r.inner_loop) {
+    const std::string at = fmt::format("pid_margins_{:g}kHz_", 1e-3 / a.sample_time_s);
+    j[at + "valid"] = a.validity.valid;
+    if (!a.validity.valid) {
+      j[at + "reason"] = a.validity.reason;
+      continue;
+    }
+    double gm = a.margins[0].gain_margin_dB, pm = a.margins[0].phase_margin_deg;
+    double fc = a.margins[0].gain_crossover_Hz;
+    for (const auto& m : a.margins) {
+      gm = std::min(gm, m.gain_margin_dB);
+      if (m.phase_margin_deg < pm) {
+        pm = m.phase_margin_deg;
+        fc = m.gain_crossover_Hz;
+      }
+    }
+    j[at + "gain_margin_dB"] = std::isfinite(gm) ? nlohmann::json(gm) : nlohmann::json();
+    j[at + "phase_margin_deg"] = std::isfinite(pm) ? nlohmann::json(pm) : nlohmann::json();
+    j[at + "gain_crossover_Hz"] = std::isfinite(fc) ? nlohmann::json(fc) : nlohmann::json();
+  }
   j["identified_A"] = matrix_json(cal.controller.matrix.a);
   j["identified_A_condition_number"] = cal.matrix.fit.condition_number;
   j["identified_A_rms_residual_um"] = cal.matrix.fit.rms_residual_um;

@@ -1,6 +1,8 @@
 // The paper's calibration stages run on the twin: each recovers what the twin is known to be.
 #include <gtest/gtest.h>
 
+#include <algorithm>
+#include <cmath>
 #include <filesystem>
 #include <fstream>
 
@@ -81,6 +83,54 @@ TEST(MatrixIdentification, RecoversThePapersMatrixFromTheTwin) {
   }
   EXPECT_NEAR(r.fit.condition_number, 1.513, 0.05);  // cond of the paper's A
   EXPECT_LT(r.fit.rms_residual_um, 0.01);
+}
+
+// A calibration that returns the paper's A on every plant proves nothing. Here the three gauges'
+// gains are off by +4, -3 and +2 % (a gauge factor and conditioner trim tolerance): the twin's true
+// A is then D A_paper with D = diag(1.04, 0.97, 1.02), its mechanics unchanged (W = A^-1 G is the
+// same, docs/twin.md). Stage 2 must find D A_paper, several times further from the paper's A than
+// from the truth, and the paper's A on this plant must tilt the plate where the identified one
+// does not.
+TEST(MatrixIdentification, FindsThePlantsOwnMatrixWhenTheGaugeGainsDiffer) {
+  const control::TransmissionMatrix paper;
+  const double d[3] = {1.04, 0.97, 1.02};
+  io::ProjectConfig config;
+  control::Mat3 truth{};
+  for (std::size_t i = 0; i < 3; ++i) {
+    for (std::size_t j = 0; j < 3; ++j)
+      truth[i][j] = d[i] * paper.a[i][j];
+  }
+  config.twin.geometry.transmission_matrix = truth;
+  experiments::Bench bench(config, control::SemiClosedLoopParams{}, 12);
+  MatrixIdentificationOptions o;
+  o.repeats = 2;
+  const MatrixIdentificationResult r = identify_matrix(bench, o);
+  double worst_to_truth = 0.0;
+  double worst_to_paper = 0.0;
+  for (std::size_t i = 0; i < 3; ++i) {
+    for (std::size_t j = 0; j < 3; ++j) {
+      worst_to_truth = std::max(worst_to_truth, std::abs(r.fit.a.a[i][j] - truth[i][j]));
+      worst_to_paper = std::max(worst_to_paper, std::abs(r.fit.a.a[i][j] - paper.a[i][j]));
+    }
+  }
+  EXPECT_LT(worst_to_truth, 0.003);  // 0.0007 (seed 12)
+  EXPECT_GT(worst_to_paper, 0.02);   // 0.027: the largest change is 0.04 x 0.6962
+
+  // Held at Z_d = 6 um on each A (p = identity), the plate's tilt: the spread of its three points.
+  const auto spread_nm = [&](const control::Mat3& a) {
+    control::SemiClosedLoopParams c;
+    c.matrix.a = a;
+    experiments::Bench b(config, c, 13);
+    b.drive_points(Vec3{6.0, 6.0, 6.0});
+    b.run(1.0);
+    const auto m = b.measure_static();
+    const auto [lo, hi] = std::minmax({m.points_um[0], m.points_um[1], m.points_um[2]});
+    return 1e3 * (hi - lo);
+  };
+  const double with_paper_nm = spread_nm(paper.a);
+  const double with_identified_nm = spread_nm(r.fit.a.a);
+  EXPECT_GT(with_paper_nm, 250.0);      // 497 nm (seed 13)
+  EXPECT_LT(with_identified_nm, 20.0);  // 7 nm
 }
 
 // The whole chain: with the identified A and p, a desired displacement is reached at the

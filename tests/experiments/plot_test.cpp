@@ -141,6 +141,22 @@ TEST(Plot, InconsistentFiguresAreRejected) {
   f = two_panel_figure();
   f.panels[0].series[0].y.pop_back();
   EXPECT_THROW(write_plot_files(f, temp_dir("sizes") / "fig"), std::invalid_argument);
+  f = two_panel_figure();
+  f.panels[1].x_log = true;  // its x starts at 0
+  EXPECT_THROW(write_plot_files(f, temp_dir("log") / "fig"), std::invalid_argument);
+}
+
+TEST(Plot, ALogarithmicAxisIsSetPerPanel) {
+  Figure f = two_panel_figure();
+  for (auto& s : f.panels[0].series)
+    for (double& x : s.x)
+      x += 1.0;
+  f.panels[0].x_log = true;
+  const std::string gp = read(write_plot_files(f, temp_dir("logscale") / "fig").script);
+  const auto first = gp.find("set logscale x\n");
+  ASSERT_NE(first, std::string::npos);
+  EXPECT_LT(first, gp.find("# panel 2"));
+  EXPECT_GT(gp.find("unset logscale x\n"), gp.find("# panel 2"));
 }
 
 }  // namespace

@@ -52,16 +52,30 @@ TEST(Reproduction, LinearityAfterCalibrationIsWithinThePapersUpperBound) {
   EXPECT_NEAR(lin.span_um, 11.0, 0.05);
 }
 
-// The paper: 2 nm at 5 um, 3 nm at 10 um; the issue's bands are 1 to 4 nm and 1.5 to 4.5 nm. On
-// the twin the spread is dominated by the lab's assumed slow drift over the ~10 min the 230 moves
-// take; over seeds 1 to 3 it is 3.3 to 4.2 nm at 5 um and 3.1 to 4.1 nm at 10 um, so the 5 um
-// band's upper edge is widened by 0.5 nm here (docs/experiments.md).
+// What the cubic is for: the same protocol, same seed, with p = identity. The SGS conditioner's
+// 0.1 % bow (Section 3.1) and the ball contact's F^(2/3) compliance leave the semi-closed loop
+// 0.29 to 0.33 % off a straight line (full schedule, seeds 1 to 8), inside the paper's band; the
+// cubic must take most of it away, or stage 3 did nothing.
+TEST(Reproduction, TheCubicRemovesTheSemiClosedLoopsOwnNonlinearity) {
+  const auto& r = quick_run();
+  ASSERT_TRUE(r.linearity_without_cubic.validity.valid)
+      << r.linearity_without_cubic.validity.reason;
+  const double raw = r.linearity_without_cubic.metrics.linearity_zero_end_pct;
+  EXPECT_GT(raw, 0.1);
+  EXPECT_LT(raw, 0.4);
+  EXPECT_GT(raw, 3.0 * r.linearity.metrics.linearity_zero_end_pct);
+}
+
+// The paper: 2 nm at 5 um, 3 nm at 10 um; issue 11's bands are 1 to 3.5 nm and 1.5 to 4.5 nm.
+// The twin's spread comes from the bridge-excitation gain drift and the metrology loop, both
+// identified from those two numbers (docs/twin.md); seed 1's quick run reads 2.10 and 2.78 nm,
+// and the full schedule over seeds 1 to 8 stays inside both bands (docs/experiments.md).
 TEST(Reproduction, RepeatabilityOf230MovesIsNanometres) {
   const auto& r = quick_run();
   EXPECT_EQ(r.repeat_5um.metrics.n, 230U);
   EXPECT_EQ(r.repeat_10um.metrics.n, 230U);
   EXPECT_GE(r.repeat_5um.metrics.repeatability_nm, 1.0);
-  EXPECT_LE(r.repeat_5um.metrics.repeatability_nm, 4.5);
+  EXPECT_LE(r.repeat_5um.metrics.repeatability_nm, 3.5);
   EXPECT_GE(r.repeat_10um.metrics.repeatability_nm, 1.5);
   EXPECT_LE(r.repeat_10um.metrics.repeatability_nm, 4.5);
   EXPECT_NEAR(r.repeat_5um.metrics.mean_um, 5.0, 0.02);
@@ -89,9 +103,13 @@ TEST(Reproduction, IdentifiedMatrixIsThePapersAndCalibrationIsDeterministic) {
 
 TEST(Reproduction, SummaryHasTheIssuesKeys) {
   const nlohmann::json j = summary_json(quick_run());
-  for (const char* key : {"travel_open_loop_um", "travel_semi_closed_um", "step_settling_time_s",
-                          "linearity_zero_end_pct", "repeatability_5um_nm", "repeatability_10um_nm",
-                          "identified_A", "fitted_p", "simulated_time_s", "wall_time_s"}) {
+  for (const char* key :
+       {"travel_open_loop_um", "travel_semi_closed_um", "step_settling_time_s",
+        "linearity_zero_end_pct", "repeatability_5um_nm", "repeatability_10um_nm", "identified_A",
+        "fitted_p", "simulated_time_s", "wall_time_s", "linearity_without_cubic_zero_end_pct",
+        "phase_step_hold_jitter_nm_rms", "phase_step_settling_time_s",
+        "oracle_phase_step_hold_jitter_nm_rms", "pid_margins_1kHz_gain_margin_dB",
+        "pid_margins_10kHz_phase_margin_deg"}) {
     EXPECT_TRUE(j.contains(key)) << key;
   }
   EXPECT_EQ(j["identified_A"].size(), 3U);
@@ -106,7 +124,7 @@ TEST(Reproduction, ReportHasTable4FiguresAndData) {
   const auto dir = std::filesystem::temp_directory_path() / "piezoshift_report_test";
   std::filesystem::remove_all(dir);
   const ReportFiles files = write_report(quick_run(), dir, "built-in defaults");
-  ASSERT_EQ(files.figures.size(), 3U);
+  ASSERT_EQ(files.figures.size(), 5U);  // Figures 10 to 12, the phase step, the Bode plot
   for (const auto& f : files.figures)
     EXPECT_GT(std::filesystem::file_size(f), 5000U) << f;
   std::ifstream md(files.markdown);
@@ -115,9 +133,13 @@ TEST(Reproduction, ReportHasTable4FiguresAndData) {
   EXPECT_NE(text.find("| S315.10 (PI)"), std::string::npos);
   EXPECT_NE(text.find("| NPS-Z-15H (Queensgate)"), std::string::npos);
   EXPECT_NE(text.find("![Figure 10"), std::string::npos);
+  EXPECT_NE(text.find("![Phase step](phase_step.png)"), std::string::npos);
+  EXPECT_NE(text.find("| hold jitter, 1 ms exposure means (rms) |"), std::string::npos);
   EXPECT_TRUE(std::filesystem::exists(dir / "report.html"));
   EXPECT_TRUE(std::filesystem::exists(dir / "calibration.toml"));
   EXPECT_TRUE(std::filesystem::exists(dir / "linearity.csv"));
+  EXPECT_TRUE(std::filesystem::exists(dir / "phase_step.csv"));
+  EXPECT_TRUE(std::filesystem::exists(dir / "linearity_without_cubic.csv"));
   std::filesystem::remove_all(dir);
 }
 

@@ -66,6 +66,7 @@ struct Panel {
   std::optional<std::pair<double, double>> x_range;  //!< empty: autoscale
   std::optional<std::pair<double, double>> y_range;
   std::string key = "top right";  //!< gnuplot legend placement; "off" hides the legend
+  bool x_log = false;             //!< logarithmic x axis (Bode plots); every x must be > 0
 };
 
 struct Figure {

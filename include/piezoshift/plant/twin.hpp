@@ -62,6 +62,9 @@ struct TwinTruth {
   //! ringing between control ticks, which the tick-rate samples miss.
   double period_max_mean_points_um = 0.0;
   double period_min_mean_points_um = 0.0;
+  //! mean(P1..P3) averaged over the physics steps of the last period: what a camera exposure of
+  //! one period integrates (experiments/phase_step.hpp).
+  double period_avg_mean_points_um = 0.0;
   Vec3 sgs_V{};  //!< conditioner outputs before the ADC (noise included)
   double air_temperature_C = 0.0;
   double structure_temperature_C = 0.0;

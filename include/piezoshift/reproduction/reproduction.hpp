@@ -8,6 +8,10 @@
 //   repeatability 10 um     seed + 50
 //   linearity, 0.25 um grid seed + 60   (levels the calibration never saw)
 //   linearity, downwards    seed + 70
+//   linearity without the cubic  seed + 30 (the paper's protocol, p = identity: what p corrects)
+//   phase step (lambda/8)   seed + 80   (beyond the paper: experiments/phase_step.hpp)
+//   inner loop identified   seed + 90 at the DAQ's rate, seed + 91 at 10 kHz, with the margins
+//                           of the calibrated PID on it (calibration/loop_identification.hpp)
 // all with the calibrated controller (the paper's structure: PID, A, p), through the loop `run`
 // and `serve` ship (experiments/bench.hpp), supervisor included. Then the same experiments, same
 // seeds, with the oracle (runtime/oracle_backend.hpp): the same loop fed the plate's true point
@@ -26,7 +30,9 @@
 #include <vector>
 
 #include "piezoshift/calibration/calibration_procedure.hpp"
+#include "piezoshift/calibration/loop_identification.hpp"
 #include "piezoshift/experiments/paper_experiments.hpp"
+#include "piezoshift/experiments/phase_step.hpp"
 #include "piezoshift/io/project_config.hpp"
 
 namespace piezoshift::reproduction {
@@ -46,6 +52,7 @@ struct Schedule {
   experiments::RepeatabilityOptions repeat_10um;
   experiments::LinearityOptions linearity_grid;  //!< the unseen 0.25 um grid
   experiments::LinearityOptions linearity_down;  //!< the paper's levels, downwards
+  experiments::PhaseStepOptions phase_step;      //!< lambda/8 at mid-travel
 
   static Schedule paper();  //!< the full schedule (Section 4)
   static Schedule quick();  //!< shortened steps, same procedure
@@ -63,12 +70,23 @@ struct ExperimentSet {
   experiments::LinearityResult linearity_down;  //!< the paper's levels, downwards
   experiments::RepeatabilityResult repeat_5um;
   experiments::RepeatabilityResult repeat_10um;
+  experiments::PhaseStepResult phase_step;  //!< beyond the paper: lambda/8, 1 ms exposures
 
   double experiments_simulated_time_s() const;
   //! Every Table 4 row (travel, step, linearity by the paper's protocol, repeatability) valid.
   bool table4_valid() const;
-  //! "name: reason" for every experiment that is not valid (the extra sweeps included).
+  //! "name: reason" for every experiment that is not valid (the extra ones included).
   std::vector<std::string> invalid_reasons() const;
+};
+
+//! The inner loop's identified plant at one sample time and the calibrated PID's margins on it.
+struct InnerLoopAnalysis {
+  double sample_time_s = 0.0;
+  calibration::LoopIdentification plant;
+  std::array<calibration::StabilityMargins, 3> margins{};
+  //! Not valid when the twin cannot run at this rate (its physics rate is not a whole multiple)
+  //! or the identification tripped the supervisor; plant and margins are then empty.
+  experiments::Validity validity;
 };
 
 //! The paper's controller's set (the base, so result.travel, result.step, ... are it) and the
@@ -79,6 +97,13 @@ struct ReproductionResult : ExperimentSet {
   calibration::CalibrationOutcome calibration;
   control::SemiClosedLoopParams oracle_controller;  //!< gains and A calibrated, p = identity
   ExperimentSet oracle;
+  //! The paper's protocol with the calibrated gains and A but p = identity, on the same seed as
+  //! `linearity`: the semi-closed loop's own nonlinearity (SGS conditioner, ball contact), which
+  //! the cubic is there to remove. Not a Table 4 row, so it does not count in valid().
+  experiments::LinearityResult linearity_without_cubic;
+  //! The calibrated PID's loop at the DAQ's rate (the paper's 1 kHz) and at 10 kHz (the same
+  //! gains re-expressed per sample, the twin's DAQ at 0.1 ms) unless that is the DAQ's rate.
+  std::vector<InnerLoopAnalysis> inner_loop;
   double simulated_time_s = 0.0;  //!< twin time over every stage and experiment
   double wall_time_s = 0.0;
 
