@@ -31,9 +31,9 @@ runtime::SafetyLimits loop_safety_limits(const runtime::SafetyLimits& installati
   runtime::SafetyLimits limits = installation;
   if (!max_overruns)
     return limits;
-  if (*max_overruns < 1 || static_cast<std::uint64_t>(*max_overruns) > kMaxOverrunsOption)
-    throw io::InputError(
-        fmt::format("--max-overruns {}: must be in [1, {}]", *max_overruns, kMaxOverrunsOption));
+  if (*max_overruns < 1 || *max_overruns > runtime::kMaxConsecutiveOverruns)
+    throw io::InputError(fmt::format("--max-overruns {}: must be in [1, {}]", *max_overruns,
+                                     runtime::kMaxConsecutiveOverruns));
   limits.max_consecutive_overruns = static_cast<std::uint32_t>(*max_overruns);
   return limits;
 }

@@ -14,6 +14,7 @@
 #include "piezoshift/io/project_config.hpp"
 #include "piezoshift/runtime/daq_backend.hpp"
 #include "piezoshift/runtime/realtime.hpp"
+#include "piezoshift/runtime/safety_ranges.hpp"
 #include "piezoshift/runtime/safety_supervisor.hpp"
 #include "piezoshift/runtime/sim_backend.hpp"
 
@@ -28,13 +29,9 @@ struct ChosenBackend {
 //! the DAQ's practical limit, docs/runtime.md).
 void check_loop_rate(double rate_Hz);
 
-//! Largest --max-overruns: a million consecutive overruns (17 min at 1 kHz) is "never", the
-//! range of [safety] max_consecutive_overruns (runtime/safety_ranges.hpp).
-inline constexpr std::uint64_t kMaxOverrunsOption = 1000000;
-
 //! The installation's limits (a config's [safety], or the built-in ones), with --max-overruns
 //! consecutive overruns instead when given; throws io::InputError when that is not in
-//! [1, kMaxOverrunsOption].
+//! [1, runtime::kMaxConsecutiveOverruns].
 runtime::SafetyLimits loop_safety_limits(const runtime::SafetyLimits& installation,
                                          std::optional<std::int64_t> max_overruns);
 

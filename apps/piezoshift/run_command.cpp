@@ -264,7 +264,7 @@ void add_run_command(CLI::App& app, Action& action) {
                 "sim only: simulated clock, as fast as possible (tests, benches)");
   cmd->add_option("--max-overruns", o->max_overruns,
                   "consecutive deadline overruns that trip the supervisor (default 3)")
-      ->check(whole_number(1, kMaxOverrunsOption));
+      ->check(whole_number(1, runtime::kMaxConsecutiveOverruns));
   cmd->add_option("--cpu", o->cpu, "CPU to pin the loop to (-1: the last one, -2: none)")
       ->capture_default_str();
   cmd->callback([&action, o] { action = [o] { return run(*o); }; });

@@ -364,7 +364,7 @@ void add_serve_command(CLI::App& app, Action& action) {
   cmd->add_option("--max-overruns", o->max_overruns,
                   "consecutive deadline overruns that trip the supervisor (default: [safety] "
                   "max_consecutive_overruns, 3)")
-      ->check(whole_number(1, kMaxOverrunsOption));
+      ->check(whole_number(1, runtime::kMaxConsecutiveOverruns));
   cmd->add_option("--cpu", o->cpu, "CPU to pin the loop to (-1: the last one, -2: none)")
       ->capture_default_str();
   cmd->add_option("--log", o->log, "CSV log of every tick (flushed every 0.25 s)");

@@ -17,6 +17,10 @@
 
 namespace piezoshift::runtime {
 
+//! Largest max_consecutive_overruns (and --max-overruns): a million in a row, 17 min at 1 kHz, is
+//! "never".
+inline constexpr std::uint32_t kMaxConsecutiveOverruns = 1000000;
+
 //! Calls visit(section, key, value, bounds) for each limit (const or not); value is a double or
 //! the std::uint32_t overrun count. The ranges keep every rule meaningful: the outputs within the
 //! +-10 V a DAQ writes, times from one tick to a minute.
@@ -41,8 +45,8 @@ void visit_safety_limits(Limits& l, Visit&& visit) {
   visit("safety", "response_band_um", l.response_band_um, B::closed(0.0, 100.0));
   visit("safety", "response_time_s", l.response_time_s, B::above(0.0, 60.0));
   visit("safety", "saturation_time_s", l.saturation_time_s, B::above(0.0, 60.0));
-  // a million in a row (17 min at 1 kHz) is "never"
-  visit("safety", "max_consecutive_overruns", l.max_consecutive_overruns, B::closed(1, 1e6));
+  visit("safety", "max_consecutive_overruns", l.max_consecutive_overruns,
+        B::closed(1, kMaxConsecutiveOverruns));
 }
 
 //! The first limit outside its range, or a pair that contradicts itself (output_min_V <
