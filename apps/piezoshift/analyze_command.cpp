@@ -25,6 +25,7 @@
 #include "piezoshift/experiments/metrics_step_response.hpp"
 #include "piezoshift/io/csv_table.hpp"
 #include "piezoshift/io/plot.hpp"
+#include "whole_number.hpp"
 
 namespace piezoshift::app {
 namespace {
@@ -129,9 +130,11 @@ int run_repeatability(const AnalyzeOptions& o) {
 
 int run_step(const AnalyzeOptions& o_in) {
   AnalyzeOptions o = o_in;
-  if (o.median_window < 1 || o.median_window % 2 == 0)
+  if (o.median_window % 2 == 0)  // the option's check has its range
+    throw io::InputError(fmt::format("--median-window {}: must be odd", o.median_window));
+  if (!std::isfinite(o.step.step_time_s))
     throw io::InputError(
-        fmt::format("--median-window {}: must be an odd number >= 1", o.median_window));
+        fmt::format("--step-time-s {}: must be a finite number", o.step.step_time_s));
   o.step.median_window = static_cast<std::size_t>(o.median_window);
   const io::CsvTable t = io::CsvTable::load(o.data_path);
   t.require_columns({"t_s", o.column});
@@ -215,7 +218,8 @@ void add_analyze_command(CLI::App& app, Action& action) {
       ->check(CLI::PositiveNumber);
   step->add_option("--median-window", o->median_window,
                    "Running-median length against spikes [samples, odd; 1: off]")
-      ->capture_default_str();
+      ->capture_default_str()
+      ->check(whole_number(1, experiments::kMaxMedianWindow));
 
   lin->callback([&action, o] { action = [o] { return run_linearity(*o); }; });
   rep->callback([&action, o] { action = [o] { return run_repeatability(*o); }; });

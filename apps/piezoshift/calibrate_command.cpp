@@ -18,7 +18,9 @@
 #include "piezoshift/experiments/paper_experiments.hpp"
 #include "piezoshift/io/input_error.hpp"
 #include "piezoshift/io/project_config.hpp"
+#include "piezoshift/runtime/safety_ranges.hpp"
 #include "progress_bar.hpp"
+#include "whole_number.hpp"
 
 namespace piezoshift::app {
 namespace {
@@ -178,7 +180,7 @@ int run(const Options& o) {
   if (!o.interferometer.empty())
     throw io::InputError("--interferometer needs --daq (the guided calibration)");
   const io::ProjectConfig config =
-      o.config.empty() ? io::ProjectConfig{} : io::load_project_config(o.config);
+      o.config.empty() ? io::ProjectConfig{} : runtime::load_installation_config(o.config).project;
   calibration::CalibrationOptions co;
   co.pid = o.pid == "paper" ? calibration::PidChoice::kPaper : calibration::PidChoice::kSearch;
   calibration::CalibrationWithTravel ct;
@@ -235,7 +237,8 @@ void add_calibrate_command(CLI::App& app, Action& action) {
   CLI::App* cmd = app.add_subcommand(
       "calibrate", "The paper's three calibration stages on the twin; writes a calibration file");
   cmd->add_option("--out", o->out, "calibration file to write (TOML, replaced atomically)");
-  cmd->add_option("--seed", o->seed, "seed of the twin's random numbers");
+  cmd->add_option("--seed", o->seed, "seed of the twin's random numbers")
+      ->check(whole_number(0, kAnyUnsigned));
   cmd->add_option("--config", o->config, "TOML configuration (configs/paper.toml's sections)");
   cmd->add_option(
          "--pid", o->pid,

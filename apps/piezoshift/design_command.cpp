@@ -15,6 +15,7 @@
 #include "piezoshift/design/hinge_search.hpp"
 #include "piezoshift/io/input_error.hpp"
 #include "piezoshift/io/project_config.hpp"
+#include "piezoshift/runtime/safety_ranges.hpp"
 
 namespace piezoshift::app {
 
@@ -284,7 +285,7 @@ int run_design(const DesignOptions& opt) {
   design::DesignInputs inputs;
   std::string source = "the paper's values (Tables 1 to 3; no --config)";
   if (!opt.config_path.empty()) {
-    inputs = io::load_project_config(opt.config_path).design;
+    inputs = runtime::load_installation_config(opt.config_path).project.design;
     source = opt.config_path;
   }
   if (opt.search)

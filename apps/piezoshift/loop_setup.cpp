@@ -1,8 +1,6 @@
 #include "loop_setup.hpp"
 
-#include <algorithm>
 #include <csignal>
-#include <limits>
 
 #include <fmt/core.h>
 
@@ -10,6 +8,7 @@
 #include "piezoshift/calibration/calibration_procedure.hpp"
 #include "piezoshift/io/input_error.hpp"
 #include "piezoshift/runtime/comedi_backend.hpp"
+#include "piezoshift/runtime/safety_ranges.hpp"
 
 namespace piezoshift::app {
 
@@ -27,17 +26,27 @@ void check_loop_rate(double rate_Hz) {
         fmt::format("--rate-hz {}: supported rates are 1000 to 10000 Hz", rate_Hz));
 }
 
-runtime::SafetyLimits loop_safety_limits(std::int64_t max_overruns) {
-  if (max_overruns < 1)
-    throw io::InputError(fmt::format("--max-overruns {}: must be >= 1", max_overruns));
-  runtime::SafetyLimits limits;
-  limits.max_consecutive_overruns = static_cast<std::uint32_t>(
-      std::min<std::int64_t>(max_overruns, std::numeric_limits<std::uint32_t>::max()));
+runtime::SafetyLimits loop_safety_limits(const runtime::SafetyLimits& installation,
+                                         std::optional<std::int64_t> max_overruns) {
+  runtime::SafetyLimits limits = installation;
+  if (!max_overruns)
+    return limits;
+  if (*max_overruns < 1 || *max_overruns > runtime::kMaxConsecutiveOverruns)
+    throw io::InputError(fmt::format("--max-overruns {}: must be in [1, {}]", *max_overruns,
+                                     runtime::kMaxConsecutiveOverruns));
+  limits.max_consecutive_overruns = static_cast<std::uint32_t>(*max_overruns);
   return limits;
 }
 
+nlohmann::json safety_json(const runtime::SafetyLimits& limits) {
+  nlohmann::json j = nlohmann::json::object();
+  runtime::visit_safety_limits(limits, [&](const char*, const char* key, const auto& value,
+                                           design::Bounds) { j[key] = value; });
+  return j;
+}
+
 ChosenBackend make_backend(const std::string& daq, const io::ProjectConfig& config,
-                           std::uint64_t seed, double rate_Hz) {
+                           std::uint64_t seed, double rate_Hz, const std::string& config_path) {
   ChosenBackend chosen;
   if (daq == "sim") {
     runtime::SimOptions so;
@@ -45,6 +54,8 @@ ChosenBackend make_backend(const std::string& daq, const io::ProjectConfig& conf
     so.twin = config.twin;
     so.seed = seed;
     so.rate_Hz = rate_Hz;
+    if (!config_path.empty())
+      so.source = config_path;
     auto s = std::make_unique<runtime::SimBackend>(so);
     chosen.sim = s.get();
     chosen.backend = std::move(s);

@@ -8,10 +8,13 @@
 #include <optional>
 #include <string>
 
+#include <nlohmann/json.hpp>
+
 #include "piezoshift/control/semi_closed_loop.hpp"
 #include "piezoshift/io/project_config.hpp"
 #include "piezoshift/runtime/daq_backend.hpp"
 #include "piezoshift/runtime/realtime.hpp"
+#include "piezoshift/runtime/safety_ranges.hpp"
 #include "piezoshift/runtime/safety_supervisor.hpp"
 #include "piezoshift/runtime/sim_backend.hpp"
 
@@ -26,14 +29,20 @@ struct ChosenBackend {
 //! the DAQ's practical limit, docs/runtime.md).
 void check_loop_rate(double rate_Hz);
 
-//! The built-in safety limits with --max-overruns consecutive overruns; throws io::InputError
-//! when it is < 1.
-runtime::SafetyLimits loop_safety_limits(std::int64_t max_overruns);
+//! The installation's limits (a config's [safety], or the built-in ones), with --max-overruns
+//! consecutive overruns instead when given; throws io::InputError when that is not in
+//! [1, runtime::kMaxConsecutiveOverruns].
+runtime::SafetyLimits loop_safety_limits(const runtime::SafetyLimits& installation,
+                                         std::optional<std::int64_t> max_overruns);
+
+//! The limits as a JSON object, one member per [safety] key.
+nlohmann::json safety_json(const runtime::SafetyLimits& limits);
 
 //! "sim" (the twin of config, at rate_Hz, with seed) or "comedi[:DEVICE]". Throws io::InputError
-//! for anything else. Not configured yet.
+//! for anything else. Not configured yet. config_path: where config came from ("" built in), named
+//! in the sim backend's messages.
 ChosenBackend make_backend(const std::string& daq, const io::ProjectConfig& config,
-                           std::uint64_t seed, double rate_Hz);
+                           std::uint64_t seed, double rate_Hz, const std::string& config_path = {});
 
 //! The controller a loop runs with, and where it came from.
 struct LoopCalibration {

@@ -1,6 +1,7 @@
 // The piezoshift command-line program: one subcommand per job (design, simulate, calibrate, ...).
 #include <cstdio>
 #include <exception>
+#include <filesystem>
 
 #include <fmt/core.h>
 #include <CLI/CLI.hpp>
@@ -31,6 +32,10 @@ int main(int argc, char** argv) {
     return action ? action() : 0;
   } catch (const piezoshift::io::InputError& e) {
     fmt::print(stderr, "piezoshift: error: {}\n", e.what());
+    return piezoshift::io::kExitBadInput;
+  } catch (const std::filesystem::filesystem_error& e) {
+    // Raised on a path the user named (an output folder under a file, no permission): bad input.
+    fmt::print(stderr, "piezoshift: error: {}: {}\n", e.path1().string(), e.code().message());
     return piezoshift::io::kExitBadInput;
   } catch (const piezoshift::experiments::ProcedureFailed& e) {
     fmt::print(stderr, "piezoshift: not valid: {}\n", e.what());

@@ -27,6 +27,8 @@
 #include "piezoshift/psi/simulation.hpp"
 #include "piezoshift/psi/step_calibration.hpp"
 #include "piezoshift/psi/zernike.hpp"
+#include "piezoshift/runtime/safety_ranges.hpp"
+#include "whole_number.hpp"
 
 namespace piezoshift::app {
 namespace {
@@ -273,7 +275,7 @@ int run_calibrate(const PsiOptions& o) {
 int run_simulate(const PsiOptions& o) {
   io::ProjectConfig config;
   if (!o.config.empty())
-    config = io::load_project_config(o.config);
+    config = runtime::load_installation_config(o.config).project;  // [safety] allowed, unused
   psi::SimulationParams p;
   p.algorithm =
       o.algorithm.empty() ? psi::Algorithm::kHariharan5 : psi::parse_algorithm(o.algorithm);
@@ -395,7 +397,9 @@ void add_psi_command(CLI::App& app, Action& action) {
   sim->add_option("--frames", o->n_frames, "Frames (default: the algorithm's count, else 5)");
   sim->add_option("--algorithm", o->algorithm, "One of " + names + " (default hariharan5)");
   sim->add_option("--surface", o->surface, "Test surface, e.g. Z4=40,Z5=25,rough=0.5 (nm)");
-  sim->add_option("--seed", o->seed, "Random seed")->capture_default_str();
+  sim->add_option("--seed", o->seed, "Random seed")
+      ->capture_default_str()
+      ->check(whole_number(0, kAnyUnsigned));
   sim->add_option("--size", o->size_px, "Camera size [px], square")->capture_default_str();
   sim->add_option("--wavelength-nm", o->wavelength_nm, "Wavelength [nm]")->capture_default_str();
   sim->add_flag("!--no-budget", o->budget, "Skip the Monte Carlo error budget");

@@ -13,7 +13,9 @@
 #include "piezoshift/reproduction/report.hpp"
 #include "piezoshift/reproduction/reproduction.hpp"
 #include "piezoshift/reproduction/summary.hpp"
+#include "piezoshift/runtime/safety_ranges.hpp"
 #include "progress_bar.hpp"
+#include "whole_number.hpp"
 
 namespace piezoshift::app {
 namespace {
@@ -29,7 +31,7 @@ struct Options {
 
 int run(const Options& o) {
   const io::ProjectConfig config =
-      o.config.empty() ? io::ProjectConfig{} : io::load_project_config(o.config);
+      o.config.empty() ? io::ProjectConfig{} : runtime::load_installation_config(o.config).project;
   reproduction::ReproduceOptions ro;
   ro.seed = o.seed;
   ro.quick = o.quick;
@@ -104,7 +106,8 @@ void add_reproduce_command(CLI::App& app, Action& action) {
   CLI::App* cmd = app.add_subcommand(
       "reproduce", "Calibrate the twin, run the paper's four experiments, write the report");
   cmd->add_option("--out", o->out, "output folder for report.md, report.html, figures, CSVs");
-  cmd->add_option("--seed", o->seed, "seed of the twin's random numbers");
+  cmd->add_option("--seed", o->seed, "seed of the twin's random numbers")
+      ->check(whole_number(0, kAnyUnsigned));
   cmd->add_option("--config", o->config, "TOML configuration (configs/paper.toml's sections)");
   cmd->add_option("--pid", o->pid, "paper: the paper's gains; search: the stage-1 search's")
       ->check(CLI::IsMember({"paper", "search"}));

@@ -31,7 +31,9 @@
 #include "piezoshift/runtime/csv_logger.hpp"
 #include "piezoshift/runtime/fault_injection.hpp"
 #include "piezoshift/runtime/loop_clock.hpp"
+#include "piezoshift/runtime/safety_ranges.hpp"
 #include "piezoshift/runtime/sim_backend.hpp"
+#include "whole_number.hpp"
 
 namespace piezoshift::app {
 
@@ -55,7 +57,7 @@ struct RunOptions {
   std::uint64_t seed = 1;
   bool free_run = false;
   int cpu = -1;
-  std::int64_t max_overruns = 3;
+  std::optional<std::int64_t> max_overruns;  // absent: the installation's (3 built in)
 };
 
 double us(std::int64_t ns) {
@@ -119,8 +121,9 @@ nlohmann::json vec_json(const Vec3& v) {
 
 int run(const RunOptions& o) {
   check_loop_rate(o.rate_Hz);
-  if (!(o.duration_s > 0.0) || o.duration_s > 1e6)
-    throw io::InputError(fmt::format("--duration-s {}: must be > 0 s", o.duration_s));
+  if (!(o.duration_s > 0.0) || o.duration_s > kMaxRunDurationS)
+    throw io::InputError(
+        fmt::format("--duration-s {}: must be in (0, {}] s", o.duration_s, kMaxRunDurationS));
 
   SetpointProfile profile = !o.profile.empty() ? SetpointProfile::load_csv(o.profile)
                                                : SetpointProfile::step(o.step_um.value_or(0.0));
@@ -128,8 +131,10 @@ int run(const RunOptions& o) {
   for (const std::string& f : o.faults)
     faults.push_back(parse_fault_spec(f));
 
-  const io::ProjectConfig project =
-      o.config.empty() ? io::ProjectConfig{} : io::load_project_config(o.config);
+  const runtime::InstallationConfig installation = o.config.empty()
+                                                        ? runtime::InstallationConfig{}
+                                                        : runtime::load_installation_config(o.config);
+  const io::ProjectConfig& project = installation.project;
   const LoopCalibration cal = resolve_calibration(o.calibration, o.daq, project, o.seed);
   const control::SemiClosedLoopParams& params = cal.params;
   if (o.step_um && cal.travel_z_max_um && *o.step_um > *cal.travel_z_max_um)
@@ -144,7 +149,7 @@ int run(const RunOptions& o) {
     throw io::InputError("--fault needs --daq sim (faults are injected into the twin)");
   if (comedi && o.free_run)
     throw io::InputError("--free-run needs --daq sim (hardware runs in real time)");
-  ChosenBackend chosen = make_backend(o.daq, project, o.seed, o.rate_Hz);
+  ChosenBackend chosen = make_backend(o.daq, project, o.seed, o.rate_Hz, o.config);
   std::unique_ptr<DaqBackend> hardware = std::move(chosen.backend);
   SimBackend* sim = chosen.sim;
   hardware->configure();  // comedi: names the device it cannot open (exit 2)
@@ -180,7 +185,9 @@ int run(const RunOptions& o) {
   const bool show_live = ::isatty(STDERR_FILENO) == 1 && !o.free_run;
   if (show_live)
     config.status = &live;
-  const SafetyLimits limits = loop_safety_limits(o.max_overruns);
+  const SafetyLimits limits = loop_safety_limits(installation.safety, o.max_overruns);
+  if (!o.json)
+    fmt::print("safety: {}\n", describe(limits));
   ControlLoop loop(config, params, limits, *daq, *clock, std::move(profile),
                    logger ? &logger->ring() : nullptr);
 
@@ -259,6 +266,7 @@ int run(const RunOptions& o) {
   j["faults_injected"] = injected_list;
   j["detect_latency_ticks"] =
       has_latency ? nlohmann::json(r.fault.tick - injected) : nlohmann::json(nullptr);
+  j["safety"] = safety_json(limits);
   j["max_output_V"] = r.max_output_V;
   j["min_output_V"] = r.min_output_V;
   j["max_output_slew_V_per_ms"] = r.max_output_slew_V_per_ms;
@@ -362,12 +370,14 @@ void add_run_command(CLI::App& app, Action& action) {
   cmd->add_option("--fault", o->faults,
                   "inject KIND@T_S[:CHANNEL] into the twin (sgs-open, sgs-stuck, adc-nan, "
                   "adc-spike, amplifier-fail, actuator-crack, overrun-burst); repeatable");
-  cmd->add_option("--seed", o->seed, "twin noise seed")->capture_default_str();
+  cmd->add_option("--seed", o->seed, "twin noise seed")
+      ->capture_default_str()
+      ->check(whole_number(0, kAnyUnsigned));
   cmd->add_flag("--free-run", o->free_run,
                 "sim only: simulated clock, as fast as possible (tests, benches)");
   cmd->add_option("--max-overruns", o->max_overruns,
-                  "consecutive deadline overruns that trip the supervisor")
-      ->capture_default_str();
+                  "consecutive deadline overruns that trip the supervisor (default 3)")
+      ->check(whole_number(1, runtime::kMaxConsecutiveOverruns));
   cmd->add_option("--cpu", o->cpu, "CPU to pin the loop to (-1: the last one, -2: none)")
       ->capture_default_str();
   cmd->callback([&action, o] { action = [o] { return run(*o); }; });

@@ -37,6 +37,8 @@
 #include "piezoshift/runtime/csv_logger.hpp"
 #include "piezoshift/runtime/fault_injection.hpp"
 #include "piezoshift/runtime/loop_clock.hpp"
+#include "piezoshift/runtime/safety_ranges.hpp"
+#include "whole_number.hpp"
 
 namespace piezoshift::app {
 
@@ -61,7 +63,7 @@ struct ServeOptions {
   double on_target_um = 0.01;
   double on_target_urad = 0.5;
   double settle_s = 0.01;
-  std::int64_t max_overruns = 3;
+  std::optional<std::int64_t> max_overruns;  // absent: the installation's [safety]
   int cpu = -1;
   std::string log;
   bool json = false;
@@ -113,8 +115,10 @@ host::StageModel make_stage_model(const ServeOptions& o, const io::ProjectConfig
     mp.channel_max_V = safety.output_max_V * mp.amplifier_gain;
     return host::StageModel(mp);
   } catch (const std::invalid_argument& e) {
+    // The calibration's A and the config's geometry meet here: name both.
     throw io::InputError(fmt::format(
-        "{}: {}", o.calibration.empty() ? "built-in calibration" : o.calibration, e.what()));
+        "{} with {}: {}", o.calibration.empty() ? "built-in calibration" : o.calibration,
+        o.config.empty() ? "the built-in configuration" : o.config, e.what()));
   }
 }
 
@@ -139,18 +143,20 @@ int serve(const ServeOptions& o) {
   check(o.http_max_clients >= 1 && o.http_max_clients <= 256,
         fmt::format("--http-max-clients {}: must be 1 to 256", o.http_max_clients));
   const std::string token = http_token(o);
-  const runtime::SafetyLimits safety = loop_safety_limits(o.max_overruns);
   std::vector<runtime::FaultSpec> faults;
   for (const std::string& f : o.faults)
     faults.push_back(runtime::parse_fault_spec(f));
 
-  const io::ProjectConfig config =
-      o.config.empty() ? io::ProjectConfig{} : io::load_project_config(o.config);
+  const runtime::InstallationConfig installation =
+      o.config.empty() ? runtime::InstallationConfig{}
+                       : runtime::load_installation_config(o.config);
+  const io::ProjectConfig& config = installation.project;
+  const runtime::SafetyLimits safety = loop_safety_limits(installation.safety, o.max_overruns);
   const LoopCalibration cal = resolve_calibration(o.calibration, o.daq, config, o.seed);
   const control::SemiClosedLoopParams& params = cal.params;
   const host::StageModel model = make_stage_model(o, config, params, cal, safety);
 
-  ChosenBackend chosen = make_backend(o.daq, config, o.seed, o.rate_Hz);
+  ChosenBackend chosen = make_backend(o.daq, config, o.seed, o.rate_Hz, o.config);
   check(faults.empty() || chosen.sim != nullptr,
         "--fault needs --daq sim (faults are injected into the twin)");
   runtime::MonotonicClock clock;
@@ -248,6 +254,8 @@ int serve(const ServeOptions& o) {
   }
   fmt::print("piezoshift serve: GCS 2.0 on {}:{}, loop at {:g} Hz on {}\n", o.bind, server.port(),
              o.rate_Hz, daq.name());
+  fmt::print("piezoshift serve: safety ({}): {}\n",
+             o.config.empty() ? "built in" : o.config + " [safety]", runtime::describe(safety));
   std::fflush(stdout);
   const runtime::RealtimeReport rt = request_realtime_or_warn(o.cpu);
   if (dashboard)
@@ -300,6 +308,7 @@ int serve(const ServeOptions& o) {
     j["loop_commands_applied"] = r.host_commands_applied;
     j["samples_dropped"] = r.host_samples_dropped;
     j["max_output_slew_V_per_ms"] = r.max_output_slew_V_per_ms;
+    j["safety"] = safety_json(safety);
     if (http) {
       const host::HttpServerStats hs = http->stats();
       j["http"] = {{"requests", hs.requests},         {"refused", hs.refused},
@@ -335,7 +344,9 @@ void add_serve_command(CLI::App& app, Action& action) {
                 "allow a --bind address other than loopback (GCS has no authentication)");
   cmd->add_option("--rate-hz", o->rate_Hz, "loop rate, 1000 (the paper) to 10000 Hz")
       ->capture_default_str();
-  cmd->add_option("--seed", o->seed, "twin noise seed")->capture_default_str();
+  cmd->add_option("--seed", o->seed, "twin noise seed")
+      ->capture_default_str()
+      ->check(whole_number(0, kAnyUnsigned));
   cmd->add_option("--duration-s", o->duration_s, "stop after this long (default: at SIGINT/TERM)");
   cmd->add_option("--max-clients", o->max_clients, "clients connected at once")
       ->capture_default_str();
@@ -351,8 +362,9 @@ void add_serve_command(CLI::App& app, Action& action) {
   cmd->add_option("--settle-s", o->settle_s, "ONT? needs the tolerance held this long (s)")
       ->capture_default_str();
   cmd->add_option("--max-overruns", o->max_overruns,
-                  "consecutive deadline overruns that trip the supervisor")
-      ->capture_default_str();
+                  "consecutive deadline overruns that trip the supervisor (default: [safety] "
+                  "max_consecutive_overruns, 3)")
+      ->check(whole_number(1, runtime::kMaxConsecutiveOverruns));
   cmd->add_option("--cpu", o->cpu, "CPU to pin the loop to (-1: the last one, -2: none)")
       ->capture_default_str();
   cmd->add_option("--log", o->log, "CSV log of every tick (flushed every 0.25 s)");

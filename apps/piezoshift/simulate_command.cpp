@@ -31,9 +31,12 @@
 #include "piezoshift/io/csv_writer.hpp"
 #include "piezoshift/io/input_error.hpp"
 #include "piezoshift/io/project_config.hpp"
+#include "piezoshift/plant/simulation_cost.hpp"
 #include "piezoshift/plant/twin.hpp"
+#include "piezoshift/runtime/safety_ranges.hpp"
 #include "piezoshift/runtime/safety_supervisor.hpp"
 #include "piezoshift/runtime/setpoint_profile.hpp"
+#include "whole_number.hpp"
 
 namespace piezoshift::app {
 namespace {
@@ -53,6 +56,7 @@ struct SimulateOptions {
   std::string profile_path;
   std::string log_path;
   bool json = false;
+  double max_physics_steps = plant::kDefaultPhysicsStepBudget;
 };
 
 std::vector<std::string> log_columns(bool closed_loop) {
@@ -89,18 +93,22 @@ int run_simulate(const SimulateOptions& opt) {
   }
   if (!std::isfinite(opt.duration_s) || !(opt.duration_s > 0.0))
     throw io::InputError(fmt::format("--duration-s = {} must be positive", opt.duration_s));
+  if (!(opt.max_physics_steps >= 1.0 && opt.max_physics_steps <= 1e15))
+    throw io::InputError(
+        fmt::format("--max-physics-steps = {} must be in [1, 1e15]", opt.max_physics_steps));
   if (!std::isfinite(opt.step_at_s) || opt.step_at_s < 0.0)
     throw io::InputError(fmt::format("--step-at-s = {} must be >= 0", opt.step_at_s));
 
-  io::ProjectConfig config;
+  runtime::InstallationConfig installation;
   if (!opt.config_path.empty())
-    config = io::load_project_config(opt.config_path);
+    installation = runtime::load_installation_config(opt.config_path);
+  const io::ProjectConfig& config = installation.project;
   const double period_s = config.twin.daq.sample_time_s;
 
-  // The supervisor (the bench's, as `run`'s) passes 0 to 10 DAQ volts (0 to 150 V at the stacks);
-  // anything else would be clamped there, so it is refused here.
+  // The supervisor (the bench's, as `run`'s, with the config's [safety]) passes 0 to 10 DAQ volts
+  // by default (0 to 150 V at the stacks); anything else would be clamped there, so it is refused.
   const bool closed_loop = opt.open_loop_volts.empty();
-  const runtime::SafetyLimits limits;
+  const runtime::SafetyLimits& limits = installation.safety;
   Vec3 open_loop{};
   if (!closed_loop) {
     for (std::size_t i = 0; i < 3; ++i) {
@@ -119,6 +127,17 @@ int run_simulate(const SimulateOptions& opt) {
   if (!opt.profile_path.empty())
     profile = runtime::SetpointProfile::load_csv(opt.profile_path);
 
+  // The cost before the start: the duration and the config's rates together.
+  const plant::SimulationCost cost = plant::estimate_simulation_cost(config.twin, opt.duration_s);
+  if (const std::string p =
+          plant::simulation_budget_problem(cost, opt.max_physics_steps, "--max-physics-steps");
+      !p.empty()) {
+    throw io::InputError(
+        fmt::format("--duration-s {} with physics_rate_Hz {} and sample_time_s {} ({}): {}",
+                    opt.duration_s, config.twin.physics_rate_Hz, period_s,
+                    opt.config_path.empty() ? "built-in configuration" : opt.config_path, p));
+  }
+
   control::SemiClosedLoopParams cp;
   cp.sample_time_s = period_s;  // the paper's gains, re-expressed at the twin's DAQ period
   const auto ticks = static_cast<std::uint64_t>(std::llround(opt.duration_s / period_s));
@@ -127,7 +146,9 @@ int run_simulate(const SimulateOptions& opt) {
                                      opt.duration_s, period_s));
   std::unique_ptr<experiments::Bench> made;
   try {
-    made = std::make_unique<experiments::Bench>(config, cp, opt.seed);
+    experiments::BenchOptions bo;
+    bo.limits = limits;
+    made = std::make_unique<experiments::Bench>(config, cp, opt.seed, bo);
   } catch (const std::invalid_argument& e) {
     throw io::InputError(fmt::format(
         "{}: {}", opt.config_path.empty() ? "configuration" : opt.config_path, e.what()));
@@ -269,7 +290,8 @@ void add_simulate_command(CLI::App& app, Action& action) {
   auto opt = std::make_shared<SimulateOptions>();
   cmd->add_option("--config", opt->config_path,
                   "TOML file (configs/paper.toml's sections; absent keys keep the paper's values)");
-  cmd->add_option("--seed", opt->seed, "seed of the twin's random numbers (default 1)");
+  cmd->add_option("--seed", opt->seed, "seed of the twin's random numbers (default 1)")
+      ->check(whole_number(0, kAnyUnsigned));
   cmd->add_option("--duration-s", opt->duration_s, "simulated time [s] (default 1)");
   cmd->add_option("--open-loop-volts", opt->open_loop_volts,
                   "open loop: the three DAQ output volts V1,V2,V3 (x15 at the stacks)")
@@ -282,6 +304,9 @@ void add_simulate_command(CLI::App& app, Action& action) {
       "--profile", opt->profile_path,
       "closed loop: CSV t_s and zd_um (or zd1_um..zd3_um), piecewise linear, as `run` reads");
   cmd->add_option("--log", opt->log_path, "CSV log, one row per control tick");
+  cmd->add_option(
+      "--max-physics-steps", opt->max_physics_steps,
+      "refuse a run estimated above this many physics steps (default 1e9, about a minute)");
   cmd->add_flag("--json", opt->json, "print a JSON summary instead of the text one");
   cmd->callback([&action, opt] { action = [opt] { return run_simulate(*opt); }; });
 }

@@ -37,6 +37,7 @@
 #include "piezoshift/reproduction/report.hpp"
 #include "piezoshift/reproduction/reproduction.hpp"
 #include "piezoshift/reproduction/summary.hpp"
+#include "piezoshift/runtime/safety_ranges.hpp"
 
 namespace py = pybind11;
 namespace ps = piezoshift;
@@ -378,8 +379,12 @@ PYBIND11_MODULE(_piezoshift, m) {
       .def(py::init<>())
       .PS_RW(ps::io::ProjectConfig, design)
       .PS_RW(ps::io::ProjectConfig, twin);
-  m.def("load_project_config", &ps::io::load_project_config, py::arg("path"),
-        "Loads a TOML configuration (InputError naming file, key and reason)");
+  // An installation's file may carry [safety] (runtime/safety_ranges.hpp): read and checked here
+  // too, so that the same file loads in Python and in the CLI.
+  m.def(
+      "load_project_config",
+      [](const std::string& path) { return ps::runtime::load_installation_config(path).project; },
+      py::arg("path"), "Loads a TOML configuration (InputError naming file, key and reason)");
 
   // ---- twin -------------------------------------------------------------------------------
   py::enum_<pl::AoStatus>(m, "AoStatus")

@@ -46,3 +46,23 @@ def test_to_dict_and_repr_use_the_field_names(config):
     assert d["twin"]["contact"]["stiffness_N_per_um"] is None
     assert len(d["twin"]["geometry"]["transmission_matrix"]) == 3
     assert "thickness_m=0.002" in repr(config.design.hinge)
+
+
+def test_params_built_in_python_meet_the_readers_ranges():
+    # Issue 17: one list of ranges (plant/twin_ranges.hpp) for the TOML reader and the bindings.
+    twin = ps.TwinParams()
+    twin.physics_rate_Hz = 2e12
+    assert (ps.twin_params_problem(ps.DesignInputs(), twin)
+            == "twin.physics_rate_Hz = 2000000000000 must be in [1, 10000000]")
+    with pytest.raises(ValueError, match="twin.physics_rate_Hz"):
+        ps.Twin(ps.DesignInputs(), twin, 1)
+
+
+def test_safety_section_is_accepted_and_checked(tmp_path):
+    ok = tmp_path / "site.toml"
+    ok.write_text("[safety]\noutput_max_V = 8.0\n")
+    assert ps.load_project_config(str(ok)).twin.physics_rate_Hz == 20000.0
+    bad = tmp_path / "bad_site.toml"
+    bad.write_text("[safety]\noutput_max_V = 11.0\n")
+    with pytest.raises(ps.InputError, match=r"bad_site.toml:2:16: safety.output_max_V"):
+        ps.load_project_config(str(bad))

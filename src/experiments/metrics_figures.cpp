@@ -93,6 +93,18 @@ io::Figure linearity_figure(std::span<const double> desired_um, std::span<const 
   return f;
 }
 
+double histogram_bin_nm(double spread_nm, double bin_nm) {
+  if (!(spread_nm / bin_nm > kMaxHistogramBins))
+    return bin_nm;
+  const double least = spread_nm / kMaxHistogramBins;
+  const double decade = std::pow(10.0, std::floor(std::log10(least)));
+  for (const double m : {1.0, 2.0, 5.0}) {
+    if (m * decade >= least)
+      return m * decade;
+  }
+  return 10.0 * decade;
+}
+
 io::Figure repeatability_figure(std::span<const RepeatabilitySet> sets, double bin_nm,
                                 std::string title) {
   if (sets.empty())
@@ -107,10 +119,13 @@ io::Figure repeatability_figure(std::span<const RepeatabilitySet> sets, double b
     std::vector<double> dev_nm(s.measured_um.size());
     for (std::size_t i = 0; i < dev_nm.size(); ++i)
       dev_nm[i] = 1000.0 * (s.measured_um[i] - r.mean_um);
-    io::Panel p =
-        make_panel(fmt::format("{}: e_R = {:.2f} nm (n = {})", s.label, r.repeatability_nm, r.n),
-                   fmt::format("z - mean ({:.4f} um) [nm]", r.mean_um), "count", "off");
-    p.series.push_back(io::histogram_series("", dev_nm, bin_nm));
+    const double bin = histogram_bin_nm(1000.0 * (r.max_um - r.min_um), bin_nm);
+    io::Panel p = make_panel(
+        fmt::format("{}: e_R = {:.2f} nm (n = {})", s.label, r.repeatability_nm, r.n),
+        bin == bin_nm ? fmt::format("z - mean ({:.4f} um) [nm]", r.mean_um)
+                      : fmt::format("z - mean ({:.4f} um) [nm], bins of {:g} nm", r.mean_um, bin),
+        "count", "off");
+    p.series.push_back(io::histogram_series("", dev_nm, bin));
     // Counts start at zero, or the bars' heights mislead.
     const auto& counts = p.series.back().y;
     const double top = counts.empty() ? 1.0 : *std::max_element(counts.begin(), counts.end());

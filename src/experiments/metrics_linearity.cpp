@@ -72,6 +72,15 @@ LinearityMetrics linearity_metrics(std::span<const double> desired_um,
   }
   m.linearity_zero_end_pct = 100.0 * m.max_deviation_zero_end_um / std::abs(m.span_um);
   m.linearity_best_fit_pct = 100.0 * m.max_deviation_best_fit_um / std::abs(m.span_um);
+  // Finite points can still overflow the sums and products (1e308): a failure, never a NaN.
+  bool finite = std::isfinite(m.best_fit_slope) && std::isfinite(m.best_fit_intercept_um) &&
+                std::isfinite(m.zero_end_slope) && std::isfinite(m.zero_end_intercept_um) &&
+                std::isfinite(m.linearity_zero_end_pct) && std::isfinite(m.linearity_best_fit_pct);
+  for (std::size_t i = 0; i < n; ++i)
+    finite = finite && std::isfinite(m.deviation_zero_end_um[i]) &&
+             std::isfinite(m.deviation_best_fit_um[i]);
+  if (!finite)
+    throw MetricsError("linearity: the values overflow the fits in double precision");
   return m;
 }
 

@@ -30,6 +30,13 @@ RepeatabilityMetrics repeatability_metrics(std::span<const double> measured_um) 
   double ss = 0.0;
   for (const double z : measured_um)
     ss += (z - r.mean_um) * (z - r.mean_um);
+  // Finite values can still overflow the sum or the squares (1e308 and -1e308): a failure, not
+  // an infinite e_R.
+  if (!std::isfinite(r.mean_um) || !std::isfinite(ss) ||
+      !std::isfinite(1000.0 * (r.max_um - r.min_um)))
+    throw MetricsError(fmt::format(
+        "repeatability: the values (from {} to {} um) overflow Eq. 9 in double precision", r.min_um,
+        r.max_um));
   r.repeatability_um = std::sqrt(ss / static_cast<double>(n - 1));
   r.repeatability_nm = 1000.0 * r.repeatability_um;
   return r;

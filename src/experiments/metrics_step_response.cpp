@@ -21,15 +21,16 @@ double crossing(double ta, double ga, double tb, double gb, double level) {
 }  // namespace
 
 std::vector<double> running_median(std::span<const double> y, std::size_t window) {
-  if (window == 0 || window % 2 == 0)
-    throw MetricsError(fmt::format("running median: window {} must be odd and >= 1", window));
+  if (window == 0 || window % 2 == 0 || window > kMaxMedianWindow)
+    throw MetricsError(fmt::format("running median: window {} must be odd and in [1, {}]", window,
+                                   kMaxMedianWindow));
   const std::size_t n = y.size();
   std::vector<double> out(y.begin(), y.end());
   if (window == 1)
     return out;
   const std::size_t half = window / 2;
   std::vector<double> buf;
-  buf.reserve(window);
+  buf.reserve(std::min(window, n));
   for (std::size_t i = 0; i < n; ++i) {
     const std::size_t h = std::min({half, i, n - 1 - i});  // symmetric at the ends
     buf.assign(y.begin() + static_cast<std::ptrdiff_t>(i - h),
@@ -60,6 +61,9 @@ StepResponseMetrics step_response_metrics(std::span<const double> t_s, std::span
   if (!(o.band_pct > 0.0) || !(o.band_nm > 0.0) || !std::isfinite(o.band_pct) ||
       !std::isfinite(o.band_nm))
     throw MetricsError("step response: the settling bands must be > 0");
+  if (!std::isfinite(o.step_time_s))
+    throw MetricsError(
+        fmt::format("step response: step_time_s = {} must be finite", o.step_time_s));
   const auto first_after = static_cast<std::size_t>(
       std::lower_bound(t_s.begin(), t_s.end(), o.step_time_s) - t_s.begin());
   if (n - first_after < 3) {

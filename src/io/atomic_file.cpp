@@ -3,9 +3,13 @@
 #include <fcntl.h>
 #include <unistd.h>
 
+#include <signal.h>
+
 #include <cerrno>
+#include <charconv>
 #include <cstring>
 #include <filesystem>
+#include <limits>
 
 #include <fmt/core.h>
 
@@ -18,6 +22,27 @@ namespace {
   throw io::InputError(
       fmt::format("{}: cannot replace the file ({}): {}", path, what, std::strerror(err)));
 }
+
+// Removes "<dir>/.<name>.tmp.<pid>" left by a writer of the same file that was killed (SIGKILL
+// cannot be caught) and whose process is gone. A live PID's file is left alone: it may be another
+// writer's, mid-write. Best effort: a name that does not parse or cannot be removed is skipped.
+void remove_stale_temporaries(const std::filesystem::path& dir, const std::string& name) {
+  const std::string prefix = fmt::format(".{}.tmp.", name);
+  std::error_code ec;
+  for (std::filesystem::directory_iterator it(dir, ec), end; !ec && it != end; it.increment(ec)) {
+    const std::string entry = it->path().filename().string();
+    if (entry.size() <= prefix.size() || entry.compare(0, prefix.size(), prefix) != 0)
+      continue;
+    const std::string digits = entry.substr(prefix.size());
+    long long pid = 0;
+    const auto [end_ptr, err] = std::from_chars(digits.data(), digits.data() + digits.size(), pid);
+    if (err != std::errc() || end_ptr != digits.data() + digits.size() || pid <= 0 ||
+        pid > std::numeric_limits<pid_t>::max())
+      continue;
+    if (::kill(static_cast<pid_t>(pid), 0) != 0 && errno == ESRCH)
+      ::unlink(it->path().c_str());
+  }
+}
 }  // namespace
 
 void write_file_atomically(const std::string& path, std::string_view contents) {
@@ -26,6 +51,7 @@ void write_file_atomically(const std::string& path, std::string_view contents) {
       target.has_parent_path() ? target.parent_path() : std::filesystem::path(".");
   const std::string tmp =
       (dir / fmt::format(".{}.tmp.{}", target.filename().string(), ::getpid())).string();
+  remove_stale_temporaries(dir, target.filename().string());
 
   const int fd = ::open(tmp.c_str(), O_WRONLY | O_CREAT | O_TRUNC | O_CLOEXEC, 0644);
   if (fd < 0)

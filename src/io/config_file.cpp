@@ -11,27 +11,9 @@
 #include <toml++/toml.h>
 
 #include "piezoshift/io/input_error.hpp"
+#include "piezoshift/io/input_file.hpp"
 
 namespace piezoshift::io {
-
-bool Bounds::contains(double v) const {
-  if (!std::isfinite(v))
-    return false;
-  const bool above = lo_open ? v > lo : v >= lo;
-  const bool below = hi_open ? v < hi : v <= hi;
-  return above && below;
-}
-
-std::string Bounds::describe() const {
-  const bool no_lo = lo <= -1e308, no_hi = hi >= 1e308;
-  if (no_lo && no_hi)
-    return "a finite number";
-  if (no_hi)
-    return fmt::format("{} {}", lo_open ? ">" : ">=", lo);
-  if (no_lo)
-    return fmt::format("{} {}", hi_open ? "<" : "<=", hi);
-  return fmt::format("in {}{}, {}{}", lo_open ? "(" : "[", lo, hi, hi_open ? ")" : "]");
-}
 
 struct ConfigFileImpl {
   std::string source;
@@ -123,12 +105,11 @@ ConfigFile::~ConfigFile() = default;
 ConfigFile ConfigFile::load(const std::string& path) {
   auto impl = std::make_unique<ConfigFileImpl>();
   impl->source = path;
+  const std::string text = read_input_file(path, kMaxConfigFileBytes);
   try {
-    impl->root = toml::parse_file(path);
+    impl->root = toml::parse(text, path);
   } catch (const toml::parse_error& e) {
     const auto& b = e.source().begin;
-    if (b.line == 0)
-      throw InputError(fmt::format("{}: cannot read: {}", path, e.description()));
     throw InputError(
         fmt::format("{}:{}:{}: syntax error: {}", path, b.line, b.column, e.description()));
   }

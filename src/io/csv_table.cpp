@@ -1,15 +1,12 @@
 #include "piezoshift/io/csv_table.hpp"
 
-#include <cerrno>
 #include <charconv>
 #include <cmath>
-#include <cstring>
-#include <fstream>
-#include <sstream>
 
 #include <fmt/core.h>
 
 #include "piezoshift/io/input_error.hpp"
+#include "piezoshift/io/input_file.hpp"
 
 namespace piezoshift::io {
 namespace {
@@ -70,16 +67,7 @@ bool parse_finite_double(std::string_view cell, double& value) {
 }
 
 CsvTable CsvTable::load(const std::string& path) {
-  std::ifstream in(path, std::ios::binary);
-  if (!in) {
-    throw InputError(fmt::format("{}: cannot open: {}", path, std::strerror(errno)));
-  }
-  std::ostringstream text;
-  text << in.rdbuf();
-  if (in.bad()) {
-    throw InputError(fmt::format("{}: cannot read: {}", path, std::strerror(errno)));
-  }
-  return parse(text.str(), path);
+  return parse(read_input_file(path, kMaxDataFileBytes), path);
 }
 
 CsvTable CsvTable::parse(std::string_view text, const std::string& source_name) {

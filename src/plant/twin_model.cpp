@@ -12,6 +12,7 @@
 #include "piezoshift/design/natural_frequency.hpp"
 #include "piezoshift/kinematics/tripod.hpp"
 #include "piezoshift/plant/contact.hpp"
+#include "piezoshift/plant/twin_ranges.hpp"
 
 namespace piezoshift::plant {
 namespace {
@@ -23,10 +24,6 @@ namespace {
 void require(bool ok, const std::string& message) {
   if (!ok)
     fail(message);
-}
-
-bool positive(double v) {
-  return std::isfinite(v) && v > 0.0;
 }
 
 // n = value when value is (to rounding) a whole number >= 1.
@@ -72,20 +69,23 @@ LinearMechanics make_leg_plate_mechanics(const TwinModel& m,
 TwinModel make_twin_model(const design::DesignInputs& d, const TwinParams& p) {
   if (const std::string problem = design::design_inputs_problem(d); !problem.empty())
     fail(problem);
+  // Every value within its range first (twin_ranges.hpp); what follows checks combinations.
+  if (const std::string problem = twin_ranges_problem(p); !problem.empty())
+    fail(problem);
   TwinModel m;
   m.design = d;
   m.params = p;
 
-  // Timing
-  require(positive(p.physics_rate_Hz), "twin.physics_rate_Hz must be positive");
-  require(positive(p.daq.sample_time_s), "twin.daq.sample_time_s must be positive");
+  // Timing: the per-tick physics cost is bounded (kMaxPhysicsStepsPerTick).
+  require(p.physics_rate_Hz * p.daq.sample_time_s <= kMaxPhysicsStepsPerTick * (1.0 + 1e-9),
+          fmt::format("twin.physics_rate_Hz * twin.daq.sample_time_s = {} physics steps per "
+                      "control tick is more than the twin's limit of {}",
+                      p.physics_rate_Hz * p.daq.sample_time_s, kMaxPhysicsStepsPerTick));
   m.control_period_s = p.daq.sample_time_s;
   m.substeps = whole_number(p.physics_rate_Hz * p.daq.sample_time_s,
                             "twin.physics_rate_Hz * twin.daq.sample_time_s (physics steps per "
                             "control period)");
   m.physics_step_s = p.daq.sample_time_s / static_cast<double>(m.substeps);
-  require(positive(p.interferometer.dynamic_sample_rate_Hz),
-          "twin.interferometer.dynamic_sample_rate_Hz must be positive");
   m.interferometer_every = whole_number(
       p.physics_rate_Hz / p.interferometer.dynamic_sample_rate_Hz,
       "twin.physics_rate_Hz / twin.interferometer.dynamic_sample_rate_Hz (physics steps per "
@@ -96,19 +96,9 @@ TwinModel make_twin_model(const design::DesignInputs& d, const TwinParams& p) {
       "(samples per static reading)");
 
   // DAQ, amplifier
-  require(p.daq.resolution_bits >= 2 && p.daq.resolution_bits <= 32,
-          "twin.daq.resolution_bits must be in [2, 32]");
-  require(positive(p.daq.range_V), "twin.daq.range_V must be positive");
-  require(std::isfinite(p.daq.ai_noise_V_rms) && p.daq.ai_noise_V_rms >= 0.0,
-          "twin.daq.ai_noise_V_rms must be >= 0");
   const AmplifierParams& amp = p.amplifier;
-  require(positive(amp.gain), "twin.amplifier.gain must be positive");
-  require(std::isfinite(amp.output_min_V) && positive(amp.output_max_V) &&
-              amp.output_min_V < amp.output_max_V,
-          "twin.amplifier.output_min_V must be below twin.amplifier.output_max_V (> 0)");
-  require(positive(amp.average_power_W), "twin.amplifier.average_power_W must be positive");
-  require(positive(amp.small_signal_bandwidth_Hz),
-          "twin.amplifier.small_signal_bandwidth_Hz must be positive");
+  require(amp.output_min_V < amp.output_max_V,
+          "twin.amplifier.output_min_V must be below twin.amplifier.output_max_V");
   m.amplifier = Amplifier(amp, d.actuator.capacitance_F, m.physics_step_s);
   m.amplifier_current_limit_A = amplifier_current_limit_A(amp);
   m.amplifier_slew_V_per_s = amplifier_slew_rate_V_per_s(amp, d.actuator.capacitance_F);
@@ -117,13 +107,10 @@ TwinModel make_twin_model(const design::DesignInputs& d, const TwinParams& p) {
   m.hysteresis =
       built("twin.piezo", [&] { return PrandtlIshlinskii(p.piezo.hysteresis, amp.output_max_V); });
   m.creep = built("twin.piezo", [&] { return CreepChain(p.piezo.creep, m.control_period_s); });
-  require(positive(p.piezo.creep_reference_time_s),
-          "twin.piezo.creep_reference_time_s must be positive");
   const double f_ref = 1.0 + m.creep.step_response(p.piezo.creep_reference_time_s);
   double scale_sum = 0.0;
   for (std::size_t i = 0; i < 3; ++i) {
     const double s = p.piezo.free_stroke_scale[i];
-    require(positive(s), fmt::format("twin.piezo.free_stroke_scale[{}] must be positive", i));
     m.free_stroke_um[i] = d.actuator.nominal_stroke_um * s;
     m.stroke_gain_um[i] = m.free_stroke_um[i] / f_ref;
     scale_sum += s;
@@ -133,21 +120,14 @@ TwinModel make_twin_model(const design::DesignInputs& d, const TwinParams& p) {
   m.mechanism_stiffness_N_per_um = design::mechanism_stiffness_N_per_um(d.material, d.hinge);
   m.actuator_stiffness_N_per_um = d.actuator.stiffness_N_per_um;
   const double km = m.mechanism_stiffness_N_per_um, ka = m.actuator_stiffness_N_per_um;
-  require(positive(p.contact.open_loop_time_s), "twin.contact.open_loop_time_s must be positive");
   m.open_loop_creep_factor = (1.0 + m.creep.step_response(p.contact.open_loop_time_s)) / f_ref;
-  require(std::isfinite(p.contact.ball_radius_m) && p.contact.ball_radius_m >= 0.0,
-          "twin.contact.ball_radius_m must be >= 0");
-  require(positive(p.contact.open_loop_travel_um),
-          "twin.contact.open_loop_travel_um must be positive");
   const double free_at_measurement =
       d.actuator.nominal_stroke_um * scale_sum / 3.0 * m.open_loop_creep_factor;
   const double travel = p.contact.open_loop_travel_um;
   m.contact_modulus_Pa =
       hertz_contact_modulus_Pa(d.material.elastic_modulus_Pa, d.material.poisson_ratio);
   if (p.contact.stiffness_N_per_um.has_value()) {
-    const double kc = *p.contact.stiffness_N_per_um;
-    require(kc > 0.0 && !std::isnan(kc), "twin.contact.stiffness_N_per_um must be positive");
-    m.contact_stiffness_N_per_um = kc;
+    m.contact_stiffness_N_per_um = *p.contact.stiffness_N_per_um;
   } else if (p.contact.ball_radius_m > 0.0 &&
              (p.contact.preload_N.has_value() ||
               hertz_preload_reachable(travel, free_at_measurement, ka, km, p.contact.ball_radius_m,
@@ -155,7 +135,6 @@ TwinModel make_twin_model(const design::DesignInputs& d, const TwinParams& p) {
     const double r = p.contact.ball_radius_m, e = m.contact_modulus_Pa;
     m.contact_hertz = true;
     if (p.contact.preload_N.has_value()) {
-      require(positive(*p.contact.preload_N), "twin.contact.preload_N must be positive");
       m.contact_preload_N = *p.contact.preload_N;
     } else {
       m.contact_preload_N = built("twin.contact", [&] {
@@ -195,10 +174,6 @@ TwinModel make_twin_model(const design::DesignInputs& d, const TwinParams& p) {
   const double w_a = 2.0 * std::numbers::pi * d.actuator.resonance_frequency_Hz;
   m.stack_mass_kg = ka * 1e6 / (w_a * w_a);
   m.leg_mass_kg = m.mechanism_mass_kg + m.stack_mass_kg;
-  require(positive(p.plate.radius_m), "twin.plate.radius_m must be positive");
-  require(positive(p.plate.thickness_m), "twin.plate.thickness_m must be positive");
-  require(std::isfinite(p.plate.payload_mass_kg) && p.plate.payload_mass_kg >= 0.0,
-          "twin.plate.payload_mass_kg must be >= 0");
   m.plate = plate_inertia(p.plate, d.material.density_kg_per_m3);
 
   // Geometry and sensors
@@ -220,24 +195,12 @@ TwinModel make_twin_model(const design::DesignInputs& d, const TwinParams& p) {
     m.legs_to_pose[2][i] = pose.theta_y_urad;
   }
   const SgsParams& sgs = p.sgs;
-  require(positive(sgs.full_scale_V), "twin.sgs.full_scale_V must be positive");
-  require(std::isfinite(sgs.nonlinearity_fraction) && sgs.nonlinearity_fraction >= 0.0,
-          "twin.sgs.nonlinearity_fraction must be >= 0");
-  require(std::isfinite(sgs.noise_nm_rms) && sgs.noise_nm_rms >= 0.0,
-          "twin.sgs.noise_nm_rms must be >= 0");
-  require(positive(sgs.bandwidth_Hz), "twin.sgs.bandwidth_Hz must be positive");
-  require(std::isfinite(sgs.zero_drift_nm_per_K), "twin.sgs.zero_drift_nm_per_K must be finite");
   for (std::size_t i = 0; i < 3; ++i) {
-    require(std::isfinite(sgs.offset_V[i]), fmt::format("twin.sgs.offset_V[{}] must be finite", i));
     m.sgs_gain_per_elongation[i] = m.geometry.sgs_gain[i] / (1.0 + km / m.contact_secant_N_per_um);
   }
   m.sgs_nominal_um_per_V = d.actuator.nominal_stroke_um / sgs.full_scale_V;
   // Gauge creep: the stack's chain, scaled so a step creeps by the stated fraction in the
   // stated time (creep.hpp: the step response is linear in the per-decade fraction).
-  require(std::isfinite(sgs.gauge_creep_fraction) && sgs.gauge_creep_fraction >= 0.0 &&
-              sgs.gauge_creep_fraction <= 0.1,
-          "twin.sgs.gauge_creep_fraction must be in [0, 0.1]");
-  require(positive(sgs.gauge_creep_time_s), "twin.sgs.gauge_creep_time_s must be positive");
   CreepParams gauge = p.piezo.creep;
   gauge.per_decade_fraction = 1.0;
   const double unit_creep = built("twin.sgs", [&] {
@@ -247,12 +210,6 @@ TwinModel make_twin_model(const design::DesignInputs& d, const TwinParams& p) {
   m.gauge_creep = built("twin.sgs", [&] { return CreepChain(gauge, m.control_period_s); });
   // Flicker: the zero's 1/f level A = S_white f_corner, S_white = sigma^2 / (f_s / 2); the
   // excitation's level from its rms over the stated window (flicker.hpp).
-  require(positive(sgs.flicker_corner_Hz) || sgs.flicker_corner_Hz == 0.0,
-          "twin.sgs.flicker_corner_Hz must be >= 0");
-  require(std::isfinite(sgs.excitation_drift_ppm_rms) && sgs.excitation_drift_ppm_rms >= 0.0,
-          "twin.sgs.excitation_drift_ppm_rms must be >= 0");
-  require(positive(sgs.excitation_drift_window_s),
-          "twin.sgs.excitation_drift_window_s must be positive");
   const double white_psd_nm2_per_Hz =
       sgs.noise_nm_rms * sgs.noise_nm_rms / (0.5 / m.control_period_s);
   m.sgs_zero_flicker =
@@ -263,38 +220,7 @@ TwinModel make_twin_model(const design::DesignInputs& d, const TwinParams& p) {
                                  kSgsExcitationShortestS, kSgsFlickerLongestS, 1),
       kSgsExcitationShortestS, kSgsFlickerLongestS, 1, m.control_period_s);
 
-  // Interferometer and lab
-  const InterferometerParams& ifm = p.interferometer;
-  require(positive(ifm.wavelength_nm), "twin.interferometer.wavelength_nm must be positive");
-  require(positive(ifm.resolution_nm), "twin.interferometer.resolution_nm must be positive");
-  require(std::isfinite(ifm.accuracy_ppm) && ifm.accuracy_ppm >= 0.0,
-          "twin.interferometer.accuracy_ppm must be >= 0");
-  require(std::isfinite(ifm.noise_nm_rms) && ifm.noise_nm_rms >= 0.0,
-          "twin.interferometer.noise_nm_rms must be >= 0");
-  require(std::isfinite(ifm.cyclic_error_nm) && ifm.cyclic_error_nm >= 0.0,
-          "twin.interferometer.cyclic_error_nm must be >= 0");
-  const LabParams& lab = p.lab;
-  require(std::isfinite(lab.temperature_C), "twin.lab.temperature_C must be finite");
-  require(std::isfinite(lab.temperature_rms_K) && lab.temperature_rms_K >= 0.0,
-          "twin.lab.temperature_rms_K must be >= 0");
-  require(positive(lab.temperature_correlation_time_s),
-          "twin.lab.temperature_correlation_time_s must be positive");
-  require(positive(lab.structure_time_constant_s),
-          "twin.lab.structure_time_constant_s must be positive");
-  require(std::isfinite(lab.metrology_loop_length_m) && lab.metrology_loop_length_m >= 0.0,
-          "twin.lab.metrology_loop_length_m must be >= 0");
-  require(std::isfinite(lab.metrology_loop_cte_per_K),
-          "twin.lab.metrology_loop_cte_per_K must be finite");
-  require(std::isfinite(lab.dead_path_m) && lab.dead_path_m >= 0.0,
-          "twin.lab.dead_path_m must be >= 0");
-  require(std::isfinite(lab.air_index_per_K), "twin.lab.air_index_per_K must be finite");
-
   // Dynamics
-  const MechanicsParams& mech = p.mechanics;
-  require(mech.modal_damping_ratio >= 0.0 && mech.modal_damping_ratio < 1.0,
-          "twin.mechanics.modal_damping_ratio must be in [0, 1)");
-  require(mech.mechanism_damping_ratio >= 0.0 && mech.mechanism_damping_ratio < 1.0,
-          "twin.mechanics.mechanism_damping_ratio must be in [0, 1)");
   m.mechanics = make_leg_plate_mechanics(m, {km + ks, km + ks, km + ks});
   m.loaded_modes_Hz = m.mechanics.natural_frequencies_Hz();
   m.unloaded_mechanism_Hz = design::natural_frequency_Hz(km, m.mechanism_mass_kg);

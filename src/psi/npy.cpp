@@ -2,14 +2,13 @@
 
 #include <bit>
 #include <cstring>
-#include <fstream>
-#include <iterator>
 #include <regex>
 
 #include <fmt/core.h>
 
 #include "piezoshift/io/atomic_file.hpp"
 #include "piezoshift/io/input_error.hpp"
+#include "piezoshift/io/input_file.hpp"
 
 namespace piezoshift::psi {
 
@@ -37,10 +36,7 @@ void write_npy(const std::string& path, const Map& map) {
 }
 
 Map read_npy(const std::string& path) {
-  std::ifstream in(path, std::ios::binary);
-  if (!in)
-    throw io::InputError(fmt::format("{}: cannot open", path));
-  const std::string data((std::istreambuf_iterator<char>(in)), std::istreambuf_iterator<char>());
+  const std::string data = io::read_input_file(path, io::kMaxFrameFileBytes);
   if (data.size() < 10 || data.compare(0, 6, "\x93NUMPY") != 0)
     throw io::InputError(fmt::format("{}: not a .npy file", path));
   if (data[6] != 1)

@@ -6,8 +6,6 @@
 #include <array>
 #include <cmath>
 #include <cstring>
-#include <fstream>
-#include <iterator>
 #include <stdexcept>
 #include <vector>
 
@@ -15,6 +13,7 @@
 
 #include "piezoshift/io/atomic_file.hpp"
 #include "piezoshift/io/input_error.hpp"
+#include "piezoshift/io/input_file.hpp"
 
 namespace piezoshift::psi {
 namespace {
@@ -93,10 +92,7 @@ std::array<png_byte, 3> colour(double t) {
 }  // namespace
 
 GrayImage read_png_gray(const std::string& path) {
-  std::ifstream in(path, std::ios::binary);
-  if (!in)
-    throw io::InputError(fmt::format("{}: cannot open", path));
-  const std::string data((std::istreambuf_iterator<char>(in)), std::istreambuf_iterator<char>());
+  const std::string data = io::read_input_file(path, io::kMaxDataFileBytes);
   if (data.size() < 8 || png_sig_cmp(reinterpret_cast<png_const_bytep>(data.data()), 0, 8) != 0)
     throw io::InputError(fmt::format("{}: not a PNG file", path));
   png_structp png = png_create_read_struct(PNG_LIBPNG_VER_STRING, nullptr, on_error, on_warning);

@@ -72,6 +72,9 @@ FaultSpec parse_fault_spec(std::string_view text) {
   }
   if (!parse_double(time_text, spec.time_s) || spec.time_s < 0.0)
     throw bad(fmt::format("time '{}' is not a number of seconds >= 0", time_text));
+  if (spec.time_s > kMaxRunDurationS)
+    throw bad(
+        fmt::format("time {} s is beyond the longest run, {} s", spec.time_s, kMaxRunDurationS));
   if (spec.kind == FaultKind::kOverrunBurst) {
     if (!channel_text.empty())
       throw bad("overrun-burst takes no channel");

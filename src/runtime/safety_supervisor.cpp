@@ -4,6 +4,8 @@
 #include <stdexcept>
 #include <string>
 
+#include "piezoshift/runtime/safety_ranges.hpp"
+
 namespace piezoshift::runtime {
 
 const char* to_string(FaultReason reason) noexcept {
@@ -64,22 +66,10 @@ void SafetySupervisor::configure(
     const SafetyLimits& limits, double sample_time_s,
     const std::array<control::SignalScaling, control::kChannels>& scaling) {
   demand(sample_time_s > 0.0 && std::isfinite(sample_time_s), "sample time must be > 0");
-  demand(limits.output_min_V < limits.output_max_V, "output_min_V < output_max_V");
-  demand(limits.output_min_V <= 0.0 && limits.output_max_V >= 0.0,
-         "0 V must be inside the output range (the safe state)");
-  demand(limits.max_slew_V_per_s > 0.0, "max_slew_V_per_s > 0");
-  demand(limits.safe_ramp_V_per_s > 0.0 && limits.safe_ramp_V_per_s <= limits.max_slew_V_per_s,
-         "0 < safe_ramp_V_per_s <= max_slew_V_per_s");
-  demand(limits.sgs_min_V < limits.sgs_max_V, "sgs_min_V < sgs_max_V");
-  demand(limits.adc_full_scale_V > 0.0 && limits.rail_margin_V >= 0.0, "ADC full scale > 0");
-  demand(limits.sgs_noise_V >= 0.0 && limits.jump_factor >= 1.0, "jump rule parameters");
-  demand(limits.tracking_error_um > 0.0 && limits.tracking_time_s > 0.0, "tracking rule");
-  demand(limits.stage_gain > 0.0, "stage_gain > 0");
-  demand(limits.response_gain_min >= 0.0 && limits.response_gain_min < limits.response_gain_max &&
-             limits.response_band_um >= 0.0 && limits.response_time_s > 0.0,
-         "response rule");
-  demand(limits.saturation_time_s > 0.0, "saturation_time_s > 0");
-  demand(limits.max_consecutive_overruns >= 1, "max_consecutive_overruns >= 1");
+  // The ranges and pairs of safety_ranges.hpp (0 V, the safe state, is inside every output
+  // range it accepts).
+  if (const std::string problem = safety_limits_problem(limits); !problem.empty())
+    throw std::invalid_argument("SafetyLimits: " + problem);
   limits_ = limits;
   sample_time_s_ = sample_time_s;
   scaling_ = scaling;

@@ -21,12 +21,18 @@ void SimBackend::configure() {
   const double control_rate_Hz = 1.0 / p.daq.sample_time_s;
   const double substeps = std::ceil(p.physics_rate_Hz / control_rate_Hz - 1e-9);
   p.physics_rate_Hz = control_rate_Hz * (substeps < 1.0 ? 1.0 : substeps);
+  // The config was valid at its own DAQ period; at the loop's rate it may not be (the physics
+  // rate rounded up past its range, or no longer a multiple of the interferometer's).
+  const auto cannot = [&](const std::string& why) {
+    return io::InputError(fmt::format("sim at {} Hz: the twin of {} cannot be built: {}",
+                                      options_.rate_Hz, options_.source, why));
+  };
   if (const std::string problem = plant::twin_params_problem(options_.design, p); !problem.empty())
-    throw io::InputError(fmt::format("sim: the twin cannot be built: {}", problem));
+    throw cannot(problem);
   try {
     twin_ = std::make_unique<plant::Twin>(options_.design, p, options_.seed);
   } catch (const std::invalid_argument& e) {
-    throw io::InputError(fmt::format("sim: the twin cannot be built: {}", e.what()));
+    throw cannot(e.what());
   }
 }
 
@@ -52,6 +58,10 @@ DaqStatus SimBackend::read(const CycleTime& t, Vec3& ai_V) noexcept {
   std::int64_t n = (t.period_ns + period_ns_ / 2) / period_ns_;
   if (n < 1)
     n = 1;
+  // A tick that took longer than its period must not make the next one longer still: the twin
+  // falls behind the clock instead (the supervisor's overrun rule trips on such a loop anyway).
+  if (n > kMaxCatchUpPeriods)
+    n = kMaxCatchUpPeriods;
   for (std::int64_t i = 0; i < n; ++i)
     twin_->advance();
   ai_V = twin_->read_ai();

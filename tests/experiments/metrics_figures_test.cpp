@@ -5,6 +5,7 @@
 #include <cmath>
 #include <filesystem>
 #include <fstream>
+#include <string>
 #include <vector>
 
 namespace piezoshift::experiments {
@@ -56,6 +57,22 @@ TEST(MetricsFigures, LinearityAndRepeatabilityFiguresRender) {
     GTEST_SKIP() << "gnuplot not on PATH";
   EXPECT_GT(fs::file_size(*io::render(lin, out_dir() / "linearity").png), 1000u);
   EXPECT_GT(fs::file_size(*io::render(rep, out_dir() / "repeatability").png), 1000u);
+}
+
+// Issue 17: data spread over microns (reproduce's own linearity.csv, 0 to 11 um) needed more than
+// the histogram's 10000 bins of 1 nm: the bin widens to 1, 2 or 5 x 10^k nm, named on the axis.
+TEST(MetricsFigures, RepeatabilityHistogramWidensItsBinForMicronSpreads) {
+  EXPECT_EQ(histogram_bin_nm(4.0, 1.0), 1.0);
+  EXPECT_EQ(histogram_bin_nm(11000.0, 1.0), 50.0);   // 22 nm at least: 50 nm
+  EXPECT_EQ(histogram_bin_nm(60000.0, 1.0), 200.0);  // 120 nm at least: 200 nm
+  std::vector<RepeatabilitySet> sets{{"sweep", {}}};
+  for (int i = 0; i <= 11; ++i)
+    sets[0].measured_um.push_back(i);
+  const io::Figure f = repeatability_figure(sets);
+  ASSERT_EQ(f.panels.size(), 1u);
+  EXPECT_EQ(f.panels[0].series[0].w.front(), 50.0);
+  EXPECT_LE(f.panels[0].series[0].x.size(), 500u);
+  EXPECT_NE(f.panels[0].x_label.find("bins of 50 nm"), std::string::npos) << f.panels[0].x_label;
 }
 
 }  // namespace

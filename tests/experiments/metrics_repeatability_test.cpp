@@ -3,6 +3,7 @@
 #include <gtest/gtest.h>
 
 #include <cmath>
+#include <string>
 #include <vector>
 
 namespace piezoshift::experiments {
@@ -32,6 +33,19 @@ TEST(Repeatability, RejectsFewerThanTwoAndNonFinite) {
   EXPECT_THROW(repeatability_metrics(one), MetricsError);
   const std::vector<double> bad{1.0, NAN};
   EXPECT_THROW(repeatability_metrics(bad), MetricsError);
+}
+
+// Issue 17: finite values whose squares overflow gave e_R = inf; now a failure naming the range.
+TEST(Repeatability, ValuesThatOverflowEq9AreRefused) {
+  const std::vector<double> huge{1e308, -1e308};
+  try {
+    repeatability_metrics(huge);
+    ADD_FAILURE() << "no error";
+  } catch (const MetricsError& e) {
+    EXPECT_NE(std::string(e.what()).find("overflow Eq. 9"), std::string::npos) << e.what();
+  }
+  const std::vector<double> both{1e308, 1e308};  // the sum overflows, the spread does not
+  EXPECT_THROW(repeatability_metrics(both), MetricsError);
 }
 
 }  // namespace

@@ -472,6 +472,60 @@ TEST_F(Serve, TheGcsCommandSendsCommandsAndPrintsTheAnswersOfQueries) {
       << slurp(path("gcs2_err.txt"));
 }
 
+// Waits for s to exit, at most limit_s (a hang guard, not a timing assertion: the cases below end
+// in about 2 s); -2 and SIGKILL when it did not.
+int wait_exit_or_kill(const Spawned& s, int limit_s) {
+  for (int i = 0; i < limit_s * 100; ++i) {
+    int status = 0;
+    if (waitpid(s.pid, &status, WNOHANG) == s.pid)
+      return WIFEXITED(status) ? WEXITSTATUS(status) : -1;
+    std::this_thread::sleep_for(std::chrono::milliseconds(10));
+  }
+  kill(s.pid, SIGKILL);
+  wait_exit(s);
+  return -2;
+}
+
+// Issue 17: a twin of 2e10 Hz physics spun for minutes past --duration-s and SIGTERM. Such a rate
+// is refused by file and key; the heaviest accepted one (1e7 Hz, 10 000 physics steps per 1 ms
+// tick) honours both.
+TEST_F(Serve, HeaviestAcceptedTwinHonoursDurationAndSigterm) {
+  const std::string too_fast = write("too_fast.toml", "[twin]\nphysics_rate_Hz = 2e10\n");
+  const Spawned refused = spawn({"serve", "--port", "0", "--config", too_fast, "--duration-s", "1"},
+                                path("o.txt"), path("e.txt"));
+  EXPECT_EQ(wait_exit_or_kill(refused, 60), 2);
+  EXPECT_NE(slurp(path("e.txt")).find(too_fast + ":2:19: twin.physics_rate_Hz"), std::string::npos)
+      << slurp(path("e.txt"));
+
+  const std::string heavy = write("heavy.toml", "[twin]\nphysics_rate_Hz = 1e7\n");
+  ASSERT_NE(start({"--config", heavy, "--duration-s", "1"}), 0);
+  EXPECT_EQ(wait_exit_or_kill(server_, 120), 0) << slurp(path("err.txt"));
+  server_.pid = -1;
+  const std::string out = slurp(path("out.txt"));
+  EXPECT_NE(out.find("\"stop_reason\": \"duration\""), std::string::npos) << out;
+
+  ASSERT_NE(start({"--config", heavy}), 0);
+  kill(server_.pid, SIGTERM);
+  EXPECT_EQ(wait_exit_or_kill(server_, 120), 0) << slurp(path("err.txt"));
+  server_.pid = -1;
+  EXPECT_NE(slurp(path("out.txt")).find("\"stop_reason\": \"SIGTERM\""), std::string::npos);
+}
+
+// The installation's [safety] is applied and shown at start-up and in the summary; the command
+// line's --max-overruns (start() gives 1000000) overrides its overrun count.
+TEST_F(Serve, SafetySectionIsAppliedAndShown) {
+  const std::string site =
+      write("site.toml", "[safety]\noutput_max_V = 8.0\nmax_consecutive_overruns = 5\n");
+  ASSERT_NE(start({"--config", site, "--duration-s", "0.2"}), 0);
+  EXPECT_EQ(wait_exit_or_kill(server_, 120), 0) << slurp(path("err.txt"));
+  server_.pid = -1;
+  const std::string out = slurp(path("out.txt"));
+  EXPECT_NE(out.find("safety (" + site + " [safety]): outputs 0 to 8 V"), std::string::npos) << out;
+  const nlohmann::json j = nlohmann::json::parse(out.substr(out.find("\n{") + 1));
+  EXPECT_EQ(j.at("safety").at("output_max_V"), 8.0);
+  EXPECT_EQ(j.at("safety").at("max_consecutive_overruns"), 1000000);
+}
+
 TEST_F(Serve, RefusesARemoteAddressWithoutAllowRemoteAndBadInputWithExit2) {
   const auto refused = [&](std::vector<std::string> args, const std::string& piece) {
     const Spawned s = spawn(args, path("o.txt"), path("e.txt"));
@@ -484,6 +538,12 @@ TEST_F(Serve, RefusesARemoteAddressWithoutAllowRemoteAndBadInputWithExit2) {
   refused({"serve", "--port", "70000"}, "--port 70000");
   refused({"serve", "--port", "0", "--calibration", path("missing.toml")}, "missing.toml");
   refused({"serve", "--port", "0", "--daq", "comedi:/dev/comedi_missing"}, "comedi_missing");
+  // A config valid at its own 1 kHz but not at the loop's 3 kHz (21 kHz physics is no multiple of
+  // the interferometer's 1 kHz): the message names the rate and the file, not only a key.
+  const std::string cfg = write("twin.toml", "[twin]\nphysics_rate_Hz = 20000\n");
+  refused(
+      {"serve", "--port", "0", "--rate-hz", "3000", "--config", cfg, "--calibration", calibration_},
+      "sim at 3000 Hz: the twin of " + cfg + " cannot be built");
 }
 
 }  // namespace

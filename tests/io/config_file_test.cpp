@@ -1,5 +1,7 @@
 #include "piezoshift/io/config_file.hpp"
 
+#include <sys/stat.h>
+
 #include <cstdint>
 #include <filesystem>
 #include <fstream>
@@ -8,6 +10,7 @@
 #include <gtest/gtest.h>
 
 #include "piezoshift/io/input_error.hpp"
+#include "piezoshift/io/input_file.hpp"
 
 #include "../support/temp_dir_test.hpp"
 
@@ -252,7 +255,23 @@ TEST_F(ConfigFileOnDisk, MissingFileIsAnInputError) {
   const std::string path = (dir_ / "nope.toml").string();
   const std::string m = error_of([&] { ConfigFile::load(path); });
   EXPECT_TRUE(contains(m, path)) << m;
-  EXPECT_TRUE(contains(m, "cannot read")) << m;
+  EXPECT_TRUE(contains(m, "cannot open: No such file or directory")) << m;
+}
+
+// Issue 17: a directory read as an empty file (every key silently defaulted), a FIFO blocked or
+// streamed without end; both are refused at once, and so is a file above the limit.
+TEST_F(ConfigFileOnDisk, OnlyABoundedRegularFileIsRead) {
+  std::string m = error_of([&] { ConfigFile::load(dir_.string()); });
+  EXPECT_TRUE(contains(m, dir_.string() + ": is a directory; expected a regular file")) << m;
+  const std::string fifo = (dir_ / "pipe.toml").string();
+  ASSERT_EQ(::mkfifo(fifo.c_str(), 0600), 0);
+  m = error_of([&] { ConfigFile::load(fifo); });
+  EXPECT_TRUE(contains(m, fifo + ": is a FIFO (pipe); expected a regular file")) << m;
+  const std::string big = (dir_ / "big.toml").string();
+  std::ofstream(big) << std::string(kMaxConfigFileBytes + 1, '#');
+  m = error_of([&] { ConfigFile::load(big); });
+  EXPECT_TRUE(contains(m, "1048577 bytes is more than the limit of 1048576 bytes")) << m;
+  EXPECT_EQ(read_input_file(big, kMaxConfigFileBytes + 1).size(), kMaxConfigFileBytes + 1);
 }
 
 }  // namespace

@@ -75,10 +75,12 @@ TEST_F(ProjectConfigTest, WrongTypeNegativeZeroNan) {
   EXPECT_TRUE(contains(m, "actuator.stiffness_N_per_um: expected a number")) << m;
   m = error_for("[material]\nelastic_modulus_Pa = -2.1e11\n");
   EXPECT_TRUE(
-      contains(m, "material.elastic_modulus_Pa: value -210000000000 is not allowed: must be > 0"))
+      contains(m,
+               "material.elastic_modulus_Pa: value -210000000000 is not allowed: must be in (0, "
+               "10000000000000]"))
       << m;
   m = error_for("[hinge]\nwidth_m = 0\n");
-  EXPECT_TRUE(contains(m, "hinge.width_m: value 0 is not allowed: must be > 0")) << m;
+  EXPECT_TRUE(contains(m, "hinge.width_m: value 0 is not allowed: must be in (0, 1]")) << m;
   m = error_for("[mechanism]\nmoving_mass_kg = nan\n");
   EXPECT_TRUE(contains(m, "mechanism.moving_mass_kg: value nan")) << m;
   m = error_for("[actuator]\nnominal_stroke_um = inf\n");

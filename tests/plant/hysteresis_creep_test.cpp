@@ -1,6 +1,7 @@
 // The stack's rate-independent hysteresis and its creep chain.
 #include <algorithm>
 #include <cmath>
+#include <limits>
 #include <random>
 
 #include <gtest/gtest.h>
@@ -87,6 +88,19 @@ TEST(Hysteresis, SweepAgreesWithTheOperatorUpdateOnRandomMonotoneRuns) {
     for (std::size_t j = 0; j < pi.operators(); ++j)
       ASSERT_NEAR(a[j], b[j], 1e-15);
   }
+}
+
+// Issue 17: an input beyond every breakpoint (infinite, as a denormal output_max_V made it) used to
+// pass the last breakpoint's sentinel forever; the sweep stops after the last operator.
+TEST(Hysteresis, SweepTerminatesOnAnInfiniteInput) {
+  const PrandtlIshlinskii pi(HysteresisParams{0.125, 8}, 150.0);
+  PlayState u{};
+  PlaySweep up(pi, u, true);
+  EXPECT_EQ(up.at(std::numeric_limits<double>::infinity()),
+            std::numeric_limits<double>::infinity());
+  PlaySweep down(pi, u, false);
+  EXPECT_EQ(down.at(-std::numeric_limits<double>::infinity()),
+            -std::numeric_limits<double>::infinity());
 }
 
 TEST(Creep, SlopeIsTheStatedFractionPerDecadeInTheMiddleOfTheChain) {

@@ -111,4 +111,54 @@ TEST_F(SimulateCommand, BadInputExitsTwoWithAClearMessage) {
   EXPECT_NE(r.err.find("p.csv:3"), std::string::npos) << r.err;
 }
 
+// Issue 17: a simulation's cost is estimated before it starts and refused above the budget unless
+// the budget is raised explicitly; values beyond the twin's ranges name the file, line and key.
+TEST_F(SimulateCommand, CostIsEstimatedAndRefusedAboveTheBudgetUnlessRaised) {
+  RunResult r = run("--step-um 5 --duration-s 1e308");
+  EXPECT_EQ(r.status, 2);
+  EXPECT_NE(r.err.find("--duration-s 1e+308"), std::string::npos) << r.err;
+  EXPECT_NE(r.err.find("more than 1e+308 physics steps"), std::string::npos) << r.err;
+  EXPECT_NE(r.err.find("budget of 1e+09"), std::string::npos) << r.err;
+  EXPECT_NE(r.err.find("--max-physics-steps"), std::string::npos) << r.err;
+  // 1 MHz physics: 1000 steps per 1 ms tick, 0.05 s is 5e4 steps: under the default budget,
+  // above a budget of 1e4.
+  const std::string fast = write("fast.toml", "[twin]\nphysics_rate_Hz = 1e6\n");
+  r = run("--open-loop-volts 1,1,1 --duration-s 0.05 --config '" + fast + "'");
+  EXPECT_EQ(r.status, 0) << r.err;
+  r = run("--open-loop-volts 1,1,1 --duration-s 0.05 --max-physics-steps 1e4 --config '" + fast +
+          "'");
+  EXPECT_EQ(r.status, 2);
+  EXPECT_NE(r.err.find("5e+04 physics steps"), std::string::npos) << r.err;
+  EXPECT_NE(r.err.find(fast), std::string::npos) << r.err;
+  r = run("--step-um 5 --max-physics-steps 0");
+  EXPECT_EQ(r.status, 2);
+  EXPECT_NE(r.err.find("--max-physics-steps = 0 must be in [1, 1e15]"), std::string::npos) << r.err;
+}
+
+// The installation's [safety] is the supervisor's: 9 V passes the built-in 10 V limit, not 8 V.
+TEST_F(SimulateCommand, SafetySectionOfTheConfigIsTheSupervisors) {
+  const std::string site = write("site.toml", "[safety]\noutput_max_V = 8.0\n");
+  EXPECT_EQ(run("--open-loop-volts 9,9,9 --duration-s 0.01").status, 0);
+  const RunResult r = run("--open-loop-volts 9,9,9 --duration-s 0.01 --config '" + site + "'");
+  EXPECT_EQ(r.status, 2);
+  EXPECT_NE(r.err.find("V1 = 9 is outside the supervisor's 0 to 8 V"), std::string::npos) << r.err;
+}
+
+TEST_F(SimulateCommand, ConfigValuesThatUsedToExhaustOrHangAreRefusedByFileAndKey) {
+  const struct {
+    const char* toml;
+    const char* key;
+  } cases[] = {{"[twin]\nphysics_rate_Hz = 2e12\n", "twin.physics_rate_Hz"},
+               {"[twin]\nphysics_rate_Hz = 2e10\n", "twin.physics_rate_Hz"},
+               {"[twin.daq]\nsample_time_s = 1e6\n", "twin.daq.sample_time_s"},
+               {"[twin.amplifier]\noutput_max_V = 5e-324\n", "twin.amplifier.output_max_V"}};
+  for (const auto& c : cases) {
+    const std::string cfg = write("c.toml", c.toml);
+    const RunResult r = run("--step-um 5 --duration-s 0.05 --config '" + cfg + "'");
+    EXPECT_EQ(r.status, 2) << c.toml;
+    EXPECT_NE(r.err.find(cfg + ":2:"), std::string::npos) << r.err;
+    EXPECT_NE(r.err.find(c.key), std::string::npos) << r.err;
+  }
+}
+
 }  // namespace

@@ -8,6 +8,7 @@
 
 #include "piezoshift/io/input_error.hpp"
 #include "piezoshift/io/project_config.hpp"
+#include "piezoshift/plant/twin_ranges.hpp"
 
 namespace piezoshift::io {
 namespace {
@@ -76,6 +77,45 @@ TEST(TwinConfig, BadValuesAreRefusedByName) {
   EXPECT_NE(
       error_for("e.toml", "[twin.lab]\ntemperature_period = 900\n").find("temperature_period"),
       std::string::npos);
+}
+
+// Issue 17: values that made the twin allocate without bound (bad_alloc), run without bound or loop
+// forever are refused by the reader with the file, line, column and key.
+TEST(TwinConfig, ValuesBeyondTheTwinsBoundsAreRefusedWithFileLineAndKey) {
+  std::string m = error_for("f.toml", "[twin]\nphysics_rate_Hz = 2e12\n");
+  EXPECT_NE(m.find("f.toml:2:19: twin.physics_rate_Hz: value 2000000000000 is not allowed: must "
+                   "be in [1, 10000000]"),
+            std::string::npos)
+      << m;
+  m = error_for("g.toml", "[twin.daq]\nsample_time_s = 1e6\n");
+  EXPECT_NE(m.find("g.toml:2:17: twin.daq.sample_time_s: value 1000000 is not allowed: must be in "
+                   "[1e-05, 1]"),
+            std::string::npos)
+      << m;
+  m = error_for("h.toml", "[twin.amplifier]\noutput_max_V = 5e-324\n");
+  EXPECT_NE(m.find("h.toml:2:16: twin.amplifier.output_max_V: value 5e-324 is not allowed: must be "
+                   "in [1, 1000]"),
+            std::string::npos)
+      << m;
+  // each value in range, the pair beyond the per-tick physics limit: 1e7 Hz * 0.01 s = 1e5 steps
+  m = error_for("i.toml", "[twin]\nphysics_rate_Hz = 1e7\n[twin.daq]\nsample_time_s = 0.01\n");
+  EXPECT_NE(m.find("100000 physics steps per control tick is more than the twin's limit of 10000"),
+            std::string::npos)
+      << m;
+}
+
+// The ranges are one list: the paper's values are inside it, and a struct built in code (as the
+// Python bindings do) is checked against the same list, naming the TOML key.
+TEST(TwinConfig, TheRangesListCoversTheDefaultsAndChecksStructsBuiltInCode) {
+  EXPECT_EQ(plant::twin_ranges_problem(plant::TwinParams{}), "");
+  int values = 0;
+  plant::TwinParams t;
+  plant::visit_twin_values(t, [&](const char*, const char*, auto&, design::Bounds) { ++values; });
+  // every key of configs/paper.toml's twin sections but nonlinearity_shape (a name, read apart)
+  EXPECT_EQ(values, 58);
+  t.sgs.offset_V[2] = 200.0;
+  EXPECT_EQ(plant::twin_ranges_problem(t), "twin.sgs.offset_V[2] = 200 must be in [-100, 100]");
+  EXPECT_NE(plant::twin_params_problem({}, t).find("twin.sgs.offset_V[2]"), std::string::npos);
 }
 
 }  // namespace

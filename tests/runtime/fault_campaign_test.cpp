@@ -195,5 +195,21 @@ TEST(FaultCampaign, EveryFaultIsCaughtWithinItsStatedLatencyAndOutputsStayInLimi
   }
 }
 
+// Issue 17: after a long stall the twin advanced every missed period, so a twin slower than real
+// time made each tick longer than the last and never caught up; a read advances at most
+// kMaxCatchUpPeriods.
+TEST(SimBackendCatchUp, ALateTickAdvancesAtMostTheCatchUpLimit) {
+  SimBackend sim(SimOptions{});
+  sim.configure();
+  sim.activate();
+  Vec3 ai{};
+  ASSERT_EQ(sim.read(CycleTime{0, 0, 1'000'000}, ai), DaqStatus::kOk);
+  EXPECT_EQ(sim.twin().ticks(), 1u);
+  ASSERT_EQ(sim.read(CycleTime{1, 5'000'000, 4'000'000}, ai), DaqStatus::kOk);  // 4 periods late
+  EXPECT_EQ(sim.twin().ticks(), 5u);
+  ASSERT_EQ(sim.read(CycleTime{2, 1'005'000'000, 1'000'000'000}, ai), DaqStatus::kOk);  // 1 s
+  EXPECT_EQ(sim.twin().ticks(), 5u + SimBackend::kMaxCatchUpPeriods);
+}
+
 }  // namespace
 }  // namespace piezoshift::runtime

@@ -1,4 +1,7 @@
 // Set-up inputs of a run: setpoint profiles, the controller's TOML, atomic file replacement.
+#include <sys/wait.h>
+#include <unistd.h>
+
 #include <filesystem>
 #include <optional>
 #include <string>
@@ -125,6 +128,24 @@ TEST_F(AtomicFileTest, ReplacesContentAndLeavesNoTemporary) {
     ++files;
   }
   EXPECT_EQ(files, 1);
+}
+
+// Issue 17: `calibrate` killed during its write left ".cal.toml.tmp.PID" behind; the next write
+// removes the temporaries of dead processes and leaves a live writer's alone.
+TEST_F(AtomicFileTest, NextWriteRemovesTheTemporaryOfAKilledWriterOnly) {
+  const pid_t child = ::fork();
+  ASSERT_GE(child, 0);
+  if (child == 0)
+    ::_exit(0);
+  ASSERT_EQ(::waitpid(child, nullptr, 0), child);  // reaped: the PID no longer exists
+  const std::string dead = write(".cal.toml.tmp." + std::to_string(child), "half");
+  const std::string live = write(".cal.toml.tmp." + std::to_string(::getppid()), "busy");
+  const std::string other = write(".other.toml.tmp." + std::to_string(child), "not ours");
+  io::write_file_atomically(path("cal.toml"), "new\n");
+  EXPECT_FALSE(fs::exists(dead));
+  EXPECT_TRUE(fs::exists(live));
+  EXPECT_TRUE(fs::exists(other));
+  EXPECT_EQ(read_text(path("cal.toml")), "new\n");
 }
 
 TEST_F(AtomicFileTest, FailureLeavesTheOldFileIntact) {

@@ -24,8 +24,8 @@ struct DesignInputs {
 //! Assumes every dimension is already positive and finite.
 std::string hinge_geometry_problem(const HingeParams& hinge);
 
-//! Why inputs are not physical, or "" when they are: every number positive and finite (field
-//! named in the message), Poisson ratio in (0, 0.5), and hinge_geometry_problem().
+//! Why inputs are not physical, or "" when they are: every number within its range
+//! (design_ranges.hpp; the value is named in the message), then hinge_geometry_problem().
 std::string design_inputs_problem(const DesignInputs& inputs);
 
 }  // namespace piezoshift::design

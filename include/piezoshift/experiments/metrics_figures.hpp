@@ -32,8 +32,16 @@ struct RepeatabilitySet {
   std::vector<double> measured_um;  //!< the n repeated displacements
 };
 
+//! Most bins one histogram panel draws.
+inline constexpr double kMaxHistogramBins = 500.0;
+
+//! bin_nm, or when spread_nm would need more than kMaxHistogramBins bins of it, the smallest 1, 2
+//! or 5 x 10^k nm that needs no more (data spread over microns, e.g. a linearity sweep).
+double histogram_bin_nm(double spread_nm, double bin_nm);
+
 //! bin_nm: histogram bin width; 1 nm by default, the XL-80's resolution (paper, Section 4), so
-//! the interferometer's quantisation steps fall one per bin.
+//! the interferometer's quantisation steps fall one per bin; wider (histogram_bin_nm, named on
+//! the axis) when the data spread over more than 500 bins.
 io::Figure repeatability_figure(std::span<const RepeatabilitySet> sets, double bin_nm = 1.0,
                                 std::string title = {});
 

@@ -15,24 +15,12 @@
 #include <string>
 #include <string_view>
 
+#include "piezoshift/design/bounds.hpp"
+
 namespace piezoshift::io {
 
-//! Allowed range for a number; the bound is open (excluded) where the flag says so.
-struct Bounds {
-  double lo = -1e308;
-  double hi = 1e308;
-  bool lo_open = false;
-  bool hi_open = false;
-
-  static constexpr Bounds any() { return {}; }
-  static constexpr Bounds positive() { return {0.0, 1e308, true, false}; }
-  static constexpr Bounds non_negative() { return {0.0, 1e308, false, false}; }
-  static constexpr Bounds closed(double lo, double hi) { return {lo, hi, false, false}; }
-  static constexpr Bounds open(double lo, double hi) { return {lo, hi, true, true}; }
-
-  bool contains(double v) const;
-  std::string describe() const;  //!< e.g. "> 0" or "in [0, 1]"
-};
+//! Allowed range for a number (design/bounds.hpp, shared with the parameter structs' ranges).
+using Bounds = design::Bounds;
 
 class ConfigFile;
 struct ConfigFileImpl;  // the parsed document; lives on the heap, so sections survive a move

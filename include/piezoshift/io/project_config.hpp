@@ -10,7 +10,8 @@
 //   [hinge]      width_m, thickness_m, radius_m, link_length_m             (Table 3)
 //   [mechanism]  moving_mass_kg                                            (fitted to Figure 2c)
 //
-// Every number must be positive and finite, the Poisson ratio in (0, 0.5), and the hinge
+// Every number must be within its range (design/design_ranges.hpp and plant/twin_ranges.hpp,
+// the one list the reader, the model builders and the Python bindings share), and the hinge
 // buildable (t < 2R, L > 2R). An unknown section or key, a wrong type, a value out of range or a
 // syntax error throws io::InputError naming the file, the key and the reason.
 #include <string>

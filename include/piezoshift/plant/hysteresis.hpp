@@ -115,11 +115,11 @@ class PlaySweep {
     double x = v * op_.inv_span_;
     if (rising_) {
       x = x < x_ ? x_ : x;
-      while (x > next_)
+      while (k_ < n_ && x > next_)  // bounded even for an infinite input
         pass();
     } else {
       x = x > x_ ? x_ : x;
-      while (x < next_)
+      while (k_ < n_ && x < next_)
         pass();
     }
     x_ = x;

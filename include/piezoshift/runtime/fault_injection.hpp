@@ -55,7 +55,12 @@ struct FaultSpec {
   int channel = 0;  //!< 0..2 (CLI 1..3); -1 for overrun-burst
 };
 
-//! Parses "KIND@T_S[:CHANNEL]"; throws io::InputError naming the text and what is wrong.
+//! The longest timed run `run` accepts (--duration-s, 11.6 days), and so the latest injection
+//! time (later times overflowed the nanosecond clock and were injected at tick 0).
+inline constexpr double kMaxRunDurationS = 1e6;
+
+//! Parses "KIND@T_S[:CHANNEL]", T_S in [0, kMaxRunDurationS]; throws io::InputError naming the
+//! text and what is wrong.
 FaultSpec parse_fault_spec(std::string_view text);
 
 struct FaultInjectionParams {

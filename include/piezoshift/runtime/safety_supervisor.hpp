@@ -145,7 +145,8 @@ struct SupervisorOutput {
 class SafetySupervisor {
  public:
   SafetySupervisor() { configure(SafetyLimits{}, 1e-3, {}); }
-  //! Set-up. Throws std::invalid_argument on inconsistent limits.
+  //! Set-up. Throws std::invalid_argument on limits outside their ranges or inconsistent
+  //! (safety_limits_problem(), safety_ranges.hpp).
   void configure(const SafetyLimits& limits, double sample_time_s,
                  const std::array<control::SignalScaling, control::kChannels>& scaling);
 

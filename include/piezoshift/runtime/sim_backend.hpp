@@ -2,7 +2,7 @@
 // The `sim` backend: the digital twin (plant::Twin) behind the DAQ interface, advanced in step
 // with the loop's clock. Per tick, keeping the board's timing contract (daq_backend.hpp):
 //
-//   read(t):   n = period_ns / T (1, or more after skipped slots)
+//   read(t):   n = period_ns / T (1, or more after skipped slots; at most kMaxCatchUpPeriods)
 //              n x twin.advance()      physics over the elapsed periods with the AO held that
 //                                      went out at the previous tick; ends with the AI sample
 //              ai = twin.read_ai()
@@ -22,6 +22,7 @@
 // io::InputError for parameters that cannot make one).
 #include <cstdint>
 #include <memory>
+#include <string>
 
 #include "piezoshift/design/design_inputs.hpp"
 #include "piezoshift/plant/twin.hpp"
@@ -36,6 +37,8 @@ struct SimOptions {
   plant::TwinParams twin{};
   std::uint64_t seed = 1;
   double rate_Hz = 1000.0;  //!< the loop's rate; the twin's DAQ period is 1 / rate_Hz
+  //! Where design and twin came from (a configuration file), for messages.
+  std::string source = "the built-in configuration";
 };
 
 class SimBackend final : public DaqBackend, public PlantFaultHooks {
@@ -46,6 +49,10 @@ class SimBackend final : public DaqBackend, public PlantFaultHooks {
   void configure() override;
   void activate() override;
   void deactivate() noexcept override;
+  //! Periods one read() advances at most after skipped slots: so a twin slower than real time
+  //! (the heaviest physics the ranges accept) cannot make each tick longer than the one before.
+  static constexpr std::int64_t kMaxCatchUpPeriods = 10;
+
   DaqStatus read(const CycleTime& t, Vec3& ai_V) noexcept override;
   DaqStatus write(const CycleTime& t, const Vec3& ao_V) noexcept override;
   std::string name() const override { return "sim"; }

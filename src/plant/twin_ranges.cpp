@@ -1,0 +1,17 @@
+#include "piezoshift/plant/twin_ranges.hpp"
+
+#include <fmt/core.h>
+
+namespace piezoshift::plant {
+
+std::string twin_ranges_problem(const TwinParams& twin) {
+  std::string problem;
+  visit_twin_values(
+      twin, [&](const char* section, const char* key, const auto& value, design::Bounds bounds) {
+        if (problem.empty())
+          problem = design::range_problem(fmt::format("{}.{}", section, key), value, bounds);
+      });
+  return problem;
+}
+
+}  // namespace piezoshift::plant

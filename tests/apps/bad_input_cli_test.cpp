@@ -1,0 +1,86 @@
+// Issue 17: input that reached an `internal error`, ran without bound or was accepted though
+// wrong. Each case now exits 2 with a message naming its source (the option, or the file), or
+// finishes; the program is run as a user would.
+#include <unistd.h>
+
+#include <initializer_list>
+#include <string>
+
+#include <gtest/gtest.h>
+
+#include "../support/cli_test.hpp"
+
+namespace {
+
+using piezoshift::testing::CliResult;
+
+class BadInput : public piezoshift::testing::CliTest {
+ protected:
+  std::string dir() const { return dir_.string(); }
+  // Exit status 2, no internal error, and each piece in stderr.
+  void refused(const std::string& args, std::initializer_list<std::string> pieces) {
+    const CliResult r = run(args);
+    EXPECT_EQ(r.status, 2) << args << "\n" << r.err;
+    EXPECT_EQ(r.err.find("internal error"), std::string::npos) << r.err;
+    for (const std::string& p : pieces)
+      EXPECT_NE(r.err.find(p), std::string::npos) << args << "\n" << r.err;
+  }
+};
+
+TEST_F(BadInput, RepeatabilityOfDataSpreadOverMicronsIsComputedAndOverflowIsRefused) {
+  std::string wide = "measured_um\n";
+  for (int i = 0; i <= 11; ++i)
+    wide += std::to_string(i) + "\n";
+  const CliResult r = run("analyze repeatability --json --data '" + write("wide.csv", wide) + "'");
+  EXPECT_EQ(r.status, 0) << r.err;
+  EXPECT_NE(r.out.find("\"repeatability_nm\": 3605.55"), std::string::npos) << r.out;
+  const std::string huge = write("huge.csv", "measured_um\n1e308\n-1e308\n");
+  refused("analyze repeatability --data '" + huge + "'", {huge + ": repeatability", "overflow"});
+}
+
+TEST_F(BadInput, LinearityThatOverflowsIsAFailureNotANan) {
+  const std::string lin =
+      write("lin.csv", "desired_um,measured_um\n1e308,1e308\n-1e308,-1e308\n0,1e300\n");
+  refused("analyze linearity --data '" + lin + "'", {lin + ": linearity", "overflow"});
+}
+
+// An output folder that cannot be made (a file system error on a path the user gave) is bad
+// input, not an internal error.
+TEST_F(BadInput, AnOutputFolderThatCannotBeMadeIsBadInput) {
+  refused("psi simulate --out /dev/null/x", {"/dev/null/x"});
+}
+
+TEST_F(BadInput, StepOptionsOutOfRangeNameTheOption) {
+  const std::string step =
+      write("step.csv", "time_s,measured_um\n0,0\n0.001,1\n0.002,1\n0.003,1\n");
+  refused("analyze step --data '" + step + "' --median-window 18446744073709551615",
+          {"--median-window", "[1, 1001]"});
+  refused("analyze step --data '" + step + "' --step-time-s nan", {"--step-time-s nan"});
+}
+
+TEST_F(BadInput, DataAndConfigFilesMustBeBoundedRegularFiles) {
+  refused("analyze repeatability --data /dev/zero", {"/dev/zero: is a device"});
+  refused("analyze repeatability --data '" + dir() + "'", {dir() + ": is a directory"});
+  refused("simulate --step-um 1 --config '" + dir() + "'", {dir() + ": is a directory"});
+  refused("run --duration-s 0.01 --free-run --calibration '" + dir() + "'",
+          {dir() + ": is a directory"});
+  // one byte over the 64 MiB limit of a data file
+  const std::string big = path("big.csv");
+  ASSERT_EQ(::truncate(write("big.csv", "").c_str(), (64 << 20) + 1), 0);
+  refused("analyze repeatability --data '" + big + "'",
+          {big + ": 67108865 bytes is more than the limit of 67108864 bytes"});
+}
+
+TEST_F(BadInput, IntegerOptionsAreNotWrappedOrSaturated) {
+  refused("simulate --step-um 1 --duration-s 0.01 --seed -1", {"--seed: -1 is not a whole number"});
+  refused("run --duration-s 0.01 --free-run --max-overruns 18446744073709551616",
+          {"--max-overruns: 18446744073709551616 is not a whole number in [1, 1000000]"});
+}
+
+TEST_F(BadInput, RunTimesBeyondTheLongestRunNameTheirLimit) {
+  refused("run --duration-s 1e9", {"--duration-s 1000000000: must be in (0, 1000000] s"});
+  refused("run --duration-s 1 --free-run --fault sgs-open@1e10",
+          {"--fault 'sgs-open@1e10'", "beyond the longest run, 1000000 s"});
+}
+
+}  // namespace
