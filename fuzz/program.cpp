@@ -1,6 +1,5 @@
 #include "program.hpp"
 
-#include "known_findings.hpp"
 #include "piezoshift/experiments/validity.hpp"
 #include "piezoshift/io/input_error.hpp"
 
@@ -28,9 +27,6 @@ void Program::run(const std::vector<std::string>& args, MayRun may_run) {
     action_();
   } catch (const io::InputError&) {
   } catch (const experiments::ProcedureFailed&) {
-  } catch (const std::exception& e) {
-    if (!is_known_finding(e))
-      throw;
   }
 }
 
