@@ -40,7 +40,7 @@ TEST_F(BadInput, RepeatabilityOfDataSpreadOverMicronsIsComputedAndOverflowIsRefu
 
 TEST_F(BadInput, LinearityThatOverflowsIsAFailureNotANan) {
   const std::string lin =
-      write("lin.csv", "desired_um,measured_um\n1e308,1e308\n-1e308,-1e308\n0,1e300\n");
+      write("lin.csv", "zd_um,measured_um\n1e308,1e308\n-1e308,-1e308\n0,1e300\n");
   refused("analyze linearity --data '" + lin + "'", {lin + ": linearity", "overflow"});
 }
 
@@ -52,7 +52,7 @@ TEST_F(BadInput, AnOutputFolderThatCannotBeMadeIsBadInput) {
 
 TEST_F(BadInput, StepOptionsOutOfRangeNameTheOption) {
   const std::string step =
-      write("step.csv", "time_s,measured_um\n0,0\n0.001,1\n0.002,1\n0.003,1\n");
+      write("step.csv", "t_s,measured_um\n0,0\n0.001,1\n0.002,1\n0.003,1\n");
   refused("analyze step --data '" + step + "' --median-window 18446744073709551615",
           {"--median-window", "[1, 1001]"});
   refused("analyze step --data '" + step + "' --step-time-s nan", {"--step-time-s nan"});
