@@ -131,9 +131,9 @@ int run(const RunOptions& o) {
   for (const std::string& f : o.faults)
     faults.push_back(parse_fault_spec(f));
 
-  const runtime::InstallationConfig installation = o.config.empty()
-                                                        ? runtime::InstallationConfig{}
-                                                        : runtime::load_installation_config(o.config);
+  const runtime::InstallationConfig installation =
+      o.config.empty() ? runtime::InstallationConfig{}
+                       : runtime::load_installation_config(o.config);
   const io::ProjectConfig& project = installation.project;
   const LoopCalibration cal = resolve_calibration(o.calibration, o.daq, project, o.seed);
   const control::SemiClosedLoopParams& params = cal.params;

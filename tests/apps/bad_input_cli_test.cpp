@@ -51,8 +51,7 @@ TEST_F(BadInput, AnOutputFolderThatCannotBeMadeIsBadInput) {
 }
 
 TEST_F(BadInput, StepOptionsOutOfRangeNameTheOption) {
-  const std::string step =
-      write("step.csv", "t_s,measured_um\n0,0\n0.001,1\n0.002,1\n0.003,1\n");
+  const std::string step = write("step.csv", "t_s,measured_um\n0,0\n0.001,1\n0.002,1\n0.003,1\n");
   refused("analyze step --data '" + step + "' --median-window 18446744073709551615",
           {"--median-window", "[1, 1001]"});
   refused("analyze step --data '" + step + "' --step-time-s nan", {"--step-time-s nan"});
