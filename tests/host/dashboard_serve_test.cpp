@@ -154,7 +154,10 @@ TEST_F(Dashboard, DashboardAndGcsMoveTheSameStage) {
   ASSERT_EQ(http_status(a), 200) << a;
   GcsClient gcs("127.0.0.1", gcs_port_);
   double z = 0.0;
-  for (int i = 0; i < 200 && std::fabs(z - 4.0) > 0.01; ++i) {
+  // Up to 20 s: the move itself takes 0.04 s of the twin's time, but under ASan on a loaded CI
+  // machine the sim backend's twin can fall behind the wall clock (it catches up at most 10
+  // periods per tick, sim_backend.hpp). The wait bounds a hang; it measures nothing.
+  for (int i = 0; i < 2000 && std::fabs(z - 4.0) > 0.01; ++i) {
     std::this_thread::sleep_for(std::chrono::milliseconds(10));
     z = z_of(gcs.query_lines("POS?"));
   }
