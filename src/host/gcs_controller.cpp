@@ -980,7 +980,9 @@ std::string GcsController::wave_query(Session& s, const Args& args) {
 
 namespace {
 
-// "{generator} {integer} ..." pairs with generators 1..n; kNone on success.
+// "{generator} {integer} ..." pairs with generators 1..n, each at most once (`WGO 1 1 1 0` says
+// two things of one generator: refused as a syntax error, as a repeated axis is); kNone on
+// success.
 GcsError generator_pairs(const std::vector<std::string_view>& args, std::size_t n,
                          std::vector<std::pair<std::size_t, long long>>& out) {
   if (args.empty() || args.size() % 2 != 0)
@@ -992,7 +994,12 @@ GcsError generator_pairs(const std::vector<std::string_view>& args, std::size_t 
       return GcsError::kParamSyntax;
     if (g < 1 || g > static_cast<long long>(n))
       return GcsError::kWaveIndex;
-    out.emplace_back(static_cast<std::size_t>(g - 1), v);
+    const auto index = static_cast<std::size_t>(g - 1);
+    for (const auto& [seen, value] : out) {
+      if (seen == index)
+        return GcsError::kParamSyntax;
+    }
+    out.emplace_back(index, v);
   }
   return GcsError::kNone;
 }
