@@ -138,15 +138,19 @@ LoopIdentification identify_loop(const io::ProjectConfig& config,
   return r;
 }
 
+std::complex<double> loop_frequency_response(const ArxModel& plant, const control::PidParams& pid,
+                                             double frequency_Hz) {
+  return pid_frequency_response(pid, frequency_Hz, plant.sample_time_s) *
+         plant.frequency_response(frequency_Hz);
+}
+
 std::array<StabilityMargins, 3> pid_margins(const LoopIdentification& plant,
                                             const control::PidParams& pid) {
   std::array<StabilityMargins, 3> out{};
   for (std::size_t i = 0; i < 3; ++i) {
     const ArxModel& m = plant.channel[i];
-    const auto loop = [&](double f) {
-      return pid_frequency_response(pid, f, m.sample_time_s) * m.frequency_response(f);
-    };
-    out[i] = stability_margins(loop, 0.01, 0.5 / m.sample_time_s);
+    out[i] = stability_margins([&](double f) { return loop_frequency_response(m, pid, f); }, 0.01,
+                               0.5 / m.sample_time_s);
   }
   return out;
 }

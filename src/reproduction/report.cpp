@@ -182,11 +182,6 @@ io::Figure inner_loop_figure(const ReproductionResult& r) {
   for (const InnerLoopAnalysis& a : r.inner_loop) {
     if (!a.validity.valid)
       continue;
-    const control::PidParams pid = [&] {
-      control::SemiClosedLoopParams c = r.calibration.controller;
-      c.sample_time_s = a.sample_time_s;
-      return c.pid_params();
-    }();
     const double nyquist = 0.5 / a.sample_time_s;
     for (std::size_t i = 0; i < 3; ++i) {
       std::vector<double> fr, db, deg;
@@ -194,8 +189,7 @@ io::Figure inner_loop_figure(const ReproductionResult& r) {
       for (int k = 0; k <= 400; ++k) {
         const double hz = 0.1 * std::pow(nyquist / 0.1, k / 400.0);
         const std::complex<double> l =
-            calibration::pid_frequency_response(pid, hz, a.sample_time_s) *
-            a.plant.channel[i].frequency_response(hz);
+            calibration::loop_frequency_response(a.plant.channel[i], a.pid, hz);
         double d = std::arg(l) * 180.0 / 3.14159265358979323846;
         if (!deg.empty()) {
           while (d - unwrapped > 180.0)

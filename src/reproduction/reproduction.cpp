@@ -111,10 +111,12 @@ ReproductionResult reproduce(const io::ProjectConfig& config, const ReproduceOpt
   base.sample_time_s = config.twin.daq.sample_time_s;  // the controller runs at the DAQ's rate
   r.calibration = calibration::calibrate(config, base, seed, s.calibration, progress);
   run_set(r, config, r.calibration.controller, seed, s, progress);
-  control::SemiClosedLoopParams without_cubic = r.calibration.controller;
-  without_cubic.polynomial = control::CubicPolynomial::identity();
+  // Gains and A calibrated, p = identity: the oracle's controller, and the paper's protocol run
+  // with it on the gauges shows what p removes.
+  r.oracle_controller = r.calibration.controller;
+  r.oracle_controller.polynomial = control::CubicPolynomial::identity();
   r.linearity_without_cubic =
-      experiments::run_linearity(config, without_cubic, seed + 30, s.linearity, progress);
+      experiments::run_linearity(config, r.oracle_controller, seed + 30, s.linearity, progress);
   std::vector<double> rates{config.twin.daq.sample_time_s};
   if (config.twin.daq.sample_time_s != kFastSampleTime_s)
     rates.push_back(kFastSampleTime_s);
@@ -124,9 +126,10 @@ ReproductionResult reproduce(const io::ProjectConfig& config, const ReproduceOpt
     at.twin.daq.sample_time_s = c.sample_time_s = rates[i];
     InnerLoopAnalysis& a = r.inner_loop.emplace_back();
     a.sample_time_s = c.sample_time_s;
+    a.pid = c.pid_params();
     try {
       a.plant = calibration::identify_loop(at, c, seed + 90 + i);
-      a.margins = calibration::pid_margins(a.plant, c.pid_params());
+      a.margins = calibration::pid_margins(a.plant, a.pid);
     } catch (const std::invalid_argument& e) {  // e.g. a physics rate 10 kHz does not divide
       a.validity.fail(e.what());
     } catch (const experiments::ProcedureFailed& e) {
@@ -134,8 +137,6 @@ ReproductionResult reproduce(const io::ProjectConfig& config, const ReproduceOpt
     }
   }
   // The oracle: the same loop, gains and A, fed the plate's truth; nothing left for p to correct.
-  r.oracle_controller = r.calibration.controller;
-  r.oracle_controller.polynomial = control::CubicPolynomial::identity();
   Schedule so = s;
   with_feedback(so, experiments::Feedback::kOracle);
   run_set(r.oracle, config, r.oracle_controller, seed, so, progress);

@@ -65,6 +65,10 @@ LoopIdentification identify_loop(const io::ProjectConfig& config,
                                  const control::SemiClosedLoopParams& controller,
                                  std::uint64_t seed, const LoopIdentificationOptions& options = {});
 
+//! L = C P at frequency_Hz: the PID (per-sample gains at the model's sample time) times the model.
+std::complex<double> loop_frequency_response(const ArxModel& plant, const control::PidParams& pid,
+                                             double frequency_Hz);
+
 //! The margins of each channel's loop: the PID (per-sample gains at the models' sample time)
 //! times its identified plant, from 0.01 Hz to Nyquist.
 std::array<StabilityMargins, 3> pid_margins(const LoopIdentification& plant,

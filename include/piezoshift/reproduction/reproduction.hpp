@@ -82,6 +82,7 @@ struct ExperimentSet {
 //! The inner loop's identified plant at one sample time and the calibrated PID's margins on it.
 struct InnerLoopAnalysis {
   double sample_time_s = 0.0;
+  control::PidParams pid;  //!< the calibrated PID's, per-sample gains at sample_time_s
   calibration::LoopIdentification plant;
   std::array<calibration::StabilityMargins, 3> margins{};
   //! Not valid when the twin cannot run at this rate (its physics rate is not a whole multiple)
