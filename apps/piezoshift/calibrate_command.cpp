@@ -223,7 +223,7 @@ int run_improved(const Options& o, const io::ProjectConfig& config) {
                                            im.shaper.weight.begin() +
                                                static_cast<std::ptrdiff_t>(im.shaper.taps));
     j["shaper_rate_um_per_s"] = im.shaper.rate_um_per_s;
-    j["correction_ki"] = im.correction.ki;
+    j["correction_ki"] = im.correction_ki;
     j["travel_z_max_um"] = travel.single_move_um;
     j["travel_semi_closed_um"] = travel.semi_closed_um;
     j["travel_z_min_um"] = travel.single_move_min_um;

@@ -29,9 +29,9 @@ void read_improved(const io::ConfigFile& file, control::ImprovedParams& im) {
   s.read("reference_delay_ticks", delay,
          io::Bounds::closed(0.0, static_cast<double>(control::kMaxReferenceDelayTicks)));
   im.reference_delay_ticks = static_cast<std::size_t>(delay);
-  s.read("correction_kp", im.correction.kp, io::Bounds::non_negative());
-  s.read("correction_ki", im.correction.ki, io::Bounds::closed(0.0, 1.0));
-  s.read("correction_kd", im.correction.kd, io::Bounds::non_negative());
+  s.read("correction_ki", im.correction_ki, io::Bounds::closed(0.0, 1.0));
+  s.read("correction_ki_max", im.correction_ki_max, io::Bounds::closed(0.0, 1.0));
+  s.read("correction_boost_error_um", im.correction_boost_error_um, io::Bounds::non_negative());
   s.read("correction_limit_um", im.correction_limit_um, io::Bounds::positive());
   std::vector<double> taps;
   if (s.read("shaper_taps", taps, control::kMaxShaperTaps, io::Bounds::closed(0.0, 1.0))) {
@@ -81,10 +81,10 @@ std::string format_improved(const control::ImprovedParams& im) {
   std::string out = "\n[improved]  # the improved controller (docs/control.md), for one loop rate\n";
   out += fmt::format("sample_time_s = {:.17g}\n", im.sample_time_s);
   out += fmt::format("reference_delay_ticks = {}\n", im.reference_delay_ticks);
-  out += fmt::format("correction_kp = {:.17g}  # per-sample gains at sample_time_s\n",
-                     im.correction.kp);
-  out += fmt::format("correction_ki = {:.17g}\n", im.correction.ki);
-  out += fmt::format("correction_kd = {:.17g}\n", im.correction.kd);
+  out += fmt::format("correction_ki = {:.17g}  # per-sample at sample_time_s\n",
+                     im.correction_ki);
+  out += fmt::format("correction_ki_max = {:.17g}\n", im.correction_ki_max);
+  out += fmt::format("correction_boost_error_um = {:.17g}\n", im.correction_boost_error_um);
   out += fmt::format("correction_limit_um = {:.17g}\n", im.correction_limit_um);
   out += "shaper_taps = " + number_list(im.shaper.weight.data(), im.shaper.taps) + "\n";
   out += fmt::format("shaper_rate_um_per_s = {:.17g}\n", im.shaper.rate_um_per_s);

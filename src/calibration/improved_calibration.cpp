@@ -165,10 +165,8 @@ ImprovedCalibrationOutcome calibrate_improved(const io::ProjectConfig& config,
   out.shaped = out.mode_Hz > 0.0 && (same_rate || unfolded);
   c.improved.shaper = control::design_mode_shaper(
       out.shaped ? out.mode_Hz : 0.0, c.sample_time_s, options.slew_margin * rate_command_um_per_s * min_slope);
-  c.improved.correction = {0.0,
-                           2.0 * std::numbers::pi * options.correction_bandwidth_Hz *
-                               c.sample_time_s,
-                           0.0};
+  c.improved.correction_ki =
+      2.0 * std::numbers::pi * options.correction_bandwidth_Hz * c.sample_time_s;
   out.controller = c;
   return out;
 }

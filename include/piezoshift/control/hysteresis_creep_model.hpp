@@ -171,24 +171,31 @@ class BasicHysteresisCreepModel {
   // h(u) from the present states is continuous, piecewise linear and non-decreasing; walk its
   // breakpoints from u_ towards the target.
   constexpr T invert_hysteresis(T h_target) const noexcept {
-    std::array<T, kMaxModelOperators> bp{};
+    std::array<T, kMaxModelOperators> bp{};  // where each operator not yet moving starts to
+    std::array<T, kMaxModelOperators> bw{};  // and its weight
     std::size_t n = 0;
     const bool up = h_target >= h_;
     // Upwards operator j starts to move at u = s_j + r_j; downwards at u = s_j.
     for (std::size_t j = 0; j < p_.operators; ++j) {
       const T b = up ? s_[j] + p_.threshold_um[j] : s_[j];
-      if (up ? b > u_ : b < u_)
-        bp[n++] = b;
+      if (up ? b > u_ : b < u_) {
+        bp[n] = b;
+        bw[n] = p_.weight[j];
+        ++n;
+      }
     }
     // Insertion sort (n <= 16): ascending upwards, descending downwards.
     for (std::size_t i = 1; i < n; ++i) {
       const T v = bp[i];
+      const T w = bw[i];
       std::size_t k = i;
       while (k > 0 && (up ? bp[k - 1] > v : bp[k - 1] < v)) {
         bp[k] = bp[k - 1];
+        bw[k] = bw[k - 1];
         --k;
       }
       bp[k] = v;
+      bw[k] = w;
     }
     T slope = this->slope(up);
     T u = u_;
@@ -201,14 +208,7 @@ class BasicHysteresisCreepModel {
         return u_next;
       h += slope * (bp[i] - u);
       u = bp[i];
-      // Past this breakpoint one more operator moves with the input (up) or stops holding (down).
-      T w = T(0);
-      for (std::size_t j = 0; j < p_.operators; ++j) {
-        const T b = up ? s_[j] + p_.threshold_um[j] : s_[j];
-        if (b == u)
-          w += p_.weight[j];
-      }
-      slope += w;
+      slope += bw[i];  // past its breakpoint this operator moves with the input
     }
     return u;
   }

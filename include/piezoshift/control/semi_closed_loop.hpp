@@ -11,7 +11,10 @@
 // The improved controller (kind = kImproved, issue 12) keeps the feedforward S = A p(Z_d) and
 // replaces the PID of each channel by
 //   r   = shaper(S_i)                  rate limit at the amplifier's slew, mode-cancelling taps
-//   c   = correction PID(r(k - D), y)  slow loop on the model's error, D = the loop's delay
+//   e   = r(k - D) - y                 the model's error, D = the loop's delay
+//   c  += ki_e e, |c| <= limit          slow integral correction; ki_e = ki, raised in proportion
+//                                       to |e| above boost_error (up to ki_max) so large model
+//                                       errors go fast while the gauges' noise stays out
 //   u   = model_i^-1(r + c)            inverse hysteresis-creep model (hysteresis_creep_model.hpp)
 // so a set-point change is made by the model at once and the gauges' noise enters only through
 // the slow correction (docs/control.md).
@@ -47,9 +50,11 @@ struct BasicImprovedParams {
   T sample_time_s = T(1e-3);
   std::array<BasicHysteresisCreepParams<T>, kChannels> model{};
   BasicShaperParams<T> shaper{};
-  //! The correction loop's per-sample gains at the controller's own sample time (not rescaled:
-  //! it is designed per rate from the identified loop).
-  BasicPidGains<T> correction{T(0), T(0.03), T(0)};
+  //! The correction's per-sample integral gain at sample_time_s (not rescaled: designed per rate).
+  T correction_ki = T(0.03);
+  T correction_ki_max = T(0.3);        //!< the raised gain's ceiling (stable with D = 2 ticks)
+  T correction_boost_error_um = T(0.02);  //!< errors beyond this raise the gain
+
   T correction_limit_um = T(2);  //!< |c| at most this (SGS um): the model's error, not a move
   std::size_t reference_delay_ticks = 2;  //!< D, from command to the gauges' response
 };
@@ -63,8 +68,9 @@ constexpr BasicImprovedParams<To> convert(const BasicImprovedParams<From>& p) no
   for (std::size_t i = 0; i < kChannels; ++i)
     q.model[i] = convert<To>(p.model[i]);
   q.shaper = convert<To>(p.shaper);
-  q.correction = {static_cast<To>(p.correction.kp), static_cast<To>(p.correction.ki),
-                  static_cast<To>(p.correction.kd)};
+  q.correction_ki = static_cast<To>(p.correction_ki);
+  q.correction_ki_max = static_cast<To>(p.correction_ki_max);
+  q.correction_boost_error_um = static_cast<To>(p.correction_boost_error_um);
   q.correction_limit_um = static_cast<To>(p.correction_limit_um);
   q.reference_delay_ticks = p.reference_delay_ticks;
   return q;
@@ -147,13 +153,11 @@ class BasicSemiClosedLoopController {
       c.reset(params.output_min_um);
     }
     const BasicImprovedParams<T>& im = params.improved;
-    const T limit = im.correction_limit_um;
     delay_ = im.reference_delay_ticks < kMaxReferenceDelayTicks ? im.reference_delay_ticks
                                                                 : kMaxReferenceDelayTicks;
     for (std::size_t i = 0; i < kChannels; ++i) {
       model_[i].configure(im.model[i], params.sample_time_s);
       shaper_[i].configure(im.shaper, params.sample_time_s);
-      correction_[i].set_params(BasicPidParams<T>{im.correction, -limit, limit, T(0), T(0)});
     }
     reset_improved(filled<T>(params.output_min_um));
   }
@@ -203,14 +207,12 @@ class BasicSemiClosedLoopController {
   constexpr void set_enabled(bool enabled) noexcept {
     for (auto& c : pid_)
       c.set_enabled(enabled);
-    for (auto& c : correction_)
-      c.set_enabled(enabled);
+    enabled_ = enabled;
   }
   constexpr void hold_integrators(bool held) noexcept {
     for (auto& c : pid_)
       c.hold_integrator(held);
-    for (auto& c : correction_)
-      c.hold_integrator(held);
+    correction_held_ = held;
   }
 
   constexpr const Params& params() const noexcept { return params_; }
@@ -232,16 +234,36 @@ class BasicSemiClosedLoopController {
       for (std::size_t k = kMaxReferenceDelayTicks; k > 0; --k)
         hist[k] = hist[k - 1];
       hist[0] = r;
-      BasicIncrementalPid<T>& c = correction_[i];
-      const T corr = c.update(hist[delay_], out.feedback_um[i]);
+      const BasicImprovedParams<T>& im = params_.improved;
+      T e = hist[delay_] - out.feedback_um[i];
+      if (!(e == e))
+        e = T(0);  // a NaN reading never reaches the correction (the supervisor reports it)
+      const T ae = e < T(0) ? -e : e;
+      T ki = im.correction_ki;
+      if (ae > im.correction_boost_error_um && im.correction_boost_error_um > T(0)) {
+        ki = ki * ae / im.correction_boost_error_um;
+        ki = ki > im.correction_ki_max ? im.correction_ki_max : ki;
+      }
+      T& corr = correction_[i];
+      // No integration while held, nor deeper into a limit the command already sits at.
+      const bool at_top = last_clamped_[i] && model_[i].command_um() >= params_.output_max_um;
+      const bool at_bottom = last_clamped_[i] && model_[i].command_um() <= params_.output_min_um;
+      if (!correction_held_ && !(at_top && e > T(0)) && !(at_bottom && e < T(0)))
+        corr += ki * e;
+      const T limit = im.correction_limit_um;
+      const bool corr_limited = corr > limit || corr < -limit;
+      corr = corr > limit ? limit : (corr < -limit ? -limit : corr);
       T u = T(0);
       bool clamped = false;
-      if (c.enabled())
+      if (enabled_)
         u = model_[i].inverse(r + corr, params_.output_min_um, params_.output_max_um, clamped);
+      else
+        corr = T(0);
+      last_clamped_[i] = clamped;
       model_[i].commit(u);
       out.command_um[i] = u;
       out.dac_V[i] = s.um_to_dac(u);
-      if (clamped || c.state().saturated)
+      if (clamped || corr_limited)
         out.saturated_mask |= static_cast<std::uint8_t>(1U << i);
     }
     return out;
@@ -255,7 +277,8 @@ class BasicSemiClosedLoopController {
       const T y = model_[i].output();
       shaper_[i].reset(y);
       reference_[i].fill(y);
-      correction_[i].reset(T(0));
+      correction_[i] = T(0);
+      last_clamped_[i] = false;
     }
   }
 
@@ -263,7 +286,10 @@ class BasicSemiClosedLoopController {
   std::array<BasicIncrementalPid<T>, kChannels> pid_{};
   std::array<BasicHysteresisCreepModel<T>, kChannels> model_{};
   std::array<BasicSetpointShaper<T>, kChannels> shaper_{};
-  std::array<BasicIncrementalPid<T>, kChannels> correction_{};
+  Vec correction_{};  //!< c per channel (SGS um)
+  std::array<bool, kChannels> last_clamped_{};
+  bool enabled_ = true;
+  bool correction_held_ = false;
   std::array<std::array<T, kMaxReferenceDelayTicks + 1>, kChannels> reference_{};
   std::size_t delay_ = 0;
 };
