@@ -17,7 +17,7 @@
 namespace piezoshift::calibration {
 
 struct HysteresisFitOptions {
-  std::size_t operators = 10;           //!< play operators over the span (at most 16)
+  std::size_t operators = 16;           //!< play operators over the span (at most 16)
   double command_span_um = 16.0;        //!< thresholds (j + 1/2) span / N
   double creep_shortest_s = 0.003;      //!< creep terms from here ...
   double creep_longest_s = 300.0;       //!< ... to here

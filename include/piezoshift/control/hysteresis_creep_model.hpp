@@ -124,6 +124,25 @@ class BasicHysteresisCreepModel {
     return u;
   }
 
+  //! What the model would read after commit(u), without committing.
+  constexpr T predict(T u) const noexcept {
+    T h = p_.linear_weight * u;
+    for (std::size_t j = 0; j < p_.operators; ++j) {
+      T v = s_[j];
+      const T lo = u - p_.threshold_um[j];
+      v = v < lo ? lo : v;
+      v = v > u ? u : v;
+      h += p_.weight[j] * v;
+    }
+    T sum_a = T(0);
+    T sum_ac = T(0);
+    for (std::size_t m = 0; m < p_.creep_terms; ++m) {
+      sum_a += alpha_[m];
+      sum_ac += alpha_[m] * c_[m];
+    }
+    return p_.offset_um + h * (T(1) - p_.creep_gain * sum_a) + p_.creep_gain * sum_ac;
+  }
+
   //! The command applied this tick: the operators move, the creep terms advance one tick.
   constexpr void commit(T u) noexcept {
     for (std::size_t j = 0; j < p_.operators; ++j) {

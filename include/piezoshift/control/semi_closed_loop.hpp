@@ -15,7 +15,10 @@
 //   c  += ki_e e, |c| <= limit          slow integral correction; ki_e = ki, raised in proportion
 //                                       to |e| above boost_error (up to ki_max) so large model
 //                                       errors go fast while the gauges' noise stays out
-//   u   = model_i^-1(r + c)            inverse hysteresis-creep model (hysteresis_creep_model.hpp)
+//   t   = r + c, kept within what the model reaches now with the command inside its headroom
+//         (a reference governor: near the end of the stroke the stage waits for its creep with
+//         the command just short of the rail, and the channel reports itself saturated)
+//   u   = model_i^-1(t)                inverse hysteresis-creep model (hysteresis_creep_model.hpp)
 // so a set-point change is made by the model at once and the gauges' noise enters only through
 // the slow correction (docs/control.md).
 //
@@ -57,6 +60,9 @@ struct BasicImprovedParams {
 
   T correction_limit_um = T(2);  //!< |c| at most this (SGS um): the model's error, not a move
   std::size_t reference_delay_ticks = 2;  //!< D, from command to the gauges' response
+  //! The command range kept in reserve at each end, as a fraction of the range: the governor
+  //! holds the target within what the model reaches inside it.
+  T headroom_fraction = T(0.005);
 };
 
 using ImprovedParams = BasicImprovedParams<double>;
@@ -73,6 +79,7 @@ constexpr BasicImprovedParams<To> convert(const BasicImprovedParams<From>& p) no
   q.correction_boost_error_um = static_cast<To>(p.correction_boost_error_um);
   q.correction_limit_um = static_cast<To>(p.correction_limit_um);
   q.reference_delay_ticks = p.reference_delay_ticks;
+  q.headroom_fraction = static_cast<To>(p.headroom_fraction);
   return q;
 }
 
@@ -240,26 +247,45 @@ class BasicSemiClosedLoopController {
         e = T(0);  // a NaN reading never reaches the correction (the supervisor reports it)
       const T ae = e < T(0) ? -e : e;
       T ki = im.correction_ki;
-      if (ae > im.correction_boost_error_um && im.correction_boost_error_um > T(0)) {
+      // No boost while the reference moves (the last D + 2 ticks): a fast move's errors are the
+      // plant's lag, not the model's, and boosting on them winds the correction up.
+      const T moved = hist[0] - hist[delay_ + 2 <= kMaxReferenceDelayTicks ? delay_ + 2
+                                                                           : kMaxReferenceDelayTicks];
+      const bool moving = (moved < T(0) ? -moved : moved) > im.correction_boost_error_um;
+      if (!moving && ae > im.correction_boost_error_um && im.correction_boost_error_um > T(0)) {
         ki = ki * ae / im.correction_boost_error_um;
         ki = ki > im.correction_ki_max ? im.correction_ki_max : ki;
       }
       T& corr = correction_[i];
-      // No integration while held, nor deeper into a limit the command already sits at.
-      const bool at_top = last_clamped_[i] && model_[i].command_um() >= params_.output_max_um;
-      const bool at_bottom = last_clamped_[i] && model_[i].command_um() <= params_.output_min_um;
+      // The governor: the target within what the model reaches now with the command inside its
+      // headroom below the top (at the bottom, 0 V is a rest, not a limit to wait at). No
+      // integration while held, nor further into a limit the target sits at.
+      const T room = im.headroom_fraction * (params_.output_max_um - params_.output_min_um);
+      const T y_top = model_[i].predict(params_.output_max_um - room);
+      const bool at_top = governed_[i] > 0;
+      const bool at_bottom = governed_[i] < 0;
       if (!correction_held_ && !(at_top && e > T(0)) && !(at_bottom && e < T(0)))
         corr += ki * e;
       const T limit = im.correction_limit_um;
       const bool corr_limited = corr > limit || corr < -limit;
       corr = corr > limit ? limit : (corr < -limit ? -limit : corr);
+      T target = r + corr;
+      governed_[i] = 0;
+      if (target > y_top) {
+        target = y_top;
+        governed_[i] = 1;
+      }
       T u = T(0);
-      bool clamped = false;
-      if (enabled_)
-        u = model_[i].inverse(r + corr, params_.output_min_um, params_.output_max_um, clamped);
-      else
+      bool clamped = governed_[i] != 0;
+      if (enabled_) {
+        bool at_rail = false;
+        u = model_[i].inverse(target, params_.output_min_um, params_.output_max_um, at_rail);
+        if (at_rail && !(u > params_.output_min_um))
+          governed_[i] = -1;
+        clamped = clamped || at_rail;
+      } else {
         corr = T(0);
-      last_clamped_[i] = clamped;
+      }
       model_[i].commit(u);
       out.command_um[i] = u;
       out.dac_V[i] = s.um_to_dac(u);
@@ -278,7 +304,7 @@ class BasicSemiClosedLoopController {
       shaper_[i].reset(y);
       reference_[i].fill(y);
       correction_[i] = T(0);
-      last_clamped_[i] = false;
+      governed_[i] = 0;
     }
   }
 
@@ -287,7 +313,8 @@ class BasicSemiClosedLoopController {
   std::array<BasicHysteresisCreepModel<T>, kChannels> model_{};
   std::array<BasicSetpointShaper<T>, kChannels> shaper_{};
   Vec correction_{};  //!< c per channel (SGS um)
-  std::array<bool, kChannels> last_clamped_{};
+  //! +1: the target held below the top by the governor; -1: the command at its lower rail.
+  std::array<int, kChannels> governed_{};
   bool enabled_ = true;
   bool correction_held_ = false;
   std::array<std::array<T, kMaxReferenceDelayTicks + 1>, kChannels> reference_{};
