@@ -15,9 +15,9 @@
 #include "piezoshift/calibration/calibration_file.hpp"
 #include "piezoshift/calibration/calibration_procedure.hpp"
 #include "piezoshift/calibration/guided_calibration.hpp"
+#include "piezoshift/calibration/improved_calibration.hpp"
 #include "piezoshift/experiments/paper_experiments.hpp"
 #include "piezoshift/io/input_error.hpp"
-#include "piezoshift/calibration/improved_calibration.hpp"
 #include "piezoshift/io/project_config.hpp"
 #include "piezoshift/runtime/safety_ranges.hpp"
 #include "progress_bar.hpp"
@@ -219,9 +219,9 @@ int run_improved(const Options& o, const io::ProjectConfig& config) {
     j["mode_Hz"] = ic.mode_Hz;
     j["mode_sample_rate_Hz"] = ic.mode_sample_rate_Hz;
     j["shaped"] = ic.shaped;
-    j["shaper_taps"] = std::vector<double>(im.shaper.weight.begin(),
-                                           im.shaper.weight.begin() +
-                                               static_cast<std::ptrdiff_t>(im.shaper.taps));
+    j["shaper_taps"] =
+        std::vector<double>(im.shaper.weight.begin(),
+                            im.shaper.weight.begin() + static_cast<std::ptrdiff_t>(im.shaper.taps));
     j["shaper_rate_um_per_s"] = im.shaper.rate_um_per_s;
     j["correction_ki"] = im.correction_ki;
     j["travel_z_max_um"] = travel.single_move_um;
@@ -246,8 +246,9 @@ int run_improved(const Options& o, const io::ProjectConfig& config) {
 int run(const Options& o) {
   if (!o.daq.empty()) {
     if (o.controller != "paper")
-      throw io::InputError("--controller improved: the guided calibration calibrates the paper's "
-                           "controller only");
+      throw io::InputError(
+          "--controller improved: the guided calibration calibrates the paper's "
+          "controller only");
     return run_guided(o);
   }
   if (!o.interferometer.empty())

@@ -2,9 +2,9 @@
 
 #include <array>
 #include <cmath>
+#include <sstream>
 #include <string>
 #include <vector>
-#include <sstream>
 
 #include <fmt/core.h>
 
@@ -55,8 +55,7 @@ void read_improved(const io::ConfigFile& file, control::ImprovedParams& im) {
     c.read("thresholds_um", r, control::kMaxModelOperators, io::Bounds::positive());
     c.read("weights", w, control::kMaxModelOperators, io::Bounds::closed(0.0, 100.0));
     if (r.size() != w.size())
-      fail(file, name, "weights", fmt::format("{} weights for {} thresholds", w.size(),
-                                                   r.size()));
+      fail(file, name, "weights", fmt::format("{} weights for {} thresholds", w.size(), r.size()));
     m.operators = r.size();
     for (std::size_t j = 0; j < r.size(); ++j) {
       m.threshold_um[j] = r[j];
@@ -78,11 +77,11 @@ std::string number_list(const double* v, std::size_t n) {
 }
 
 std::string format_improved(const control::ImprovedParams& im) {
-  std::string out = "\n[improved]  # the improved controller (docs/control.md), for one loop rate\n";
+  std::string out =
+      "\n[improved]  # the improved controller (docs/control.md), for one loop rate\n";
   out += fmt::format("sample_time_s = {:.17g}\n", im.sample_time_s);
   out += fmt::format("reference_delay_ticks = {}\n", im.reference_delay_ticks);
-  out += fmt::format("correction_ki = {:.17g}  # per-sample at sample_time_s\n",
-                     im.correction_ki);
+  out += fmt::format("correction_ki = {:.17g}  # per-sample at sample_time_s\n", im.correction_ki);
   out += fmt::format("correction_ki_max = {:.17g}\n", im.correction_ki_max);
   out += fmt::format("correction_boost_error_um = {:.17g}\n", im.correction_boost_error_um);
   out += fmt::format("correction_limit_um = {:.17g}\n", im.correction_limit_um);
@@ -95,8 +94,9 @@ std::string format_improved(const control::ImprovedParams& im) {
     out += fmt::format("linear_weight = {:.17g}\n", m.linear_weight);
     out += "thresholds_um = " + number_list(m.threshold_um.data(), m.operators) + "\n";
     out += "weights = " + number_list(m.weight.data(), m.operators) + "\n";
-    out += "creep_time_constants_s = " +
-           number_list(m.creep_time_constant_s.data(), m.creep_terms) + "\n";
+    out +=
+        "creep_time_constants_s = " + number_list(m.creep_time_constant_s.data(), m.creep_terms) +
+        "\n";
     out += fmt::format("creep_gain = {:.17g}\n", m.creep_gain);
   }
   return out;

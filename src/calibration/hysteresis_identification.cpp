@@ -1,8 +1,8 @@
 #include "piezoshift/calibration/hysteresis_identification.hpp"
 
+#include <fmt/format.h>
 #include <Eigen/Dense>
 #include <cmath>
-#include <fmt/format.h>
 #include <limits>
 #include <vector>
 
@@ -85,8 +85,8 @@ HysteresisFit fit_hysteresis_creep(std::span<const double> command_um,
     throw FitError("hysteresis fit: invalid options");
   const std::size_t min_rows = 20 * (o.operators + 4) + o.max_delay_ticks;
   if (command_um.size() < min_rows)
-    throw FitError(fmt::format("hysteresis fit: {} samples, at least {} needed", command_um.size(),
-                               min_rows));
+    throw FitError(
+        fmt::format("hysteresis fit: {} samples, at least {} needed", command_um.size(), min_rows));
 
   HysteresisCreepParams base{};
   base.operators = o.operators;
@@ -95,9 +95,9 @@ HysteresisFit fit_hysteresis_creep(std::span<const double> command_um,
         (static_cast<double>(j) + 0.5) * o.command_span_um / static_cast<double>(o.operators);
   const double decades = std::log10(o.creep_longest_s / o.creep_shortest_s);
   base.creep_terms = std::min<std::size_t>(
-      control::kMaxCreepTerms,
-      static_cast<std::size_t>(std::floor(decades * static_cast<double>(o.creep_terms_per_decade))) +
-          1);
+      control::kMaxCreepTerms, static_cast<std::size_t>(std::floor(
+                                   decades * static_cast<double>(o.creep_terms_per_decade))) +
+                                   1);
   for (std::size_t m = 0; m < base.creep_terms; ++m)
     base.creep_time_constant_s[m] =
         o.creep_shortest_s *

@@ -1,9 +1,9 @@
 #include "piezoshift/calibration/improved_calibration.hpp"
 
+#include <fmt/format.h>
 #include <Eigen/Dense>
 #include <algorithm>
 #include <cmath>
-#include <fmt/format.h>
 #include <numbers>
 
 #include "piezoshift/experiments/bench.hpp"
@@ -23,20 +23,76 @@ struct Segment {
 // at mid-travel approached from below (what a phase step does). Ramps stay well below the
 // amplifier's slew (16 um of command in 1 s).
 constexpr Segment kExcitation[] = {
-    {0.5, 0.0},   {1.0, 16.0},  {1.0, 0.0},   {0.75, 12.0}, {0.5, 4.0},   {0.4, 10.0},
-    {0.3, 6.0},   {0.2, 8.0},   {0.1, 7.0},   {0.3, 7.0},   {0.0, 8.0},   {3.0, 8.0},
-    {0.0, 3.0},   {3.0, 3.0},   {0.0, 13.0},  {3.0, 13.0},  {0.0, 5.0},   {2.0, 5.0},
-    {0.0, 5.1},   {0.5, 5.1},   {0.0, 5.2},   {0.5, 5.2},   {0.0, 5.1},   {0.5, 5.1},
-    {0.0, 5.15},  {0.5, 5.15},  {0.0, 10.0},  {3.0, 10.0},  {0.3, 16.0},  {2.0, 16.0},
-    {0.0, 15.0},  {1.0, 15.0},
+    {0.5, 0.0},
+    {1.0, 16.0},
+    {1.0, 0.0},
+    {0.75, 12.0},
+    {0.5, 4.0},
+    {0.4, 10.0},
+    {0.3, 6.0},
+    {0.2, 8.0},
+    {0.1, 7.0},
+    {0.3, 7.0},
+    {0.0, 8.0},
+    {3.0, 8.0},
+    {0.0, 3.0},
+    {3.0, 3.0},
+    {0.0, 13.0},
+    {3.0, 13.0},
+    {0.0, 5.0},
+    {2.0, 5.0},
+    {0.0, 5.1},
+    {0.5, 5.1},
+    {0.0, 5.2},
+    {0.5, 5.2},
+    {0.0, 5.1},
+    {0.5, 5.1},
+    {0.0, 5.15},
+    {0.5, 5.15},
+    {0.0, 10.0},
+    {3.0, 10.0},
+    {0.3, 16.0},
+    {2.0, 16.0},
+    {0.0, 15.0},
+    {1.0, 15.0},
     // Small reversals at three levels: the slope right after a reversal (the linear weight
     // alone), which a phase step after any settling meets.
-    {0.5, 3.0},   {0.5, 3.0},   {0.05, 3.3},  {0.2, 3.3},   {0.05, 3.15}, {0.2, 3.15},
-    {0.05, 3.23}, {0.2, 3.23},  {0.05, 3.19}, {0.2, 3.19},  {0.3, 8.0},   {0.5, 8.0},
-    {0.05, 8.3},  {0.2, 8.3},   {0.05, 8.15}, {0.2, 8.15},  {0.05, 8.23}, {0.2, 8.23},
-    {0.05, 8.19}, {0.2, 8.19},  {0.05, 8.4},  {0.2, 8.4},   {0.3, 6.0},   {0.5, 6.0},
-    {0.05, 5.7},  {0.2, 5.7},   {0.05, 5.85}, {0.2, 5.85},  {0.05, 5.77}, {0.2, 5.77},
-    {0.05, 5.81}, {0.2, 5.81},  {0.05, 5.6},  {0.2, 5.6},   {0.5, 0.0},   {2.0, 0.0},
+    {0.5, 3.0},
+    {0.5, 3.0},
+    {0.05, 3.3},
+    {0.2, 3.3},
+    {0.05, 3.15},
+    {0.2, 3.15},
+    {0.05, 3.23},
+    {0.2, 3.23},
+    {0.05, 3.19},
+    {0.2, 3.19},
+    {0.3, 8.0},
+    {0.5, 8.0},
+    {0.05, 8.3},
+    {0.2, 8.3},
+    {0.05, 8.15},
+    {0.2, 8.15},
+    {0.05, 8.23},
+    {0.2, 8.23},
+    {0.05, 8.19},
+    {0.2, 8.19},
+    {0.05, 8.4},
+    {0.2, 8.4},
+    {0.3, 6.0},
+    {0.5, 6.0},
+    {0.05, 5.7},
+    {0.2, 5.7},
+    {0.05, 5.85},
+    {0.2, 5.85},
+    {0.05, 5.77},
+    {0.2, 5.77},
+    {0.05, 5.81},
+    {0.2, 5.81},
+    {0.05, 5.6},
+    {0.2, 5.6},
+    {0.5, 0.0},
+    {2.0, 0.0},
 };
 
 }  // namespace
@@ -78,8 +134,7 @@ ImprovedCalibrationOutcome calibrate_improved(const io::ProjectConfig& config,
   {
     experiments::Bench bench(config, paper, seed + 4);
     const double T = bench.sample_time_s();
-    const auto ticks =
-        static_cast<std::size_t>(std::llround(improved_excitation_duration_s() / T));
+    const auto ticks = static_cast<std::size_t>(std::llround(improved_excitation_duration_s() / T));
     for (std::size_t k = 0; k < ticks; ++k) {
       const double u = std::clamp(improved_excitation_um(static_cast<double>(k) * T),
                                   paper.output_min_um, paper.output_max_um);
@@ -172,10 +227,13 @@ ImprovedCalibrationOutcome calibrate_improved(const io::ProjectConfig& config,
   const bool unfolded = out.mode_Hz > 0.0 && out.mode_Hz < 0.45 * out.mode_sample_rate_Hz &&
                         out.mode_sample_rate_Hz >= loop_rate_Hz;
   out.shaped = out.mode_Hz > 0.0 && (same_rate || unfolded);
-  c.improved.shaper = control::design_mode_shaper(
-      out.shaped ? out.mode_Hz : 0.0, c.sample_time_s, options.slew_margin * rate_command_um_per_s * min_slope);
+  c.improved.shaper =
+      control::design_mode_shaper(out.shaped ? out.mode_Hz : 0.0, c.sample_time_s,
+                                  options.slew_margin * rate_command_um_per_s * min_slope);
   c.improved.correction_ki =
       2.0 * std::numbers::pi * options.correction_bandwidth_Hz * c.sample_time_s;
+  c.improved.correction_ki_max =
+      2.0 * std::numbers::pi * options.boost_bandwidth_Hz * c.sample_time_s;
   out.controller = c;
   return out;
 }

@@ -155,4 +155,18 @@ std::array<StabilityMargins, 3> pid_margins(const LoopIdentification& plant,
   return out;
 }
 
+std::array<StabilityMargins, 3> correction_margins(const LoopIdentification& plant,
+                                                   const control::ImprovedParams& improved,
+                                                   double ki) {
+  std::array<StabilityMargins, 3> out{};
+  for (std::size_t i = 0; i < 3; ++i) {
+    control::PidParams c{};
+    c.gains = {0.0, ki / improved.model[i].linear_weight, 0.0};
+    const ArxModel& m = plant.channel[i];
+    out[i] = stability_margins([&](double f) { return loop_frequency_response(m, c, f); }, 0.01,
+                               0.5 / m.sample_time_s);
+  }
+  return out;
+}
+
 }  // namespace piezoshift::calibration

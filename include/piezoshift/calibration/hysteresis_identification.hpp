@@ -17,10 +17,10 @@
 namespace piezoshift::calibration {
 
 struct HysteresisFitOptions {
-  std::size_t operators = 16;           //!< play operators over the span (at most 16)
-  double command_span_um = 16.0;        //!< thresholds (j + 1/2) span / N
-  double creep_shortest_s = 0.003;      //!< creep terms from here ...
-  double creep_longest_s = 300.0;       //!< ... to here
+  std::size_t operators = 16;       //!< play operators over the span (at most 16)
+  double command_span_um = 16.0;    //!< thresholds (j + 1/2) span / N
+  double creep_shortest_s = 0.003;  //!< creep terms from here ...
+  double creep_longest_s = 300.0;   //!< ... to here
   std::size_t creep_terms_per_decade = 2;
   std::size_t max_delay_ticks = 4;
   //! Samples this long after a command jump are left out: the amplifier's slew and the plate's

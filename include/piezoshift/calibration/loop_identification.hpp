@@ -74,4 +74,14 @@ std::complex<double> loop_frequency_response(const ArxModel& plant, const contro
 std::array<StabilityMargins, 3> pid_margins(const LoopIdentification& plant,
                                             const control::PidParams& pid);
 
+//! The improved controller's correction loop (control/semi_closed_loop.hpp) on the identified
+//! plant: c integrates the error with ki per sample and reaches the command through the model's
+//! inverse, whose small-signal gain is 1 / w0 (the linear weight: the smallest slope, so the
+//! largest loop gain), so L = ki / (1 - z^-1) P / w0 per channel. Evaluated at ki the hold's gain
+//! and at ki_max the boost's ceiling; the plant's models must be at the improved controller's
+//! sample time.
+std::array<StabilityMargins, 3> correction_margins(const LoopIdentification& plant,
+                                                   const control::ImprovedParams& improved,
+                                                   double ki);
+
 }  // namespace piezoshift::calibration

@@ -33,19 +33,20 @@ inline constexpr std::size_t kMaxCreepTerms = 12;
 template <class T>
 struct BasicHysteresisCreepParams {
   T offset_um = T(0);
-  T linear_weight = T(1);                                   //!< w0 (SGS um per um of command)
-  std::size_t operators = 0;                                //!< play operators in use
-  std::array<T, kMaxModelOperators> threshold_um{};         //!< r_j, increasing
-  std::array<T, kMaxModelOperators> weight{};               //!< w_j >= 0
-  std::size_t creep_terms = 0;                              //!< creep terms in use
-  std::array<T, kMaxCreepTerms> creep_time_constant_s{};    //!< tau_m
-  T creep_gain = T(0);                                      //!< per term (the fit's coefficient)
+  T linear_weight = T(1);                                 //!< w0 (SGS um per um of command)
+  std::size_t operators = 0;                              //!< play operators in use
+  std::array<T, kMaxModelOperators> threshold_um{};       //!< r_j, increasing
+  std::array<T, kMaxModelOperators> weight{};             //!< w_j >= 0
+  std::size_t creep_terms = 0;                            //!< creep terms in use
+  std::array<T, kMaxCreepTerms> creep_time_constant_s{};  //!< tau_m
+  T creep_gain = T(0);                                    //!< per term (the fit's coefficient)
 };
 
 using HysteresisCreepParams = BasicHysteresisCreepParams<double>;
 
 template <class To, class From>
-constexpr BasicHysteresisCreepParams<To> convert(const BasicHysteresisCreepParams<From>& p) noexcept {
+constexpr BasicHysteresisCreepParams<To> convert(
+    const BasicHysteresisCreepParams<From>& p) noexcept {
   BasicHysteresisCreepParams<To> q{};
   q.offset_um = static_cast<To>(p.offset_um);
   q.linear_weight = static_cast<To>(p.linear_weight);
@@ -107,8 +108,7 @@ class BasicHysteresisCreepModel {
       sum_a += alpha_[m];
       sum_ac += alpha_[m] * c_[m];
     }
-    const T h_target =
-        (y - p_.offset_um - p_.creep_gain * sum_ac) / (T(1) - p_.creep_gain * sum_a);
+    const T h_target = (y - p_.offset_um - p_.creep_gain * sum_ac) / (T(1) - p_.creep_gain * sum_a);
     T u = invert_hysteresis(h_target);
     clamped = false;
     if (!(u == u))

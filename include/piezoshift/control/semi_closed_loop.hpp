@@ -55,7 +55,7 @@ struct BasicImprovedParams {
   BasicShaperParams<T> shaper{};
   //! The correction's per-sample integral gain at sample_time_s (not rescaled: designed per rate).
   T correction_ki = T(0.03);
-  T correction_ki_max = T(0.3);        //!< the raised gain's ceiling (stable with D = 2 ticks)
+  T correction_ki_max = T(0.3);           //!< the raised gain's ceiling (stable with D = 2 ticks)
   T correction_boost_error_um = T(0.02);  //!< errors beyond this raise the gain
 
   T correction_limit_um = T(2);  //!< |c| at most this (SGS um): the model's error, not a move
@@ -249,8 +249,9 @@ class BasicSemiClosedLoopController {
       T ki = im.correction_ki;
       // No boost while the reference moves (the last D + 2 ticks): a fast move's errors are the
       // plant's lag, not the model's, and boosting on them winds the correction up.
-      const T moved = hist[0] - hist[delay_ + 2 <= kMaxReferenceDelayTicks ? delay_ + 2
-                                                                           : kMaxReferenceDelayTicks];
+      const T moved =
+          hist[0] -
+          hist[delay_ + 2 <= kMaxReferenceDelayTicks ? delay_ + 2 : kMaxReferenceDelayTicks];
       const bool moving = (moved < T(0) ? -moved : moved) > im.correction_boost_error_um;
       if (!moving && ae > im.correction_boost_error_um && im.correction_boost_error_um > T(0)) {
         ki = ki * ae / im.correction_boost_error_um;
