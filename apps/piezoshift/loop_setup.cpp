@@ -1,5 +1,7 @@
 #include "loop_setup.hpp"
 
+#include <cmath>
+
 #include <csignal>
 
 #include <fmt/core.h>
@@ -71,10 +73,18 @@ ChosenBackend make_backend(const std::string& daq, const io::ProjectConfig& conf
 }
 
 LoopCalibration resolve_calibration(const std::string& path, const std::string& daq,
-                                    const io::ProjectConfig& config, std::uint64_t seed) {
+                                    const io::ProjectConfig& config, std::uint64_t seed,
+                                    double loop_sample_time_s) {
   LoopCalibration c;
   if (!path.empty()) {
     c.params = calibration::load_calibration_file(path, &c.travel_z_max_um, &c.travel_z_min_um);
+    const double t = c.params.improved.sample_time_s;
+    if (c.params.kind == control::ControllerKind::kImproved &&
+        std::fabs(t - loop_sample_time_s) > 1e-9 * loop_sample_time_s)
+      throw io::InputError(fmt::format(
+          "{}: [improved] sample_time_s = {} s, but the loop runs at {} s ({} Hz): calibrate the "
+          "improved controller at the loop's rate",
+          path, t, loop_sample_time_s, 1.0 / loop_sample_time_s));
     c.source = path;
     return c;
   }

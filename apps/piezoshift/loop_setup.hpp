@@ -56,9 +56,12 @@ struct LoopCalibration {
 //! procedure with the paper's gains run on that twin first (one line on stderr says so: a few
 //! hundred simulated seconds, well under a second on an idle machine), so that the controller
 //! and the twin agree and the advertised travel is the one measured; on hardware, the paper's
-//! own values (Section 4) with a warning, since nothing else is known of the stage.
+//! own values (Section 4) with a warning, since nothing else is known of the stage. A file of the
+//! improved controller calibrated at another rate than loop_sample_time_s is refused (its shaper
+//! and correction hold at one rate only).
 LoopCalibration resolve_calibration(const std::string& path, const std::string& daq,
-                                    const io::ProjectConfig& config, std::uint64_t seed);
+                                    const io::ProjectConfig& config, std::uint64_t seed,
+                                    double loop_sample_time_s);
 
 //! Set by the handlers StopSignals installs: the signal number, 0 until one arrives.
 extern std::atomic<int> g_stop_signal;

@@ -135,7 +135,8 @@ int run(const RunOptions& o) {
       o.config.empty() ? runtime::InstallationConfig{}
                        : runtime::load_installation_config(o.config);
   const io::ProjectConfig& project = installation.project;
-  const LoopCalibration cal = resolve_calibration(o.calibration, o.daq, project, o.seed);
+  const LoopCalibration cal =
+      resolve_calibration(o.calibration, o.daq, project, o.seed, 1.0 / o.rate_Hz);
   const control::SemiClosedLoopParams& params = cal.params;
   if (o.step_um && cal.travel_z_max_um && *o.step_um > *cal.travel_z_max_um)
     throw io::InputError(

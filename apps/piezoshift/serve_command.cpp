@@ -152,7 +152,8 @@ int serve(const ServeOptions& o) {
                        : runtime::load_installation_config(o.config);
   const io::ProjectConfig& config = installation.project;
   const runtime::SafetyLimits safety = loop_safety_limits(installation.safety, o.max_overruns);
-  const LoopCalibration cal = resolve_calibration(o.calibration, o.daq, config, o.seed);
+  const LoopCalibration cal =
+      resolve_calibration(o.calibration, o.daq, config, o.seed, 1.0 / o.rate_Hz);
   const control::SemiClosedLoopParams& params = cal.params;
   const host::StageModel model = make_stage_model(o, config, params, cal, safety);
 
