@@ -61,6 +61,18 @@ std::optional<std::vector<std::uint64_t>> parse_seeds(const std::string& text) {
   return out;
 }
 
+// A median as the terminal shows it: never a number when it is not valid.
+std::string cell(const reproduction::FigureValue& m, const std::string& unit) {
+  if (!m.measured)
+    return "-";
+  if (!m.validity.valid)
+    return "NOT VALID";
+  if (!std::isfinite(m.value))
+    return unit == "s" ? "not settled" : "none";
+  return unit == "s" ? fmt::format("{:.2f} ms", 1e3 * m.value)
+                     : fmt::format("{:.4g} {}", m.value, unit);
+}
+
 struct Options {
   std::string config;
   std::string seeds = "1-8";
@@ -100,24 +112,17 @@ int run(const Options& o) {
     for (std::size_t i = 0; i < result.figures.size(); ++i) {
       const auto& f = result.figures[i];
       std::string cells;
-      for (const auto& m : result.medians[i]) {
-        std::string c = !m.measured               ? "-"
-                        : !m.validity.valid       ? "NOT VALID"
-                        : !std::isfinite(m.value) ? "not settled"
-                        : f.unit == "s"           ? fmt::format("{:.2f} ms", 1e3 * m.value)
-                                                  : fmt::format("{:.4g} {}", m.value, f.unit);
-        cells += fmt::format(" {:>14}", c);
-      }
+      for (const auto& m : result.medians[i])
+        cells += fmt::format(" {:>14}", cell(m, f.unit));
       fmt::print("  {:<48}{}\n", f.label, cells);
     }
     fmt::print("targets (improved controller's medians):\n");
     for (const auto& t : result.targets) {
       const auto& m = t.improved;
       const std::string value =
-          !m.measured ? "not measured"
-          : !m.validity.valid
-              ? "NOT VALID"
-              : fmt::format("{} (median {:.4g})", t.met ? "met" : "NOT MET", m.value);
+          !m.measured || !m.validity.valid
+              ? cell(m, "")
+              : fmt::format("{} (median {})", t.met ? "met" : "NOT MET", cell(m, t.unit));
       fmt::print("  {:<54} {:<28} {}\n", t.text, t.bound_text, value);
     }
     fmt::print("{}", report);

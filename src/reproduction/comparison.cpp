@@ -22,6 +22,12 @@ FigureValue figure(double value, const Validity& v) {
   return f;
 }
 
+FigureValue not_measured() {
+  FigureValue f;
+  f.measured = false;
+  return f;
+}
+
 // A figure of an experiment of the set; a failed calibration makes every figure not valid.
 template <class Get>
 std::function<FigureValue(const ControllerRun&)> from_set(Get get) {
@@ -59,6 +65,26 @@ Target target(std::string text, std::string key, double bound, bool at_least,
   t.at_least = at_least;
   t.bound_text = std::move(bound_text);
   return t;
+}
+
+constexpr double kFastSampleTime_s = 1e-4;  // 10 kHz, issue 12's second loop rate
+
+// The lambda/8 step with the loop at 10 kHz: the same controller re-expressed per sample.
+experiments::PhaseStepResult phase_step_at_10kHz(const io::ProjectConfig& config,
+                                                 const control::SemiClosedLoopParams& controller,
+                                                 std::uint64_t seed,
+                                                 const experiments::PhaseStepOptions& options,
+                                                 const experiments::Progress& progress) {
+  io::ProjectConfig at = config;
+  control::SemiClosedLoopParams c = controller;
+  at.twin.daq.sample_time_s = c.sample_time_s = kFastSampleTime_s;
+  try {
+    return experiments::run_phase_step(at, c, seed, options, progress);
+  } catch (const std::invalid_argument& e) {  // e.g. a physics rate 10 kHz does not divide
+    experiments::PhaseStepResult r;
+    r.validity.fail(e.what());
+    return r;
+  }
 }
 
 }  // namespace
@@ -136,6 +162,22 @@ std::vector<FigureSpec> comparison_figures(const io::ProjectConfig& config) {
       {"phase_step_final_error_nm", "lambda/8 step, final error", "nm", from_set([](const S& s) {
          return figure(s.phase_step.final_error_nm, s.phase_step.validity);
        })},
+      {"phase_step_10kHz_hold_jitter_nm_rms", "lambda/8 step at 10 kHz, hold jitter (rms)", "nm",
+       [](const ControllerRun& r) {
+         if (!r.calibration.valid)
+           return figure(0.0, r.calibration);
+         if (!r.ran_10kHz)
+           return not_measured();
+         return figure(r.phase_step_10kHz.hold_jitter_nm_rms, r.phase_step_10kHz.validity);
+       }},
+      {"phase_step_10kHz_settling_time_s", "lambda/8 step at 10 kHz, settling to +-1 nm", "s",
+       [](const ControllerRun& r) {
+         if (!r.calibration.valid)
+           return figure(0.0, r.calibration);
+         if (!r.ran_10kHz)
+           return not_measured();
+         return figure(r.phase_step_10kHz.settling_time_s, r.phase_step_10kHz.validity);
+       }},
   };
   const std::vector<double> rates = inner_loop_sample_times_s(config);
   for (std::size_t i = 0; i < rates.size(); ++i) {
@@ -264,8 +306,13 @@ ComparisonResult compare(const io::ProjectConfig& config, const CompareOptions& 
       run.set = run_experiment_set(config, run.controller, seed, is_oracle ? oracle_schedule : s,
                                    labelled(k));
       run.simulated_time_s += run.set.experiments_simulated_time_s();
-      if (!is_oracle)
+      if (!is_oracle) {
         run.inner_loop = analyze_inner_loop(config, run.controller, seed);
+        run.phase_step_10kHz =
+            phase_step_at_10kHz(config, run.controller, seed + 85, s.phase_step, labelled(k));
+        run.ran_10kHz = true;
+        run.simulated_time_s += run.phase_step_10kHz.simulated_time_s;
+      }
       r.simulated_time_s += run.simulated_time_s;
     }
   }
@@ -288,7 +335,8 @@ ComparisonResult compare(const io::ProjectConfig& config, const CompareOptions& 
              "<= 10 ms"),
       target("lambda/8 step settles to +-1 nm (1 ms means), 1 kHz", "phase_step_settling_time_s",
              5e-3, false, "<= 5 ms"),
-      target("lambda/8 step settles to +-1 nm (1 ms means), 10 kHz", "", 2e-3, false, "<= 2 ms"),
+      target("lambda/8 step settles to +-1 nm (1 ms means), 10 kHz",
+             "phase_step_10kHz_settling_time_s", 2e-3, false, "<= 2 ms"),
       target("hold jitter of the 1 ms means", "phase_step_hold_jitter_nm_rms", 0.3, false,
              "<= 0.3 nm rms"),
       target("linearity, the paper's protocol", "linearity_zero_end_pct", 0.02, false, "<= 0.02 %"),
@@ -331,6 +379,7 @@ ComparisonResult compare(const io::ProjectConfig& config, const CompareOptions& 
       x.improved.measured = false;  // compare does not measure it (yet)
       continue;
     }
+    x.unit = r.figures[i].unit;
     x.improved = r.medians[i][static_cast<std::size_t>(ControllerKind::kImproved)];
     const double v = x.improved.value;
     x.met = x.improved.measured && x.improved.validity.valid && std::isfinite(x.bound) &&

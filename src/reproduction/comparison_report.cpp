@@ -192,7 +192,7 @@ nlohmann::json comparison_json(const ComparisonResult& r) {
   nlohmann::json targets = nlohmann::json::array();
   for (const Target& t : r.targets) {
     nlohmann::json x{{"target", t.text}, {"bound", t.bound_text}};
-    x["key"] = t.key.empty() ? nlohmann::json() : nlohmann::json("improved_" + t.key);
+    x["key"] = "improved_" + t.key;
     x["improved"] = number_or_null(t.improved);
     x["measured"] = t.improved.measured;
     if (!t.improved.validity.valid)
@@ -292,17 +292,12 @@ ReportFiles write_comparison_report(const ComparisonResult& r, const fs::path& d
   h(2, "Issue 12's targets, on the improved controller's medians");
   std::vector<std::vector<std::string>> trows{{"target", "bound", "improved (median)", "met"}};
   for (const Target& t : r.targets) {
-    const std::string unit = t.key.empty() ? "" : [&] {
-      for (const FigureSpec& f : r.figures)
-        if (f.key == t.key)
-          return f.unit;
-      return std::string();
-    }();
-    trows.push_back({t.text, t.bound_text,
-                     t.improved.measured ? value_text(t.improved, unit) : "not measured by compare",
-                     !t.improved.measured ? "-"
-                     : t.met              ? "yes"
-                                          : "no"});
+    trows.push_back(
+        {t.text, t.bound_text,
+         t.improved.measured ? value_text(t.improved, t.unit) : "not measured by compare",
+         !t.improved.measured ? "-"
+         : t.met              ? "yes"
+                              : "no"});
   }
   table(std::move(trows));
 

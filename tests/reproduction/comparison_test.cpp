@@ -45,6 +45,11 @@ TEST(Comparison, RunsTheThreeControllersThroughEveryExperiment) {
   EXPECT_EQ(r.seeds[0][ControllerKind::kPaper].inner_loop.size(), 2U);
   EXPECT_EQ(r.seeds[0][ControllerKind::kImproved].inner_loop.size(), 2U);
   EXPECT_TRUE(r.seeds[0][ControllerKind::kOracle].inner_loop.empty());
+  // The phase step at 10 kHz: ten ticks per 1 ms exposure, the same step asked for.
+  const auto& fast = r.seeds[0][ControllerKind::kPaper].phase_step_10kHz;
+  EXPECT_TRUE(fast.validity.valid) << fast.validity.reason;
+  EXPECT_NEAR(fast.step_nm, 632.8 / 8.0, 1e-9);
+  EXPECT_FALSE(r.seeds[0][ControllerKind::kOracle].ran_10kHz);
 }
 
 // The oracle is the paper's calibration with p = identity, fed the plate's truth.
@@ -143,7 +148,9 @@ TEST(Comparison, JsonHasThePrefixedMediansAndPerSeedValues) {
         "improved_phase_step_hold_jitter_nm_rms", "improved_travel_semi_closed_um",
         "paper_pid_margins_1kHz_gain_margin_dB", "improved_pid_margins_10kHz_phase_margin_deg"})
     EXPECT_TRUE(j.contains(key)) << key;
+  EXPECT_TRUE(j.contains("improved_phase_step_10kHz_settling_time_s"));
   EXPECT_FALSE(j.contains("oracle_pid_margins_1kHz_gain_margin_dB"));  // not its own
+  EXPECT_FALSE(j.contains("oracle_phase_step_10kHz_settling_time_s"));
   ASSERT_EQ(j["per_seed"].size(), 1U);
   EXPECT_EQ(j["per_seed"][0]["seed"], 1);
   // One seed: the median is that seed's value.

@@ -5,16 +5,18 @@
 //   paper     calibration::calibrate(s) (reproduce()'s), then run_experiment_set(s) and
 //             analyze_inner_loop(s)
 //   improved  calibration::calibrate_improved(s), then the same set and analysis
+//             and the lambda/8 step again at 10 kHz (seed + 85)
 //   oracle    the paper's calibrated gains and A with p = identity, fed the plate's true position
 //             (Feedback::kOracle, as reproduce()): impossible on hardware, the floor of any
-//             controller fed by the strain gauges; no inner-loop analysis of its own
+//             controller fed by the strain gauges; the same set, no 10 kHz step and no
+//             inner-loop analysis of its own
 // so a figure of the paper's controller on seed s is bit for bit reproduce()'s on seed s.
 //
 // Every figure (travel, the 11 um step, the three linearity sweeps, repeatability at 5 and 10 um,
-// the lambda/8 phase step, the PID's margins at each loop rate) is a number per controller and
-// seed, or not valid with its reason (a calibration that failed makes every figure of that
-// controller on that seed not valid). The median over seeds of a figure is not valid when any
-// seed's value is not: a failure is never averaged away.
+// the lambda/8 phase step at the DAQ's rate and at 10 kHz, the PID's margins at each loop rate) is
+// a number per controller and seed, or not valid with its reason (a calibration that failed makes
+// every figure of that controller on that seed not valid). The median over seeds of a figure is not
+// valid when any seed's value is not: a failure is never averaged away.
 //
 // The targets are issue 12's done-when criteria, judged on the improved controller's medians.
 #include <array>
@@ -48,7 +50,13 @@ struct ControllerRun {
   experiments::Validity calibration;
   ExperimentSet set;
   std::vector<InnerLoopAnalysis> inner_loop;  //!< empty for the oracle
-  double simulated_time_s = 0.0;              //!< its calibration and experiments
+  //! The lambda/8 step again with the loop at 10 kHz (seed + 85): the twin's DAQ at 0.1 ms and
+  //! the controller's sample time set to it, as analyze_inner_loop does. Not valid when the twin
+  //! cannot run at that rate. Not run for the oracle (ran_10kHz false): at 10 kHz its plate
+  //! feedback trips the supervisor's sgs-jump rule in the approach (docs/compare.md).
+  experiments::PhaseStepResult phase_step_10kHz;
+  bool ran_10kHz = false;
+  double simulated_time_s = 0.0;  //!< its calibration and experiments
 };
 
 struct SeedComparison {
@@ -85,7 +93,8 @@ FigureValue median_over_seeds(const std::vector<FigureValue>& per_seed,
 //! One of issue 12's done-when criteria on the improved controller's median.
 struct Target {
   std::string text;  //!< e.g. "11 um step settles to +-10 nm"
-  std::string key;   //!< the figure, empty when compare does not measure it
+  std::string key;   //!< the figure
+  std::string unit;  //!< the figure's
   std::string bound_text;
   FigureValue improved;   //!< its median (not measured: compare cannot judge it)
   double bound = 0.0;     //!< the limit, absolute or oracle_factor x the oracle's median
