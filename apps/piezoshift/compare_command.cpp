@@ -89,8 +89,9 @@ int run(const Options& o) {
   co.quick = o.quick;
   reproduction::ComparisonResult result;
   {
-    // Per seed: two calibrations (3 stages each) and three experiment sets (8 each).
-    ProgressBar bar(static_cast<int>(co.seeds.size()) * (2 * 3 + 3 * 8));
+    // Per seed: two calibrations (3 stages each), three experiment sets (8 each) and two phase
+    // steps at 10 kHz.
+    ProgressBar bar(static_cast<int>(co.seeds.size()) * (2 * 3 + 3 * 8 + 2));
     result = reproduction::compare(config, co, bar.callback());
   }
   const int status = result.valid() ? 0 : experiments::kExitNotValid;

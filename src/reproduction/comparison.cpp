@@ -7,6 +7,7 @@
 
 #include <fmt/core.h>
 
+#include "piezoshift/calibration/fit_error.hpp"
 #include "piezoshift/calibration/improved_calibration.hpp"
 
 namespace piezoshift::reproduction {
@@ -280,6 +281,8 @@ ComparisonResult compare(const io::ProjectConfig& config, const CompareOptions& 
           cal.pid.simulated_time_s + cal.matrix.simulated_time_s + cal.polynomial.simulated_time_s;
     } catch (const experiments::ProcedureFailed& e) {
       paper.calibration.fail(fmt::format("calibration: {}", e.what()));
+    } catch (const calibration::FitError& e) {  // the twin's records, not the user's input
+      paper.calibration.fail(fmt::format("calibration: a fit failed: {}", e.what()));
     }
     try {
       calibration::ImprovedCalibrationOptions io_opts;
@@ -292,6 +295,8 @@ ComparisonResult compare(const io::ProjectConfig& config, const CompareOptions& 
           m.pid.simulated_time_s + m.matrix.simulated_time_s + m.polynomial.simulated_time_s;
     } catch (const experiments::ProcedureFailed& e) {
       improved.calibration.fail(fmt::format("calibration: {}", e.what()));
+    } catch (const calibration::FitError& e) {  // the twin's records, not the user's input
+      improved.calibration.fail(fmt::format("calibration: a fit failed: {}", e.what()));
     }
     oracle.calibration = paper.calibration;
     oracle.controller = paper.controller;

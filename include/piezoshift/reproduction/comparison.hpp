@@ -46,7 +46,8 @@ const char* controller_label(ControllerKind k);
 //! One controller on one seed.
 struct ControllerRun {
   control::SemiClosedLoopParams controller;
-  //! Not valid when its calibration failed (experiments::ProcedureFailed); nothing ran then.
+  //! Not valid when its calibration failed (experiments::ProcedureFailed, or calibration::FitError
+  //! on the twin's records); nothing ran then.
   experiments::Validity calibration;
   ExperimentSet set;
   std::vector<InnerLoopAnalysis> inner_loop;  //!< empty for the oracle
