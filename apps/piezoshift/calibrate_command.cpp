@@ -17,6 +17,7 @@
 #include "piezoshift/calibration/guided_calibration.hpp"
 #include "piezoshift/experiments/paper_experiments.hpp"
 #include "piezoshift/io/input_error.hpp"
+#include "piezoshift/calibration/improved_calibration.hpp"
 #include "piezoshift/io/project_config.hpp"
 #include "piezoshift/runtime/safety_ranges.hpp"
 #include "progress_bar.hpp"
@@ -30,6 +31,7 @@ struct Options {
   std::uint64_t seed = 1;
   std::string config;
   std::string pid = "paper";
+  std::string controller = "paper";
   bool json = false;
   std::string daq;             //!< guided: sim or comedi[:DEVICE]
   std::string interferometer;  //!< guided: prompt, file:PATH or sim
@@ -174,13 +176,86 @@ int run_guided(const Options& o) {
   return 0;
 }
 
+// The improved controller (issue 12): the paper's stages for A and p, then its own models.
+int run_improved(const Options& o, const io::ProjectConfig& config) {
+  if (o.pid != "paper")
+    throw io::InputError("--pid search: the improved controller has no PID to search");
+  control::SemiClosedLoopParams base;
+  base.sample_time_s = config.twin.daq.sample_time_s;
+  calibration::ImprovedCalibrationOutcome ic;
+  experiments::TravelRangeResult travel;
+  {
+    ProgressBar bar(3);
+    ic = calibration::calibrate_improved(config, base, o.seed, {}, bar.callback());
+    travel = experiments::run_travel_range(config, ic.controller, o.seed + 3,
+                                           calibration::CalibrationOptions{}.travel);
+  }
+  if (!(travel.single_move_um > 0.0))
+    throw experiments::ProcedureFailed(
+        fmt::format("calibration: the improved loop has no semi-closed-loop travel: {}",
+                    travel.validity.reason));
+  const control::ImprovedParams& im = ic.controller.improved;
+  calibration::write_calibration_file(
+      o.out, ic.controller,
+      fmt::format("piezoshift calibration of the improved controller, identified on the digital "
+                  "twin by `piezoshift calibrate --controller improved`\nseed {}, configuration: "
+                  "{}",
+                  o.seed, o.config.empty() ? "built-in defaults" : o.config),
+      travel.single_move_um, travel.single_move_min_um);
+  if (o.json) {
+    nlohmann::json j;
+    j["calibration_file"] = o.out;
+    j["controller"] = "improved";
+    j["A"] = matrix_json(ic.controller.matrix.a);
+    const auto& p = ic.controller.polynomial;
+    j["p"] = {p.p3, p.p2, p.p1, p.p0};
+    nlohmann::json models = nlohmann::json::array();
+    for (const auto& m : ic.model)
+      models.push_back({{"rms_residual_um", m.rms_residual_um},
+                        {"delay_ticks", m.delay_ticks},
+                        {"linear_weight", m.params.linear_weight},
+                        {"creep_gain", m.params.creep_gain}});
+    j["models"] = models;
+    j["mode_Hz"] = ic.mode_Hz;
+    j["mode_sample_rate_Hz"] = ic.mode_sample_rate_Hz;
+    j["shaped"] = ic.shaped;
+    j["shaper_taps"] = std::vector<double>(im.shaper.weight.begin(),
+                                           im.shaper.weight.begin() +
+                                               static_cast<std::ptrdiff_t>(im.shaper.taps));
+    j["shaper_rate_um_per_s"] = im.shaper.rate_um_per_s;
+    j["correction_ki"] = im.correction_ki;
+    j["travel_z_max_um"] = travel.single_move_um;
+    j["travel_semi_closed_um"] = travel.semi_closed_um;
+    j["travel_z_min_um"] = travel.single_move_min_um;
+    fmt::print("{}\n", j.dump(2));
+    return 0;
+  }
+  print_fits(ic.controller, ic.static_map.matrix, ic.static_map.polynomial);
+  for (std::size_t i = 0; i < 3; ++i)
+    fmt::print("model {}  hysteresis + creep, rms residual {:.1f} nm, delay {} ticks, w0 {:.4f}\n",
+               i + 1, 1e3 * ic.model[i].rms_residual_um, ic.model[i].delay_ticks,
+               ic.model[i].params.linear_weight);
+  fmt::print("shaper   mode {:.0f} Hz as sampled at {:.0f} Hz; {} taps; rate limit {:.0f} um/s\n",
+             ic.mode_Hz, ic.mode_sample_rate_Hz, im.shaper.taps, im.shaper.rate_um_per_s);
+  fmt::print("travel   semi-closed loop {:.2f} um; one move reaches {:.2f} to {:.2f} um\n",
+             travel.semi_closed_um, travel.single_move_min_um, travel.single_move_um);
+  fmt::print("written: {}\n", o.out);
+  return 0;
+}
+
 int run(const Options& o) {
-  if (!o.daq.empty())
+  if (!o.daq.empty()) {
+    if (o.controller != "paper")
+      throw io::InputError("--controller improved: the guided calibration calibrates the paper's "
+                           "controller only");
     return run_guided(o);
+  }
   if (!o.interferometer.empty())
     throw io::InputError("--interferometer needs --daq (the guided calibration)");
   const io::ProjectConfig config =
       o.config.empty() ? io::ProjectConfig{} : runtime::load_installation_config(o.config).project;
+  if (o.controller == "improved")
+    return run_improved(o, config);
   calibration::CalibrationOptions co;
   co.pid = o.pid == "paper" ? calibration::PidChoice::kPaper : calibration::PidChoice::kSearch;
   calibration::CalibrationWithTravel ct;
@@ -244,6 +319,10 @@ void add_calibrate_command(CLI::App& app, Action& action) {
          "--pid", o->pid,
          "paper: keep 0.6/0.2/0.001 (default); search: grid-search the gains on the full loop")
       ->check(CLI::IsMember({"paper", "search"}));
+  cmd->add_option("--controller", o->controller,
+                  "paper: the paper's PID, A and p (default); improved: A and p, then the "
+                  "improved controller's models (docs/control.md)")
+      ->check(CLI::IsMember({"paper", "improved"}));
   cmd->add_flag("--json", o->json, "print a JSON summary");
   cmd->add_option(
       "--daq", o->daq,

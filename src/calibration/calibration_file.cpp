@@ -1,6 +1,9 @@
 #include "piezoshift/calibration/calibration_file.hpp"
 
 #include <array>
+#include <cmath>
+#include <string>
+#include <vector>
 #include <sstream>
 
 #include <fmt/core.h>
@@ -10,6 +13,96 @@
 #include "piezoshift/io/input_error.hpp"
 
 namespace piezoshift::calibration {
+
+namespace {
+
+[[noreturn]] void fail(const io::ConfigFile& file, std::string_view section, std::string_view key,
+                       const std::string& why) {
+  throw io::InputError(fmt::format("{}: [{}] {}: {}", file.source(), section, key, why));
+}
+
+void read_improved(const io::ConfigFile& file, control::ImprovedParams& im) {
+  const io::ConfigSection s = file.section("improved");
+  if (!s.read("sample_time_s", im.sample_time_s, io::Bounds::positive()))
+    fail(file, "improved", "sample_time_s", "missing (kind = \"improved\" needs [improved])");
+  std::int64_t delay = static_cast<std::int64_t>(im.reference_delay_ticks);
+  s.read("reference_delay_ticks", delay,
+         io::Bounds::closed(0.0, static_cast<double>(control::kMaxReferenceDelayTicks)));
+  im.reference_delay_ticks = static_cast<std::size_t>(delay);
+  s.read("correction_ki", im.correction_ki, io::Bounds::closed(0.0, 1.0));
+  s.read("correction_ki_max", im.correction_ki_max, io::Bounds::closed(0.0, 1.0));
+  s.read("correction_boost_error_um", im.correction_boost_error_um, io::Bounds::non_negative());
+  s.read("correction_limit_um", im.correction_limit_um, io::Bounds::positive());
+  std::vector<double> taps;
+  if (s.read("shaper_taps", taps, control::kMaxShaperTaps, io::Bounds::closed(0.0, 1.0))) {
+    im.shaper.taps = taps.size();
+    im.shaper.weight = {};
+    double sum = 0.0;
+    for (std::size_t i = 0; i < taps.size(); ++i)
+      sum += im.shaper.weight[i] = taps[i];
+    if (std::fabs(sum - 1.0) > 1e-9)
+      fail(file, "improved", "shaper_taps", fmt::format("must sum to 1 (they sum to {})", sum));
+  }
+  s.read("shaper_rate_um_per_s", im.shaper.rate_um_per_s, io::Bounds::positive());
+  for (std::size_t i = 0; i < control::kChannels; ++i) {
+    const std::string name = fmt::format("improved.channel{}", i + 1);
+    const io::ConfigSection c = file.section(name);
+    control::HysteresisCreepParams& m = im.model[i];
+    c.read("offset_um", m.offset_um, io::Bounds::closed(-100.0, 100.0));
+    if (!c.read("linear_weight", m.linear_weight, io::Bounds::closed(1e-3, 100.0)))
+      fail(file, name, "linear_weight", "missing");
+    std::vector<double> r, w, tau;
+    c.read("thresholds_um", r, control::kMaxModelOperators, io::Bounds::positive());
+    c.read("weights", w, control::kMaxModelOperators, io::Bounds::closed(0.0, 100.0));
+    if (r.size() != w.size())
+      fail(file, name, "weights", fmt::format("{} weights for {} thresholds", w.size(),
+                                                   r.size()));
+    m.operators = r.size();
+    for (std::size_t j = 0; j < r.size(); ++j) {
+      m.threshold_um[j] = r[j];
+      m.weight[j] = w[j];
+    }
+    c.read("creep_time_constants_s", tau, control::kMaxCreepTerms, io::Bounds::positive());
+    m.creep_terms = tau.size();
+    for (std::size_t k = 0; k < tau.size(); ++k)
+      m.creep_time_constant_s[k] = tau[k];
+    c.read("creep_gain", m.creep_gain, io::Bounds::closed(-0.05, 0.05));
+  }
+}
+
+std::string number_list(const double* v, std::size_t n) {
+  std::string out = "[";
+  for (std::size_t i = 0; i < n; ++i)
+    out += fmt::format("{}{:.17g}", i == 0 ? "" : ", ", v[i]);
+  return out + "]";
+}
+
+std::string format_improved(const control::ImprovedParams& im) {
+  std::string out = "\n[improved]  # the improved controller (docs/control.md), for one loop rate\n";
+  out += fmt::format("sample_time_s = {:.17g}\n", im.sample_time_s);
+  out += fmt::format("reference_delay_ticks = {}\n", im.reference_delay_ticks);
+  out += fmt::format("correction_ki = {:.17g}  # per-sample at sample_time_s\n",
+                     im.correction_ki);
+  out += fmt::format("correction_ki_max = {:.17g}\n", im.correction_ki_max);
+  out += fmt::format("correction_boost_error_um = {:.17g}\n", im.correction_boost_error_um);
+  out += fmt::format("correction_limit_um = {:.17g}\n", im.correction_limit_um);
+  out += "shaper_taps = " + number_list(im.shaper.weight.data(), im.shaper.taps) + "\n";
+  out += fmt::format("shaper_rate_um_per_s = {:.17g}\n", im.shaper.rate_um_per_s);
+  for (std::size_t i = 0; i < control::kChannels; ++i) {
+    const control::HysteresisCreepParams& m = im.model[i];
+    out += fmt::format("\n[improved.channel{}]  # gauge um from command um\n", i + 1);
+    out += fmt::format("offset_um = {:.17g}\n", m.offset_um);
+    out += fmt::format("linear_weight = {:.17g}\n", m.linear_weight);
+    out += "thresholds_um = " + number_list(m.threshold_um.data(), m.operators) + "\n";
+    out += "weights = " + number_list(m.weight.data(), m.operators) + "\n";
+    out += "creep_time_constants_s = " +
+           number_list(m.creep_time_constant_s.data(), m.creep_terms) + "\n";
+    out += fmt::format("creep_gain = {:.17g}\n", m.creep_gain);
+  }
+  return out;
+}
+
+}  // namespace
 
 void read_controller_section(const io::ConfigFile& file, control::SemiClosedLoopParams& params) {
   const io::ConfigSection c = file.section("controller");
@@ -22,6 +115,17 @@ void read_controller_section(const io::ConfigFile& file, control::SemiClosedLoop
   if (c.read("p", p))
     params.polynomial = control::CubicPolynomial{p[0], p[1], p[2], p[3]};
   c.read("A", params.matrix.a);
+  std::string kind = "paper";
+  if (c.read("kind", kind)) {
+    if (kind == "improved")
+      params.kind = control::ControllerKind::kImproved;
+    else if (kind == "paper")
+      params.kind = control::ControllerKind::kPaper;
+    else
+      fail(file, "controller", "kind", "expected \"paper\" or \"improved\"");
+  }
+  if (params.kind == control::ControllerKind::kImproved)
+    read_improved(file, params.improved);
 }
 
 control::SemiClosedLoopParams load_calibration_file(const std::string& path,
@@ -66,6 +170,10 @@ std::string format_calibration(const control::SemiClosedLoopParams& params,
   for (std::size_t r = 0; r < 3; ++r) {
     out += fmt::format("{}[{:.17g}, {:.17g}, {:.17g}]{}", r == 0 ? "" : "     ", a[r][0], a[r][1],
                        a[r][2], r == 2 ? "]  # S = A Z_S, Eq. 8\n" : ",\n");
+  }
+  if (params.kind == control::ControllerKind::kImproved) {
+    out += "kind = \"improved\"\n";
+    out += format_improved(params.improved);
   }
   if (travel_z_max_um) {
     out += "\n[travel]\n";

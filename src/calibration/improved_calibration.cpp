@@ -1,6 +1,60 @@
 #include "piezoshift/calibration/improved_calibration.hpp"
 
+#include <Eigen/Dense>
+#include <algorithm>
+#include <cmath>
+#include <fmt/format.h>
+#include <numbers>
+
+#include "piezoshift/experiments/bench.hpp"
+#include "piezoshift/experiments/validity.hpp"
+#include "piezoshift/plant/amplifier.hpp"
+
 namespace piezoshift::calibration {
+
+namespace {
+
+// The excitation: segments (duration, level at the end), linear in between.
+struct Segment {
+  double duration_s;
+  double level_um;
+};
+// A major loop, reversal curves at decreasing amplitude, steps held for creep, and small steps
+// at mid-travel approached from below (what a phase step does). Ramps stay well below the
+// amplifier's slew (16 um of command in 1 s).
+constexpr Segment kExcitation[] = {
+    {0.5, 0.0},   {1.0, 16.0},  {1.0, 0.0},   {0.75, 12.0}, {0.5, 4.0},   {0.4, 10.0},
+    {0.3, 6.0},   {0.2, 8.0},   {0.1, 7.0},   {0.3, 7.0},   {0.0, 8.0},   {3.0, 8.0},
+    {0.0, 3.0},   {3.0, 3.0},   {0.0, 13.0},  {3.0, 13.0},  {0.0, 5.0},   {2.0, 5.0},
+    {0.0, 5.1},   {0.5, 5.1},   {0.0, 5.2},   {0.5, 5.2},   {0.0, 5.1},   {0.5, 5.1},
+    {0.0, 5.15},  {0.5, 5.15},  {0.0, 10.0},  {3.0, 10.0},  {0.0, 0.0},   {2.0, 0.0},
+};
+
+}  // namespace
+
+double improved_excitation_duration_s() {
+  double t = 0.0;
+  for (const Segment& s : kExcitation)
+    t += s.duration_s;
+  return t;
+}
+
+double improved_excitation_um(double t_s) {
+  double t0 = 0.0;
+  double level = 0.0;
+  for (const Segment& s : kExcitation) {
+    if (s.duration_s == 0.0) {
+      if (t_s >= t0)
+        level = s.level_um;
+      continue;
+    }
+    if (t_s < t0 + s.duration_s)
+      return level + (s.level_um - level) * (t_s - t0) / s.duration_s;
+    t0 += s.duration_s;
+    level = s.level_um;
+  }
+  return level;
+}
 
 ImprovedCalibrationOutcome calibrate_improved(const io::ProjectConfig& config,
                                               const control::SemiClosedLoopParams& base,
@@ -9,7 +63,111 @@ ImprovedCalibrationOutcome calibrate_improved(const io::ProjectConfig& config,
                                               const experiments::Progress& progress) {
   ImprovedCalibrationOutcome out;
   out.static_map = calibrate(config, base, seed, options.paper, progress);
-  out.controller = out.static_map.controller;
+  const control::SemiClosedLoopParams& paper = out.static_map.controller;
+
+  // Stage 4: the channel models from an open-loop excitation.
+  {
+    experiments::Bench bench(config, paper, seed + 4);
+    const double T = bench.sample_time_s();
+    const auto ticks =
+        static_cast<std::size_t>(std::llround(improved_excitation_duration_s() / T));
+    for (std::size_t k = 0; k < ticks; ++k) {
+      const double u = std::clamp(improved_excitation_um(static_cast<double>(k) * T),
+                                  paper.output_min_um, paper.output_max_um);
+      control::Vec3 volts{};
+      for (std::size_t i = 0; i < 3; ++i)
+        volts[i] = paper.scaling[i].um_to_dac(u);
+      bench.drive_open_loop(volts);
+      bench.run(T);
+      const runtime::CycleSample& s = bench.last_cycle();
+      out.record_t_s.push_back(static_cast<double>(k) * T);
+      for (std::size_t i = 0; i < 3; ++i) {
+        out.record_command_um[i].push_back(u);
+        out.record_gauge_um[i].push_back(paper.scaling[i].sgs_to_um(s.ai_V[i]));
+      }
+    }
+    if (bench.faulted())
+      throw experiments::ProcedureFailed(
+          fmt::format("improved calibration: the excitation tripped the supervisor ({})",
+                      runtime::to_string(bench.fault().reason)));
+    for (std::size_t i = 0; i < 3; ++i)
+      out.model[i] =
+          fit_hysteresis_creep(out.record_command_um[i], out.record_gauge_um[i], T, options.model);
+  }
+
+  // Stage 5: the plate's mode, from the interferometer's dynamic samples after a small open-loop
+  // step (the gauges' conditioner filters it out; the plate rings). Prony's method on the
+  // samples: x_k = a1 x_{k-1} + a2 x_{k-2} + c, a damped cosine's recursion, gives cos(theta)
+  // = a1 / (2 sqrt(-a2)) at the interferometer's rate, folded like any sampled mode.
+  {
+    experiments::Bench bench(config, paper, seed + 5);
+    const auto volts = [&](double u) {
+      control::Vec3 v{};
+      for (std::size_t i = 0; i < 3; ++i)
+        v[i] = paper.scaling[i].um_to_dac(u);
+      return v;
+    };
+    bench.drive_open_loop(volts(options.mode_step_from_um));
+    bench.run(1.0);
+    bench.drive_open_loop(volts(options.mode_step_from_um + options.mode_step_um));
+    std::vector<double> x;
+    double last_t = -1.0;
+    bench.run(options.mode_record_s, [&](const experiments::Bench& b) {
+      const plant::InterferometerReading& r = b.twin().interferometer();
+      if (r.dynamic_time_s != last_t) {
+        last_t = r.dynamic_time_s;
+        x.push_back((r.dynamic_um[0] + r.dynamic_um[1] + r.dynamic_um[2]) / 3.0);
+      }
+    });
+    const double rate_Hz = config.twin.interferometer.dynamic_sample_rate_Hz;
+    out.mode_Hz = 0.0;
+    if (x.size() > 8) {
+      Eigen::MatrixXd X(static_cast<Eigen::Index>(x.size() - 3), 3);
+      Eigen::VectorXd y(X.rows());
+      for (Eigen::Index k = 0; k < X.rows(); ++k) {
+        const auto j = static_cast<std::size_t>(k) + 3;  // the step's first sample left out
+        X(k, 0) = x[j - 1];
+        X(k, 1) = x[j - 2];
+        X(k, 2) = 1.0;
+        y(k) = x[j];
+      }
+      const Eigen::Vector3d a = X.colPivHouseholderQr().solve(y);
+      if (a(1) < 0.0) {
+        const double c = std::clamp(a(0) / (2.0 * std::sqrt(-a(1))), -1.0, 1.0);
+        out.mode_theta_rad = std::acos(c);
+        out.mode_Hz = out.mode_theta_rad * rate_Hz / (2.0 * std::numbers::pi);
+      }
+    }
+    out.mode_sample_rate_Hz = rate_Hz;
+  }
+
+  // Stage 6: the controller.
+  control::SemiClosedLoopParams c = paper;
+  c.kind = control::ControllerKind::kImproved;
+  double min_slope = 1e9;
+  for (std::size_t i = 0; i < 3; ++i) {
+    c.improved.model[i] = out.model[i].params;
+    min_slope = std::min(min_slope, out.model[i].params.linear_weight);
+  }
+  c.improved.sample_time_s = c.sample_time_s;
+  c.improved.reference_delay_ticks = out.model[0].delay_ticks;
+  const double slew_V_per_s = plant::amplifier_slew_rate_V_per_s(
+      config.twin.amplifier, config.design.actuator.capacitance_F);
+  const double rate_command_um_per_s =
+      slew_V_per_s / config.twin.amplifier.gain / paper.scaling[0].drive_V_per_um;
+  // The mode as folded at the interferometer's rate is what the shaper needs when the loop runs at
+  // that rate; at another rate the fold is ambiguous unless the interferometer saw the mode below
+  // its Nyquist frequency.
+  const double loop_rate_Hz = 1.0 / c.sample_time_s;
+  const bool same_rate = std::fabs(loop_rate_Hz - out.mode_sample_rate_Hz) < 1e-6 * loop_rate_Hz;
+  const bool unfolded = out.mode_Hz > 0.0 && out.mode_Hz < 0.45 * out.mode_sample_rate_Hz &&
+                        out.mode_sample_rate_Hz >= loop_rate_Hz;
+  out.shaped = out.mode_Hz > 0.0 && (same_rate || unfolded);
+  c.improved.shaper = control::design_mode_shaper(
+      out.shaped ? out.mode_Hz : 0.0, c.sample_time_s, options.slew_margin * rate_command_um_per_s * min_slope);
+  c.improved.correction_ki =
+      2.0 * std::numbers::pi * options.correction_bandwidth_Hz * c.sample_time_s;
+  out.controller = c;
   return out;
 }
 

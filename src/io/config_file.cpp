@@ -256,6 +256,22 @@ bool ConfigSection::read(std::string_view key, std::array<double, 4>& value, Bou
   return true;
 }
 
+bool ConfigSection::read(std::string_view key, std::vector<double>& value, std::size_t max_count,
+                         Bounds bounds) const {
+  const auto& impl = *file_;
+  std::string path;
+  const toml::node* n = impl.take(name_, key, path);
+  if (n == nullptr)
+    return false;
+  const auto* a = n->as_array();
+  if (a == nullptr || a->empty() || a->size() > max_count)
+    impl.fail(path, n->source(), fmt::format("expected a list of 1 to {} numbers", max_count));
+  value.clear();
+  for (std::size_t i = 0; i < a->size(); ++i)
+    value.push_back(impl.number(fmt::format("{}[{}]", path, i), *a->get(i), bounds));
+  return true;
+}
+
 bool ConfigSection::read(std::string_view key, std::array<std::array<double, 3>, 3>& value,
                          Bounds bounds) const {
   const auto& impl = *file_;

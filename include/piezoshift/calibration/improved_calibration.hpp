@@ -1,28 +1,61 @@
 #pragma once
-// Calibration of the improved controller (issue 12): the paper's static map (stages 2 and 3: A
-// and p, the gauge-to-plate path) and the identification of the improved controller's own
-// models, on the twin through the shipping loop. Work in progress: for now it returns the paper's
-// calibration.
+// Calibration of the improved controller (control/semi_closed_loop.hpp, kind = kImproved; issue
+// 12), on the twin through the shipping loop (experiments/bench.hpp), each step on a bench of its
+// own:
+//   1-3. the paper's procedure (calibration_procedure.hpp): A and p, the gauge-to-plate map the
+//        improved controller keeps as its feedforward          seeds seed .. seed + 2
+//   4.   the channel models: an open-loop excitation (a major loop, reversal curves, steps held
+//        for creep, small steps at mid-travel), the commands and gauge readings recorded every
+//        tick and fitted (hysteresis_identification.hpp)        seed + 4
+//   5.   the plate's mode: a small open-loop step, the interferometer's dynamic samples fitted by
+//        Prony's method; it sets the shaper's taps                  seed + 5
+//   6.   the correction loop's integral gain for a chosen bandwidth, and the rate limit from the
+//        amplifier's slew (its current limit into the stack's capacitance).
 #include <cstdint>
+#include <vector>
 
 #include "piezoshift/calibration/calibration_procedure.hpp"
+#include "piezoshift/calibration/hysteresis_identification.hpp"
 
 namespace piezoshift::calibration {
 
 struct ImprovedCalibrationOptions {
   CalibrationOptions paper{};  //!< the static map's stages (A, p), as the paper's procedure
+  HysteresisFitOptions model{};
+  //! The correction loop's crossover: low, so the gauges' noise stays out of the plate (a 1 ms
+  //! exposure's jitter grows with its square root), high enough to follow creep the model misses.
+  double correction_bandwidth_Hz = 5.0;
+  double slew_margin = 0.7;  //!< the rate limit as this fraction of the amplifier's slew
+  double mode_step_from_um = 5.0;  //!< stage 5: open-loop command held, then
+  double mode_step_um = 0.3;       //!< stepped by this
+  double mode_record_s = 0.03;     //!< and the interferometer recorded this long
 };
 
 struct ImprovedCalibrationOutcome {
   control::SemiClosedLoopParams controller;  //!< the improved controller to load
   CalibrationOutcome static_map;             //!< stages 1 to 3 as the paper's procedure ran them
+  std::array<HysteresisFit, 3> model{};
+  //! The plate's mode as the interferometer's dynamic samples show it (folded into [0, rate/2];
+  //! 0 when none was found), the rate, and whether the shaper uses it.
+  double mode_Hz = 0.0;
+  double mode_theta_rad = 0.0;
+  double mode_sample_rate_Hz = 0.0;
+  bool shaped = false;
+  //! The excitation as recorded (stage 4), per tick: t_s, command and gauge per channel.
+  std::vector<double> record_t_s;
+  std::array<std::vector<double>, 3> record_command_um, record_gauge_um;
 };
 
-//! base supplies the sample time, limits and scaling.
+//! base supplies the sample time, limits and scaling. Throws experiments::ProcedureFailed when a
+//! stage trips the supervisor, FitError when a fit fails.
 ImprovedCalibrationOutcome calibrate_improved(const io::ProjectConfig& config,
                                               const control::SemiClosedLoopParams& base,
                                               std::uint64_t seed,
                                               const ImprovedCalibrationOptions& options = {},
                                               const experiments::Progress& progress = {});
+
+//! The command (um) of the stage-4 excitation at time t_s, and its duration.
+double improved_excitation_um(double t_s);
+double improved_excitation_duration_s();
 
 }  // namespace piezoshift::calibration

@@ -8,6 +8,17 @@
 // Z_d are the desired displacements of the measurement points P1..P3 (um). update_actuators()
 // skips the feedforward and takes actuator targets S directly (calibration stages 1 and 2).
 //
+// The improved controller (kind = kImproved, issue 12) keeps the feedforward S = A p(Z_d) and
+// replaces the PID of each channel by
+//   r   = shaper(S_i)                  rate limit at the amplifier's slew, mode-cancelling taps
+//   e   = r(k - D) - y                 the model's error, D = the loop's delay
+//   c  += ki_e e, |c| <= limit          slow integral correction; ki_e = ki, raised in proportion
+//                                       to |e| above boost_error (up to ki_max) so large model
+//                                       errors go fast while the gauges' noise stays out
+//   u   = model_i^-1(r + c)            inverse hysteresis-creep model (hysteresis_creep_model.hpp)
+// so a set-point change is made by the model at once and the gauges' noise enters only through
+// the slow correction (docs/control.md).
+//
 // Real-time safe: no heap, no exceptions, no I/O; every member is noexcept. Templated on the
 // scalar type (see vec3.hpp): SemiClosedLoopController is the double one, the firmware runs
 // BasicSemiClosedLoopController<float>.
@@ -15,15 +26,59 @@
 #include <cstdint>
 
 #include "piezoshift/control/cubic_polynomial.hpp"
+#include "piezoshift/control/hysteresis_creep_model.hpp"
 #include "piezoshift/control/incremental_pid.hpp"
+#include "piezoshift/control/setpoint_shaper.hpp"
 #include "piezoshift/control/signal_scaling.hpp"
 #include "piezoshift/control/transmission_matrix.hpp"
 #include "piezoshift/control/vec3.hpp"
 
 namespace piezoshift::control {
 
+enum class ControllerKind : std::uint8_t {
+  kPaper,     //!< the paper's PIDs (Eqs. 6, 7)
+  kImproved,  //!< model inverse, shaping and a slow correction (issue 12)
+};
+
+inline constexpr std::size_t kMaxReferenceDelayTicks = 8;
+
+//! The improved controller's parts (identified by calibration/improved_calibration.hpp).
+template <class T>
+struct BasicImprovedParams {
+  //! The sample time the shaper's taps and the correction's gains were designed at; the loop
+  //! refuses to run them at another (runtime/control_cycle.cpp).
+  T sample_time_s = T(1e-3);
+  std::array<BasicHysteresisCreepParams<T>, kChannels> model{};
+  BasicShaperParams<T> shaper{};
+  //! The correction's per-sample integral gain at sample_time_s (not rescaled: designed per rate).
+  T correction_ki = T(0.03);
+  T correction_ki_max = T(0.3);        //!< the raised gain's ceiling (stable with D = 2 ticks)
+  T correction_boost_error_um = T(0.02);  //!< errors beyond this raise the gain
+
+  T correction_limit_um = T(2);  //!< |c| at most this (SGS um): the model's error, not a move
+  std::size_t reference_delay_ticks = 2;  //!< D, from command to the gauges' response
+};
+
+using ImprovedParams = BasicImprovedParams<double>;
+
+template <class To, class From>
+constexpr BasicImprovedParams<To> convert(const BasicImprovedParams<From>& p) noexcept {
+  BasicImprovedParams<To> q{};
+  q.sample_time_s = static_cast<To>(p.sample_time_s);
+  for (std::size_t i = 0; i < kChannels; ++i)
+    q.model[i] = convert<To>(p.model[i]);
+  q.shaper = convert<To>(p.shaper);
+  q.correction_ki = static_cast<To>(p.correction_ki);
+  q.correction_ki_max = static_cast<To>(p.correction_ki_max);
+  q.correction_boost_error_um = static_cast<To>(p.correction_boost_error_um);
+  q.correction_limit_um = static_cast<To>(p.correction_limit_um);
+  q.reference_delay_ticks = p.reference_delay_ticks;
+  return q;
+}
+
 template <class T>
 struct BasicSemiClosedLoopParams {
+  ControllerKind kind = ControllerKind::kPaper;
   T sample_time_s = T(1e-3);        //!< T_s, Section 4: 1 ms
   BasicPidGains<T> gains{};         //!< per-sample gains, valid at gains_sample_time_s
   T gains_sample_time_s = T(1e-3);  //!< the sample time the gains were tuned at (paper: 1 ms)
@@ -34,6 +89,7 @@ struct BasicSemiClosedLoopParams {
   BasicCubicPolynomial<T> polynomial{};
   BasicTransmissionMatrix<T> matrix{};
   std::array<BasicSignalScaling<T>, kChannels> scaling{};
+  BasicImprovedParams<T> improved{};  //!< used when kind == kImproved
 
   //! The PID parameters each channel runs with, gains re-expressed at sample_time_s.
   constexpr BasicPidParams<T> pid_params() const noexcept {
@@ -49,6 +105,8 @@ using SemiClosedLoopParams = BasicSemiClosedLoopParams<double>;
 template <class To, class From>
 constexpr BasicSemiClosedLoopParams<To> convert(const BasicSemiClosedLoopParams<From>& p) noexcept {
   BasicSemiClosedLoopParams<To> q{};
+  q.kind = p.kind;
+  q.improved = convert<To>(p.improved);
   q.sample_time_s = static_cast<To>(p.sample_time_s);
   q.gains = {static_cast<To>(p.gains.kp), static_cast<To>(p.gains.ki), static_cast<To>(p.gains.kd)};
   q.gains_sample_time_s = static_cast<To>(p.gains_sample_time_s);
@@ -94,6 +152,14 @@ class BasicSemiClosedLoopController {
       c.set_params(pid);
       c.reset(params.output_min_um);
     }
+    const BasicImprovedParams<T>& im = params.improved;
+    delay_ = im.reference_delay_ticks < kMaxReferenceDelayTicks ? im.reference_delay_ticks
+                                                                : kMaxReferenceDelayTicks;
+    for (std::size_t i = 0; i < kChannels; ++i) {
+      model_[i].configure(im.model[i], params.sample_time_s);
+      shaper_[i].configure(im.shaper, params.sample_time_s);
+    }
+    reset_improved(filled<T>(params.output_min_um));
   }
 
   //! Outer feedforward only: S = A p(Z_d).
@@ -111,6 +177,8 @@ class BasicSemiClosedLoopController {
 
   //! A tick from actuator targets in SGS micrometres (inner loop only).
   constexpr Output update_actuators(const Vec& target_um, const Vec& sgs_V) noexcept {
+    if (params_.kind == ControllerKind::kImproved)
+      return update_improved(target_um, sgs_V);
     Output out{};
     out.target_um = target_um;
     for (std::size_t i = 0; i < kChannels; ++i) {
@@ -127,28 +195,103 @@ class BasicSemiClosedLoopController {
   constexpr void reset() noexcept {
     for (auto& c : pid_)
       c.reset(params_.output_min_um);
+    reset_improved(filled<T>(params_.output_min_um));
   }
   //! Clears the history and starts each channel from a given command (bumpless hand-over, e.g.
   //! from open loop to closed loop at the voltage already applied).
   constexpr void reset_to(const Vec& command_um) noexcept {
     for (std::size_t i = 0; i < kChannels; ++i)
       pid_[i].reset(command_um[i]);
+    reset_improved(command_um);
   }
   constexpr void set_enabled(bool enabled) noexcept {
     for (auto& c : pid_)
       c.set_enabled(enabled);
+    enabled_ = enabled;
   }
   constexpr void hold_integrators(bool held) noexcept {
     for (auto& c : pid_)
       c.hold_integrator(held);
+    correction_held_ = held;
   }
 
   constexpr const Params& params() const noexcept { return params_; }
   constexpr const BasicIncrementalPid<T>& channel(std::size_t i) const noexcept { return pid_[i]; }
+  //! The improved controller's model of channel i (its state follows the commands sent).
+  constexpr const BasicHysteresisCreepModel<T>& model(std::size_t i) const noexcept {
+    return model_[i];
+  }
 
  private:
+  constexpr Output update_improved(const Vec& target_um, const Vec& sgs_V) noexcept {
+    Output out{};
+    out.target_um = target_um;
+    for (std::size_t i = 0; i < kChannels; ++i) {
+      const BasicSignalScaling<T>& s = params_.scaling[i];
+      out.feedback_um[i] = s.sgs_to_um(sgs_V[i]);
+      const T r = shaper_[i].update(target_um[i]);
+      auto& hist = reference_[i];
+      for (std::size_t k = kMaxReferenceDelayTicks; k > 0; --k)
+        hist[k] = hist[k - 1];
+      hist[0] = r;
+      const BasicImprovedParams<T>& im = params_.improved;
+      T e = hist[delay_] - out.feedback_um[i];
+      if (!(e == e))
+        e = T(0);  // a NaN reading never reaches the correction (the supervisor reports it)
+      const T ae = e < T(0) ? -e : e;
+      T ki = im.correction_ki;
+      if (ae > im.correction_boost_error_um && im.correction_boost_error_um > T(0)) {
+        ki = ki * ae / im.correction_boost_error_um;
+        ki = ki > im.correction_ki_max ? im.correction_ki_max : ki;
+      }
+      T& corr = correction_[i];
+      // No integration while held, nor deeper into a limit the command already sits at.
+      const bool at_top = last_clamped_[i] && model_[i].command_um() >= params_.output_max_um;
+      const bool at_bottom = last_clamped_[i] && model_[i].command_um() <= params_.output_min_um;
+      if (!correction_held_ && !(at_top && e > T(0)) && !(at_bottom && e < T(0)))
+        corr += ki * e;
+      const T limit = im.correction_limit_um;
+      const bool corr_limited = corr > limit || corr < -limit;
+      corr = corr > limit ? limit : (corr < -limit ? -limit : corr);
+      T u = T(0);
+      bool clamped = false;
+      if (enabled_)
+        u = model_[i].inverse(r + corr, params_.output_min_um, params_.output_max_um, clamped);
+      else
+        corr = T(0);
+      last_clamped_[i] = clamped;
+      model_[i].commit(u);
+      out.command_um[i] = u;
+      out.dac_V[i] = s.um_to_dac(u);
+      if (clamped || corr_limited)
+        out.saturated_mask |= static_cast<std::uint8_t>(1U << i);
+    }
+    return out;
+  }
+
+  // The models start from the commands held (history unknown: a rising branch), the shapers and
+  // the reference delay lines from what the models read there, the corrections from 0.
+  constexpr void reset_improved(const Vec& command_um) noexcept {
+    for (std::size_t i = 0; i < kChannels; ++i) {
+      model_[i].reset_to(command_um[i]);
+      const T y = model_[i].output();
+      shaper_[i].reset(y);
+      reference_[i].fill(y);
+      correction_[i] = T(0);
+      last_clamped_[i] = false;
+    }
+  }
+
   Params params_{};
   std::array<BasicIncrementalPid<T>, kChannels> pid_{};
+  std::array<BasicHysteresisCreepModel<T>, kChannels> model_{};
+  std::array<BasicSetpointShaper<T>, kChannels> shaper_{};
+  Vec correction_{};  //!< c per channel (SGS um)
+  std::array<bool, kChannels> last_clamped_{};
+  bool enabled_ = true;
+  bool correction_held_ = false;
+  std::array<std::array<T, kMaxReferenceDelayTicks + 1>, kChannels> reference_{};
+  std::size_t delay_ = 0;
 };
 
 using SemiClosedLoopController = BasicSemiClosedLoopController<double>;

@@ -13,6 +13,7 @@
 #include <cstdint>
 #include <memory>
 #include <string>
+#include <vector>
 #include <string_view>
 
 #include "piezoshift/design/bounds.hpp"
@@ -37,6 +38,9 @@ class ConfigSection {
             Bounds bounds = Bounds::any()) const;
   //! A list of four numbers (e.g. the cubic's p = [p3, p2, p1, p0]).
   bool read(std::string_view key, std::array<double, 4>& value,
+            Bounds bounds = Bounds::any()) const;
+  //! A list of 1 to max_count numbers.
+  bool read(std::string_view key, std::vector<double>& value, std::size_t max_count,
             Bounds bounds = Bounds::any()) const;
   //! A 3x3 matrix as a list of three rows.
   bool read(std::string_view key, std::array<std::array<double, 3>, 3>& value,

@@ -1,0 +1,194 @@
+#include "piezoshift/calibration/hysteresis_identification.hpp"
+
+#include <Eigen/Dense>
+#include <cmath>
+#include <fmt/format.h>
+#include <limits>
+#include <vector>
+
+#include "piezoshift/calibration/fit_error.hpp"
+
+namespace piezoshift::calibration {
+
+namespace {
+
+using control::HysteresisCreepParams;
+
+// Operator outputs s_j(u_k) with unit weights, from rest at 0.
+Eigen::MatrixXd play_outputs(std::span<const double> u, const HysteresisCreepParams& p) {
+  Eigen::MatrixXd s(static_cast<Eigen::Index>(u.size()), static_cast<Eigen::Index>(p.operators));
+  std::vector<double> state(p.operators, 0.0);
+  for (std::size_t k = 0; k < u.size(); ++k) {
+    for (std::size_t j = 0; j < p.operators; ++j) {
+      double v = state[j];
+      v = std::max(v, u[k] - p.threshold_um[j]);
+      v = std::min(v, u[k]);
+      state[j] = v;
+      s(static_cast<Eigen::Index>(k), static_cast<Eigen::Index>(j)) = v;
+    }
+  }
+  return s;
+}
+
+// sum_m (c_m - h) with c_m the unit-gain first-order terms driven by h, from rest.
+Eigen::VectorXd creep_regressor(const Eigen::VectorXd& h, const HysteresisCreepParams& p,
+                                double sample_time_s) {
+  std::vector<double> a(p.creep_terms), c(p.creep_terms, 0.0);
+  for (std::size_t m = 0; m < p.creep_terms; ++m)
+    a[m] = std::exp(-sample_time_s / p.creep_time_constant_s[m]);
+  Eigen::VectorXd z(h.size());
+  for (Eigen::Index k = 0; k < h.size(); ++k) {
+    double sum = 0.0;
+    for (std::size_t m = 0; m < p.creep_terms; ++m) {
+      c[m] = a[m] * c[m] + (1.0 - a[m]) * h(k);
+      sum += c[m] - h(k);
+    }
+    z(k) = sum;
+  }
+  return z;
+}
+
+struct Solved {
+  Eigen::VectorXd x;
+  double rms = std::numeric_limits<double>::infinity();
+};
+
+Eigen::MatrixXd select(const Eigen::MatrixXd& X, const std::vector<Eigen::Index>& rows) {
+  Eigen::MatrixXd out(static_cast<Eigen::Index>(rows.size()), X.cols());
+  for (std::size_t r = 0; r < rows.size(); ++r)
+    out.row(static_cast<Eigen::Index>(r)) = X.row(rows[r]);
+  return out;
+}
+
+Solved solve(const Eigen::MatrixXd& X, const Eigen::VectorXd& y) {
+  Solved s;
+  s.x = X.colPivHouseholderQr().solve(y);
+  const Eigen::VectorXd r = X * s.x - y;
+  s.rms = std::sqrt(r.squaredNorm() / static_cast<double>(r.size()));
+  return s;
+}
+
+}  // namespace
+
+HysteresisFit fit_hysteresis_creep(std::span<const double> command_um,
+                                   std::span<const double> gauge_um, double sample_time_s,
+                                   const HysteresisFitOptions& o) {
+  if (command_um.size() != gauge_um.size())
+    throw FitError(fmt::format("hysteresis fit: {} commands but {} gauge readings",
+                               command_um.size(), gauge_um.size()));
+  for (std::size_t k = 0; k < command_um.size(); ++k)
+    if (!std::isfinite(command_um[k]) || !std::isfinite(gauge_um[k]))
+      throw FitError(fmt::format("hysteresis fit: a non-finite value at sample {}", k));
+  if (o.operators < 1 || o.operators > control::kMaxModelOperators || !(o.command_span_um > 0.0) ||
+      !(o.creep_shortest_s > 0.0) || !(o.creep_longest_s >= o.creep_shortest_s) ||
+      o.creep_terms_per_decade < 1 || !(sample_time_s > 0.0))
+    throw FitError("hysteresis fit: invalid options");
+  const std::size_t min_rows = 20 * (o.operators + 4) + o.max_delay_ticks;
+  if (command_um.size() < min_rows)
+    throw FitError(fmt::format("hysteresis fit: {} samples, at least {} needed", command_um.size(),
+                               min_rows));
+
+  HysteresisCreepParams base{};
+  base.operators = o.operators;
+  for (std::size_t j = 0; j < o.operators; ++j)
+    base.threshold_um[j] =
+        (static_cast<double>(j) + 0.5) * o.command_span_um / static_cast<double>(o.operators);
+  const double decades = std::log10(o.creep_longest_s / o.creep_shortest_s);
+  base.creep_terms = std::min<std::size_t>(
+      control::kMaxCreepTerms,
+      static_cast<std::size_t>(std::floor(decades * static_cast<double>(o.creep_terms_per_decade))) +
+          1);
+  for (std::size_t m = 0; m < base.creep_terms; ++m)
+    base.creep_time_constant_s[m] =
+        o.creep_shortest_s *
+        std::pow(10.0, static_cast<double>(m) / static_cast<double>(o.creep_terms_per_decade));
+
+  const Eigen::MatrixXd s_all = play_outputs(command_um, base);
+  // Rows kept: not within exclude_after_jump_s of a jump of the command (by the row's own u).
+  std::vector<char> quiet(command_um.size(), 1);
+  {
+    const auto hold = static_cast<std::size_t>(std::ceil(o.exclude_after_jump_s / sample_time_s));
+    std::size_t since = hold;
+    for (std::size_t k = 0; k < command_um.size(); ++k) {
+      if (k > 0 && std::fabs(command_um[k] - command_um[k - 1]) > o.jump_um)
+        since = 0;
+      quiet[k] = since >= hold ? 1 : 0;
+      ++since;
+    }
+  }
+  HysteresisFit best;
+  best.rms_residual_um = std::numeric_limits<double>::infinity();
+  for (std::size_t d = 0; d <= o.max_delay_ticks; ++d) {
+    const auto n = static_cast<Eigen::Index>(command_um.size() - d);
+    const auto di = static_cast<Eigen::Index>(d);
+    Eigen::VectorXd y(n);
+    Eigen::VectorXd u(n);
+    for (Eigen::Index k = 0; k < n; ++k) {
+      y(k) = gauge_um[static_cast<std::size_t>(k + di)];
+      u(k) = command_um[static_cast<std::size_t>(k)];
+    }
+    std::vector<Eigen::Index> rows;
+    for (Eigen::Index k = 0; k < n; ++k)
+      if (quiet[static_cast<std::size_t>(k)] != 0)
+        rows.push_back(k);
+    if (rows.size() < min_rows)
+      throw FitError(fmt::format("hysteresis fit: {} quiet samples, at least {} needed",
+                                 rows.size(), min_rows));
+    std::vector<std::size_t> kept(o.operators);
+    for (std::size_t j = 0; j < o.operators; ++j)
+      kept[j] = j;
+    Solved sol;
+    HysteresisCreepParams p = base;
+    for (int pass = 0; pass < 2; ++pass) {
+      // Pass 0 without creep, pass 1 with the creep regressor run on pass 0's h.
+      Eigen::VectorXd z;
+      if (pass == 1) {
+        Eigen::VectorXd h = p.linear_weight * u;
+        for (std::size_t j = 0; j < o.operators; ++j)
+          h += p.weight[j] * s_all.col(static_cast<Eigen::Index>(j)).head(n);
+        z = creep_regressor(h, p, sample_time_s);
+      }
+      for (;;) {
+        const auto cols = static_cast<Eigen::Index>(2 + kept.size() + (pass == 1 ? 1 : 0));
+        Eigen::MatrixXd X(n, cols);
+        X.col(0).setOnes();
+        X.col(1) = u;
+        for (std::size_t j = 0; j < kept.size(); ++j)
+          X.col(static_cast<Eigen::Index>(2 + j)) =
+              s_all.col(static_cast<Eigen::Index>(kept[j])).head(n);
+        if (pass == 1)
+          X.col(cols - 1) = z;
+        sol = solve(select(X, rows), select(y, rows));
+        std::size_t worst = kept.size();
+        double worst_w = 0.0;
+        for (std::size_t j = 0; j < kept.size(); ++j)
+          if (sol.x(static_cast<Eigen::Index>(2 + j)) < worst_w) {
+            worst_w = sol.x(static_cast<Eigen::Index>(2 + j));
+            worst = j;
+          }
+        if (worst == kept.size())
+          break;
+        kept.erase(kept.begin() + static_cast<std::ptrdiff_t>(worst));
+      }
+      p = base;
+      p.offset_um = sol.x(0);
+      p.linear_weight = sol.x(1);
+      p.weight = {};
+      for (std::size_t j = 0; j < kept.size(); ++j)
+        p.weight[kept[j]] = sol.x(static_cast<Eigen::Index>(2 + j));
+      p.creep_gain = pass == 1 ? sol.x(sol.x.size() - 1) : 0.0;
+    }
+    if (sol.rms < best.rms_residual_um) {
+      best.params = p;
+      best.delay_ticks = d;
+      best.rms_residual_um = sol.rms;
+      best.operators_dropped = o.operators - kept.size();
+      best.samples_fitted = rows.size();
+    }
+  }
+  if (!(best.params.linear_weight > 0.0))
+    throw FitError("hysteresis fit: the gauges do not follow the command (slope <= 0)");
+  return best;
+}
+
+}  // namespace piezoshift::calibration

@@ -1,0 +1,126 @@
+// The improved controller (issue 12), calibrated by its own procedure on the twin and judged
+// through the shipping loop beside the paper's controller calibrated on the same plant: the
+// lambda/8 phase step (1 ms exposures of the true plate) and the 11 um step. Figures in
+// docs/control.md; the issue's targets not met are listed there.
+#include <gtest/gtest.h>
+
+#include "piezoshift/calibration/calibration_file.hpp"
+#include "piezoshift/calibration/improved_calibration.hpp"
+#include "piezoshift/experiments/paper_experiments.hpp"
+#include "piezoshift/experiments/phase_step.hpp"
+#include "piezoshift/io/config_file.hpp"
+#include "piezoshift/runtime/control_cycle.hpp"
+
+namespace piezoshift::calibration {
+namespace {
+
+ImprovedCalibrationOutcome calibrated(const io::ProjectConfig& config, std::uint64_t seed) {
+  ImprovedCalibrationOptions o;
+  o.paper = CalibrationOptions::paper_gains_only();
+  control::SemiClosedLoopParams base;
+  base.sample_time_s = config.twin.daq.sample_time_s;
+  return calibrate_improved(config, base, seed, o);
+}
+
+struct PhaseSteps {
+  experiments::PhaseStepResult paper, improved;
+};
+
+PhaseSteps phase_steps(const io::ProjectConfig& config, const ImprovedCalibrationOutcome& c,
+                       std::uint64_t seed) {
+  const experiments::PhaseStepOptions o;
+  return {experiments::run_phase_step(config, c.static_map.controller, seed + 80, o),
+          experiments::run_phase_step(config, c.controller, seed + 80, o)};
+}
+
+// Default twin, seed 1. Measured: hold jitter 0.26 nm against the paper's 0.53; settling to
+// +-1 nm in 32 ms against 80 ms; the 11 um step within 2 % in 13 ms against 36 ms.
+TEST(ImprovedController, OnTheDefaultTwinItHoldsQuieterAndSettlesFaster) {
+  const io::ProjectConfig config;
+  const ImprovedCalibrationOutcome c = calibrated(config, 1);
+  EXPECT_TRUE(c.shaped);
+  // The piston mode, 1419 Hz, folds to 419 Hz at the interferometer's 1 kHz.
+  EXPECT_NEAR(c.mode_Hz, 419.0, 25.0);
+  for (const HysteresisFit& m : c.model) {
+    EXPECT_EQ(m.delay_ticks, 2U);
+    EXPECT_LT(m.rms_residual_um, 0.012);
+  }
+  const PhaseSteps p = phase_steps(config, c, 1);
+  ASSERT_TRUE(p.improved.validity.valid) << p.improved.validity.reason;
+  EXPECT_LE(p.improved.hold_jitter_nm_rms, 0.3);  // the issue's target
+  EXPECT_LT(p.improved.hold_jitter_nm_rms, 0.6 * p.paper.hold_jitter_nm_rms);
+  EXPECT_LT(p.improved.settling_time_s, 0.6 * p.paper.settling_time_s);
+
+  const experiments::StepExperimentOptions so;
+  const auto paper = experiments::run_step_response(config, c.static_map.controller, 21, so);
+  const auto improved = experiments::run_step_response(config, c.controller, 21, so);
+  ASSERT_TRUE(improved.validity.valid) << improved.validity.reason;
+  EXPECT_LT(improved.metrics.settling_time_pct_s, 0.5 * paper.metrics.settling_time_pct_s);
+}
+
+// The same procedure on plants other than the default (within docs/twin.md's ranges): a stiffer
+// hysteresis with twice the gauge creep; a 0.5 kg payload (the plate's modes move down) on a
+// smaller ball; other stroke spreads with faster creep. On each the calibration finds its own
+// models and mode, and the hold is quieter than the paper's controller's on that plant.
+TEST(ImprovedController, TheSameProcedureWorksOnOtherPlants) {
+  io::ProjectConfig a;
+  a.twin.piezo.hysteresis.hysteresis_fraction = 0.15;
+  a.twin.sgs.gauge_creep_fraction = 0.0004;
+  io::ProjectConfig b;
+  b.twin.plate.payload_mass_kg = 0.5;
+  b.twin.contact.ball_radius_m = 0.004;
+  io::ProjectConfig d;
+  d.twin.piezo.free_stroke_scale = {1.05, 0.95, 1.0};
+  d.twin.piezo.creep.per_decade_fraction = 0.02;
+  double default_mode_Hz = 0.0;
+  int k = 0;
+  for (const io::ProjectConfig* config : {&a, &b, &d}) {
+    SCOPED_TRACE(k++);
+    const ImprovedCalibrationOutcome c = calibrated(*config, 3);
+    if (config == &a) {
+      default_mode_Hz = c.mode_Hz;
+    } else if (config == &b) {
+      // A heavier plate: a lower mode (above 1 kHz), which folds to a lower alias at 1 kHz.
+      EXPECT_LT(c.mode_Hz, default_mode_Hz - 100.0);
+    }
+    const PhaseSteps p = phase_steps(*config, c, 3);
+    ASSERT_TRUE(p.improved.validity.valid) << p.improved.validity.reason;
+    EXPECT_LE(p.improved.hold_jitter_nm_rms, 0.35);
+    EXPECT_LT(p.improved.hold_jitter_nm_rms, 0.7 * p.paper.hold_jitter_nm_rms);
+  }
+}
+
+TEST(ImprovedController, CalibrationFileRoundTripsAndRefusesAnotherRate) {
+  const ImprovedCalibrationOutcome c = calibrated(io::ProjectConfig{}, 2);
+  const std::string text = format_calibration(c.controller, "test");
+  const io::ConfigFile file = io::ConfigFile::parse(text, "cal.toml");
+  control::SemiClosedLoopParams back;
+  read_controller_section(file, back);
+  ASSERT_EQ(back.kind, control::ControllerKind::kImproved);
+  const control::ImprovedParams& x = c.controller.improved;
+  const control::ImprovedParams& y = back.improved;
+  EXPECT_EQ(y.shaper.taps, x.shaper.taps);
+  EXPECT_EQ(y.shaper.weight, x.shaper.weight);
+  EXPECT_EQ(y.correction_ki, x.correction_ki);
+  EXPECT_EQ(y.reference_delay_ticks, x.reference_delay_ticks);
+  for (std::size_t i = 0; i < 3; ++i) {
+    EXPECT_EQ(y.model[i].weight, x.model[i].weight);
+    EXPECT_EQ(y.model[i].creep_gain, x.model[i].creep_gain);
+    EXPECT_EQ(y.model[i].creep_terms, x.model[i].creep_terms);
+  }
+  back.sample_time_s = 1e-4;  // a loop at 10 kHz cannot run taps designed at 1 kHz
+  EXPECT_THROW(runtime::ControlCycle(back, runtime::SafetyLimits{}), std::invalid_argument);
+  // A tap list that does not sum to 1 is refused, naming the key.
+  std::string bad = text;
+  bad.replace(bad.find("shaper_taps = ["), 15, "shaper_taps = [0.5, ");
+  try {
+    const io::ConfigFile f = io::ConfigFile::parse(bad, "bad.toml");
+    read_controller_section(f, back);
+    FAIL() << "accepted";
+  } catch (const io::InputError& e) {
+    EXPECT_NE(std::string(e.what()).find("shaper_taps"), std::string::npos) << e.what();
+  }
+}
+
+}  // namespace
+}  // namespace piezoshift::calibration
