@@ -81,27 +81,33 @@ std::vector<double> inner_loop_sample_times_s(const io::ProjectConfig& config) {
   return rates;
 }
 
+InnerLoopAnalysis analyze_inner_loop_at(const io::ProjectConfig& config,
+                                        const control::SemiClosedLoopParams& controller,
+                                        double sample_time_s, std::uint64_t seed) {
+  io::ProjectConfig at = config;
+  control::SemiClosedLoopParams c = controller;
+  at.twin.daq.sample_time_s = c.sample_time_s = sample_time_s;
+  InnerLoopAnalysis a;
+  a.sample_time_s = c.sample_time_s;
+  a.pid = c.pid_params();
+  try {
+    a.plant = calibration::identify_loop(at, c, seed);
+    a.margins = calibration::pid_margins(a.plant, a.pid);
+  } catch (const std::invalid_argument& e) {  // e.g. a physics rate 10 kHz does not divide
+    a.validity.fail(e.what());
+  } catch (const experiments::ProcedureFailed& e) {
+    a.validity.fail(e.what());
+  }
+  return a;
+}
+
 std::vector<InnerLoopAnalysis> analyze_inner_loop(const io::ProjectConfig& config,
                                                   const control::SemiClosedLoopParams& controller,
                                                   std::uint64_t seed) {
   const std::vector<double> rates = inner_loop_sample_times_s(config);
   std::vector<InnerLoopAnalysis> out;
-  for (std::size_t i = 0; i < rates.size(); ++i) {
-    io::ProjectConfig at = config;
-    control::SemiClosedLoopParams c = controller;
-    at.twin.daq.sample_time_s = c.sample_time_s = rates[i];
-    InnerLoopAnalysis& a = out.emplace_back();
-    a.sample_time_s = c.sample_time_s;
-    a.pid = c.pid_params();
-    try {
-      a.plant = calibration::identify_loop(at, c, seed + 90 + i);
-      a.margins = calibration::pid_margins(a.plant, a.pid);
-    } catch (const std::invalid_argument& e) {  // e.g. a physics rate 10 kHz does not divide
-      a.validity.fail(e.what());
-    } catch (const experiments::ProcedureFailed& e) {
-      a.validity.fail(e.what());
-    }
-  }
+  for (std::size_t i = 0; i < rates.size(); ++i)
+    out.push_back(analyze_inner_loop_at(config, controller, rates[i], seed + 90 + i));
   return out;
 }
 

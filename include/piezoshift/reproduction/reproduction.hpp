@@ -113,6 +113,11 @@ std::vector<double> inner_loop_sample_times_s(const io::ProjectConfig& config);
 std::vector<InnerLoopAnalysis> analyze_inner_loop(const io::ProjectConfig& config,
                                                   const control::SemiClosedLoopParams& controller,
                                                   std::uint64_t seed);
+//! One rate of analyze_inner_loop: the twin's DAQ and the controller's sample time set to
+//! sample_time_s, identified on seed.
+InnerLoopAnalysis analyze_inner_loop_at(const io::ProjectConfig& config,
+                                        const control::SemiClosedLoopParams& controller,
+                                        double sample_time_s, std::uint64_t seed);
 
 //! The paper's controller's set (the base, so result.travel, result.step, ... are it) and the
 //! oracle's.
