@@ -17,6 +17,7 @@ void add_fit_command(CLI::App& app, Action& action);        // fit_command.cpp
 void add_analyze_command(CLI::App& app, Action& action);    // analyze_command.cpp
 void add_run_command(CLI::App& app, Action& action);        // run_command.cpp
 void add_reproduce_command(CLI::App& app, Action& action);  // reproduce_command.cpp
+void add_compare_command(CLI::App& app, Action& action);    // compare_command.cpp
 void add_calibrate_command(CLI::App& app, Action& action);  // calibrate_command.cpp
 void add_serve_command(CLI::App& app, Action& action);      // serve_command.cpp
 void add_gcs_command(CLI::App& app, Action& action);        // gcs_command.cpp

@@ -16,6 +16,7 @@ void build_program(CLI::App& app, Action& action) {
   add_serve_command(app, action);
   add_gcs_command(app, action);
   add_reproduce_command(app, action);
+  add_compare_command(app, action);
   add_psi_command(app, action);
 }
 

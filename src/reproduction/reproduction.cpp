@@ -1,5 +1,6 @@
 #include "piezoshift/reproduction/reproduction.hpp"
 
+#include <algorithm>
 #include <chrono>
 #include <stdexcept>
 
@@ -43,7 +44,9 @@ namespace {
 
 constexpr double kFastSampleTime_s = 1e-4;  // 10 kHz, the second loop rate
 
-void with_feedback(Schedule& s, experiments::Feedback f) {
+}  // namespace
+
+Schedule with_feedback(Schedule s, experiments::Feedback f) {
   s.travel.bench.feedback = f;
   s.step.bench.feedback = f;
   s.linearity.bench.feedback = f;
@@ -52,12 +55,14 @@ void with_feedback(Schedule& s, experiments::Feedback f) {
   s.phase_step.bench.feedback = f;
   s.repeat_5um.bench.feedback = f;
   s.repeat_10um.bench.feedback = f;
+  return s;
 }
 
-void run_set(ExperimentSet& r, const io::ProjectConfig& config,
-             const control::SemiClosedLoopParams& c, std::uint64_t seed, const Schedule& s,
-             const experiments::Progress& progress) {
+ExperimentSet run_experiment_set(const io::ProjectConfig& config,
+                                 const control::SemiClosedLoopParams& c, std::uint64_t seed,
+                                 const Schedule& s, const experiments::Progress& progress) {
   namespace ex = experiments;
+  ExperimentSet r;
   r.travel = ex::run_travel_range(config, c, seed + 10, s.travel, progress);
   r.step = ex::run_step_response(config, c, seed + 20, s.step, progress);
   r.linearity = ex::run_linearity(config, c, seed + 30, s.linearity, progress);
@@ -66,9 +71,57 @@ void run_set(ExperimentSet& r, const io::ProjectConfig& config,
   r.linearity_grid = ex::run_linearity(config, c, seed + 60, s.linearity_grid, progress);
   r.linearity_down = ex::run_linearity(config, c, seed + 70, s.linearity_down, progress);
   r.phase_step = ex::run_phase_step(config, c, seed + 80, s.phase_step, progress);
+  return r;
 }
 
-}  // namespace
+std::vector<double> inner_loop_sample_times_s(const io::ProjectConfig& config) {
+  std::vector<double> rates{config.twin.daq.sample_time_s};
+  if (config.twin.daq.sample_time_s != kFastSampleTime_s)
+    rates.push_back(kFastSampleTime_s);
+  return rates;
+}
+
+InnerLoopAnalysis analyze_inner_loop_at(const io::ProjectConfig& config,
+                                        const control::SemiClosedLoopParams& controller,
+                                        double sample_time_s, std::uint64_t seed) {
+  io::ProjectConfig at = config;
+  control::SemiClosedLoopParams c = controller;
+  at.twin.daq.sample_time_s = c.sample_time_s = sample_time_s;
+  InnerLoopAnalysis a;
+  a.sample_time_s = c.sample_time_s;
+  a.pid = c.pid_params();
+  try {
+    a.plant = calibration::identify_loop(at, c, seed);
+    a.margins = calibration::pid_margins(a.plant, a.pid);
+  } catch (const std::invalid_argument& e) {  // e.g. a physics rate 10 kHz does not divide
+    a.validity.fail(e.what());
+  } catch (const experiments::ProcedureFailed& e) {
+    a.validity.fail(e.what());
+  }
+  return a;
+}
+
+std::vector<InnerLoopAnalysis> analyze_inner_loop(const io::ProjectConfig& config,
+                                                  const control::SemiClosedLoopParams& controller,
+                                                  std::uint64_t seed) {
+  const std::vector<double> rates = inner_loop_sample_times_s(config);
+  std::vector<InnerLoopAnalysis> out;
+  for (std::size_t i = 0; i < rates.size(); ++i)
+    out.push_back(analyze_inner_loop_at(config, controller, rates[i], seed + 90 + i));
+  return out;
+}
+
+calibration::StabilityMargins InnerLoopAnalysis::worst() const {
+  calibration::StabilityMargins w = margins[0];
+  for (const auto& m : margins) {
+    w.gain_margin_dB = std::min(w.gain_margin_dB, m.gain_margin_dB);
+    if (m.phase_margin_deg < w.phase_margin_deg) {
+      w.phase_margin_deg = m.phase_margin_deg;
+      w.gain_crossover_Hz = m.gain_crossover_Hz;
+    }
+  }
+  return w;
+}
 
 double ExperimentSet::experiments_simulated_time_s() const {
   return travel.simulated_time_s + step.simulated_time_s + linearity.simulated_time_s +
@@ -110,36 +163,18 @@ ReproductionResult reproduce(const io::ProjectConfig& config, const ReproduceOpt
   control::SemiClosedLoopParams base{};
   base.sample_time_s = config.twin.daq.sample_time_s;  // the controller runs at the DAQ's rate
   r.calibration = calibration::calibrate(config, base, seed, s.calibration, progress);
-  run_set(r, config, r.calibration.controller, seed, s, progress);
+  static_cast<ExperimentSet&>(r) =
+      run_experiment_set(config, r.calibration.controller, seed, s, progress);
   // Gains and A calibrated, p = identity: the oracle's controller, and the paper's protocol run
   // with it on the gauges shows what p removes.
   r.oracle_controller = r.calibration.controller;
   r.oracle_controller.polynomial = control::CubicPolynomial::identity();
   r.linearity_without_cubic =
       experiments::run_linearity(config, r.oracle_controller, seed + 30, s.linearity, progress);
-  std::vector<double> rates{config.twin.daq.sample_time_s};
-  if (config.twin.daq.sample_time_s != kFastSampleTime_s)
-    rates.push_back(kFastSampleTime_s);
-  for (std::size_t i = 0; i < rates.size(); ++i) {
-    io::ProjectConfig at = config;
-    control::SemiClosedLoopParams c = r.calibration.controller;
-    at.twin.daq.sample_time_s = c.sample_time_s = rates[i];
-    InnerLoopAnalysis& a = r.inner_loop.emplace_back();
-    a.sample_time_s = c.sample_time_s;
-    a.pid = c.pid_params();
-    try {
-      a.plant = calibration::identify_loop(at, c, seed + 90 + i);
-      a.margins = calibration::pid_margins(a.plant, a.pid);
-    } catch (const std::invalid_argument& e) {  // e.g. a physics rate 10 kHz does not divide
-      a.validity.fail(e.what());
-    } catch (const experiments::ProcedureFailed& e) {
-      a.validity.fail(e.what());
-    }
-  }
+  r.inner_loop = analyze_inner_loop(config, r.calibration.controller, seed);
   // The oracle: the same loop, gains and A, fed the plate's truth; nothing left for p to correct.
-  Schedule so = s;
-  with_feedback(so, experiments::Feedback::kOracle);
-  run_set(r.oracle, config, r.oracle_controller, seed, so, progress);
+  r.oracle = run_experiment_set(config, r.oracle_controller, seed,
+                                with_feedback(s, experiments::Feedback::kOracle), progress);
   r.simulated_time_s =
       r.calibration.pid.simulated_time_s + r.calibration.matrix.simulated_time_s +
       r.calibration.polynomial.simulated_time_s + r.experiments_simulated_time_s() +

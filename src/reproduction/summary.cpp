@@ -103,15 +103,8 @@ nlohmann::json summary_json(const ReproductionResult& r) {
       j[at + "reason"] = a.validity.reason;
       continue;
     }
-    double gm = a.margins[0].gain_margin_dB, pm = a.margins[0].phase_margin_deg;
-    double fc = a.margins[0].gain_crossover_Hz;
-    for (const auto& m : a.margins) {
-      gm = std::min(gm, m.gain_margin_dB);
-      if (m.phase_margin_deg < pm) {
-        pm = m.phase_margin_deg;
-        fc = m.gain_crossover_Hz;
-      }
-    }
+    const calibration::StabilityMargins w = a.worst();
+    const double gm = w.gain_margin_dB, pm = w.phase_margin_deg, fc = w.gain_crossover_Hz;
     j[at + "gain_margin_dB"] = std::isfinite(gm) ? nlohmann::json(gm) : nlohmann::json();
     j[at + "phase_margin_deg"] = std::isfinite(pm) ? nlohmann::json(pm) : nlohmann::json();
     j[at + "gain_crossover_Hz"] = std::isfinite(fc) ? nlohmann::json(fc) : nlohmann::json();

@@ -88,7 +88,36 @@ struct InnerLoopAnalysis {
   //! Not valid when the twin cannot run at this rate (its physics rate is not a whole multiple)
   //! or the identification tripped the supervisor; plant and margins are then empty.
   experiments::Validity validity;
+
+  //! The worst of the three channels: the smallest gain margin, the smallest phase margin and
+  //! its gain crossover.
+  calibration::StabilityMargins worst() const;
 };
+
+//! The schedule with every experiment's feedback set to f (the oracle: Feedback::kOracle).
+Schedule with_feedback(Schedule s, experiments::Feedback f);
+
+//! Every experiment of the set with one controller, each on its own seed (the table above:
+//! seed + 10 ... seed + 80). reproduce() and compare() run their controllers through this.
+ExperimentSet run_experiment_set(const io::ProjectConfig& config,
+                                 const control::SemiClosedLoopParams& controller,
+                                 std::uint64_t seed, const Schedule& schedule,
+                                 const experiments::Progress& progress = {});
+
+//! The loop rates the inner loop is analysed at: the DAQ's, and 10 kHz unless that is the DAQ's.
+std::vector<double> inner_loop_sample_times_s(const io::ProjectConfig& config);
+
+//! The controller's inner loop identified at each rate of inner_loop_sample_times_s (seeds
+//! seed + 90, seed + 91), with its PID's margins on it; the controller's gains re-expressed per
+//! sample at each rate. A rate the twin cannot run at is an analysis that is not valid.
+std::vector<InnerLoopAnalysis> analyze_inner_loop(const io::ProjectConfig& config,
+                                                  const control::SemiClosedLoopParams& controller,
+                                                  std::uint64_t seed);
+//! One rate of analyze_inner_loop: the twin's DAQ and the controller's sample time set to
+//! sample_time_s, identified on seed.
+InnerLoopAnalysis analyze_inner_loop_at(const io::ProjectConfig& config,
+                                        const control::SemiClosedLoopParams& controller,
+                                        double sample_time_s, std::uint64_t seed);
 
 //! The paper's controller's set (the base, so result.travel, result.step, ... are it) and the
 //! oracle's.

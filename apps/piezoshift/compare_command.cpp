@@ -1,0 +1,165 @@
+// `piezoshift compare`: the paper's controller, the improved one and the oracle, side by side
+// (issue 12, docs/compare.md).
+#include <algorithm>
+#include <charconv>
+#include <cmath>
+#include <cstdio>
+#include <memory>
+#include <optional>
+#include <string>
+#include <vector>
+
+#include <fmt/core.h>
+
+#include "command.hpp"
+#include "piezoshift/io/project_config.hpp"
+#include "piezoshift/reproduction/comparison.hpp"
+#include "piezoshift/reproduction/comparison_report.hpp"
+#include "piezoshift/runtime/safety_ranges.hpp"
+#include "progress_bar.hpp"
+
+namespace piezoshift::app {
+namespace {
+
+// Each seed is a full calibration and experiment set per controller (about 10 s with the
+// paper's schedule), so a list this long is already a night's run.
+constexpr std::size_t kMaxSeeds = 100;
+
+// "1-8", "3", "1,4,9" or "1-3,7": whole numbers, ranges low to high, no seed twice.
+std::optional<std::vector<std::uint64_t>> parse_seeds(const std::string& text) {
+  std::vector<std::uint64_t> out;
+  const auto number = [](std::string_view s, std::uint64_t& v) {
+    const auto r = std::from_chars(s.data(), s.data() + s.size(), v);
+    return !s.empty() && r.ec == std::errc() && r.ptr == s.data() + s.size();
+  };
+  std::string_view rest = text;
+  while (true) {
+    const std::size_t comma = rest.find(',');
+    const std::string_view item = rest.substr(0, comma);
+    const std::size_t dash = item.find('-');
+    std::uint64_t lo = 0, hi = 0;
+    if (dash == std::string_view::npos) {
+      if (!number(item, lo))
+        return std::nullopt;
+      hi = lo;
+    } else if (!number(item.substr(0, dash), lo) || !number(item.substr(dash + 1), hi) || hi < lo) {
+      return std::nullopt;
+    }
+    if (hi - lo >= kMaxSeeds)
+      return std::nullopt;
+    for (std::uint64_t s = lo; s <= hi; ++s) {
+      if (std::find(out.begin(), out.end(), s) != out.end() || out.size() >= kMaxSeeds)
+        return std::nullopt;
+      out.push_back(s);
+      if (s == hi)  // hi may be the largest uint64
+        break;
+    }
+    if (comma == std::string_view::npos)
+      break;
+    rest.remove_prefix(comma + 1);
+  }
+  return out;
+}
+
+// A median as the terminal shows it: never a number when it is not valid.
+std::string cell(const reproduction::FigureValue& m, const std::string& unit) {
+  if (!m.measured)
+    return "-";
+  if (!m.validity.valid)
+    return "NOT VALID";
+  if (!std::isfinite(m.value))
+    return unit == "s" ? "not settled" : "none";
+  return unit == "s" ? fmt::format("{:.2f} ms", 1e3 * m.value)
+                     : fmt::format("{:.4g} {}", m.value, unit);
+}
+
+struct Options {
+  std::string config;
+  std::string seeds = "1-8";
+  std::string out;
+  bool quick = false;
+  bool json = false;
+};
+
+int run(const Options& o) {
+  const io::ProjectConfig config =
+      o.config.empty() ? io::ProjectConfig{} : runtime::load_installation_config(o.config).project;
+  reproduction::CompareOptions co;
+  co.seeds = *parse_seeds(o.seeds);  // checked by the option's validator
+  co.quick = o.quick;
+  reproduction::ComparisonResult result;
+  {
+    // Per seed: two calibrations (3 stages each), three experiment sets (8 each) and two phase
+    // steps at 10 kHz.
+    ProgressBar bar(static_cast<int>(co.seeds.size()) * (2 * 3 + 3 * 8 + 2));
+    result = reproduction::compare(config, co, bar.callback());
+  }
+  const int status = result.valid() ? 0 : experiments::kExitNotValid;
+  std::string report;
+  if (!o.out.empty()) {
+    const std::string label =
+        o.config.empty() ? "built-in defaults (configs/paper.toml)" : o.config;
+    const reproduction::ReportFiles files =
+        reproduction::write_comparison_report(result, o.out, label);
+    report = fmt::format("report: {}\n        {}\n", files.markdown.string(), files.html.string());
+  }
+  if (o.json) {
+    fmt::print("{}\n", reproduction::comparison_json(result).dump(2));
+  } else {
+    fmt::print("piezoshift compare: {} seed(s), {:.0f} s simulated in {:.1f} s\n", co.seeds.size(),
+               result.simulated_time_s, result.wall_time_s);
+    fmt::print("  {:<48} {:>14} {:>14} {:>14}\n", "median over seeds", "paper", "improved",
+               "oracle");
+    for (std::size_t i = 0; i < result.figures.size(); ++i) {
+      const auto& f = result.figures[i];
+      std::string cells;
+      for (const auto& m : result.medians[i])
+        cells += fmt::format(" {:>14}", cell(m, f.unit));
+      fmt::print("  {:<48}{}\n", f.label, cells);
+    }
+    fmt::print("targets (improved controller's medians):\n");
+    for (const auto& t : result.targets) {
+      const auto& m = t.improved;
+      const std::string value =
+          !m.measured || !m.validity.valid
+              ? cell(m, "")
+              : fmt::format("{} (median {})", t.met ? "met" : "NOT MET", cell(m, t.unit));
+      fmt::print("  {:<54} {:<28} {}\n", t.text, t.bound_text, value);
+    }
+    fmt::print("{}", report);
+  }
+  if (status != 0) {
+    fmt::print(stderr, "piezoshift: compare: not valid (exit status 4):\n");
+    for (const std::string& why : result.invalid_reasons())
+      fmt::print(stderr, "  {}\n", why);
+  }
+  return status;
+}
+
+}  // namespace
+
+void add_compare_command(CLI::App& app, Action& action) {
+  auto o = std::make_shared<Options>();
+  CLI::App* cmd = app.add_subcommand(
+      "compare",
+      "The paper's controller, the improved one and the oracle through the same experiments");
+  cmd->add_option("--config", o->config, "TOML configuration (configs/paper.toml's sections)");
+  cmd->add_option("--seeds", o->seeds, "seeds of the twin: A-B, a comma list, or both (1-3,7)")
+      ->check(CLI::Validator(
+          [](std::string& text) -> std::string {
+            return parse_seeds(text)
+                       ? std::string()
+                       : fmt::format(
+                             "{} is not a list of distinct seeds (e.g. 1-8 or 1,3,5; at "
+                             "most {})",
+                             text, kMaxSeeds);
+          },
+          "SEEDS"));
+  cmd->add_flag("--quick", o->quick, "shortened schedule (tests, a first look)");
+  cmd->add_flag("--json", o->json, "print the JSON summary");
+  cmd->add_option("--out", o->out,
+                  "output folder for comparison.md, comparison.html, figures, CSVs");
+  cmd->callback([o, &action] { action = [o] { return run(*o); }; });
+}
+
+}  // namespace piezoshift::app

@@ -1,0 +1,132 @@
+#pragma once
+// `piezoshift compare` (issue 12): the paper's controller, the improved one and the oracle side by
+// side, each calibrated by its own procedure, through the same experiments and the same seeds.
+// For each seed s:
+//   paper     calibration::calibrate(s) (reproduce()'s), then run_experiment_set(s) and
+//             analyze_inner_loop(s)
+//   improved  calibration::calibrate_improved(s), then the same set and analysis
+//             and the lambda/8 step again at 10 kHz (seed + 85); the improved controller is
+//             calibrated again at 10 kHz for its 10 kHz figures
+//   oracle    the paper's calibrated gains and A with p = identity, fed the plate's true position
+//             (Feedback::kOracle, as reproduce()): impossible on hardware, the floor of any
+//             controller fed by the strain gauges; the same set, no 10 kHz step and no
+//             inner-loop analysis of its own
+// so a figure of the paper's controller on seed s is bit for bit reproduce()'s on seed s.
+//
+// Every figure (travel, the 11 um step, the three linearity sweeps, repeatability at 5 and 10 um,
+// the lambda/8 phase step at the DAQ's rate and at 10 kHz, the PID's margins at each loop rate) is
+// a number per controller and seed, or not valid with its reason (a calibration that failed makes
+// every figure of that controller on that seed not valid). The median over seeds of a figure is not
+// valid when any seed's value is not: a failure is never averaged away.
+//
+// The targets are issue 12's done-when criteria, judged on the improved controller's medians.
+#include <array>
+#include <cstdint>
+#include <functional>
+#include <limits>
+#include <string>
+#include <vector>
+
+#include "piezoshift/reproduction/reproduction.hpp"
+
+namespace piezoshift::reproduction {
+
+struct CompareOptions {
+  std::vector<std::uint64_t> seeds{1, 2, 3, 4, 5, 6, 7, 8};
+  bool quick = false;  //!< Schedule::quick() instead of Schedule::paper()
+};
+
+enum class ControllerKind { kPaper = 0, kImproved = 1, kOracle = 2 };
+inline constexpr std::array<ControllerKind, 3> kControllerKinds{
+    ControllerKind::kPaper, ControllerKind::kImproved, ControllerKind::kOracle};
+//! "paper", "improved", "oracle": the JSON prefixes (without the underscore).
+const char* controller_key(ControllerKind k);
+//! How the report names it.
+const char* controller_label(ControllerKind k);
+
+//! One controller on one seed.
+struct ControllerRun {
+  control::SemiClosedLoopParams controller;
+  //! Not valid when its calibration failed (experiments::ProcedureFailed, or calibration::FitError
+  //! on the twin's records); nothing ran then.
+  experiments::Validity calibration;
+  ExperimentSet set;
+  std::vector<InnerLoopAnalysis> inner_loop;  //!< empty for the oracle
+  //! The lambda/8 step again with the loop at 10 kHz (seed + 85): the twin's DAQ at 0.1 ms; the
+  //! paper's gains re-expressed per sample (as analyze_inner_loop does), the improved controller
+  //! calibrated again at 10 kHz by its own procedure (same seeds), which also gives its 10 kHz
+  //! inner-loop analysis. Not valid when the twin cannot run at that rate. Not run for the oracle
+  //! (ran_10kHz false): at 10 kHz its plate feedback trips the supervisor's sgs-jump rule in the
+  //! approach (docs/compare.md).
+  experiments::PhaseStepResult phase_step_10kHz;
+  bool ran_10kHz = false;
+  double simulated_time_s = 0.0;  //!< its calibration and experiments
+};
+
+struct SeedComparison {
+  std::uint64_t seed = 0;
+  std::array<ControllerRun, 3> runs;  //!< indexed by ControllerKind
+  const ControllerRun& operator[](ControllerKind k) const {
+    return runs[static_cast<std::size_t>(k)];
+  }
+};
+
+//! One figure of one run: a number (infinite for a time that never came: not settled), or not
+//! valid with its reason, or not measured for that controller (the oracle's margins).
+struct FigureValue {
+  double value = std::numeric_limits<double>::quiet_NaN();
+  experiments::Validity validity;
+  bool measured = true;
+};
+
+struct FigureSpec {
+  std::string key;    //!< JSON key after the prefix, unit last: "step_settling_time_10nm_s"
+  std::string label;  //!< the report's row
+  std::string unit;   //!< shown after the number: "s", "nm", "%", "um", "dB", "deg"
+  std::function<FigureValue(const ControllerRun&)> of;
+};
+
+//! The figures compare reports, in the report's order (the margins at the config's loop rates).
+std::vector<FigureSpec> comparison_figures(const io::ProjectConfig& config);
+
+//! The median over seeds of one figure for one controller (the mean of the middle two for an even
+//! count). Not valid when a seed's value is not: the reason names the first such seed.
+FigureValue median_over_seeds(const std::vector<FigureValue>& per_seed,
+                              const std::vector<std::uint64_t>& seeds);
+
+//! One of issue 12's done-when criteria on the improved controller's median.
+struct Target {
+  std::string text;  //!< e.g. "11 um step settles to +-10 nm"
+  std::string key;   //!< the figure
+  std::string unit;  //!< the figure's
+  std::string bound_text;
+  FigureValue improved;   //!< its median (not measured: compare cannot judge it)
+  double bound = 0.0;     //!< the limit, absolute or oracle_factor x the oracle's median
+  bool at_least = false;  //!< >= bound (travel, margins), else <= bound
+  bool met = false;
+};
+
+struct ComparisonResult {
+  CompareOptions options;
+  Schedule schedule;
+  std::vector<FigureSpec> figures;
+  std::vector<SeedComparison> seeds;
+  //! [figure][controller]: the median over seeds.
+  std::vector<std::array<FigureValue, 3>> medians;
+  std::vector<Target> targets;
+  double simulated_time_s = 0.0;
+  double wall_time_s = 0.0;
+
+  //! The per-seed values of one figure of one controller.
+  std::vector<FigureValue> per_seed(std::size_t figure, ControllerKind k) const;
+  //! Every measured median of every controller valid.
+  bool valid() const;
+  //! "controller: figure: reason" for every median that is not valid.
+  std::vector<std::string> invalid_reasons() const;
+};
+
+//! Throws std::invalid_argument on an empty seed list.
+ComparisonResult compare(const io::ProjectConfig& config, const CompareOptions& options,
+                         const experiments::Progress& progress = {});
+
+}  // namespace piezoshift::reproduction

@@ -1,0 +1,32 @@
+#pragma once
+// The outputs of `piezoshift compare` (comparison.hpp):
+//   comparison_json()   the medians, keys prefixed paper_, improved_, oracle_ with the unit last
+//                       (null: a time that never came, or a figure not valid; the reason is in
+//                       <prefix>not_valid), the targets, and per_seed: one object per seed
+//                       with the same prefixed keys
+//   write_comparison_report(dir)
+//     comparison.md, comparison.html   the three columns, the targets, the figures
+//     compare_step_response.png        the 11 um steps overlaid (first seed)
+//     compare_phase_step.png           the lambda/8 steps' 1 ms exposure means (first seed)
+//     compare_linearity_error.png      zero-end deviations of the paper's protocol and the grid
+//     compare_repeatability.png        histograms at 5 and 10 um, one per controller
+//     per_seed_<controller>.csv        one row per seed, one column per figure (nan: not valid)
+//     comparison.json                  comparison_json()
+// Throws io::InputError when the folder cannot be written and io::PlotError when gnuplot fails.
+#include <filesystem>
+#include <string>
+
+#include <nlohmann/json.hpp>
+
+#include "piezoshift/reproduction/comparison.hpp"
+#include "piezoshift/reproduction/report.hpp"
+
+namespace piezoshift::reproduction {
+
+nlohmann::json comparison_json(const ComparisonResult& r);
+
+//! config_label says where the configuration came from (a path, or the built-in defaults).
+ReportFiles write_comparison_report(const ComparisonResult& r, const std::filesystem::path& dir,
+                                    const std::string& config_label);
+
+}  // namespace piezoshift::reproduction

@@ -1,0 +1,24 @@
+#pragma once
+// A report as a list of blocks rendered twice, as Markdown and as HTML, so both say the same
+// (`reproduce`'s report.md / report.html, `compare`'s comparison.md / comparison.html).
+#include <filesystem>
+#include <string>
+#include <vector>
+
+namespace piezoshift::reproduction {
+
+struct Block {
+  enum Kind { kHeading, kParagraph, kTable, kImage, kCode } kind;
+  int level = 0;
+  std::string text;                            //!< heading, paragraph, code, image caption
+  std::vector<std::vector<std::string>> rows;  //!< table: first row is the header
+  std::string path;                            //!< image, relative to the document
+};
+
+std::string to_markdown(const std::vector<Block>& blocks);
+//! A standalone page; text is escaped.
+std::string to_html(const std::vector<Block>& blocks, const std::string& title);
+//! Throws io::InputError naming the path when it cannot be written.
+void write_text(const std::filesystem::path& path, const std::string& text);
+
+}  // namespace piezoshift::reproduction

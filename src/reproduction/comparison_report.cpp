@@ -1,0 +1,333 @@
+#include "piezoshift/reproduction/comparison_report.hpp"
+
+#include <cmath>
+#include <system_error>
+
+#include <fmt/core.h>
+
+#include "piezoshift/experiments/metrics_figures.hpp"
+#include "piezoshift/io/csv_writer.hpp"
+#include "piezoshift/io/input_error.hpp"
+#include "piezoshift/io/plot.hpp"
+#include "piezoshift/reproduction/document.hpp"
+
+namespace piezoshift::reproduction {
+namespace {
+
+namespace fs = std::filesystem;
+
+std::size_t idx(ControllerKind k) {
+  return static_cast<std::size_t>(k);
+}
+
+// JSON has no infinity and no "not valid": both are null, the reason beside it.
+nlohmann::json number_or_null(const FigureValue& f) {
+  return f.validity.valid && std::isfinite(f.value) ? nlohmann::json(f.value) : nlohmann::json();
+}
+
+// Prefixed keys of one controller's figures; values(i) is figure i's value.
+template <class Values>
+void prefixed(nlohmann::json& j, const ComparisonResult& r, ControllerKind k, Values values) {
+  const std::string prefix = std::string(controller_key(k)) + "_";
+  nlohmann::json not_valid = nlohmann::json::object();
+  for (std::size_t i = 0; i < r.figures.size(); ++i) {
+    const FigureValue f = values(i);
+    if (!f.measured)
+      continue;
+    j[prefix + r.figures[i].key] = number_or_null(f);
+    if (!f.validity.valid)
+      not_valid[r.figures[i].key] = f.validity.reason;
+  }
+  j[prefix + "not_valid"] = not_valid;
+}
+
+std::string value_text(const FigureValue& f, const std::string& unit) {
+  if (!f.measured)
+    return "-";
+  if (!f.validity.valid)
+    return "NOT VALID: " + f.validity.reason;
+  if (std::isinf(f.value))
+    return unit == "s" ? "not settled" : "none";
+  if (unit == "s")
+    return fmt::format("{:.2f} ms", 1e3 * f.value);
+  return fmt::format("{:.4g} {}", f.value, unit);
+}
+
+const char* const kColour[3] = {"#d62728", "#1f77b4", "#2ca02c"};  // paper, improved, oracle
+
+// The 11 um steps as the interferometer saw them, and a zoom on the last 50 nm around the
+// target with the +-10 nm band.
+io::Figure step_figure(const SeedComparison& sc) {
+  io::Figure f;
+  f.title = fmt::format("11 um step, seed {} (twin, interferometer dynamic mode)", sc.seed);
+  f.rows = 2;
+  f.width_px = 900;
+  f.height_px = 750;
+  io::Panel all, zoom;
+  all.x_label = zoom.x_label = "time from the step [s]";
+  all.y_label = "mean of P1..P3 [um]";
+  zoom.y_label = "error from the target [nm]";
+  all.key = "bottom right";
+  zoom.y_range = std::pair{-50.0, 50.0};
+  double t0 = 0.0, t1 = 0.0;
+  for (ControllerKind k : kControllerKinds) {
+    const ControllerRun& run = sc[k];
+    const auto& st = run.set.step;
+    if (!run.calibration.valid || st.time_s.empty())
+      continue;
+    t0 = std::min(t0, st.time_s.front());
+    t1 = std::max(t1, st.time_s.back());
+    std::vector<double> err_nm;
+    for (std::size_t n = 0; n < st.measured_um.size(); ++n)
+      err_nm.push_back(1e3 * (st.measured_um[n] - st.desired_um.back()));
+    all.series.push_back(
+        io::line_series(controller_key(k), st.time_s, st.measured_um, kColour[idx(k)]));
+    zoom.series.push_back(io::line_series(controller_key(k), st.time_s, err_nm, kColour[idx(k)]));
+  }
+  zoom.series.insert(zoom.series.begin(), io::band_series("+-10 nm", t0, t1, -10.0, 10.0));
+  f.panels = {std::move(all), std::move(zoom)};
+  return f;
+}
+
+io::Figure phase_step_figure(const SeedComparison& sc, double tolerance_nm) {
+  io::Figure f;
+  f.title = fmt::format("lambda/8 step, seed {} (true plate, 1 ms exposure means)", sc.seed);
+  f.width_px = 900;
+  f.height_px = 500;
+  io::Panel p;
+  p.x_label = "time from the step command [s]";
+  p.y_label = "exposure mean - level before [nm]";
+  p.key = "bottom right";
+  bool band = false;
+  for (ControllerKind k : kControllerKinds) {
+    const ControllerRun& run = sc[k];
+    const auto& ps = run.set.phase_step;
+    if (!run.calibration.valid || ps.time_s.empty())
+      continue;
+    if (!band) {
+      p.series.push_back(io::band_series(fmt::format("+-{:g} nm", tolerance_nm), ps.time_s.front(),
+                                         ps.time_s.back(), ps.step_nm - tolerance_nm,
+                                         ps.step_nm + tolerance_nm));
+      band = true;
+    }
+    p.series.push_back(
+        io::line_series(controller_key(k), ps.time_s, ps.exposure_mean_nm, kColour[idx(k)]));
+  }
+  f.panels.push_back(std::move(p));
+  return f;
+}
+
+// Zero-end deviations of the paper's protocol and of the unseen grid.
+io::Figure linearity_error_figure(const SeedComparison& sc) {
+  io::Figure f;
+  f.title = fmt::format("Linearity error (zero-end line), seed {}", sc.seed);
+  f.cols = 2;
+  f.width_px = 1100;
+  f.height_px = 500;
+  io::Panel a, b;
+  a.title = "the paper's protocol (1 um levels)";
+  b.title = "unseen 0.25 um grid";
+  a.x_label = b.x_label = "desired [um]";
+  a.y_label = b.y_label = "deviation from the zero-end line [nm]";
+  for (ControllerKind k : kControllerKinds) {
+    const ControllerRun& run = sc[k];
+    if (!run.calibration.valid)
+      continue;
+    for (auto [panel, lin] :
+         {std::pair{&a, &run.set.linearity}, std::pair{&b, &run.set.linearity_grid}}) {
+      std::vector<double> nm;
+      for (double d : lin->metrics.deviation_zero_end_um)
+        nm.push_back(1e3 * d);
+      if (nm.size() != lin->desired_um.size() || nm.empty())
+        continue;
+      panel->series.push_back(
+          io::line_series(controller_key(k), lin->desired_um, nm, kColour[idx(k)]));
+    }
+  }
+  f.panels = {std::move(a), std::move(b)};
+  return f;
+}
+
+io::Figure repeatability_figure(const SeedComparison& sc) {
+  std::vector<experiments::RepeatabilitySet> sets;
+  for (ControllerKind k : kControllerKinds) {
+    const ControllerRun& run = sc[k];
+    if (!run.calibration.valid)
+      continue;
+    sets.push_back({fmt::format("{}, 5 um", controller_key(k)), run.set.repeat_5um.measured_um});
+    sets.push_back({fmt::format("{}, 10 um", controller_key(k)), run.set.repeat_10um.measured_um});
+  }
+  io::Figure f = experiments::repeatability_figure(
+      sets, 1.0, fmt::format("Repeatability, seed {} (interferometer)", sc.seed));
+  // Two rows (5 and 10 um), one column per controller.
+  f.cols = static_cast<int>(sets.size() + 1) / 2;
+  f.rows = 2;
+  std::vector<io::Panel> reordered;
+  for (std::size_t r = 0; r < 2; ++r)
+    for (std::size_t c = r; c < f.panels.size(); c += 2)
+      reordered.push_back(f.panels[c]);
+  f.panels = std::move(reordered);
+  f.width_px = 400 * f.cols;
+  f.height_px = 700;
+  return f;
+}
+
+}  // namespace
+
+nlohmann::json comparison_json(const ComparisonResult& r) {
+  nlohmann::json j;
+  j["seeds"] = r.options.seeds;
+  j["schedule"] = r.options.quick ? "quick" : "paper";
+  for (ControllerKind k : kControllerKinds)
+    prefixed(j, r, k, [&](std::size_t i) { return r.medians[i][idx(k)]; });
+  nlohmann::json per = nlohmann::json::array();
+  for (std::size_t s = 0; s < r.seeds.size(); ++s) {
+    nlohmann::json o;
+    o["seed"] = r.seeds[s].seed;
+    for (ControllerKind k : kControllerKinds)
+      prefixed(o, r, k, [&](std::size_t i) { return r.figures[i].of(r.seeds[s][k]); });
+    per.push_back(std::move(o));
+  }
+  j["per_seed"] = std::move(per);
+  nlohmann::json targets = nlohmann::json::array();
+  for (const Target& t : r.targets) {
+    nlohmann::json x{{"target", t.text}, {"bound", t.bound_text}};
+    x["key"] = "improved_" + t.key;
+    x["improved"] = number_or_null(t.improved);
+    x["measured"] = t.improved.measured;
+    if (!t.improved.validity.valid)
+      x["not_valid"] = t.improved.validity.reason;
+    x["met"] = t.met;
+    targets.push_back(std::move(x));
+  }
+  j["targets"] = std::move(targets);
+  j["valid"] = r.valid();
+  j["invalid_reasons"] = r.invalid_reasons();
+  j["simulated_time_s"] = r.simulated_time_s;
+  j["wall_time_s"] = r.wall_time_s;
+  return j;
+}
+
+ReportFiles write_comparison_report(const ComparisonResult& r, const fs::path& dir,
+                                    const std::string& config_label) {
+  std::error_code ec;
+  fs::create_directories(dir, ec);
+  if (ec)
+    throw io::InputError(
+        fmt::format("{}: cannot create the folder: {}", dir.string(), ec.message()));
+  ReportFiles files;
+
+  // One CSV per controller: a row per seed, a column per figure it measures.
+  for (ControllerKind k : kControllerKinds) {
+    std::vector<std::size_t> cols;
+    std::vector<std::string> names{"seed"};
+    for (std::size_t i = 0; i < r.figures.size(); ++i) {
+      if (r.figures[i].of(r.seeds.front()[k]).measured) {
+        cols.push_back(i);
+        names.push_back(r.figures[i].key);
+      }
+    }
+    const fs::path path = dir / fmt::format("per_seed_{}.csv", controller_key(k));
+    io::CsvWriter w(path.string(), names, 9);
+    for (const SeedComparison& sc : r.seeds) {
+      std::vector<double> row{static_cast<double>(sc.seed)};
+      for (std::size_t i : cols) {
+        const FigureValue f = r.figures[i].of(sc[k]);
+        row.push_back(f.validity.valid ? f.value : std::numeric_limits<double>::quiet_NaN());
+      }
+      w.row(row);
+    }
+    w.close();
+    files.data.push_back(path);
+  }
+  write_text(dir / "comparison.json", comparison_json(r).dump(2) + "\n");
+  files.data.push_back(dir / "comparison.json");
+
+  const SeedComparison& first = r.seeds.front();
+  const io::Figure figs[] = {step_figure(first),
+                             phase_step_figure(first, r.schedule.phase_step.tolerance_nm),
+                             linearity_error_figure(first), repeatability_figure(first)};
+  const char* const stems[] = {"compare_step_response", "compare_phase_step",
+                               "compare_linearity_error", "compare_repeatability"};
+  for (std::size_t i = 0; i < 4; ++i)
+    files.figures.push_back(*io::render(figs[i], dir / stems[i]).png);
+
+  std::vector<Block> doc;
+  auto h = [&](int level, std::string t) {
+    doc.push_back({Block::kHeading, level, std::move(t), {}, {}});
+  };
+  auto p = [&](std::string t) { doc.push_back({Block::kParagraph, 0, std::move(t), {}, {}}); };
+  auto table = [&](std::vector<std::vector<std::string>> rows) {
+    doc.push_back({Block::kTable, 0, {}, std::move(rows), {}});
+  };
+  auto image = [&](std::string caption, std::string path) {
+    doc.push_back({Block::kImage, 0, std::move(caption), {}, std::move(path)});
+  };
+  std::string seeds;
+  for (const std::uint64_t s : r.options.seeds)
+    seeds += (seeds.empty() ? "" : ", ") + std::to_string(s);
+
+  h(1, "The paper's controller, the improved one and the oracle, side by side");
+  p(fmt::format(
+      "Each controller calibrated by its own procedure on the digital twin, then the same "
+      "experiments through the loop that ships, on the same seeds: {}. {} schedule, "
+      "configuration: {}. {:.0f} s of simulated time in {:.1f} s of wall time. Every number is "
+      "the median over the seeds; a figure that is not valid on one seed is not valid here.",
+      seeds, r.options.quick ? "Quick (shortened)" : "The paper's full", config_label,
+      r.simulated_time_s, r.wall_time_s));
+  h(2, "Medians over the seeds");
+  std::vector<std::vector<std::string>> rows{{"figure", "paper's controller", "improved controller",
+                                              "oracle (plate feedback: impossible on hardware)"}};
+  for (std::size_t i = 0; i < r.figures.size(); ++i) {
+    std::vector<std::string> row{r.figures[i].label};
+    for (ControllerKind k : kControllerKinds)
+      row.push_back(value_text(r.medians[i][idx(k)], r.figures[i].unit));
+    rows.push_back(std::move(row));
+  }
+  table(std::move(rows));
+  p("The oracle is the paper's loop with its calibrated gains and A, fed the plate's true point "
+    "displacements instead of the strain gauges (so with no cubic to correct): the floor no "
+    "controller fed by the gauges can beat. It has no margins of its own (the paper's PID).");
+
+  h(2, "Issue 12's targets, on the improved controller's medians");
+  std::vector<std::vector<std::string>> trows{{"target", "bound", "improved (median)", "met"}};
+  for (const Target& t : r.targets) {
+    trows.push_back(
+        {t.text, t.bound_text,
+         t.improved.measured ? value_text(t.improved, t.unit) : "not measured by compare",
+         !t.improved.measured ? "-"
+         : t.met              ? "yes"
+                              : "no"});
+  }
+  table(std::move(trows));
+
+  h(2, fmt::format("Figures (seed {})", first.seed));
+  image("The 11 um step of the three controllers", "compare_step_response.png");
+  image("The lambda/8 phase step on 1 ms exposure means", "compare_phase_step.png");
+  image("Linearity error curves", "compare_linearity_error.png");
+  image("Repeatability histograms at 5 and 10 um", "compare_repeatability.png");
+
+  h(2, "Per seed");
+  std::vector<std::vector<std::string>> srows{{"seed", "figure", "paper", "improved", "oracle"}};
+  for (const SeedComparison& sc : r.seeds) {
+    for (const FigureSpec& f : r.figures) {
+      std::vector<std::string> row{std::to_string(sc.seed), f.label};
+      for (ControllerKind k : kControllerKinds)
+        row.push_back(value_text(f.of(sc[k]), f.unit));
+      srows.push_back(std::move(row));
+    }
+  }
+  table(std::move(srows));
+  std::string list;
+  for (const auto& f : files.data)
+    list += f.filename().string() + "  ";
+  p("Data beside this report (CSV: one row per seed, nan where not valid): " + list);
+
+  files.markdown = dir / "comparison.md";
+  files.html = dir / "comparison.html";
+  write_text(files.markdown, to_markdown(doc));
+  write_text(files.html, to_html(doc, "piezoshift compare"));
+  return files;
+}
+
+}  // namespace piezoshift::reproduction
