@@ -50,6 +50,9 @@ class StandInLoop {
           case HostCommand::Kind::kOpenLoop:
             s.ao_V = c.ao_V;
             break;
+          case HostCommand::Kind::kActuators:  // the guided calibration's, never the server's
+          case HostCommand::Kind::kConfigure:
+            break;
           case HostCommand::Kind::kWave: {
             const auto bit = static_cast<std::uint8_t>(1u << c.wave.generator);
             if (c.wave.action == runtime::WaveCommand::Action::kStart) {

@@ -6,19 +6,24 @@
 #include <filesystem>
 #include <iostream>
 #include <memory>
+#include <optional>
 #include <string>
 
 #include <fmt/core.h>
 #include <nlohmann/json.hpp>
 
 #include "command.hpp"
+#include "loop_setup.hpp"
 #include "piezoshift/calibration/calibration_file.hpp"
 #include "piezoshift/calibration/calibration_procedure.hpp"
 #include "piezoshift/calibration/guided_calibration.hpp"
 #include "piezoshift/calibration/improved_calibration.hpp"
+#include "piezoshift/calibration/loop_rig.hpp"
 #include "piezoshift/experiments/paper_experiments.hpp"
 #include "piezoshift/io/input_error.hpp"
 #include "piezoshift/io/project_config.hpp"
+#include "piezoshift/runtime/loop_clock.hpp"
+#include "piezoshift/runtime/paced_clock.hpp"
 #include "piezoshift/runtime/safety_ranges.hpp"
 #include "progress_bar.hpp"
 #include "whole_number.hpp"
@@ -35,6 +40,7 @@ struct Options {
   bool json = false;
   std::string daq;             //!< guided: sim or comedi[:DEVICE]
   std::string interferometer;  //!< guided: prompt, file:PATH or sim
+  bool free_run = false;       //!< guided, sim-rt: the loop paced by the procedure
   bool restart = false;
   double max_zero_drift_um = calibration::GuidedOptions{}.max_zero_drift_um;
 };
@@ -71,25 +77,34 @@ int run_guided(const Options& o) {
         "--pid search: the guided calibration keeps the paper's gains (the search scores the "
         "plate's motion between the ticks, which a bench does not see)");
   const bool sim = o.daq == "sim";
-  if (!sim && o.daq.rfind("comedi", 0) == 0)
+  const bool sim_rt = o.daq == "sim-rt";
+  const bool comedi = o.daq == "comedi" || o.daq.rfind("comedi:", 0) == 0;
+  if (!sim && !sim_rt && !comedi)
+    throw io::InputError(
+        fmt::format("--daq {}: expected sim, sim-rt or comedi:/dev/comediN", o.daq));
+  if (o.free_run && !sim_rt)
     throw io::InputError(fmt::format(
-        "--daq {}: the guided calibration on hardware is not built yet (only --daq sim); see "
-        "docs/calibration.md",
-        o.daq));
-  if (!sim)
-    throw io::InputError(fmt::format("--daq {}: expected sim or comedi:/dev/comediN", o.daq));
+        "--free-run needs --daq sim-rt (--daq {} {})", o.daq,
+        sim ? "runs on a simulated clock already" : "runs in real time: it is hardware"));
   const std::string& ifm = o.interferometer;
   if (ifm.empty())
     throw io::InputError("--daq needs --interferometer prompt, file:PATH or sim");
   if (ifm != "prompt" && ifm != "sim" && !(ifm.rfind("file:", 0) == 0 && ifm.size() > 5))
     throw io::InputError(
         fmt::format("--interferometer {}: expected prompt, file:PATH or sim", ifm));
+  if (comedi && ifm == "sim")
+    throw io::InputError(
+        fmt::format("--interferometer sim: the twin's interferometer does not see the stage on "
+                    "--daq {}; give prompt or file:PATH",
+                    o.daq));
   if (!(o.max_zero_drift_um > 0.0))
     throw io::InputError(
         fmt::format("--max-zero-drift-um {}: must be a positive length", o.max_zero_drift_um));
 
-  const io::ProjectConfig config =
-      o.config.empty() ? io::ProjectConfig{} : io::load_project_config(o.config);
+  const runtime::InstallationConfig installation =
+      o.config.empty() ? runtime::InstallationConfig{}
+                       : runtime::load_installation_config(o.config);
+  const io::ProjectConfig& config = installation.project;
   calibration::GuidedOptions go;
   go.max_zero_drift_um = o.max_zero_drift_um;
   const std::vector<calibration::GuidedStep> plan = calibration::guided_plan(go);
@@ -116,13 +131,6 @@ int run_guided(const Options& o) {
   control::SemiClosedLoopParams base;
   base.sample_time_s = config.twin.daq.sample_time_s;
   base.gains_sample_time_s = base.sample_time_s;
-  // Stage 2 on seed + 1, stage 3 on seed + 2, as `calibrate` on the twin.
-  experiments::Bench bench2(config, base, o.seed + 1);
-  experiments::Bench bench3(config, base, o.seed + 2);
-  const double window_s = config.twin.interferometer.static_average_s;
-  calibration::BenchRig rig2(bench2, window_s);
-  calibration::BenchRig rig3(bench3, window_s, &rig2);
-
   const auto say = [](const std::string& text) {
     fmt::print(stderr, "{}", text);
     std::fflush(stderr);
@@ -140,8 +148,58 @@ int run_guided(const Options& o) {
                             }};
   // Written before the stage moves: a folder that cannot take the session is found now.
   calibration::save_guided_session(session_file, session);
+  // The rigs: on --daq sim, the twin on a simulated clock (stage 2 on seed + 1, stage 3 on
+  // seed + 2, as `calibrate` on the twin); otherwise one rig on the real-time loop in a thread of
+  // its own, for both stages.
+  std::optional<StopSignals> signals;  // outlives the loop: Ctrl-C during its ramp is harmless
+  std::unique_ptr<experiments::Bench> bench2, bench3;
+  std::unique_ptr<calibration::BenchRig> bench_rig2, bench_rig3;
+  std::unique_ptr<runtime::DaqBackend> daq;
+  std::unique_ptr<runtime::LoopClock> clock;
+  std::unique_ptr<calibration::LoopRig> loop_rig;
+  calibration::GuidedRig* rig2 = nullptr;
+  calibration::GuidedRig* rig3 = nullptr;
+  const double window_s = config.twin.interferometer.static_average_s;
+  if (sim) {
+    bench2 = std::make_unique<experiments::Bench>(config, base, o.seed + 1);
+    bench3 = std::make_unique<experiments::Bench>(config, base, o.seed + 2);
+    bench_rig2 = std::make_unique<calibration::BenchRig>(*bench2, window_s);
+    bench_rig3 = std::make_unique<calibration::BenchRig>(*bench3, window_s, bench_rig2.get());
+    rig2 = bench_rig2.get();
+    rig3 = bench_rig3.get();
+  } else {
+    const double rate_Hz = 1.0 / base.sample_time_s;
+    check_loop_rate(rate_Hz);
+    ChosenBackend chosen =
+        make_backend(sim_rt ? "sim" : o.daq, config, o.seed + 1, rate_Hz, o.config);
+    daq = std::move(chosen.backend);
+    daq->configure();  // comedi: names the device it cannot open, or says it is not built in
+    runtime::PacedClock* paced = nullptr;
+    if (o.free_run) {
+      auto c = std::make_unique<runtime::PacedClock>();
+      paced = c.get();
+      clock = std::move(c);
+    } else {
+      clock = std::make_unique<runtime::MonotonicClock>();
+    }
+    calibration::LoopRigOptions lo;
+    lo.rate_Hz = rate_Hz;
+    lo.window_s = window_s;
+    // An interferometer log is stamped by the wall clock: real-time windows are in Unix time.
+    lo.unix_time = clock->real_time();
+    signals.emplace();  // Ctrl-C ramps the stage to 0 V instead of leaving it driven
+    lo.stop_signal = &g_stop_signal;
+    loop_rig = std::make_unique<calibration::LoopRig>(
+        *daq, *clock, paced, base, loop_safety_limits(installation.safety, std::nullopt), lo);
+    for (const std::string& refusal : loop_rig->realtime().refusals)
+      fmt::print(stderr, "piezoshift: warning: the loop runs without real-time treatment: {}\n",
+                 refusal);
+    rig2 = loop_rig.get();
+    rig3 = loop_rig.get();
+  }
+
   const calibration::GuidedOutcome r =
-      calibration::run_guided_calibration(rig2, rig3, base, session, gio, go);
+      calibration::run_guided_calibration(*rig2, *rig3, base, session, gio, go);
   if (!r.complete)
     throw io::InputError(fmt::format(
         "{} ended: {} of {} steps are recorded in {}; run the same command again to resume",
@@ -325,12 +383,16 @@ void add_calibrate_command(CLI::App& app, Action& action) {
                   "improved controller's models (docs/control.md)")
       ->check(CLI::IsMember({"paper", "improved"}));
   cmd->add_flag("--json", o->json, "print a JSON summary");
-  cmd->add_option(
-      "--daq", o->daq,
-      "guided calibration on a bench: sim (the twin; comedi:/dev/comediN is not built yet)");
+  cmd->add_option("--daq", o->daq,
+                  "guided calibration on a bench: comedi:/dev/comediN (hardware, through the "
+                  "real-time loop), sim (the twin, simulated clock) or sim-rt (the twin through "
+                  "the real-time loop)");
   cmd->add_option("--interferometer", o->interferometer,
                   "guided: prompt (readings typed on stdin), file:PATH (the interferometer "
-                  "software's CSV log, t_s,displacement_um) or sim (the twin's, --daq sim)");
+                  "software's CSV log, t_s,displacement_um) or sim (the twin's; not on comedi)");
+  cmd->add_flag("--free-run", o->free_run,
+                "guided, --daq sim-rt: the loop runs as fast as the CPU allows, paced by the "
+                "procedure (deterministic), instead of in real time");
   cmd->add_flag("--restart", o->restart,
                 "guided: discard the session recorded beside --out instead of resuming it");
   cmd->add_option("--max-zero-drift-um", o->max_zero_drift_um,

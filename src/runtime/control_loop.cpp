@@ -137,16 +137,28 @@ LoopResult ControlLoop::run() noexcept {
         case HostCommand::Kind::kWave:
           wave.apply(cmd.wave, host_zd);
           break;
+        case HostCommand::Kind::kActuators:
+          cycle_.drive(DriveMode::kActuators, cmd.zd_um);
+          break;
+        case HostCommand::Kind::kConfigure: {
+          control::SemiClosedLoopParams p{};
+          if (host->params.try_pop(p)) {
+            // The loop's period, so that configure() cannot refuse it.
+            p.sample_time_s = params_.sample_time_s;
+            cycle_.configure(p);
+          }
+          break;
+        }
       }
     }
     if (host == nullptr) {
       cycle_.drive(DriveMode::kPoints, profile_.at(static_cast<double>(ct.since_start_ns) * 1e-9));
     } else {
-      // The host's set-point plus its running wave generators (stopped while open loop or
-      // faulted).
-      const bool closed = cycle_.mode() != DriveMode::kOpenLoop;
-      const Vec3 zd = wave.next(host_zd, closed && !supervisor.faulted());
-      if (closed)
+      // The host's set-point plus its running wave generators (stopped unless the servo is on
+      // Z_d and no fault is latched).
+      const bool points = cycle_.mode() == DriveMode::kPoints;
+      const Vec3 zd = wave.next(host_zd, points && !supervisor.faulted());
+      if (points)
         cycle_.drive(DriveMode::kPoints, zd);
     }
 
@@ -154,7 +166,7 @@ LoopResult ControlLoop::run() noexcept {
     const SupervisorOutput& s = cs.supervisor;
     const control::ControllerOutput& c = cs.controller;
     const bool closed_loop = cs.mode != DriveMode::kOpenLoop;
-    const Vec3 zd = closed_loop ? cs.setpoint : Vec3{};
+    const Vec3 zd = cs.mode == DriveMode::kPoints ? cs.setpoint : Vec3{};  // S is no Z_d
     if (supervisor.faulted() && !result.fault_detected) {
       result.fault_detected = true;
       result.fault = supervisor.fault();
@@ -239,6 +251,8 @@ LoopResult ControlLoop::run() noexcept {
       h.wake_latency_us = static_cast<double>(wake - deadline) * 1e-3;
       h.overrun = previous_overran ? 1 : 0;
       h.closed_loop = closed_loop && !supervisor.faulted() ? 1 : 0;
+      h.actuators = cs.mode == DriveMode::kActuators ? 1 : 0;
+      h.saturated_mask = closed_loop ? c.saturated_mask : 0;
       h.state = static_cast<std::uint8_t>(s.state);
       h.fault_reason = static_cast<std::uint8_t>(supervisor.fault().reason);
       h.fault_channel = static_cast<std::int8_t>(supervisor.fault().channel);

@@ -128,6 +128,74 @@ TEST(HostMode, ServoOffHoldsTheAppliedVolts) {
     EXPECT_NEAR(after.ao_V[i], before.ao_V[i], 1e-3) << i;
 }
 
+TEST(HostMode, ActuatorTargetsHoldTheSgsOnSAndAreNoZd) {
+  // The guided calibration's stage 2 (calibration/loop_rig.hpp): the PIDs alone on S.
+  const Vec3 s_um{2.0, 9.0, 2.0};
+  const HostRun r = run_host({command(HostCommand::Kind::kActuators, 1, s_um)}, 0.3);
+  EXPECT_FALSE(r.result.fault_detected) << to_string(r.result.fault.reason);
+  const HostSample& h = r.samples.at(299);
+  EXPECT_EQ(h.closed_loop, 1);
+  EXPECT_EQ(h.actuators, 1);
+  EXPECT_EQ(h.zd_um, Vec3{});  // S is not a Z_d
+  EXPECT_EQ(h.target_um, s_um);
+  for (std::size_t i = 0; i < 3; ++i)
+    EXPECT_NEAR(h.sgs_V[i] * 1.6, s_um[i], 0.005) << i;  // FakeBackend: sgs_V = x / 1.6 um/V
+}
+
+TEST(HostMode, NewParametersAreAppliedBetweenTwoTicksBumplessly) {
+  // On S = 5 um, then a controller with a matrix A that doubles the targets and other gains: the
+  // output does not jump at the switch (the PIDs restart from the command held), the inner loops
+  // stay on S, and the new controller asks S = A Z_d = 4 um for Z_d = 2 um.
+  HostLink* link = nullptr;
+  control::SemiClosedLoopParams p{};
+  p.matrix.a = {{{2.0, 0.0, 0.0}, {0.0, 2.0, 0.0}, {0.0, 0.0, 2.0}}};
+  p.polynomial = control::CubicPolynomial::identity();
+  p.gains.kp = 0.3;
+  FakeBackend daq;
+  daq.configure();
+  daq.activate();
+  SimulatedClock clock;
+  HostLink l;
+  link = &l;
+  ASSERT_TRUE(
+      link->commands.try_push(command(HostCommand::Kind::kActuators, 1, control::filled(5.0))));
+  LoopConfig cfg;
+  cfg.rate_Hz = 1000.0;
+  cfg.duration_s = 0.6;
+  cfg.host = link;
+  ControlLoop loop(cfg, control::SemiClosedLoopParams{}, SafetyLimits{}, daq, clock,
+                   SetpointProfile::step(0.0));
+  struct Switch {
+    HostLink* link;
+    control::SemiClosedLoopParams params;
+  } sw{link, p};
+  daq.on_tick = [](void* c) {
+    auto* s = static_cast<Switch*>(c);
+    s->link->params.try_push(s->params);
+    s->link->commands.try_push(command(HostCommand::Kind::kConfigure, 2));
+  };
+  daq.on_tick_context = &sw;
+  daq.on_tick_at = 299;
+  const LoopResult result = loop.run();
+  EXPECT_FALSE(result.fault_detected) << to_string(result.fault.reason);
+  std::vector<HostSample> samples;
+  for (HostSample h{}; link->samples.try_pop(h);)
+    samples.push_back(h);
+  const HostSample& before = samples.at(299);
+  const HostSample& at = samples.at(300);
+  EXPECT_EQ(before.applied_sequence, 1u);
+  EXPECT_EQ(at.applied_sequence, 2u);
+  for (std::size_t i = 0; i < 3; ++i)
+    EXPECT_NEAR(at.ao_V[i], before.ao_V[i], 1e-3) << i;
+  EXPECT_EQ(loop.controller().params().gains.kp, 0.3);
+  EXPECT_NEAR(loop.controller().params().sample_time_s, 1e-3, 1e-15);  // the loop's, kept
+  EXPECT_EQ(loop.controller().actuator_targets(control::filled(2.0)), control::filled(4.0));
+  const HostSample& end = samples.at(599);
+  EXPECT_EQ(end.actuators, 1);
+  for (std::size_t i = 0; i < 3; ++i)
+    EXPECT_NEAR(end.sgs_V[i] * 1.6, 5.0, 0.005) << i;
+}
+
 HostCommand wave_start(std::uint64_t sequence, const double* values, std::uint32_t length,
                        std::uint32_t rate, std::uint32_t cycles, double reference) {
   HostCommand c;

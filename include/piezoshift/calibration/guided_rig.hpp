@@ -2,9 +2,10 @@
 // The stage as the guided calibration (guided_calibration.hpp) drives it: poses held by the one
 // control tick (runtime/control_cycle.hpp), settling, and one averaging window of the strain
 // gauges per reading. BenchRig is the twin through experiments::Bench (simulated clock, `--daq
-// sim`); a rig for hardware (runtime::ControlLoop in its own real-time thread, the operator's
-// prompt in the main one) is not built yet. A window's times are on the rig's clock, which is
-// what an interferometer log file is matched against.
+// sim`); LoopRig (loop_rig.hpp) is runtime::ControlLoop in its own real-time thread, the
+// operator's prompt in the main one (`--daq comedi:/dev/comediN`, and the twin as `--daq
+// sim-rt`). A window's times are on the rig's clock, which is what an interferometer log file is
+// matched against.
 #include <optional>
 #include <string>
 

@@ -19,8 +19,10 @@
 //     done when the supervisor has stopped, or has faulted and the outputs are at 0 V
 //     D_{k+1} = D_k + T; if E_k > D_{k+1}: skip to the first slot after E_k (counted)
 //
-// Host mode (LoopConfig::host set, `piezoshift serve`): the loop starts with the servo off and the
-// outputs at 0 V, and takes its set-points from the host's commands instead of the profile.
+// Host mode (LoopConfig::host set, `piezoshift serve`, the guided calibration's LoopRig): the
+// loop starts with the servo off and the outputs at 0 V, and takes its set-points (Z_d, actuator
+// targets S or open-loop volts) and parameter changes from the host's commands instead of the
+// profile.
 //
 // run() is real-time safe: everything it touches is allocated by the constructor; the telemetry
 // and host pushes are lock-free ring writes that drop (and count) on a full ring.

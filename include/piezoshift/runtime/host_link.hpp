@@ -16,10 +16,16 @@
 //   kOpenLoop    servo off: the DAQ outputs := ao_V (through the safety supervisor's limits)
 //   kWave        starts or stops one wave generator (wave_generator.hpp); it plays into Z_d while
 //                the servo is on and no fault is latched, and stops otherwise
+//   kActuators   the PIDs alone on the SGS targets S := zd_um (calibration stage 2, the guided
+//                calibration's LoopRig); bumpless from open loop; kServoOn returns to Z_d
+//   kConfigure   pops the next parameter set from `params` and makes it the controller's, with
+//                the loop's own sample time, bumplessly (ControlCycle::configure): the one safe
+//                point to change parameters is between two ticks, in the loop's thread
 // Every sample carries the sequence number of the last command applied, so the host knows when
 // its command has reached the loop.
 #include <cstdint>
 
+#include "piezoshift/control/semi_closed_loop.hpp"
 #include "piezoshift/control/vec3.hpp"
 #include "piezoshift/runtime/spsc_ring.hpp"
 #include "piezoshift/runtime/wave_generator.hpp"
@@ -29,10 +35,18 @@ namespace piezoshift::runtime {
 using control::Vec3;
 
 struct HostCommand {
-  enum class Kind : std::uint8_t { kMoveTo, kServoOn, kServoOff, kOpenLoop, kWave };
+  enum class Kind : std::uint8_t {
+    kMoveTo,
+    kServoOn,
+    kServoOff,
+    kOpenLoop,
+    kWave,
+    kActuators,
+    kConfigure
+  };
   Kind kind = Kind::kMoveTo;
   std::uint64_t sequence = 0;  //!< set by the host, increasing
-  Vec3 zd_um{};                //!< kMoveTo, kServoOn: Z_d of P1..P3
+  Vec3 zd_um{};                //!< kMoveTo, kServoOn: Z_d of P1..P3; kActuators: S
   Vec3 ao_V{};                 //!< kOpenLoop: DAQ volts per channel
   WaveCommand wave{};          //!< kWave
 };
@@ -50,6 +64,8 @@ struct HostSample {
   double wake_latency_us = 0.0;        //!< wake-up - deadline of this tick
   std::uint8_t overrun = 0;            //!< this tick's work ended after the next deadline
   std::uint8_t closed_loop = 0;        //!< servo on
+  std::uint8_t actuators = 0;          //!< closed loop on S alone (kActuators)
+  std::uint8_t saturated_mask = 0;     //!< bit i: PID i at its output limit (closed loop)
   std::uint8_t has_truth = 0;          //!< the backend is the twin
   std::uint8_t state = 0;              //!< SupervisorState as a number
   std::uint8_t fault_reason = 0;       //!< FaultReason as a number (0 = none)
@@ -65,6 +81,8 @@ struct HostLink {
   static constexpr int kMaxCommandsPerTick = 8;
 
   SpscRing<HostCommand> commands{kCommandCapacity};
+  //! kConfigure's parameter sets, pushed before their command (a few are ever in flight).
+  SpscRing<control::SemiClosedLoopParams> params{4};
   SpscRing<HostSample> samples{kSampleCapacity};
 };
 
