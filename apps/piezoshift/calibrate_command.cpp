@@ -20,6 +20,7 @@
 #include "piezoshift/calibration/improved_calibration.hpp"
 #include "piezoshift/calibration/loop_rig.hpp"
 #include "piezoshift/experiments/paper_experiments.hpp"
+#include "piezoshift/io/csv_writer.hpp"
 #include "piezoshift/io/input_error.hpp"
 #include "piezoshift/io/project_config.hpp"
 #include "piezoshift/runtime/loop_clock.hpp"
@@ -211,11 +212,36 @@ int run_guided(const Options& o) {
                   "with the interferometer from {}\nseed {}, configuration: {}, session: {}",
                   o.daq, ifm, o.seed, o.config.empty() ? "built-in defaults" : o.config,
                   session_file));
+  // The data of the two fits, in the formats `fit matrix|poly --data` read (docs/files.md), so
+  // that A and p can be fitted again from them (or from a part of them).
+  const std::filesystem::path folder = std::filesystem::path(o.out).parent_path();
+  const std::string poses_file = (folder / "matrix_poses.csv").string();
+  const std::string points_file = (folder / "polynomial_points.csv").string();
+  {
+    io::CsvWriter w(poses_file, {"s1_um", "s2_um", "s3_um", "z1_um", "z2_um", "z3_um"}, 9);
+    w.comment(fmt::format("guided calibration stage 2: poses (dS, dZ), session {}", session_file));
+    for (std::size_t k = 0; k < r.matrix.ds_um.size(); ++k) {
+      const control::Vec3& ds = r.matrix.ds_um[k];
+      const control::Vec3& dz = r.matrix.dz_um[k];
+      w.row({ds[0], ds[1], ds[2], dz[0], dz[1], dz[2]});
+    }
+    w.close();
+  }
+  {
+    io::CsvWriter w(points_file, {"command_um", "measured_um"}, 9);
+    w.comment(
+        fmt::format("guided calibration stage 3: commands and readings, session {}", session_file));
+    for (std::size_t k = 0; k < r.polynomial.command_um.size(); ++k)
+      w.row({r.polynomial.command_um[k], r.polynomial.measured_um[k]});
+    w.close();
+  }
   const auto& p = r.controller.polynomial;
   if (o.json) {
     nlohmann::json j;
     j["calibration_file"] = o.out;
     j["session_file"] = session_file;
+    j["matrix_poses_file"] = poses_file;
+    j["polynomial_points_file"] = points_file;
     j["readings_taken"] = r.taken;
     j["steps"] = plan.size();
     const auto& g = r.controller.gains;
@@ -230,7 +256,7 @@ int run_guided(const Options& o) {
     return 0;
   }
   print_fits(r.controller, r.matrix, r.polynomial);
-  fmt::print("written: {} (session: {})\n", o.out, session_file);
+  fmt::print("written: {}, {}, {} (session: {})\n", o.out, poses_file, points_file, session_file);
   return 0;
 }
 

@@ -35,6 +35,15 @@ Fit fit_of(const std::string& json) {
   return f;
 }
 
+// `fit poly`'s JSON: p only (A left at 0).
+Fit fit_of_p(const std::string& json) {
+  const auto j = nlohmann::json::parse(json);
+  Fit f;
+  for (int i = 0; i < 4; ++i)
+    f.p[i] = j.at("p").at(i).get<double>();
+  return f;
+}
+
 double max_difference(const Fit& x, const Fit& y) {
   double d = 0.0;
   for (int r = 0; r < 3; ++r)
@@ -92,6 +101,18 @@ TEST_F(LoopRigCli, TheLoopRigGivesTheTwinCalibrationsAAndP) {
   }
   for (int i = 0; i < 3; ++i)
     EXPECT_NEAR(session_.at("readings").at(0).at("sgs_um").at(i).get<double>(), 2.0, 0.01);
+  // The fits' data beside the calibration file: `fit` gets the same A and p from it.
+  const CliResult m = run("fit matrix --json --data '" + path("loop/matrix_poses.csv") + "'");
+  ASSERT_EQ(m.status, 0) << m.err;
+  const CliResult p = run("fit poly --json --data '" + path("loop/polynomial_points.csv") + "'");
+  ASSERT_EQ(p.status, 0) << p.err;
+  EXPECT_EQ(nlohmann::json::parse(m.out).at("poses").get<int>(), 9);
+  Fit refit = fit_of_p(p.out);
+  const auto a = nlohmann::json::parse(m.out).at("A");
+  for (int r = 0; r < 3; ++r)
+    for (int c = 0; c < 3; ++c)
+      refit.a[r][c] = a.at(r).at(c).get<double>();
+  EXPECT_LT(max_difference(refit, loop_fit_), 1e-7);
 }
 
 TEST_F(LoopRigCli, PromptedAndLoggedReadingsThroughTheLoopGiveTheSameNumbers) {

@@ -7,7 +7,7 @@
 //   LogFileSource   read from the CSV the interferometer software writes, columns t_s (on the
 //                   rig's clock) and displacement_um: the mean of the rows inside the window
 //                   (docs/files.md); the log must already reach past the window's end
-//   TwinSource      the twin's own interferometer (`--daq sim` only)
+//   TwinSource      the twin's own interferometer (`--daq sim`, `--daq sim-rt`)
 // read() returns nothing when the source has ended (the operator closed the input): the session
 // so far is recorded and a later run resumes it.
 #include <cstddef>
