@@ -201,6 +201,9 @@ int run_guided(const Options& o) {
 
   const calibration::GuidedOutcome r =
       calibration::run_guided_calibration(*rig2, *rig3, base, session, gio, go);
+  std::optional<runtime::LoopResult> loop_result;
+  if (loop_rig)
+    loop_result = loop_rig->stop();  // the stage at rest at 0 V before anything is written
   if (!r.complete)
     throw io::InputError(fmt::format(
         "{} ended: {} of {} steps are recorded in {}; run the same command again to resume",
@@ -252,10 +255,21 @@ int run_guided(const Options& o) {
     j["condition_number"] = r.matrix.fit.condition_number;
     j["p_rms_residual_um"] = r.polynomial.fit.rms_residual_um;
     j["p_skipped_commands"] = r.polynomial.saturated_points;
+    if (loop_rig) {
+      const runtime::LoopStats& st = loop_rig->loop_stats();
+      j["loop"] = {{"ticks", loop_result->ticks},
+                   {"overruns", st.overruns},
+                   {"max_consecutive_overruns", st.max_consecutive_overruns},
+                   {"skipped_slots", st.skipped_slots},
+                   {"host_samples_dropped", loop_result->host_samples_dropped}};
+    }
     fmt::print("{}\n", j.dump(2));
     return 0;
   }
   print_fits(r.controller, r.matrix, r.polynomial);
+  if (loop_rig)
+    fmt::print("loop     {} ticks, {} overruns (at most {} in a row)\n", loop_result->ticks,
+               loop_rig->loop_stats().overruns, loop_rig->loop_stats().max_consecutive_overruns);
   fmt::print("written: {}, {}, {} (session: {})\n", o.out, poses_file, points_file, session_file);
   return 0;
 }

@@ -212,9 +212,16 @@ void LoopRig::rest(double settle_s) {
 }
 
 RigWindow LoopRig::measure() {
+  // Samples waiting in the ring may be old ones (a ring that overflowed keeps its oldest): after
+  // them, the loop's present tick. A paced loop leaves none.
   runtime::HostSample h;
-  while (link_.samples.try_pop(h))
+  bool waiting = false;
+  while (link_.samples.try_pop(h)) {
     take(h);
+    waiting = true;
+  }
+  if (waiting)
+    catch_up();
   window_ticks_ = std::max<std::uint64_t>(1, ticks_of(options_.window_s));
   window_n_ = 0;
   window_sgs_V_ = Vec3{};

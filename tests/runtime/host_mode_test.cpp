@@ -284,9 +284,12 @@ TEST(HostMode, CommandsAndSamplesMakeNoHeapAllocation) {
       command(HostCommand::Kind::kServoOn, 1),
       command(HostCommand::Kind::kMoveTo, 2, Vec3{3, 4, 5}),
       command(HostCommand::Kind::kServoOff, 3),
-      command(HostCommand::Kind::kOpenLoop, 4, {}, Vec3{2, 2, 2})};
+      command(HostCommand::Kind::kOpenLoop, 4, {}, Vec3{2, 2, 2}),
+      command(HostCommand::Kind::kActuators, 5, Vec3{1, 1, 1}),
+      command(HostCommand::Kind::kConfigure, 6)};
   for (const HostCommand& c : commands)
     ASSERT_TRUE(link.commands.try_push(c));
+  ASSERT_TRUE(link.params.try_push(control::SemiClosedLoopParams{}));
   LoopConfig cfg;
   cfg.rate_Hz = 10'000.0;
   cfg.duration_s = 0.6;  // 6000 ticks: more than the sample ring holds
@@ -296,7 +299,7 @@ TEST(HostMode, CommandsAndSamplesMakeNoHeapAllocation) {
   testing::AllocationCounter counter;
   const LoopResult r = loop.run();
   EXPECT_EQ(counter.stop(), 0);
-  EXPECT_EQ(r.host_commands_applied, 4u);
+  EXPECT_EQ(r.host_commands_applied, 6u);
   EXPECT_EQ(r.host_samples_dropped, r.ticks - HostLink::kSampleCapacity)
       << "a full ring drops, never blocks";
 }

@@ -76,6 +76,8 @@ class LoopRig final : public GuidedRig {
   //! Stops the loop through its ramp to 0 V, waits for it and returns its result (once; the
   //! destructor does it when this was not called).
   runtime::LoopResult stop();
+  //! The loop's timing statistics (complete after stop()).
+  const runtime::LoopStats& loop_stats() const { return loop_->stats(); }
   //! Seconds on the rig's clock of the last tick seen.
   double clock_s() const;
 
