@@ -62,7 +62,7 @@ struct BasicImprovedParams {
   std::size_t reference_delay_ticks = 2;  //!< D, from command to the gauges' response
   //! The command range kept in reserve at each end, as a fraction of the range: the governor
   //! holds the target within what the model reaches inside it.
-  T headroom_fraction = T(0.005);
+  T headroom_fraction = T(0.001);
 };
 
 using ImprovedParams = BasicImprovedParams<double>;

@@ -83,7 +83,7 @@ struct SafetyLimits {
   //! hysteresis included (docs/safety.md); a stack that does not answer its drive gives ~0.
   double response_gain_min = 0.4;
   double response_gain_max = 1.3;   //!< highest plausible (Eq. 1's 0.91 plus margin)
-  double response_band_um = 0.5;    //!< absolute band around the window
+  double response_band_um = 0.8;    //!< absolute band around the window
   double response_time_s = 0.02;    //!< must persist this long (slewing and ringing settle)
   double saturation_time_s = 0.05;  //!< output pinned at output_max_V this long
 
