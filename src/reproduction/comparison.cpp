@@ -320,6 +320,10 @@ ComparisonResult compare(const io::ProjectConfig& config, const CompareOptions& 
       control::SemiClosedLoopParams fast = run.controller;
       io::ProjectConfig at = config;
       at.twin.daq.sample_time_s = fast.sample_time_s = kFastSampleTime_s;
+      // The interferometer's dynamic mode at the loop's rate (an XL-80 samples up to 50 kHz),
+      // so the improved calibration sees the plate's mode below its Nyquist frequency.
+      at.twin.interferometer.dynamic_sample_rate_Hz =
+          std::max(at.twin.interferometer.dynamic_sample_rate_Hz, 1.0 / kFastSampleTime_s);
       if (k == ControllerKind::kImproved && config.twin.daq.sample_time_s != kFastSampleTime_s) {
         try {
           control::SemiClosedLoopParams fast_base = base;

@@ -2,6 +2,9 @@
 
 #include <algorithm>
 #include <chrono>
+#include <cmath>
+
+#include <fmt/core.h>
 #include <stdexcept>
 
 namespace piezoshift::reproduction {
@@ -91,8 +94,34 @@ InnerLoopAnalysis analyze_inner_loop_at(const io::ProjectConfig& config,
   a.sample_time_s = c.sample_time_s;
   a.pid = c.pid_params();
   try {
-    a.plant = calibration::identify_loop(at, c, seed);
-    a.margins = calibration::pid_margins(a.plant, a.pid);
+    if (c.kind == control::ControllerKind::kImproved) {
+      // The plant is identified through the PIDs (they hold the operating point, then the loop
+      // is opened); the improved controller's loop is its correction through the model's inverse,
+      // judged at the hold's gain and at the boost's ceiling, the worse of the two kept.
+      const control::ImprovedParams& im = c.improved;
+      if (std::fabs(im.sample_time_s - sample_time_s) > 1e-9 * sample_time_s)
+        throw std::invalid_argument(
+            fmt::format("the improved controller was calibrated at {} s, not {} s",
+                        im.sample_time_s, sample_time_s));
+      control::SemiClosedLoopParams through_pids = c;
+      through_pids.kind = control::ControllerKind::kPaper;
+      a.plant = calibration::identify_loop(at, through_pids, seed);
+      a.pid = control::PidParams{};
+      a.pid.gains = {0.0, im.correction_ki, 0.0};
+      a.margins = calibration::correction_margins(a.plant, im, im.correction_ki);
+      const auto boosted = calibration::correction_margins(a.plant, im, im.correction_ki_max);
+      for (std::size_t i = 0; i < 3; ++i) {
+        a.margins[i].gain_margin_dB =
+            std::min(a.margins[i].gain_margin_dB, boosted[i].gain_margin_dB);
+        if (boosted[i].phase_margin_deg < a.margins[i].phase_margin_deg) {
+          a.margins[i].phase_margin_deg = boosted[i].phase_margin_deg;
+          a.margins[i].gain_crossover_Hz = boosted[i].gain_crossover_Hz;
+        }
+      }
+    } else {
+      a.plant = calibration::identify_loop(at, c, seed);
+      a.margins = calibration::pid_margins(a.plant, a.pid);
+    }
   } catch (const std::invalid_argument& e) {  // e.g. a physics rate 10 kHz does not divide
     a.validity.fail(e.what());
   } catch (const experiments::ProcedureFailed& e) {

@@ -82,7 +82,10 @@ struct ExperimentSet {
 //! The inner loop's identified plant at one sample time and the calibrated PID's margins on it.
 struct InnerLoopAnalysis {
   double sample_time_s = 0.0;
-  control::PidParams pid;  //!< the calibrated PID's, per-sample gains at sample_time_s
+  //! The calibrated PID's, per-sample gains at sample_time_s; for the improved controller its
+  //! correction's integral gain (the margins are then the worse of the hold's gain and the
+  //! boost's ceiling, calibration::correction_margins).
+  control::PidParams pid;
   calibration::LoopIdentification plant;
   std::array<calibration::StabilityMargins, 3> margins{};
   //! Not valid when the twin cannot run at this rate (its physics rate is not a whole multiple)
