@@ -210,11 +210,7 @@ nlohmann::json comparison_json(const ComparisonResult& r) {
 
 ReportFiles write_comparison_report(const ComparisonResult& r, const fs::path& dir,
                                     const std::string& config_label) {
-  std::error_code ec;
-  fs::create_directories(dir, ec);
-  if (ec)
-    throw io::InputError(
-        fmt::format("{}: cannot create the folder: {}", dir.string(), ec.message()));
+  create_report_folder(dir);
   ReportFiles files;
 
   // One CSV per controller: a row per seed, a column per figure it measures.

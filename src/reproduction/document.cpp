@@ -1,6 +1,7 @@
 #include "piezoshift/reproduction/document.hpp"
 
 #include <fstream>
+#include <system_error>
 
 #include <fmt/core.h>
 
@@ -114,6 +115,14 @@ void write_text(const std::filesystem::path& path, const std::string& text) {
   f.close();
   if (!f)
     throw io::InputError(fmt::format("{}: cannot write", path.string()));
+}
+
+void create_report_folder(const std::filesystem::path& dir) {
+  std::error_code ec;
+  std::filesystem::create_directories(dir, ec);
+  if (ec)
+    throw io::InputError(
+        fmt::format("{}: cannot create the folder: {}", dir.string(), ec.message()));
 }
 
 }  // namespace piezoshift::reproduction

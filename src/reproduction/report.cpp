@@ -223,11 +223,7 @@ void write_data(const ReproductionResult& r, const fs::path& dir, ReportFiles& f
 
 ReportFiles write_report(const ReproductionResult& r, const fs::path& dir,
                          const std::string& config_label) {
-  std::error_code ec;
-  fs::create_directories(dir, ec);
-  if (ec)
-    throw io::InputError(
-        fmt::format("{}: cannot create the folder: {}", dir.string(), ec.message()));
+  create_report_folder(dir);
   ReportFiles files;
   write_data(r, dir, files);
 

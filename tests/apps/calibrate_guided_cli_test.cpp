@@ -11,37 +11,16 @@
 #include <gtest/gtest.h>
 #include <nlohmann/json.hpp>
 
+#include "../support/calibration_fit.hpp"
 #include "../support/cli_test.hpp"
 
 namespace {
 
 using piezoshift::testing::CliResult;
 
-struct Fit {
-  double a[3][3]{};
-  double p[4]{};
-};
-
-Fit fit_of(const std::string& json) {
-  const auto j = nlohmann::json::parse(json);
-  Fit f;
-  for (int r = 0; r < 3; ++r)
-    for (int c = 0; c < 3; ++c)
-      f.a[r][c] = j.at("A").at(r).at(c).get<double>();
-  for (int i = 0; i < 4; ++i)
-    f.p[i] = j.at("p").at(i).get<double>();
-  return f;
-}
-
-double max_difference(const Fit& x, const Fit& y) {
-  double d = 0.0;
-  for (int r = 0; r < 3; ++r)
-    for (int c = 0; c < 3; ++c)
-      d = std::max(d, std::fabs(x.a[r][c] - y.a[r][c]));
-  for (int i = 0; i < 4; ++i)
-    d = std::max(d, std::fabs(x.p[i] - y.p[i]));
-  return d;
-}
+using piezoshift::testing::Fit;
+using piezoshift::testing::fit_of;
+using piezoshift::testing::max_difference;
 
 class GuidedCalibrateCli : public piezoshift::testing::CliTest {
  protected:

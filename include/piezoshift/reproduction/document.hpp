@@ -20,5 +20,7 @@ std::string to_markdown(const std::vector<Block>& blocks);
 std::string to_html(const std::vector<Block>& blocks, const std::string& title);
 //! Throws io::InputError naming the path when it cannot be written.
 void write_text(const std::filesystem::path& path, const std::string& text);
+//! Creates dir and its parents; throws io::InputError naming it when that fails.
+void create_report_folder(const std::filesystem::path& dir);
 
 }  // namespace piezoshift::reproduction
