@@ -181,7 +181,7 @@ TEST(SafetySupervisor, TrackingErrorMustPersist100Ticks) {
 TEST(SafetySupervisor, StackNotAnsweringItsDriveMustPersist20Ticks) {
   // A dead amplifier: 5 V out, the SGS stays at 0, the controller's target is at 0 too (so the
   // tracking rule is quiet). The check at tick k uses the output of tick k-1: 1.5 V at tick 1 is
-  // u = 2.4 um, whose window starts at 0.4 * 2.4 - 0.5 = 0.46 um > 0, so counting starts at tick 1
+  // u = 2.4 um, whose window starts at 0.4 * 2.4 - 0.8 = 0.16 um > 0, so counting starts at tick 1
   // and trips at tick 20.
   SafetySupervisor s = make();
   SupervisorInput in = steady(0, 0.0);
@@ -193,7 +193,7 @@ TEST(SafetySupervisor, StackNotAnsweringItsDriveMustPersist20Ticks) {
   }
   EXPECT_EQ(s.fault().reason, FaultReason::kResponse);
   EXPECT_EQ(s.fault().channel, 0);
-  EXPECT_NEAR(s.fault().limit, 0.4 * 8.0 - 0.5, 1e-12);  // u = 5 V / 0.625 V/um
+  EXPECT_NEAR(s.fault().limit, 0.4 * 8.0 - 0.8, 1e-12);  // u = 5 V / 0.625 V/um, b = 0.8 um
 }
 
 TEST(SafetySupervisor, ResponseWindowSpansHysteresis) {
@@ -211,7 +211,7 @@ TEST(SafetySupervisor, ResponseWindowSpansHysteresis) {
     EXPECT_EQ(s.faulted(), gain > 1.3) << gain;
     if (s.faulted()) {
       EXPECT_EQ(s.fault().reason, FaultReason::kResponse);
-      EXPECT_NEAR(s.fault().limit, 1.3 * 9.6 + 0.5, 1e-9);
+      EXPECT_NEAR(s.fault().limit, 1.3 * 9.6 + 0.8, 1e-9);
     }
   }
 }
