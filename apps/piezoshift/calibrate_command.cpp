@@ -13,6 +13,7 @@
 #include <nlohmann/json.hpp>
 
 #include "command.hpp"
+#include "improved_summary.hpp"
 #include "loop_setup.hpp"
 #include "piezoshift/calibration/calibration_file.hpp"
 #include "piezoshift/calibration/calibration_procedure.hpp"
@@ -292,7 +293,6 @@ int run_improved(const Options& o, const io::ProjectConfig& config) {
     throw experiments::ProcedureFailed(
         fmt::format("calibration: the improved loop has no semi-closed-loop travel: {}",
                     travel.validity.reason));
-  const control::ImprovedParams& im = ic.controller.improved;
   calibration::write_calibration_file(
       o.out, ic.controller,
       fmt::format("piezoshift calibration of the improved controller, identified on the digital "
@@ -300,44 +300,32 @@ int run_improved(const Options& o, const io::ProjectConfig& config) {
                   "{}",
                   o.seed, o.config.empty() ? "built-in defaults" : o.config),
       travel.single_move_um, travel.single_move_min_um);
+  // The records stages 4 and 5 fitted, in the formats `fit improved` reads (docs/files.md).
+  const std::filesystem::path folder = std::filesystem::path(o.out).parent_path();
+  const std::string excitation_file = (folder / "excitation.csv").string();
+  const std::string mode_file = (folder / "mode_step.csv").string();
+  write_improved_records(ic, excitation_file, mode_file);
+  const ImprovedSummary summary{ic.controller.improved, ic.model, ic.mode, ic.shaped};
   if (o.json) {
-    nlohmann::json j;
+    nlohmann::json j = improved_json(summary);
     j["calibration_file"] = o.out;
     j["controller"] = "improved";
     j["A"] = matrix_json(ic.controller.matrix.a);
     const auto& p = ic.controller.polynomial;
     j["p"] = {p.p3, p.p2, p.p1, p.p0};
-    nlohmann::json models = nlohmann::json::array();
-    for (const auto& m : ic.model)
-      models.push_back({{"rms_residual_um", m.rms_residual_um},
-                        {"delay_ticks", m.delay_ticks},
-                        {"linear_weight", m.params.linear_weight},
-                        {"creep_gain", m.params.creep_gain}});
-    j["models"] = models;
-    j["mode_Hz"] = ic.mode_Hz;
-    j["mode_sample_rate_Hz"] = ic.mode_sample_rate_Hz;
-    j["shaped"] = ic.shaped;
-    j["shaper_taps"] =
-        std::vector<double>(im.shaper.weight.begin(),
-                            im.shaper.weight.begin() + static_cast<std::ptrdiff_t>(im.shaper.taps));
-    j["shaper_rate_um_per_s"] = im.shaper.rate_um_per_s;
-    j["correction_ki"] = im.correction_ki;
     j["travel_z_max_um"] = travel.single_move_um;
     j["travel_semi_closed_um"] = travel.semi_closed_um;
     j["travel_z_min_um"] = travel.single_move_min_um;
+    j["excitation_file"] = excitation_file;
+    j["mode_file"] = mode_file;
     fmt::print("{}\n", j.dump(2));
     return 0;
   }
   print_fits(ic.controller, ic.static_map.matrix, ic.static_map.polynomial);
-  for (std::size_t i = 0; i < 3; ++i)
-    fmt::print("model {}  hysteresis + creep, rms residual {:.1f} nm, delay {} ticks, w0 {:.4f}\n",
-               i + 1, 1e3 * ic.model[i].rms_residual_um, ic.model[i].delay_ticks,
-               ic.model[i].params.linear_weight);
-  fmt::print("shaper   mode {:.0f} Hz as sampled at {:.0f} Hz; {} taps; rate limit {:.0f} um/s\n",
-             ic.mode_Hz, ic.mode_sample_rate_Hz, im.shaper.taps, im.shaper.rate_um_per_s);
+  print_improved(summary);
   fmt::print("travel   semi-closed loop {:.2f} um; one move reaches {:.2f} to {:.2f} um\n",
              travel.semi_closed_um, travel.single_move_min_um, travel.single_move_um);
-  fmt::print("written: {}\n", o.out);
+  fmt::print("written: {}, {}, {}\n", o.out, excitation_file, mode_file);
   return 0;
 }
 

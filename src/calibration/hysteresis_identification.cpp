@@ -68,11 +68,9 @@ Solved solve(const Eigen::MatrixXd& X, const Eigen::VectorXd& y) {
   return s;
 }
 
-}  // namespace
-
-HysteresisFit fit_hysteresis_creep(std::span<const double> command_um,
-                                   std::span<const double> gauge_um, double sample_time_s,
-                                   const HysteresisFitOptions& o) {
+HysteresisFit fit_with_creep_from(std::span<const double> command_um,
+                                  std::span<const double> gauge_um, double sample_time_s,
+                                  const HysteresisFitOptions& o) {
   if (command_um.size() != gauge_um.size())
     throw FitError(fmt::format("hysteresis fit: {} commands but {} gauge readings",
                                command_um.size(), gauge_um.size()));
@@ -134,29 +132,38 @@ HysteresisFit fit_hysteresis_creep(std::span<const double> command_um,
     if (rows.size() < min_rows)
       throw FitError(fmt::format("hysteresis fit: {} quiet samples, at least {} needed",
                                  rows.size(), min_rows));
-    std::vector<std::size_t> kept(o.operators);
-    for (std::size_t j = 0; j < o.operators; ++j)
-      kept[j] = j;
     Solved sol;
     HysteresisCreepParams p = base;
-    for (int pass = 0; pass < 2; ++pass) {
-      // Pass 0 without creep, pass 1 with the creep regressor run on pass 0's h.
+    std::size_t dropped = 0;
+    std::vector<std::size_t> kept;
+    // Pass 0 without creep; then the creep regressor run on the previous pass's hysteresis, and
+    // all together again, max_creep_passes times or until the creep gain settles (the creep is
+    // bilinear in the weights and its gain; each pass is the exact least squares given the last
+    // pass's h).
+    for (std::size_t pass = 0; pass <= o.max_creep_passes; ++pass) {
       Eigen::VectorXd z;
-      if (pass == 1) {
+      if (pass > 0) {
         Eigen::VectorXd h = p.linear_weight * u;
         for (std::size_t j = 0; j < o.operators; ++j)
           h += p.weight[j] * s_all.col(static_cast<Eigen::Index>(j)).head(n);
         z = creep_regressor(h, p, sample_time_s);
       }
+      // Pass 1 keeps the operators pass 0 kept; a later pass starts from all again (an operator
+      // dropped while the creep was missing may be needed once it is modelled).
+      if (pass != 1) {
+        kept.resize(o.operators);
+        for (std::size_t j = 0; j < o.operators; ++j)
+          kept[j] = j;
+      }
       for (;;) {
-        const auto cols = static_cast<Eigen::Index>(2 + kept.size() + (pass == 1 ? 1 : 0));
+        const auto cols = static_cast<Eigen::Index>(2 + kept.size() + (pass > 0 ? 1 : 0));
         Eigen::MatrixXd X(n, cols);
         X.col(0).setOnes();
         X.col(1) = u;
         for (std::size_t j = 0; j < kept.size(); ++j)
           X.col(static_cast<Eigen::Index>(2 + j)) =
               s_all.col(static_cast<Eigen::Index>(kept[j])).head(n);
-        if (pass == 1)
+        if (pass > 0)
           X.col(cols - 1) = z;
         sol = solve(select(X, rows), select(y, rows));
         std::size_t worst = kept.size();
@@ -170,24 +177,51 @@ HysteresisFit fit_hysteresis_creep(std::span<const double> command_um,
           break;
         kept.erase(kept.begin() + static_cast<std::ptrdiff_t>(worst));
       }
+      const double last_gain = p.creep_gain;
       p = base;
       p.offset_um = sol.x(0);
       p.linear_weight = sol.x(1);
       p.weight = {};
       for (std::size_t j = 0; j < kept.size(); ++j)
         p.weight[kept[j]] = sol.x(static_cast<Eigen::Index>(2 + j));
-      p.creep_gain = pass == 1 ? sol.x(sol.x.size() - 1) : 0.0;
+      p.creep_gain = pass > 0 ? sol.x(sol.x.size() - 1) : 0.0;
+      dropped = o.operators - kept.size();
+      if (pass > 1 && std::fabs(p.creep_gain - last_gain) <= o.creep_gain_tolerance)
+        break;
     }
     if (sol.rms < best.rms_residual_um) {
       best.params = p;
       best.delay_ticks = d;
       best.rms_residual_um = sol.rms;
-      best.operators_dropped = o.operators - kept.size();
+      best.operators_dropped = dropped;
       best.samples_fitted = rows.size();
     }
   }
   if (!(best.params.linear_weight > 0.0))
     throw FitError("hysteresis fit: the gauges do not follow the command (slope <= 0)");
+  return best;
+}
+
+}  // namespace
+
+HysteresisFit fit_hysteresis_creep(std::span<const double> command_um,
+                                   std::span<const double> gauge_um, double sample_time_s,
+                                   const HysteresisFitOptions& o) {
+  // The creep law's short end is identified too: a log creep that the stack does not have at
+  // its shortest time constants makes the model expect a fast rise after every step.
+  HysteresisFit best;
+  best.rms_residual_um = std::numeric_limits<double>::infinity();
+  for (std::size_t i = 0; i < std::max<std::size_t>(o.creep_start_candidates, 1); ++i) {
+    HysteresisFitOptions oi = o;
+    oi.creep_shortest_s =
+        o.creep_shortest_s *
+        std::pow(10.0, static_cast<double>(i) / static_cast<double>(o.creep_terms_per_decade));
+    if (i > 0 && !(oi.creep_shortest_s <= o.creep_longest_s))
+      break;
+    const HysteresisFit f = fit_with_creep_from(command_um, gauge_um, sample_time_s, oi);
+    if (f.rms_residual_um < best.rms_residual_um)
+      best = f;
+  }
   return best;
 }
 

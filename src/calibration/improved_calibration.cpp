@@ -174,47 +174,42 @@ ImprovedCalibrationOutcome calibrate_improved(const io::ProjectConfig& config,
     bench.drive_open_loop(volts(options.mode_step_from_um));
     bench.run(1.0);
     bench.drive_open_loop(volts(options.mode_step_from_um + options.mode_step_um));
-    std::vector<double> x;
     double last_t = -1.0;
+    const double step_t = bench.time_s();
     bench.run(options.mode_record_s, [&](const experiments::Bench& b) {
       const plant::InterferometerReading& r = b.twin().interferometer();
       if (r.dynamic_time_s != last_t) {
         last_t = r.dynamic_time_s;
-        x.push_back((r.dynamic_um[0] + r.dynamic_um[1] + r.dynamic_um[2]) / 3.0);
+        out.mode_record_t_s.push_back(r.dynamic_time_s - step_t);
+        out.mode_record_um.push_back((r.dynamic_um[0] + r.dynamic_um[1] + r.dynamic_um[2]) / 3.0);
       }
     });
-    const double rate_Hz = config.twin.interferometer.dynamic_sample_rate_Hz;
-    out.mode_Hz = 0.0;
-    if (x.size() > 8) {
-      Eigen::MatrixXd X(static_cast<Eigen::Index>(x.size() - 3), 3);
-      Eigen::VectorXd y(X.rows());
-      for (Eigen::Index k = 0; k < X.rows(); ++k) {
-        const auto j = static_cast<std::size_t>(k) + 3;  // the step's first sample left out
-        X(k, 0) = x[j - 1];
-        X(k, 1) = x[j - 2];
-        X(k, 2) = 1.0;
-        y(k) = x[j];
-      }
-      const Eigen::Vector3d a = X.colPivHouseholderQr().solve(y);
-      if (a(1) < 0.0) {
-        const double c = std::clamp(a(0) / (2.0 * std::sqrt(-a(1))), -1.0, 1.0);
-        out.mode_theta_rad = std::acos(c);
-        out.mode_Hz = out.mode_theta_rad * rate_Hz / (2.0 * std::numbers::pi);
-      }
-    }
-    out.mode_sample_rate_Hz = rate_Hz;
+    out.mode =
+        identify_plate_mode(out.mode_record_um, config.twin.interferometer.dynamic_sample_rate_Hz);
   }
 
-  // Stage 6: the controller.
+  const ImprovedDesign design =
+      design_improved_controller(config, paper, out.model, out.mode, options);
+  out.controller = design.controller;
+  out.shaped = design.shaped;
+  return out;
+}
+
+ImprovedDesign design_improved_controller(const io::ProjectConfig& config,
+                                          const control::SemiClosedLoopParams& paper,
+                                          const std::array<HysteresisFit, 3>& model,
+                                          const PlateModeEstimate& mode,
+                                          const ImprovedCalibrationOptions& options) {
+  ImprovedDesign out;
   control::SemiClosedLoopParams c = paper;
   c.kind = control::ControllerKind::kImproved;
   double min_slope = 1e9;
   for (std::size_t i = 0; i < 3; ++i) {
-    c.improved.model[i] = out.model[i].params;
-    min_slope = std::min(min_slope, out.model[i].params.linear_weight);
+    c.improved.model[i] = model[i].params;
+    min_slope = std::min(min_slope, model[i].params.linear_weight);
   }
   c.improved.sample_time_s = c.sample_time_s;
-  c.improved.reference_delay_ticks = out.model[0].delay_ticks;
+  c.improved.reference_delay_ticks = model[0].delay_ticks;
   const double slew_V_per_s = plant::amplifier_slew_rate_V_per_s(
       config.twin.amplifier, config.design.actuator.capacitance_F);
   const double rate_command_um_per_s =
@@ -223,12 +218,12 @@ ImprovedCalibrationOutcome calibrate_improved(const io::ProjectConfig& config,
   // that rate; at another rate the fold is ambiguous unless the interferometer saw the mode below
   // its Nyquist frequency.
   const double loop_rate_Hz = 1.0 / c.sample_time_s;
-  const bool same_rate = std::fabs(loop_rate_Hz - out.mode_sample_rate_Hz) < 1e-6 * loop_rate_Hz;
-  const bool unfolded = out.mode_Hz > 0.0 && out.mode_Hz < 0.45 * out.mode_sample_rate_Hz &&
-                        out.mode_sample_rate_Hz >= loop_rate_Hz;
-  out.shaped = out.mode_Hz > 0.0 && (same_rate || unfolded);
+  const bool same_rate = std::fabs(loop_rate_Hz - mode.sample_rate_Hz) < 1e-6 * loop_rate_Hz;
+  const bool unfolded = mode.mode_Hz > 0.0 && mode.mode_Hz < 0.45 * mode.sample_rate_Hz &&
+                        mode.sample_rate_Hz >= loop_rate_Hz;
+  out.shaped = mode.mode_Hz > 0.0 && (same_rate || unfolded);
   c.improved.shaper =
-      control::design_mode_shaper(out.shaped ? out.mode_Hz : 0.0, c.sample_time_s,
+      control::design_mode_shaper(out.shaped ? mode.mode_Hz : 0.0, c.sample_time_s,
                                   options.slew_margin * rate_command_um_per_s * min_slope);
   c.improved.correction_ki =
       2.0 * std::numbers::pi * options.correction_bandwidth_Hz * c.sample_time_s;

@@ -2,6 +2,7 @@
 // into the calibration `run` loads, `run`'s and `simulate`'s logs into `analyze --column`, one
 // profile for `run` and `simulate`, `run --config`, and `run`'s final position in its summary.
 #include <cmath>
+#include <filesystem>
 #include <string>
 #include <vector>
 
@@ -14,6 +15,7 @@
 #include "piezoshift/control/cubic_polynomial.hpp"
 #include "piezoshift/control/transmission_matrix.hpp"
 #include "piezoshift/io/csv_table.hpp"
+#include "piezoshift/io/csv_writer.hpp"
 
 namespace {
 
@@ -141,7 +143,10 @@ namespace {
 
 // `calibrate --controller improved` writes a file `run` loads: the run holds 5 um within 20 nm
 // at every point; the same file at another loop rate is refused as input (exit 2, naming it).
-TEST_F(ConnectedFilesCli, ImprovedCalibrationRunsAndIsRefusedAtAnotherRate) {
+// The records it fitted (excitation.csv, mode_step.csv) fit again by `fit improved` into a copy
+// of the file to the same controller: the CSV's 12 decimals leave the models within 1e-9 and
+// the shaper's taps (the ring-down's 9 decimals) within 1e-8.
+TEST_F(ConnectedFilesCli, ImprovedCalibrationRunsFitsAgainFromItsRecordsAndIsRefusedAtAnotherRate) {
   const std::string cal = path("improved.toml");
   const CliResult c = run("calibrate --controller improved --json --out '" + cal + "'");
   ASSERT_EQ(c.status, 0) << c.err;
@@ -158,6 +163,42 @@ TEST_F(ConnectedFilesCli, ImprovedCalibrationRunsAndIsRefusedAtAnotherRate) {
       run("run --calibration '" + cal + "' --step-um 5 --duration-s 1 --free-run --rate-hz 10000");
   EXPECT_EQ(bad.status, 2);
   EXPECT_NE(bad.err.find("improved.toml: [improved] sample_time_s"), std::string::npos) << bad.err;
+
+  const std::string excitation = j["excitation_file"], mode = j["mode_file"];
+  const std::string refit = path("refit.toml");
+  std::filesystem::copy_file(cal, refit);
+  const CliResult f = run("fit improved --data '" + excitation + "' --mode-data '" + mode +
+                          "' --out '" + refit + "' --json");
+  ASSERT_EQ(f.status, 0) << f.err;
+  const auto a = piezoshift::calibration::load_calibration_file(cal).improved;
+  const auto b = piezoshift::calibration::load_calibration_file(refit).improved;
+  EXPECT_EQ(b.sample_time_s, a.sample_time_s);
+  EXPECT_EQ(b.reference_delay_ticks, a.reference_delay_ticks);
+  ASSERT_EQ(b.shaper.taps, a.shaper.taps);
+  for (std::size_t k = 0; k < a.shaper.taps; ++k)
+    EXPECT_NEAR(b.shaper.weight[k], a.shaper.weight[k], 1e-8);
+  for (std::size_t i = 0; i < 3; ++i) {
+    EXPECT_NEAR(b.model[i].linear_weight, a.model[i].linear_weight, 1e-9);
+    EXPECT_NEAR(b.model[i].creep_gain, a.model[i].creep_gain, 1e-9);
+    for (std::size_t k = 0; k < a.model[i].operators; ++k)
+      EXPECT_NEAR(b.model[i].weight[k], a.model[i].weight[k], 1e-9);
+  }
+  // A record with a missing tick is refused, naming the file and the line.
+  {
+    const auto t = piezoshift::io::CsvTable::load(excitation);
+    piezoshift::io::CsvWriter w(
+        path("gap.csv"), {"t_s", "u1_um", "u2_um", "u3_um", "sgs1_um", "sgs2_um", "sgs3_um"});
+    std::vector<std::vector<double>> cols;
+    for (const char* name : {"t_s", "u1_um", "u2_um", "u3_um", "sgs1_um", "sgs2_um", "sgs3_um"})
+      cols.push_back(t.column(name));
+    for (std::size_t k = 0; k < t.rows(); ++k)
+      if (k != 500)
+        w.row({cols[0][k], cols[1][k], cols[2][k], cols[3][k], cols[4][k], cols[5][k], cols[6][k]});
+    w.close();
+  }
+  const CliResult gap = run("fit improved --data '" + path("gap.csv") + "'");
+  EXPECT_EQ(gap.status, 2);
+  EXPECT_NE(gap.err.find("gap.csv:502: t_s steps by 0.002 s"), std::string::npos) << gap.err;
   const CliResult guided =
       run("calibrate --controller improved --daq sim --interferometer sim "
           "--out '" +

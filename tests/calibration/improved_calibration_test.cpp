@@ -41,7 +41,7 @@ TEST(ImprovedController, OnTheDefaultTwinItHoldsQuieterAndSettlesFaster) {
   const ImprovedCalibrationOutcome c = calibrated(config, 1);
   EXPECT_TRUE(c.shaped);
   // The piston mode, 1419 Hz, folds to 419 Hz at the interferometer's 1 kHz.
-  EXPECT_NEAR(c.mode_Hz, 419.0, 25.0);
+  EXPECT_NEAR(c.mode.mode_Hz, 419.0, 25.0);
   for (const HysteresisFit& m : c.model) {
     EXPECT_EQ(m.delay_ticks, 2U);
     EXPECT_LT(m.rms_residual_um, 0.012);
@@ -90,10 +90,10 @@ TEST(ImprovedController, TheSameProcedureWorksOnOtherPlants) {
     SCOPED_TRACE(k++);
     const ImprovedCalibrationOutcome c = calibrated(*config, 3);
     if (config == &a) {
-      default_mode_Hz = c.mode_Hz;
+      default_mode_Hz = c.mode.mode_Hz;
     } else if (config == &b) {
       // A heavier plate: a lower mode (above 1 kHz), which folds to a lower alias at 1 kHz.
-      EXPECT_LT(c.mode_Hz, default_mode_Hz - 100.0);
+      EXPECT_LT(c.mode.mode_Hz, default_mode_Hz - 100.0);
     }
     const PhaseSteps p = phase_steps(*config, c, 3);
     ASSERT_TRUE(p.improved.validity.valid) << p.improved.validity.reason;

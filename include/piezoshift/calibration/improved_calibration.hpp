@@ -16,6 +16,7 @@
 
 #include "piezoshift/calibration/calibration_procedure.hpp"
 #include "piezoshift/calibration/hysteresis_identification.hpp"
+#include "piezoshift/calibration/mode_identification.hpp"
 
 namespace piezoshift::calibration {
 
@@ -38,15 +39,20 @@ struct ImprovedCalibrationOutcome {
   control::SemiClosedLoopParams controller;  //!< the improved controller to load
   CalibrationOutcome static_map;             //!< stages 1 to 3 as the paper's procedure ran them
   std::array<HysteresisFit, 3> model{};
-  //! The plate's mode as the interferometer's dynamic samples show it (folded into [0, rate/2];
-  //! 0 when none was found), the rate, and whether the shaper uses it.
-  double mode_Hz = 0.0;
-  double mode_theta_rad = 0.0;
-  double mode_sample_rate_Hz = 0.0;
+  //! The plate's mode as the interferometer's dynamic samples show it, and whether the shaper
+  //! uses it.
+  PlateModeEstimate mode;
   bool shaped = false;
   //! The excitation as recorded (stage 4), per tick: t_s, command and gauge per channel.
   std::vector<double> record_t_s;
   std::array<std::vector<double>, 3> record_command_um, record_gauge_um;
+  //! The ring-down (stage 5): the interferometer's mean of P1..P3 at its rate, t_s from the step.
+  std::vector<double> mode_record_t_s, mode_record_um;
+};
+
+struct ImprovedDesign {
+  control::SemiClosedLoopParams controller;
+  bool shaped = false;  //!< the shaper nulls the mode (false: no mode, or one it cannot place)
 };
 
 //! base supplies the sample time, limits and scaling. Throws experiments::ProcedureFailed when a
@@ -56,6 +62,17 @@ ImprovedCalibrationOutcome calibrate_improved(const io::ProjectConfig& config,
                                               std::uint64_t seed,
                                               const ImprovedCalibrationOptions& options = {},
                                               const experiments::Progress& progress = {});
+
+//! Stage 6 alone, from the other stages' results however they were obtained (the twin above, or
+//! recorded bench files through `piezoshift fit improved`): paper supplies A, p, the scaling, the
+//! limits and the loop's sample time; config the amplifier's slew (its current limit into the
+//! stacks' capacitance). The shaper nulls the mode when the loop runs at the rate it was sampled
+//! at, or when it was sampled unfolded at least as fast as the loop.
+ImprovedDesign design_improved_controller(const io::ProjectConfig& config,
+                                          const control::SemiClosedLoopParams& paper,
+                                          const std::array<HysteresisFit, 3>& model,
+                                          const PlateModeEstimate& mode,
+                                          const ImprovedCalibrationOptions& options = {});
 
 //! The command (um) of the stage-4 excitation at time t_s, and its duration.
 double improved_excitation_um(double t_s);
