@@ -70,7 +70,7 @@ Solved solve(const Eigen::MatrixXd& X, const Eigen::VectorXd& y) {
 
 HysteresisFit fit_with_creep_from(std::span<const double> command_um,
                                   std::span<const double> gauge_um, double sample_time_s,
-                                  const HysteresisFitOptions& o) {
+                                  const HysteresisFitOptions& o, double threshold_phase) {
   if (command_um.size() != gauge_um.size())
     throw FitError(fmt::format("hysteresis fit: {} commands but {} gauge readings",
                                command_um.size(), gauge_um.size()));
@@ -89,8 +89,8 @@ HysteresisFit fit_with_creep_from(std::span<const double> command_um,
   HysteresisCreepParams base{};
   base.operators = o.operators;
   for (std::size_t j = 0; j < o.operators; ++j)
-    base.threshold_um[j] =
-        (static_cast<double>(j) + 0.5) * o.command_span_um / static_cast<double>(o.operators);
+    base.threshold_um[j] = (static_cast<double>(j) + threshold_phase) * o.command_span_um /
+                           static_cast<double>(o.operators);
   const double decades = std::log10(o.creep_longest_s / o.creep_shortest_s);
   base.creep_terms = std::min<std::size_t>(
       control::kMaxCreepTerms, static_cast<std::size_t>(std::floor(
@@ -211,6 +211,7 @@ HysteresisFit fit_hysteresis_creep(std::span<const double> command_um,
   // its shortest time constants makes the model expect a fast rise after every step.
   HysteresisFit best;
   best.rms_residual_um = std::numeric_limits<double>::infinity();
+  const std::size_t phases = std::max<std::size_t>(o.threshold_phase_candidates, 1);
   for (std::size_t i = 0; i < std::max<std::size_t>(o.creep_start_candidates, 1); ++i) {
     HysteresisFitOptions oi = o;
     oi.creep_shortest_s =
@@ -218,9 +219,15 @@ HysteresisFit fit_hysteresis_creep(std::span<const double> command_um,
         std::pow(10.0, static_cast<double>(i) / static_cast<double>(o.creep_terms_per_decade));
     if (i > 0 && !(oi.creep_shortest_s <= o.creep_longest_s))
       break;
-    const HysteresisFit f = fit_with_creep_from(command_um, gauge_um, sample_time_s, oi);
-    if (f.rms_residual_um < best.rms_residual_um)
-      best = f;
+    for (std::size_t k = 0; k < phases; ++k) {
+      // 1/2 first (the centred grid), then on by 1/phases of a spacing, wrapped into (0, 1].
+      double phase = 0.5 + static_cast<double>(k) / static_cast<double>(phases);
+      if (phase > 1.0)
+        phase -= 1.0;
+      const HysteresisFit f = fit_with_creep_from(command_um, gauge_um, sample_time_s, oi, phase);
+      if (f.rms_residual_um < best.rms_residual_um)
+        best = f;
+    }
   }
   return best;
 }

@@ -163,6 +163,15 @@ std::vector<FigureSpec> comparison_figures(const io::ProjectConfig& config) {
       {"phase_step_final_error_nm", "lambda/8 step, final error", "nm", from_set([](const S& s) {
          return figure(s.phase_step.final_error_nm, s.phase_step.validity);
        })},
+      {"phase_step_own_settling_time_s",
+       "lambda/8 step, settling of the step minus the same seed without it (+-1 nm)", "s",
+       from_set([](const S& s) {
+         return figure(s.phase_step.own_settling_time_s, s.phase_step.validity);
+       })},
+      {"phase_step_still_wander_nm", "lambda/8 step's record without the step, largest wander",
+       "nm", from_set([](const S& s) {
+         return figure(s.phase_step.still_wander_nm, s.phase_step.validity);
+       })},
       {"phase_step_10kHz_hold_jitter_nm_rms", "lambda/8 step at 10 kHz, hold jitter (rms)", "nm",
        [](const ControllerRun& r) {
          if (!r.calibration.valid)
@@ -178,6 +187,15 @@ std::vector<FigureSpec> comparison_figures(const io::ProjectConfig& config) {
          if (!r.ran_10kHz)
            return not_measured();
          return figure(r.phase_step_10kHz.settling_time_s, r.phase_step_10kHz.validity);
+       }},
+      {"phase_step_10kHz_own_settling_time_s",
+       "lambda/8 step at 10 kHz, settling of the step minus the same seed without it", "s",
+       [](const ControllerRun& r) {
+         if (!r.calibration.valid)
+           return figure(0.0, r.calibration);
+         if (!r.ran_10kHz)
+           return not_measured();
+         return figure(r.phase_step_10kHz.own_settling_time_s, r.phase_step_10kHz.validity);
        }},
   };
   const std::vector<double> rates = inner_loop_sample_times_s(config);

@@ -113,6 +113,17 @@ io::Figure phase_step_figure(const SeedComparison& sc, double tolerance_nm) {
     p.series.push_back(
         io::line_series(controller_key(k), ps.time_s, ps.exposure_mean_nm, kColour[idx(k)]));
   }
+  // The improved controller's run without the step, lifted to the target: how much of its
+  // trace is the plate's own wander (the gauges' drift), not the step.
+  if (const ControllerRun& run = sc[ControllerKind::kImproved];
+      run.calibration.valid && !run.set.phase_step.still_exposure_mean_nm.empty()) {
+    const auto& ps = run.set.phase_step;
+    std::vector<double> lifted(ps.still_exposure_mean_nm);
+    for (double& v : lifted)
+      v += ps.step_nm;
+    p.series.push_back(io::line_series("improved, same seed without the step, + step", ps.time_s,
+                                       lifted, "#7f7f7f"));
+  }
   f.panels.push_back(std::move(p));
   return f;
 }

@@ -66,6 +66,8 @@ void set_json(nlohmann::json& j, const std::string& prefix, const ExperimentSet&
   j[prefix + "phase_step_hold_jitter_nm_rms"] = e.phase_step.hold_jitter_nm_rms;
   j[prefix + "phase_step_settling_time_s"] = time_or_null(e.phase_step.settling_time_s);
   j[prefix + "phase_step_final_error_nm"] = e.phase_step.final_error_nm;
+  j[prefix + "phase_step_own_settling_time_s"] = time_or_null(e.phase_step.own_settling_time_s);
+  j[prefix + "phase_step_still_wander_nm"] = e.phase_step.still_wander_nm;
   j[prefix + "valid"] = e.table4_valid();
   j[prefix + "invalid_reasons"] = e.invalid_reasons();
   const auto validity = [](const experiments::Validity& v) {

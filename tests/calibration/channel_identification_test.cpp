@@ -18,13 +18,13 @@ constexpr double kT = 1e-3;
 
 // A model on the fit's own grid (16 operators over 16 um, 11 creep terms 3 ms .. 300 s), with
 // weights of mixed sizes and two operators at zero.
-control::HysteresisCreepParams truth(double creep_gain) {
+control::HysteresisCreepParams truth(double creep_gain, double threshold_phase = 0.5) {
   control::HysteresisCreepParams p;
   p.offset_um = 0.012;
   p.linear_weight = 0.52;
   p.operators = 16;
   for (std::size_t j = 0; j < p.operators; ++j) {
-    p.threshold_um[j] = (static_cast<double>(j) + 0.5);
+    p.threshold_um[j] = static_cast<double>(j) + threshold_phase;
     p.weight[j] = (j == 5 || j == 11) ? 0.0 : 0.01 + 0.004 * static_cast<double>(j % 7);
   }
   p.creep_terms = 11;
@@ -94,6 +94,26 @@ TEST(ChannelModelFit, OnePassLeavesTheCreepApproximate) {
   EXPECT_NEAR(f.params.linear_weight, p.linear_weight, 0.002 * p.linear_weight);  // 0.1 % seen
   EXPECT_NEAR(f.params.creep_gain, p.creep_gain, 0.02 * p.creep_gain);            // 1.1 % seen
   EXPECT_GT(f.rms_residual_um, 1e-3);  // 6.1 nm seen: one pass is not exact
+}
+
+// The twin's stack has its play thresholds at odd microns of command (8 operators over 150 V =
+// 16 um), which the centred grid (0.5, 1.5, ...) misses by half a spacing; the grid's phase is
+// identified. On a model whose thresholds sit at whole microns, the centred grid alone is not
+// exact and the search (1/2, then 1) is.
+TEST(ChannelModelFit, IdentifiesTheThresholdGridsPhase) {
+  control::HysteresisCreepParams p = truth(0.0, 1.0);
+  p.weight[15] = 0.0;  // its threshold, 16 um, is beyond the excitation: never seen
+  const Record r = record(p, 1);
+  HysteresisFitOptions centred;
+  centred.threshold_phase_candidates = 1;
+  EXPECT_GT(fit_hysteresis_creep(r.u, r.y, kT, centred).rms_residual_um, 1e-4);
+  const HysteresisFit f = fit_hysteresis_creep(r.u, r.y, kT);
+  EXPECT_LT(f.rms_residual_um, 1e-9);
+  EXPECT_NEAR(f.params.linear_weight, p.linear_weight, 1e-9);
+  for (std::size_t j = 0; j < p.operators; ++j) {
+    EXPECT_DOUBLE_EQ(f.params.threshold_um[j], p.threshold_um[j]) << "operator " << j;
+    EXPECT_NEAR(f.params.weight[j], p.weight[j], 1e-9) << "operator " << j;
+  }
 }
 
 TEST(ChannelModelFit, RefusesRecordsItCannotFit) {

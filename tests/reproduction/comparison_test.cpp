@@ -150,12 +150,14 @@ TEST(Comparison, JsonHasThePrefixedMediansAndPerSeedValues) {
        {"paper_step_settling_time_10nm_s", "improved_step_settling_time_10nm_s",
         "oracle_step_settling_time_10nm_s", "paper_phase_step_settling_time_s",
         "oracle_linearity_zero_end_pct", "improved_repeatability_5um_nm",
-        "improved_phase_step_hold_jitter_nm_rms", "improved_travel_semi_closed_um",
+        "improved_phase_step_hold_jitter_nm_rms", "improved_phase_step_own_settling_time_s",
+        "oracle_phase_step_still_wander_nm", "improved_travel_semi_closed_um",
         "paper_pid_margins_1kHz_gain_margin_dB", "improved_pid_margins_10kHz_phase_margin_deg"})
     EXPECT_TRUE(j.contains(key)) << key;
   EXPECT_TRUE(j.contains("improved_phase_step_10kHz_settling_time_s"));
   EXPECT_FALSE(j.contains("oracle_pid_margins_1kHz_gain_margin_dB"));  // not its own
   EXPECT_FALSE(j.contains("oracle_phase_step_10kHz_settling_time_s"));
+  EXPECT_FALSE(j.contains("oracle_phase_step_10kHz_own_settling_time_s"));
   ASSERT_EQ(j["per_seed"].size(), 1U);
   EXPECT_EQ(j["per_seed"][0]["seed"], 1);
   // One seed: the median is that seed's value.

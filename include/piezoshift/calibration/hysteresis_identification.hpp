@@ -2,8 +2,9 @@
 // Identification of the improved controller's channel model (control/hysteresis_creep_model.hpp)
 // from a recorded open-loop run: the command u_k written at tick k and the gauge reading y_k read
 // at tick k, per channel. With the thresholds and creep time constants fixed (evenly spread over
-// the command's span and over the decades), the model is linear in its parameters once the
-// operators and the creep terms are run on the record, so it is fitted by least squares:
+// the command's span, the grid's phase the best of a few, and over the decades), the model is
+// linear in its parameters once the operators and the creep terms are run on the record, so it is
+// fitted by least squares:
 //   1. y_k ~ offset + w0 u_{k-D} + sum_j w_j s_j(u)_{k-D}           (operators on u)
 //   2. the creep regressor sum_m (c_m - h) run on the last fit's h, then all together again;
 //      optionally repeated until the creep gain settles (the creep term is bilinear in the
@@ -20,8 +21,15 @@
 namespace piezoshift::calibration {
 
 struct HysteresisFitOptions {
-  std::size_t operators = 16;       //!< play operators over the span (at most 16)
-  double command_span_um = 16.0;    //!< thresholds (j + 1/2) span / N
+  std::size_t operators = 16;     //!< play operators over the span (at most 16)
+  double command_span_um = 16.0;  //!< thresholds (j + phase) span / N
+  //! Grid phases tried, the best residual kept: 1/2 (centred), then on by 1/n of a spacing,
+  //! wrapped into (0, 1] (2: 1/2 and 1; costs a fit per candidate). Where a stack's thresholds
+  //! sit is not known beforehand; a grid half a spacing off them leaves the small-step slope
+  //! after a move a few % wrong. Over seeds 1 to 8 of the default twin (thresholds at odd
+  //! microns), 2 instead of 1 took the lambda/8 step's median settling at 10 kHz from 5.1 to
+  //! 3.7 ms (seeds 5 and 6: 13 -> 2.6 ms, 43 -> 24 ms) and changed no other median.
+  std::size_t threshold_phase_candidates = 2;
   double creep_shortest_s = 0.003;  //!< creep terms from here ...
   double creep_longest_s = 300.0;   //!< ... to here
   std::size_t creep_terms_per_decade = 2;
@@ -33,10 +41,10 @@ struct HysteresisFitOptions {
   //! Iterated (e.g. 20), the passes converge on the true model (exact on a record the model
   //! made, ChannelModelFit.*) and leave 3.5 to 4.0 nm rms on the default twin instead of 5.3 to
   //! 5.9; but over seeds 1 to 8 the lambda/8 step then settles in a median 12.5 ms at 1 kHz and
-  //! 26.6 ms at 10 kHz (6.5 and 5.1 ms with one pass), while the 11 um step to +-10 nm improves
-  //! from 61 to 27 ms. The small-step slope, not the residual, limits the phase step, so the
-  //! calibration keeps one pass until the small-step slope is identified directly
-  //! (docs/calibration.md).
+  //! 26.6 ms at 10 kHz (6.5 and 5.1 ms with one pass; measured with the centred grid only), while
+  //! the 11 um step to +-10 nm improves from 61 to 27 ms. The small-step slope, not the residual,
+  //! limits the phase step, so the calibration keeps one pass until the small-step slope is
+  //! identified directly (docs/calibration.md).
   std::size_t max_creep_passes = 1;
   double creep_gain_tolerance = 1e-7;
   //! Samples this long after a command jump are left out: the amplifier's slew and the plate's

@@ -13,6 +13,10 @@
 //                   record_s; infinite when the record ends outside the band.
 // The level before the step is the hold's trend line at the step instant. Seeds and the loop are
 // the other experiments' (experiments/bench.hpp): the shipping tick, supervisor included.
+//   own settling    the same, for the stepped run minus a second run of the same seed without
+//                   the step: a controller's own step with the wander the plant brings to a
+//                   held plate (the gauges' drift, which a semi-closed loop follows) removed. It
+//                   separates what a controller can improve from what the sensor limits.
 //
 // Not settling within +-1 nm is a result, not a failure. The experiment is not valid (validity)
 // when the supervisor tripped, a PID sat at its output limit, or the plate ended further than
@@ -49,6 +53,13 @@ struct PhaseStepResult {
   double hold_jitter_nm_rms = 0.0;
   double settling_time_s = 0.0;  //!< infinite when never within the band until the record's end
   double final_error_nm = 0.0;   //!< mean of the last 10 exposures minus step_nm
+  //! The same run without the step (same seed: the same noise and drift), from its own level
+  //! before: how far the plate wanders on its own over the record (what the gauges' drift and
+  //! the controller's hold bring), and the settling time of the stepped run minus this one (the
+  //! controller's own step, that wander removed).
+  std::vector<double> still_exposure_mean_nm;
+  double still_wander_nm = 0.0;  //!< largest |still_exposure_mean_nm|
+  double own_settling_time_s = 0.0;
   Validity validity;
   double simulated_time_s = 0.0;
 };
