@@ -39,6 +39,18 @@ std::function<FigureValue(const ControllerRun&)> from_set(Get get) {
   };
 }
 
+// A figure of the phase step at 10 kHz; not measured where it was not run (the oracle).
+std::function<FigureValue(const ControllerRun&)> at_10kHz(
+    double experiments::PhaseStepResult::*member) {
+  return [member](const ControllerRun& r) {
+    if (!r.calibration.valid)
+      return figure(0.0, r.calibration);
+    if (!r.ran_10kHz)
+      return not_measured();
+    return figure(r.phase_step_10kHz.*member, r.phase_step_10kHz.validity);
+  };
+}
+
 // The worst channel's margin at the i-th loop rate; the oracle has no analysis of its own.
 std::function<FigureValue(const ControllerRun&)> margin(std::size_t i, bool gain) {
   return [i, gain](const ControllerRun& r) {
@@ -173,30 +185,12 @@ std::vector<FigureSpec> comparison_figures(const io::ProjectConfig& config) {
          return figure(s.phase_step.still_wander_nm, s.phase_step.validity);
        })},
       {"phase_step_10kHz_hold_jitter_nm_rms", "lambda/8 step at 10 kHz, hold jitter (rms)", "nm",
-       [](const ControllerRun& r) {
-         if (!r.calibration.valid)
-           return figure(0.0, r.calibration);
-         if (!r.ran_10kHz)
-           return not_measured();
-         return figure(r.phase_step_10kHz.hold_jitter_nm_rms, r.phase_step_10kHz.validity);
-       }},
+       at_10kHz(&experiments::PhaseStepResult::hold_jitter_nm_rms)},
       {"phase_step_10kHz_settling_time_s", "lambda/8 step at 10 kHz, settling to +-1 nm", "s",
-       [](const ControllerRun& r) {
-         if (!r.calibration.valid)
-           return figure(0.0, r.calibration);
-         if (!r.ran_10kHz)
-           return not_measured();
-         return figure(r.phase_step_10kHz.settling_time_s, r.phase_step_10kHz.validity);
-       }},
+       at_10kHz(&experiments::PhaseStepResult::settling_time_s)},
       {"phase_step_10kHz_own_settling_time_s",
        "lambda/8 step at 10 kHz, settling of the step minus the same seed without it", "s",
-       [](const ControllerRun& r) {
-         if (!r.calibration.valid)
-           return figure(0.0, r.calibration);
-         if (!r.ran_10kHz)
-           return not_measured();
-         return figure(r.phase_step_10kHz.own_settling_time_s, r.phase_step_10kHz.validity);
-       }},
+       at_10kHz(&experiments::PhaseStepResult::own_settling_time_s)},
   };
   const std::vector<double> rates = inner_loop_sample_times_s(config);
   for (std::size_t i = 0; i < rates.size(); ++i) {
