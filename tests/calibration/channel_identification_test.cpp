@@ -67,13 +67,12 @@ TEST(ChannelModelFit, RecoversAModelWithoutCreepExactly) {
 }
 
 // With creep, each pass runs the creep regressor on the previous pass's hysteresis; iterated,
-// the passes converge on the true model. (The calibration's default single pass leaves 6.1 nm
-// rms on this noise-free record, w0 0.1 % off and seven operators dropped: the next test.)
+// the passes converge on the true model (the calibration's default). A single pass leaves 6.1 nm
+// rms on this noise-free record, w0 0.1 % off and seven operators dropped: the next test.
 TEST(ChannelModelFit, RecoversCreepByIteratingThePasses) {
   const control::HysteresisCreepParams p = truth(0.007);
   const Record r = record(p, 1);
   HysteresisFitOptions o;
-  o.max_creep_passes = 20;
   o.creep_start_candidates = 3;  // 3 ms (the truth's), 9.5 ms, 30 ms: the search must pick 3 ms
   const HysteresisFit f = fit_hysteresis_creep(r.u, r.y, kT, o);
   EXPECT_EQ(f.params.creep_time_constant_s[0], 0.003);
@@ -89,7 +88,9 @@ TEST(ChannelModelFit, RecoversCreepByIteratingThePasses) {
 
 TEST(ChannelModelFit, OnePassLeavesTheCreepApproximate) {
   const control::HysteresisCreepParams p = truth(0.007);
-  const HysteresisFit f = fit_hysteresis_creep(record(p, 1).u, record(p, 1).y, kT);
+  HysteresisFitOptions one;
+  one.max_creep_passes = 1;
+  const HysteresisFit f = fit_hysteresis_creep(record(p, 1).u, record(p, 1).y, kT, one);
   EXPECT_EQ(f.delay_ticks, 1u);
   EXPECT_NEAR(f.params.linear_weight, p.linear_weight, 0.002 * p.linear_weight);  // 0.1 % seen
   EXPECT_NEAR(f.params.creep_gain, p.creep_gain, 0.02 * p.creep_gain);            // 1.1 % seen

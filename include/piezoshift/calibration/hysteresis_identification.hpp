@@ -38,14 +38,13 @@ struct HysteresisFitOptions {
   std::size_t creep_start_candidates = 1;
   std::size_t max_delay_ticks = 4;
   //! Step 2's passes at most, stopping early when the gain moves less than the tolerance.
-  //! Iterated (e.g. 20), the passes converge on the true model (exact on a record the model
-  //! made, ChannelModelFit.*) and leave 3.5 to 4.0 nm rms on the default twin instead of 5.3 to
-  //! 5.9; but over seeds 1 to 8 the lambda/8 step then settles in a median 12.5 ms at 1 kHz and
-  //! 26.6 ms at 10 kHz (6.5 and 5.1 ms with one pass; measured with the centred grid only), while
-  //! the 11 um step to +-10 nm improves from 61 to 27 ms. The small-step slope, not the residual,
-  //! limits the phase step, so the calibration keeps one pass until the small-step slope is
-  //! identified directly (docs/calibration.md).
-  std::size_t max_creep_passes = 1;
+  //! Iterated, the passes converge on the true model (exact on a record the model made,
+  //! ChannelModelFit.*). With the grid's phase identified, over seeds 1 to 8 of the default twin
+  //! 20 instead of 1 took the lambda/8 step's median settling from 6.5 to 4.0 ms at 1 kHz and
+  //! from 3.7 to 1.6 ms at 10 kHz, and the 11 um step to +-10 nm from 61 to 29 ms (one pass
+  //! leaves the small-step slope a few % off; measured before the phase was identified, the
+  //! passes had made the phase step slower, docs/calibration.md).
+  std::size_t max_creep_passes = 20;
   double creep_gain_tolerance = 1e-7;
   //! Samples this long after a command jump are left out: the amplifier's slew and the plate's
   //! ringing are dynamics the static model does not hold (the shaper and the loop handle them).
