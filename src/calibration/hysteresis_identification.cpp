@@ -6,6 +6,7 @@
 #include <limits>
 #include <vector>
 
+#include "piezoshift/calibration/compressed_least_squares.hpp"
 #include "piezoshift/calibration/fit_error.hpp"
 
 namespace piezoshift::calibration {
@@ -47,62 +48,6 @@ Eigen::VectorXd creep_regressor(const Eigen::VectorXd& h, const HysteresisCreepP
   }
   return z;
 }
-
-struct Solved {
-  Eigen::VectorXd x;
-  double rms = std::numeric_limits<double>::infinity();
-};
-
-// Least squares of y on a subset of the fixed columns B and optionally one more column z, over
-// the same rows again and again (every pass, every operator dropped). B = Q R once; then
-// ||y - B_S w - g z||^2 = ||Q'y - R_S w - g Q'z||^2 + ||y_p - g z_p||^2 (y_p, z_p: the parts
-// outside Q's span), a problem of (columns + 1) rows. Exact in exact arithmetic; a pass costs
-// Q'z (rows x columns) instead of a QR of the whole record (370 000 rows at 10 kHz).
-class CompressedLeastSquares {
- public:
-  CompressedLeastSquares(const Eigen::MatrixXd& B, const Eigen::VectorXd& y) : rows_(B.rows()) {
-    const Eigen::HouseholderQR<Eigen::MatrixXd> qr(B);
-    q_ = qr.householderQ() * Eigen::MatrixXd::Identity(B.rows(), B.cols());
-    r_ = qr.matrixQR().topRows(B.cols()).triangularView<Eigen::Upper>();
-    qy_ = q_.transpose() * y;
-    y_perp_ = y - q_ * qy_;
-  }
-
-  //! The fit on columns `cols` of B, and z's when z is not empty (its coefficient last).
-  Solved solve(const std::vector<std::size_t>& cols, const Eigen::VectorXd& z) const {
-    const auto k = static_cast<Eigen::Index>(cols.size());
-    const Eigen::Index m = r_.rows();
-    const bool with_z = z.size() > 0;
-    Eigen::MatrixXd A = Eigen::MatrixXd::Zero(m + 1, k + (with_z ? 1 : 0));
-    Eigen::VectorXd b = Eigen::VectorXd::Zero(m + 1);
-    for (Eigen::Index j = 0; j < k; ++j)
-      A.col(j).head(m) = r_.col(static_cast<Eigen::Index>(cols[static_cast<std::size_t>(j)]));
-    b.head(m) = qy_;
-    double rest = y_perp_.squaredNorm();
-    if (with_z) {
-      const Eigen::VectorXd qz = q_.transpose() * z;
-      const Eigen::VectorXd z_perp = z - q_ * qz;
-      const double alpha = z_perp.norm();
-      A.col(k).head(m) = qz;
-      A(m, k) = alpha;
-      if (alpha > 0.0) {
-        const double along = z_perp.dot(y_perp_) / alpha;
-        b(m) = along;
-        rest -= along * along;
-      }
-    }
-    Solved s;
-    s.x = A.colPivHouseholderQr().solve(b);
-    const double sq = (A * s.x - b).squaredNorm() + std::max(rest, 0.0);
-    s.rms = std::sqrt(sq / static_cast<double>(rows_));
-    return s;
-  }
-
- private:
-  Eigen::Index rows_;
-  Eigen::MatrixXd q_, r_;
-  Eigen::VectorXd qy_, y_perp_;
-};
 
 HysteresisFit fit_with_creep_from(std::span<const double> command_um,
                                   std::span<const double> gauge_um, double sample_time_s,
@@ -180,7 +125,7 @@ HysteresisFit fit_with_creep_from(std::span<const double> command_um,
       y_rows(ri) = y(rows[r]);
     }
     const CompressedLeastSquares ls(B, y_rows);
-    Solved sol;
+    LeastSquaresSolution sol;
     HysteresisCreepParams p = base;
     std::size_t dropped = 0;
     std::vector<std::size_t> kept;

@@ -34,23 +34,26 @@ PhaseStepResult run_phase_step(const io::ProjectConfig& config,
     throw std::invalid_argument("phase step: every duration, length and tolerance must be > 0");
   PhaseStepResult r;
   r.step_nm = o.step_nm();
+  const double z0_um = o.start_um;
+  const double z1_um = z0_um + 1e-3 * r.step_nm;
+  Bench bench(config, controller, seed, o.bench);
+  const double ts = bench.sample_time_s();
+  const double periods = o.exposure_s / ts;
+  const auto per_exposure = static_cast<std::size_t>(std::llround(periods));
+  if (per_exposure < 1 || std::fabs(periods - static_cast<double>(per_exposure)) > 1e-6)
+    throw std::invalid_argument(fmt::format(
+        "phase step: the exposure ({:g} s) must be a whole number of control periods ({:g} s)",
+        o.exposure_s, ts));
+
   // One run: settle, hold (its exposure means' trend line gives the level before), then drive
-  // to z0 + step_um and record. Returns the exposure's length in ticks.
+  // to target_um and record.
   struct Run {
     std::vector<double> time_s, mean_nm;
     double hold_jitter_nm_rms = 0.0;
   };
-  const double z0_um = o.start_um;
-  const auto run_once = [&](Bench& bench, double step_um, Run& run) {
-    const double ts = bench.sample_time_s();
-    const double periods = o.exposure_s / ts;
-    const auto per_exposure = static_cast<std::size_t>(std::llround(periods));
-    if (per_exposure < 1 || std::fabs(periods - static_cast<double>(per_exposure)) > 1e-6)
-      throw std::invalid_argument(fmt::format(
-          "phase step: the exposure ({:g} s) must be a whole number of control periods ({:g} s)",
-          o.exposure_s, ts));
-    bench.drive_points(Vec3{z0_um, z0_um, z0_um});
-    bench.run(o.settle_s);
+  const auto run_once = [&](Bench& on, double target_um, Run& run) {
+    on.drive_points(Vec3{z0_um, z0_um, z0_um});
+    on.run(o.settle_s);
 
     // One exposure mean per tick: a boxcar over the last per_exposure period averages.
     std::deque<double> window;
@@ -68,8 +71,8 @@ PhaseStepResult run_phase_step(const io::ProjectConfig& config,
 
     // The hold: exposure means (once the window is full) and their least-squares line.
     std::vector<double> hold_t, hold_v;
-    const double t_hold = bench.time_s();
-    bench.run(o.hold_s, [&](const Bench& b) {
+    const double t_hold = on.time_s();
+    on.run(o.hold_s, [&](const Bench& b) {
       const double v = exposure_mean_nm(b);
       if (window.size() == per_exposure) {
         hold_t.push_back(b.time_s() - t_hold);
@@ -94,23 +97,20 @@ PhaseStepResult run_phase_step(const io::ProjectConfig& config,
       ss += e * e;
     }
     run.hold_jitter_nm_rms = hold_t.size() > 2 ? std::sqrt(ss / (n - 2.0)) : 0.0;
-    const double t_step = bench.time_s();
+    const double t_step = on.time_s();
     const double level_nm = mv + slope * (t_step - t_hold - mt);
-    if (step_um != 0.0)
-      if (const std::string sat = detail::saturation_problem(bench, z0_um); !sat.empty())
+    if (target_um != z0_um)
+      if (const std::string sat = detail::saturation_problem(on, z0_um); !sat.empty())
         r.validity.fail(sat + " before the step");
-    const double z1_um = z0_um + step_um;
-    bench.drive_points(Vec3{z1_um, z1_um, z1_um});
-    bench.run(o.record_s, [&](const Bench& b) {
+    on.drive_points(Vec3{target_um, target_um, target_um});
+    on.run(o.record_s, [&](const Bench& b) {
       run.time_s.push_back(b.time_s() - t_step);
       run.mean_nm.push_back(exposure_mean_nm(b) - level_nm);
     });
-    return per_exposure;
   };
 
-  Bench bench(config, controller, seed, o.bench);
   Run stepped;
-  const std::size_t per_exposure = run_once(bench, 1e-3 * r.step_nm, stepped);
+  run_once(bench, z1_um, stepped);
   r.time_s = stepped.time_s;
   r.exposure_mean_nm = stepped.mean_nm;
   r.hold_jitter_nm_rms = stepped.hold_jitter_nm_rms;
@@ -122,7 +122,6 @@ PhaseStepResult run_phase_step(const io::ProjectConfig& config,
   for (std::size_t k = r.exposure_mean_nm.size() - tail; k < r.exposure_mean_nm.size(); ++k)
     final_nm += r.exposure_mean_nm[k] / static_cast<double>(tail);
   r.final_error_nm = final_nm - r.step_nm;
-  const double z1_um = z0_um + 1e-3 * r.step_nm;
   detail::check_fault(bench, r.validity, "during the phase step");
   if (const std::string sat = detail::saturation_problem(bench, z1_um); !sat.empty())
     r.validity.fail(sat + " at the end of the record");
@@ -136,7 +135,7 @@ PhaseStepResult run_phase_step(const io::ProjectConfig& config,
   // 79 nm in 5 um changes it by 1.6 %, well below the figures' resolution).
   Bench still_bench(config, controller, seed, o.bench);
   Run still;
-  run_once(still_bench, 0.0, still);
+  run_once(still_bench, z0_um, still);
   r.simulated_time_s += still_bench.time_s();
   detail::check_fault(still_bench, r.validity, "during the phase step's run without the step");
   r.still_exposure_mean_nm = still.mean_nm;
