@@ -45,6 +45,25 @@ TEST_F(ProjectConfigTest, PaperTomlGivesExactlyTheDefaults) {
   EXPECT_EQ(c.design.mechanism.moving_mass_kg, 0.05075);
 }
 
+// The what-if twins docs/compare.md measures change exactly the one thing they name.
+TEST_F(ProjectConfigTest, WhatIfConfigsChangeOnlyWhatTheyName) {
+  const ProjectConfig equal =
+      load_project_config(PIEZOSHIFT_SOURCE_DIR "/configs/what-if/equal-legs.toml");
+  plant::TwinParams expected;
+  EXPECT_NE(expected.piezo.free_stroke_scale[1], 1.0);  // the default's short leg
+  expected.piezo.free_stroke_scale = {1.0, 1.0, 1.0};
+  EXPECT_TRUE(equal.twin == expected);
+  EXPECT_TRUE(equal.design == design::DesignInputs{});
+
+  const ProjectConfig still =
+      load_project_config(PIEZOSHIFT_SOURCE_DIR "/configs/what-if/no-excitation-drift.toml");
+  expected = plant::TwinParams{};
+  EXPECT_GT(expected.sgs.excitation_drift_ppm_rms, 0.0);
+  expected.sgs.excitation_drift_ppm_rms = 0.0;
+  EXPECT_TRUE(still.twin == expected);
+  EXPECT_TRUE(still.design == design::DesignInputs{});
+}
+
 TEST_F(ProjectConfigTest, EmptyFileGivesTheDefaults) {
   EXPECT_TRUE(load_project_config(write("")).design == design::DesignInputs{});
 }
