@@ -1,12 +1,13 @@
 # The two commands of the README: `make demo` and `make test`. Each installs what is missing
-# (scripts/install-deps), configures with a CMake preset, builds and runs.
+# (scripts/install-deps), configures with a CMake preset, builds and runs. Compiles go through
+# ccache (cmake/Ccache.cmake), so a rebuild in another folder or preset reuses the objects.
 PRESET ?= release
 JOBS ?= $(shell nproc)
 BUILD_DIR = build/$(PRESET)
 PIEZOSHIFT = $(BUILD_DIR)/apps/piezoshift/piezoshift
 DEMO_OUT ?= out/demo
 
-.PHONY: all deps configure build test demo mcu python python-install sanitize fuzz bench format format-check clean
+.PHONY: all deps configure build test test-fast demo mcu python python-install sanitize fuzz bench format format-check clean
 
 all: build
 
@@ -19,10 +20,19 @@ configure: deps
 build: configure
 	@cmake --build --preset $(PRESET) -j $(JOBS)
 
+# Every tier (unit, integration, acceptance; docs/testing.md). TEST_LABELS narrows it to a
+# regular expression of tiers, as `test-fast` and `sanitize` do.
+TEST_LABELS ?=
 test: build
-	@ctest --preset $(PRESET) -j $(JOBS)
+	@scripts/run-tests $(BUILD_DIR) $(PRESET) $(JOBS) '$(TEST_LABELS)'
 
-demo: build
+# The unit tier only: the edit-compile loop.
+test-fast:
+	@$(MAKE) --no-print-directory test TEST_LABELS=unit
+
+# Builds only what the demo runs: the program (and the dashboard page it carries).
+demo: configure
+	@cmake --build --preset $(PRESET) -j $(JOBS) --target piezoshift_cli
 	@$(PIEZOSHIFT) reproduce --out $(DEMO_OUT)
 
 # The controller in float on a Cortex-M4F under QEMU (docs/mcu.md): cross-builds the firmware,
@@ -43,10 +53,12 @@ python: configure
 python-install: python
 	@cmake --install $(BUILD_DIR) --component python --prefix $(HOME)/.local
 
+# The unit and integration tiers under ASan + UBSan; acceptance runs once, in release (`make test`).
 sanitize:
-	@$(MAKE) --no-print-directory test PRESET=sanitize
+	@$(MAKE) --no-print-directory test PRESET=sanitize TEST_LABELS='unit|integration'
 
-# libFuzzer targets under ASan + UBSan (preset fuzz, clang; docs/fuzzing.md), FUZZ_SECONDS each.
+# libFuzzer targets under ASan + UBSan (the `sanitize` build, clang; docs/fuzzing.md), FUZZ_SECONDS
+# each, JOBS at a time.
 FUZZ_SECONDS ?= 60
 fuzz: deps
 	@FUZZ_SECONDS=$(FUZZ_SECONDS) JOBS=$(JOBS) scripts/fuzz

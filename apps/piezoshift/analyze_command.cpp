@@ -11,6 +11,7 @@
 // with gnuplot (PNG, or SVG for a .svg name) and keeps its .gp script and .dat data beside it.
 #include <algorithm>
 #include <cmath>
+#include <filesystem>
 #include <memory>
 #include <string>
 #include <vector>
@@ -56,6 +57,10 @@ auto with_file(const std::string& path, F&& metric) {
 int draw(const AnalyzeOptions& o, const io::Figure& figure) {
   if (o.plot_path.empty())
     return 0;
+  // A folder is not a figure's name: it was `internal error: plot: empty output name` (issue 27).
+  if (!std::filesystem::path(o.plot_path).has_filename())
+    throw io::InputError(fmt::format("--plot {}: names a folder; give a file, e.g. {}figure.png",
+                                     o.plot_path, o.plot_path));
   io::Figure f = figure;
   const bool svg = o.plot_path.size() > 4 && o.plot_path.ends_with(".svg");
   f.png = !svg;

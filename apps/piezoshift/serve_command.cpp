@@ -7,9 +7,9 @@
 // Exit status: 0 stopped by SIGINT/SIGTERM or --duration-s; 2 bad input (including an address
 // that cannot be bound or a DAQ device that cannot be opened); 1 internal error.
 #include <cmath>
+#include <cstdint>
 #include <cstdio>
 #include <exception>
-#include <fstream>
 #include <limits>
 #include <memory>
 #include <mutex>
@@ -32,6 +32,7 @@
 #include "piezoshift/host/locked_line_handler.hpp"
 #include "piezoshift/host/stage_model.hpp"
 #include "piezoshift/io/input_error.hpp"
+#include "piezoshift/io/input_file.hpp"
 #include "piezoshift/io/project_config.hpp"
 #include "piezoshift/runtime/control_loop.hpp"
 #include "piezoshift/runtime/csv_logger.hpp"
@@ -80,15 +81,23 @@ void check(bool ok, const std::string& message) {
     throw io::InputError(message);
 }
 
+// A token file holds one line; it is read as every input file is (a regular file, bounded), so
+// /dev/zero or a FIFO is refused at once instead of exhausting memory or hanging the start-up.
+constexpr std::uintmax_t kMaxTokenFileBytes = 64u << 10;
+
 // --http-token, or the first line of --http-token-file (without surrounding blanks).
 std::string http_token(const ServeOptions& o) {
   check(o.http_token.empty() || o.http_token_file.empty(),
         "--http-token and --http-token-file: give one of them");
   std::string token = o.http_token;
   if (!o.http_token_file.empty()) {
-    std::ifstream in(o.http_token_file);
-    check(in.good(), fmt::format("--http-token-file {}: cannot read it", o.http_token_file));
-    std::getline(in, token);
+    std::string text;
+    try {
+      text = io::read_input_file(o.http_token_file, kMaxTokenFileBytes);
+    } catch (const io::InputError& e) {
+      check(false, fmt::format("--http-token-file: {}", e.what()));
+    }
+    token = text.substr(0, text.find('\n'));
     const auto blank = [](char c) { return c == ' ' || c == '\t' || c == '\r'; };
     while (!token.empty() && blank(token.back()))
       token.pop_back();

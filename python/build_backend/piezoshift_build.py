@@ -13,6 +13,7 @@ Environment:
 
 import base64
 import hashlib
+import json
 import os
 import pathlib
 import subprocess
@@ -40,17 +41,61 @@ def _metadata():
             "Requires-Python: >=3.9\nRequires-Dist: numpy\n" % (NAME, VERSION, SUMMARY))
 
 
+def _check_interpreter():
+    """Fails with the reason when this interpreter cannot build or use the package.
+
+    The extension is compiled against the running interpreter's headers with Debian's pybind11
+    and imported with its numpy; pip itself would only say "No matching distribution found for
+    numpy" when another Python (pyenv, a conda one) comes first on PATH, since it cannot
+    download anything here."""
+    missing = []
+    # In a child without pip's build-isolation paths: numpy is needed where the package runs.
+    env = {k: v for k, v in os.environ.items()
+           if k not in ("PYTHONPATH", "PYTHONNOUSERSITE", "PYTHONHOME")}
+    if subprocess.run([sys.executable, "-c", "import numpy"], env=env,
+                      stdout=subprocess.DEVNULL, stderr=subprocess.DEVNULL).returncode != 0:
+        missing.append("numpy (Debian's python3-numpy, seen through --system-site-packages)")
+    include = pathlib.Path(sysconfig.get_paths()["include"]) / "Python.h"
+    if not include.exists():
+        missing.append("the Python headers %s (Debian's python3-dev)" % include)
+    pybind11 = [pathlib.Path(p) / "pybind11" / "pybind11Config.cmake"
+                for p in ("/usr/lib/cmake", "/usr/share/cmake", "/usr/local/lib/cmake")]
+    if not any(p.exists() for p in pybind11):
+        missing.append("pybind11 (Debian's pybind11-dev)")
+    if missing:
+        raise RuntimeError(
+            "piezoshift: cannot build for %s: missing %s. Build with Debian's Python: "
+            "`/usr/bin/python3 -m venv --system-site-packages .venv && .venv/bin/pip install .` "
+            "after scripts/install-deps (docs/python.md)." % (sys.executable, "; ".join(missing)))
+
+
+def _release_preset_variables():
+    """The cacheVariables of CMakePresets.json's `release` preset, inherited ones included."""
+    presets = {p["name"]: p for p in
+               json.loads((_SOURCE / "CMakePresets.json").read_text())["configurePresets"]}
+    variables = {}
+
+    def collect(name):
+        preset = presets[name]
+        inherits = preset.get("inherits", [])
+        for parent in [inherits] if isinstance(inherits, str) else inherits:
+            collect(parent)
+        variables.update(preset.get("cacheVariables", {}))
+
+    collect("release")
+    return variables
+
+
 def _build_package():
     """Runs CMake; returns the directory holding the importable package."""
+    _check_interpreter()
     build = pathlib.Path(os.environ.get("PIEZOSHIFT_PIP_BUILD_DIR", _SOURCE / "build" / "pip"))
-    configure = [
-        "cmake", "-S", str(_SOURCE), "-B", str(build), "-G", "Ninja",
-        # The flags of the `release` preset, so that ccache (when set up) reuses `make`'s objects;
-        # the debug info is stripped from the wheel.
-        "-DCMAKE_BUILD_TYPE=RelWithDebInfo", "-DPIEZOSHIFT_BUILD_TESTS=OFF",
-        "-DPIEZOSHIFT_BUILD_BENCH=OFF", "-DPIEZOSHIFT_BUILD_PYTHON=ON",
-        "-DPython3_EXECUTABLE=" + sys.executable,
-    ]
+    configure = ["cmake", "-S", str(_SOURCE), "-B", str(build), "-G", "Ninja"]
+    # The cache variables of the `release` preset, so that ccache (cmake/Ccache.cmake) reuses the
+    # objects `make` compiled; the debug info is stripped from the wheel.
+    configure += ["-D%s=%s" % kv for kv in sorted(_release_preset_variables().items())]
+    configure += ["-DPIEZOSHIFT_BUILD_TESTS=OFF", "-DPIEZOSHIFT_BUILD_BENCH=OFF",
+                  "-DPIEZOSHIFT_BUILD_PYTHON=ON", "-DPython3_EXECUTABLE=" + sys.executable]
     subprocess.run(configure, check=True, stdout=sys.stderr)
     subprocess.run(["cmake", "--build", str(build), "--target", "_piezoshift"], check=True,
                    stdout=sys.stderr)
@@ -90,6 +135,8 @@ def get_requires_for_build_editable(config_settings=None):
 
 
 def prepare_metadata_for_build_wheel(metadata_directory, config_settings=None):
+    # Before pip resolves the numpy dependency, which it cannot download here.
+    _check_interpreter()
     dist_info = pathlib.Path(metadata_directory) / ("%s-%s.dist-info" % (NAME, VERSION))
     dist_info.mkdir(parents=True, exist_ok=True)
     (dist_info / "METADATA").write_text(_metadata())

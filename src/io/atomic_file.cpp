@@ -43,6 +43,18 @@ void remove_stale_temporaries(const std::filesystem::path& dir, const std::strin
       ::unlink(it->path().c_str());
   }
 }
+
+// The temporary is created, never opened if it exists (O_EXCL) nor through a symlink
+// (O_NOFOLLOW): a symlink planted at ".NAME.tmp.PID" made `calibrate --out` overwrite the file it
+// pointed to. One already there (a file of an earlier process with this PID, or a planted link)
+// is unlinked, which removes a link and not its target, and the create tried once more.
+int create_temporary(const std::string& tmp) {
+  constexpr int kFlags = O_WRONLY | O_CREAT | O_EXCL | O_NOFOLLOW | O_CLOEXEC;
+  int fd = ::open(tmp.c_str(), kFlags, 0644);
+  if (fd < 0 && errno == EEXIST && ::unlink(tmp.c_str()) == 0)
+    fd = ::open(tmp.c_str(), kFlags, 0644);
+  return fd;
+}
 }  // namespace
 
 void write_file_atomically(const std::string& path, std::string_view contents) {
@@ -53,7 +65,7 @@ void write_file_atomically(const std::string& path, std::string_view contents) {
       (dir / fmt::format(".{}.tmp.{}", target.filename().string(), ::getpid())).string();
   remove_stale_temporaries(dir, target.filename().string());
 
-  const int fd = ::open(tmp.c_str(), O_WRONLY | O_CREAT | O_TRUNC | O_CLOEXEC, 0644);
+  const int fd = create_temporary(tmp);
   if (fd < 0)
     fail(path, "create temporary file", errno);
   const char* p = contents.data();

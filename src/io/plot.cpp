@@ -23,14 +23,24 @@ namespace {
 constexpr const char* kPalette[] = {"#1f77b4", "#d62728", "#2ca02c", "#ff7f0e",
                                     "#9467bd", "#8c564b", "#e377c2", "#7f7f7f"};
 
-// gnuplot single-quoted string: '' stands for one quote; no line breaks.
+// Text that must stay on one line of the script or the data file: a line break (or any other
+// control character) in a title or a file name would end the comment or string it is in and put
+// the rest into gnuplot's command stream, where `system` runs a shell (issue 27).
+std::string one_line(std::string_view s) {
+  std::string out;
+  out.reserve(s.size());
+  for (char ch : s)
+    out += (static_cast<unsigned char>(ch) < 0x20 || ch == 0x7f) ? ' ' : ch;
+  return out;
+}
+
+// gnuplot single-quoted string: '' stands for one quote, and nothing else is special in it
+// (a backslash is a backslash); on one line.
 std::string gp_quote(std::string_view s) {
   std::string out = "'";
-  for (char ch : s) {
+  for (char ch : one_line(s)) {
     if (ch == '\'')
       out += "''";
-    else if (ch == '\n' || ch == '\r')
-      out += ' ';
     else
       out += ch;
   }
@@ -63,6 +73,12 @@ void validate(const Figure& f) {
   for (const Panel& p : f.panels) {
     if (p.series.empty())
       throw std::invalid_argument(fmt::format("plot: panel '{}' has no series", p.title));
+    // The key's position is written into the script as it is (`set key bottom right`): words
+    // and numbers only, nothing that could end the command (a line break, `;`, a quote).
+    if (p.key.find_first_not_of("abcdefghijklmnopqrstuvwxyzABCDEFGHIJKLMNOPQRSTUVWXYZ0123456789_"
+                                " .,+-") != std::string::npos)
+      throw std::invalid_argument(fmt::format("plot: key position '{}' of panel '{}' is not words",
+                                              one_line(p.key), one_line(p.title)));
     for (const Series& s : p.series) {
       if (p.x_log) {
         for (const double x : s.x) {
@@ -227,12 +243,12 @@ PlotFiles write_plot_files(const Figure& figure, const fs::path& stem_in) {
   files.data = fs::path(stem).concat(".dat");
   files.script = fs::path(stem).concat(".gp");
 
-  std::string data =
-      fmt::format("# piezoshift figure data for {}.gp: one index block per series\n", name);
+  std::string data = fmt::format("# piezoshift figure data for {}.gp: one index block per series\n",
+                                 one_line(name));
   int index = 0;
   for (std::size_t pi = 0; pi < figure.panels.size(); ++pi) {
     for (const Series& s : figure.panels[pi].series) {
-      data += fmt::format("# index {}: panel {}, '{}'\n", index++, pi + 1, s.title);
+      data += fmt::format("# index {}: panel {}, '{}'\n", index++, pi + 1, one_line(s.title));
       for (std::size_t i = 0; i < s.x.size(); ++i) {
         data += number(s.x[i]) + ' ' + number(s.y[i]);
         if (!s.w.empty())
@@ -250,7 +266,8 @@ PlotFiles write_plot_files(const Figure& figure, const fs::path& stem_in) {
       "# Redraw after editing: run `gnuplot {}.gp` in this folder.\n"
       "datafile = {}\n"
       "set encoding utf8\n",
-      figure.title.empty() ? "" : ": ", figure.title, name, gp_quote(name + ".dat"));
+      figure.title.empty() ? "" : ": ", one_line(figure.title), one_line(name),
+      gp_quote(name + ".dat"));
   const std::string size = fmt::format("size {},{}", figure.width_px, figure.height_px);
   if (figure.png) {
     script += fmt::format(

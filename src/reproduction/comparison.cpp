@@ -255,130 +255,124 @@ std::vector<std::string> ComparisonResult::invalid_reasons() const {
   return out;
 }
 
-ComparisonResult compare(const io::ProjectConfig& config, const CompareOptions& options,
-                         const experiments::Progress& progress) {
-  if (options.seeds.empty())
-    throw std::invalid_argument("compare: no seed");
-  const auto start = std::chrono::steady_clock::now();
-  ComparisonResult r;
-  r.options = options;
-  r.schedule = options.quick ? Schedule::quick() : Schedule::paper();
-  r.figures = comparison_figures(config);
-  const Schedule& s = r.schedule;
-  const Schedule oracle_schedule = with_feedback(s, experiments::Feedback::kOracle);
-  control::SemiClosedLoopParams base{};
-  base.sample_time_s = config.twin.daq.sample_time_s;  // as reproduce(): the DAQ's rate
+namespace {
 
-  for (const std::uint64_t seed : options.seeds) {
-    SeedComparison& sc = r.seeds.emplace_back();
-    sc.seed = seed;
-    const auto labelled = [&](ControllerKind k) -> experiments::Progress {
-      if (!progress)
-        return {};
-      return [&progress, seed, k](double done, double total, std::string_view label) {
-        progress(done, total, fmt::format("seed {} {}: {}", seed, controller_key(k), label));
-      };
-    };
-    // Each controller calibrated by its own procedure; a calibration that cannot finish makes
-    // that controller's seed not valid, the others still run.
-    ControllerRun& paper = sc.runs[0];
-    ControllerRun& improved = sc.runs[1];
-    ControllerRun& oracle = sc.runs[2];
-    double paper_calibration_s = 0.0;
+// How a calibration that cannot finish is reported: that controller's seed is not valid, the
+// others still run.
+template <class Calibrate>
+void calibrate_or_fail(Validity& validity, const char* what, Calibrate&& calibrate) {
+  try {
+    calibrate();
+  } catch (const experiments::ProcedureFailed& e) {
+    validity.fail(fmt::format("{}: {}", what, e.what()));
+  } catch (const calibration::FitError& e) {  // the twin's records, not the user's input
+    validity.fail(fmt::format("{}: a fit failed: {}", what, e.what()));
+  }
+}
+
+// The 10 kHz figures of the paper's or the improved controller: its inner loop at 10 kHz and
+// the lambda/8 step with the loop at that rate.
+void run_at_10kHz(const io::ProjectConfig& config, const control::SemiClosedLoopParams& base,
+                  std::uint64_t seed, const Schedule& s, ControllerKind k, ControllerRun& run,
+                  const experiments::Progress& progress) {
+  // The paper's gains are re-expressed per sample at 10 kHz (as reproduce() does); the
+  // improved controller's models are sampled at their rate, so its own procedure calibrates
+  // it again there (same seeds) for the 10 kHz figures.
+  control::SemiClosedLoopParams fast = run.controller;
+  io::ProjectConfig at = config;
+  at.twin.daq.sample_time_s = fast.sample_time_s = kFastSampleTime_s;
+  // The interferometer's dynamic mode at the loop's rate (an XL-80 samples up to 50 kHz),
+  // so the improved calibration sees the plate's mode below its Nyquist frequency.
+  at.twin.interferometer.dynamic_sample_rate_Hz =
+      std::max(at.twin.interferometer.dynamic_sample_rate_Hz, 1.0 / kFastSampleTime_s);
+  if (k == ControllerKind::kImproved && config.twin.daq.sample_time_s != kFastSampleTime_s) {
     try {
-      const calibration::CalibrationOutcome cal = calibration::calibrate(
-          config, base, seed, s.calibration, labelled(ControllerKind::kPaper));
-      paper.controller = cal.controller;
-      paper_calibration_s =
-          cal.pid.simulated_time_s + cal.matrix.simulated_time_s + cal.polynomial.simulated_time_s;
-    } catch (const experiments::ProcedureFailed& e) {
-      paper.calibration.fail(fmt::format("calibration: {}", e.what()));
-    } catch (const calibration::FitError& e) {  // the twin's records, not the user's input
-      paper.calibration.fail(fmt::format("calibration: a fit failed: {}", e.what()));
-    }
-    try {
+      control::SemiClosedLoopParams fast_base = base;
+      fast_base.sample_time_s = kFastSampleTime_s;
       calibration::ImprovedCalibrationOptions io_opts;
       io_opts.paper = s.calibration;
-      const calibration::ImprovedCalibrationOutcome cal = calibration::calibrate_improved(
-          config, base, seed, io_opts, labelled(ControllerKind::kImproved));
-      improved.controller = cal.controller;
-      const auto& m = cal.static_map;
-      improved.simulated_time_s =
-          m.pid.simulated_time_s + m.matrix.simulated_time_s + m.polynomial.simulated_time_s;
-    } catch (const experiments::ProcedureFailed& e) {
-      improved.calibration.fail(fmt::format("calibration: {}", e.what()));
-    } catch (const calibration::FitError& e) {  // the twin's records, not the user's input
-      improved.calibration.fail(fmt::format("calibration: a fit failed: {}", e.what()));
+      calibrate_or_fail(run.phase_step_10kHz.validity, "calibration at 10 kHz", [&] {
+        fast = calibration::calibrate_improved(at, fast_base, seed, io_opts, progress).controller;
+      });
+    } catch (const std::invalid_argument& e) {  // the twin cannot run at 10 kHz
+      run.phase_step_10kHz.validity.fail(e.what());
     }
-    oracle.calibration = paper.calibration;
-    oracle.controller = paper.controller;
-    oracle.controller.polynomial = control::CubicPolynomial::identity();
-    paper.simulated_time_s = paper_calibration_s;
-
-    for (ControllerKind k : kControllerKinds) {
-      ControllerRun& run = sc.runs[static_cast<std::size_t>(k)];
-      if (!run.calibration.valid)
-        continue;
-      const bool is_oracle = k == ControllerKind::kOracle;
-      run.set = run_experiment_set(config, run.controller, seed, is_oracle ? oracle_schedule : s,
-                                   labelled(k));
-      run.simulated_time_s += run.set.experiments_simulated_time_s();
-      if (is_oracle)
-        continue;
-      run.inner_loop = analyze_inner_loop(config, run.controller, seed);
-      // The paper's gains are re-expressed per sample at 10 kHz (as reproduce() does); the
-      // improved controller's models are sampled at their rate, so its own procedure calibrates
-      // it again there (same seeds) for the 10 kHz figures.
-      control::SemiClosedLoopParams fast = run.controller;
-      io::ProjectConfig at = config;
-      at.twin.daq.sample_time_s = fast.sample_time_s = kFastSampleTime_s;
-      // The interferometer's dynamic mode at the loop's rate (an XL-80 samples up to 50 kHz),
-      // so the improved calibration sees the plate's mode below its Nyquist frequency.
-      at.twin.interferometer.dynamic_sample_rate_Hz =
-          std::max(at.twin.interferometer.dynamic_sample_rate_Hz, 1.0 / kFastSampleTime_s);
-      if (k == ControllerKind::kImproved && config.twin.daq.sample_time_s != kFastSampleTime_s) {
-        try {
-          control::SemiClosedLoopParams fast_base = base;
-          fast_base.sample_time_s = kFastSampleTime_s;
-          calibration::ImprovedCalibrationOptions io_opts;
-          io_opts.paper = s.calibration;
-          fast =
-              calibration::calibrate_improved(at, fast_base, seed, io_opts, labelled(k)).controller;
-        } catch (const std::invalid_argument& e) {  // the twin cannot run at 10 kHz
-          run.phase_step_10kHz.validity.fail(e.what());
-        } catch (const experiments::ProcedureFailed& e) {
-          run.phase_step_10kHz.validity.fail(fmt::format("calibration at 10 kHz: {}", e.what()));
-        } catch (const calibration::FitError& e) {
-          run.phase_step_10kHz.validity.fail(
-              fmt::format("calibration at 10 kHz: a fit failed: {}", e.what()));
-        }
-      }
-      run.ran_10kHz = true;
-      if (!run.phase_step_10kHz.validity.valid) {
-        for (InnerLoopAnalysis& a : run.inner_loop)
-          if (a.sample_time_s == kFastSampleTime_s)
-            a.validity.fail(run.phase_step_10kHz.validity.reason);
-        continue;
-      }
-      for (std::size_t i = 0; i < run.inner_loop.size(); ++i) {
-        if (run.inner_loop[i].sample_time_s == kFastSampleTime_s && k == ControllerKind::kImproved)
-          run.inner_loop[i] = analyze_inner_loop_at(config, fast, kFastSampleTime_s, seed + 90 + i);
-      }
-      run.phase_step_10kHz =
-          phase_step_at_10kHz(config, fast, seed + 85, s.phase_step, labelled(k));
-      run.simulated_time_s += run.phase_step_10kHz.simulated_time_s;
-    }
-    for (const ControllerRun& run : sc.runs)
-      r.simulated_time_s += run.simulated_time_s;
   }
-
-  for (std::size_t i = 0; i < r.figures.size(); ++i) {
-    std::array<FigureValue, 3>& m = r.medians.emplace_back();
-    for (ControllerKind k : kControllerKinds)
-      m[static_cast<std::size_t>(k)] = median_over_seeds(r.per_seed(i, k), options.seeds);
+  run.ran_10kHz = true;
+  if (!run.phase_step_10kHz.validity.valid) {
+    for (InnerLoopAnalysis& a : run.inner_loop)
+      if (a.sample_time_s == kFastSampleTime_s)
+        a.validity.fail(run.phase_step_10kHz.validity.reason);
+    return;
   }
+  for (std::size_t i = 0; i < run.inner_loop.size(); ++i) {
+    if (run.inner_loop[i].sample_time_s == kFastSampleTime_s && k == ControllerKind::kImproved)
+      run.inner_loop[i] = analyze_inner_loop_at(config, fast, kFastSampleTime_s, seed + 90 + i);
+  }
+  run.phase_step_10kHz = phase_step_at_10kHz(config, fast, seed + 85, s.phase_step, progress);
+  run.simulated_time_s += run.phase_step_10kHz.simulated_time_s;
+}
 
-  // Issue 12's done-when criteria.
+// The three controllers on one seed, each calibrated by its own procedure.
+SeedComparison compare_seed(const io::ProjectConfig& config, std::uint64_t seed, const Schedule& s,
+                            const experiments::Progress& progress) {
+  control::SemiClosedLoopParams base{};
+  base.sample_time_s = config.twin.daq.sample_time_s;  // as reproduce(): the DAQ's rate
+  SeedComparison sc;
+  sc.seed = seed;
+  const auto labelled = [&](ControllerKind k) -> experiments::Progress {
+    if (!progress)
+      return {};
+    return [&progress, seed, k](double done, double total, std::string_view label) {
+      progress(done, total, fmt::format("seed {} {}: {}", seed, controller_key(k), label));
+    };
+  };
+  ControllerRun& paper = sc.runs[0];
+  ControllerRun& improved = sc.runs[1];
+  ControllerRun& oracle = sc.runs[2];
+  double paper_calibration_s = 0.0;
+  calibrate_or_fail(paper.calibration, "calibration", [&] {
+    const calibration::CalibrationOutcome cal =
+        calibration::calibrate(config, base, seed, s.calibration, labelled(ControllerKind::kPaper));
+    paper.controller = cal.controller;
+    paper_calibration_s =
+        cal.pid.simulated_time_s + cal.matrix.simulated_time_s + cal.polynomial.simulated_time_s;
+  });
+  calibrate_or_fail(improved.calibration, "calibration", [&] {
+    calibration::ImprovedCalibrationOptions io_opts;
+    io_opts.paper = s.calibration;
+    const calibration::ImprovedCalibrationOutcome cal = calibration::calibrate_improved(
+        config, base, seed, io_opts, labelled(ControllerKind::kImproved));
+    improved.controller = cal.controller;
+    const auto& m = cal.static_map;
+    improved.simulated_time_s =
+        m.pid.simulated_time_s + m.matrix.simulated_time_s + m.polynomial.simulated_time_s;
+  });
+  oracle.calibration = paper.calibration;
+  oracle.controller = paper.controller;
+  oracle.controller.polynomial = control::CubicPolynomial::identity();
+  paper.simulated_time_s = paper_calibration_s;
+
+  const Schedule oracle_schedule = with_feedback(s, experiments::Feedback::kOracle);
+  for (ControllerKind k : kControllerKinds) {
+    ControllerRun& run = sc.runs[static_cast<std::size_t>(k)];
+    if (!run.calibration.valid)
+      continue;
+    const bool is_oracle = k == ControllerKind::kOracle;
+    run.set = run_experiment_set(config, run.controller, seed, is_oracle ? oracle_schedule : s,
+                                 labelled(k));
+    run.simulated_time_s += run.set.experiments_simulated_time_s();
+    if (is_oracle)
+      continue;
+    run.inner_loop = analyze_inner_loop(config, run.controller, seed);
+    run_at_10kHz(config, base, seed, s, k, run, labelled(k));
+  }
+  return sc;
+}
+
+// Issue 12's done-when criteria, as restated: absolute bounds, then bounds relative to the
+// oracle's median, then travel and the margins at the config's loop rates.
+std::vector<Target> comparison_targets(const io::ProjectConfig& config, const ComparisonResult& r) {
   const auto index_of = [&](const std::string& key) -> std::size_t {
     for (std::size_t i = 0; i < r.figures.size(); ++i)
       if (r.figures[i].key == key)
@@ -398,7 +392,6 @@ ComparisonResult compare(const io::ProjectConfig& config, const CompareOptions& 
       target("linearity, unseen 0.25 um grid", "linearity_grid_zero_end_pct", 0.02, false,
              "<= 0.02 %"),
   };
-  // Relative to the oracle's median: the bound is known once the oracle's median is.
   struct Relative {
     const char* text;
     const char* key;
@@ -440,7 +433,43 @@ ComparisonResult compare(const io::ProjectConfig& config, const CompareOptions& 
     x.met = x.improved.measured && x.improved.validity.valid && std::isfinite(x.bound) &&
             (x.at_least ? v >= x.bound : v <= x.bound);
   }
-  r.targets = std::move(t);
+  return t;
+}
+
+}  // namespace
+
+ComparisonResult summarize_comparison(const io::ProjectConfig& config,
+                                      const CompareOptions& options,
+                                      std::vector<SeedComparison> seeds) {
+  if (seeds.size() != options.seeds.size())
+    throw std::invalid_argument("summarize_comparison: one SeedComparison per seed of the options");
+  ComparisonResult r;
+  r.options = options;
+  r.schedule = options.quick ? Schedule::quick() : Schedule::paper();
+  r.figures = comparison_figures(config);
+  r.seeds = std::move(seeds);
+  for (const SeedComparison& sc : r.seeds)
+    for (const ControllerRun& run : sc.runs)
+      r.simulated_time_s += run.simulated_time_s;
+  for (std::size_t i = 0; i < r.figures.size(); ++i) {
+    std::array<FigureValue, 3>& m = r.medians.emplace_back();
+    for (ControllerKind k : kControllerKinds)
+      m[static_cast<std::size_t>(k)] = median_over_seeds(r.per_seed(i, k), options.seeds);
+  }
+  r.targets = comparison_targets(config, r);
+  return r;
+}
+
+ComparisonResult compare(const io::ProjectConfig& config, const CompareOptions& options,
+                         const experiments::Progress& progress) {
+  if (options.seeds.empty())
+    throw std::invalid_argument("compare: no seed");
+  const auto start = std::chrono::steady_clock::now();
+  const Schedule schedule = options.quick ? Schedule::quick() : Schedule::paper();
+  std::vector<SeedComparison> seeds;
+  for (const std::uint64_t seed : options.seeds)
+    seeds.push_back(compare_seed(config, seed, schedule, progress));
+  ComparisonResult r = summarize_comparison(config, options, std::move(seeds));
   r.wall_time_s = std::chrono::duration<double>(std::chrono::steady_clock::now() - start).count();
   return r;
 }

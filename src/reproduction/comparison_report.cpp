@@ -1,5 +1,6 @@
 #include "piezoshift/reproduction/comparison_report.hpp"
 
+#include <algorithm>
 #include <cmath>
 #include <system_error>
 
@@ -250,14 +251,21 @@ ReportFiles write_comparison_report(const ComparisonResult& r, const fs::path& d
   write_text(dir / "comparison.json", comparison_json(r).dump(2) + "\n");
   files.data.push_back(dir / "comparison.json");
 
-  const SeedComparison& first = r.seeds.front();
-  const io::Figure figs[] = {step_figure(first),
-                             phase_step_figure(first, r.schedule.phase_step.tolerance_nm),
-                             linearity_error_figure(first), repeatability_figure(first)};
-  const char* const stems[] = {"compare_step_response", "compare_phase_step",
-                               "compare_linearity_error", "compare_repeatability"};
-  for (std::size_t i = 0; i < 4; ++i)
-    files.figures.push_back(*io::render(figs[i], dir / stems[i]).png);
+  // The figures show the first seed on which a controller was calibrated; none when no
+  // controller was on any seed (then there is nothing to draw, and the report says so).
+  const auto drawn = std::find_if(r.seeds.begin(), r.seeds.end(), [](const SeedComparison& sc) {
+    return std::any_of(sc.runs.begin(), sc.runs.end(),
+                       [](const ControllerRun& run) { return run.calibration.valid; });
+  });
+  if (drawn != r.seeds.end()) {
+    const io::Figure figs[] = {step_figure(*drawn),
+                               phase_step_figure(*drawn, r.schedule.phase_step.tolerance_nm),
+                               linearity_error_figure(*drawn), repeatability_figure(*drawn)};
+    const char* const stems[] = {"compare_step_response", "compare_phase_step",
+                                 "compare_linearity_error", "compare_repeatability"};
+    for (std::size_t i = 0; i < 4; ++i)
+      files.figures.push_back(*io::render(figs[i], dir / stems[i]).png);
+  }
 
   std::vector<Block> doc;
   auto h = [&](int level, std::string t) {
@@ -308,11 +316,16 @@ ReportFiles write_comparison_report(const ComparisonResult& r, const fs::path& d
   }
   table(std::move(trows));
 
-  h(2, fmt::format("Figures (seed {})", first.seed));
-  image("The 11 um step of the three controllers", "compare_step_response.png");
-  image("The lambda/8 phase step on 1 ms exposure means", "compare_phase_step.png");
-  image("Linearity error curves", "compare_linearity_error.png");
-  image("Repeatability histograms at 5 and 10 um", "compare_repeatability.png");
+  if (drawn != r.seeds.end()) {
+    h(2, fmt::format("Figures (seed {})", drawn->seed));
+    image("The 11 um step of the three controllers", "compare_step_response.png");
+    image("The lambda/8 phase step on 1 ms exposure means", "compare_phase_step.png");
+    image("Linearity error curves", "compare_linearity_error.png");
+    image("Repeatability histograms at 5 and 10 um", "compare_repeatability.png");
+  } else {
+    h(2, "Figures");
+    p("None: no controller was calibrated on any seed, so no experiment ran.");
+  }
 
   h(2, "Per seed");
   std::vector<std::vector<std::string>> srows{{"seed", "figure", "paper", "improved", "oracle"}};

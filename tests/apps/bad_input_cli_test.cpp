@@ -27,6 +27,13 @@ class BadInput : public piezoshift::testing::CliTest {
   }
 };
 
+// Issue 27: `--plot somedir/` was an internal error.
+TEST_F(BadInput, APlotPathThatNamesAFolderIsRefusedNamingTheOption) {
+  const std::string data = write("lin.csv", "zd_um,measured_um\n0,0\n1,1.001\n2,2\n");
+  refused("analyze linearity --data '" + data + "' --plot '" + dir() + "/'",
+          {"--plot " + dir() + "/", "names a folder"});
+}
+
 TEST_F(BadInput, RepeatabilityOfDataSpreadOverMicronsIsComputedAndOverflowIsRefused) {
   std::string wide = "measured_um\n";
   for (int i = 0; i <= 11; ++i)

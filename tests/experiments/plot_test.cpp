@@ -123,6 +123,37 @@ TEST(Plot, MissingGnuplotIsAClearError) {
   }
 }
 
+// Issue 27: a data file's name with a line break, written unescaped into a comment of the script,
+// put its next line into gnuplot's command stream, and gnuplot's `system` ran a shell. Titles,
+// labels and names with line breaks, quotes and backslashes stay inside their comment or string.
+TEST(Plot, NoTitleLabelOrNameReachesGnuplotsCommandStream) {
+  const fs::path dir = temp_dir("hostile");
+  const fs::path pwned = dir / "PWNED";
+  const std::string hostile =
+      "a\nsystem('touch " + pwned.string() + "')\r\n# b' \\' c\\\n!touch " + pwned.string();
+  Figure f = two_panel_figure();
+  f.title = hostile;
+  f.panels[0].title = f.panels[0].x_label = f.panels[0].y_label = hostile;
+  f.panels[0].series[0].title = hostile;
+  f.panels[0].markers[0].label = hostile;
+  const PlotFiles files = write_plot_files(f, dir / "fig");
+  for (const fs::path& p : {files.script, files.data}) {
+    std::istringstream lines(read(p));
+    for (std::string line; std::getline(lines, line);) {
+      EXPECT_NE(line.rfind("system", 0), 0U) << p << ": " << line;
+      EXPECT_NE(line.rfind("!", 0), 0U) << p << ": " << line;
+    }
+  }
+  // A key position is written as it is, so it must be words.
+  Figure bad = two_panel_figure();
+  bad.panels[0].key = "top\nsystem('id')";
+  EXPECT_THROW(write_plot_files(bad, dir / "bad"), std::invalid_argument);
+  if (!find_gnuplot())
+    return;  // the script's lines were checked; drawing needs gnuplot
+  render(f, dir / "fig");
+  EXPECT_FALSE(fs::exists(pwned));
+}
+
 TEST(Plot, HistogramBinsAlignOnMultiplesOfTheWidth) {
   const std::vector<double> v{0.1, 0.2, 2.7, 2.9, 1.0, -0.5};
   const Series s = histogram_series("h", v, 1.0);

@@ -3,11 +3,15 @@
 // and 10 event streams beside GCS round trips. As in serve_test.cpp the overrun rule is lifted
 // so that a loaded machine cannot turn a test into a fault run.
 #include <signal.h>
+#include <sys/stat.h>
+#include <unistd.h>
 
 #include <algorithm>
 #include <atomic>
 #include <chrono>
 #include <cmath>
+#include <cstdio>
+#include <filesystem>
 #include <functional>
 #include <regex>
 #include <string>
@@ -146,6 +150,33 @@ TEST(DashboardOptions, ANonLoopbackBindWithoutATokenIsRefusedAtStartUp) {
                           ">/dev/null 2>&1";
   const int status = std::system(cmd.c_str());
   EXPECT_EQ(WEXITSTATUS(status), 2);
+}
+
+// Issue 27: a token file is read as every input file is. /dev/zero grew the process to 2 GB before
+// `internal error: std::bad_alloc`, and a FIFO hung the start-up; each is now refused at once,
+// with exit 2 and the file named, before the loop starts.
+TEST(DashboardOptions, ATokenFileThatIsNotASmallRegularFileIsRefusedNamingIt) {
+  const std::string fifo = (std::filesystem::temp_directory_path() /
+                            ("piezoshift_token_fifo_" + std::to_string(::getpid())))
+                               .string();
+  ::unlink(fifo.c_str());
+  ASSERT_EQ(::mkfifo(fifo.c_str(), 0600), 0);
+  for (const std::string& file : {std::string("/dev/zero"), fifo}) {
+    const std::string cmd = std::string("'") + PIEZOSHIFT_CLI +
+                            "' serve --port 0 --http-port 0 --duration-s 1 --http-token-file '" +
+                            file + "' 2>&1 >/dev/null";
+    FILE* pipe = ::popen(cmd.c_str(), "r");
+    ASSERT_NE(pipe, nullptr);
+    std::string err;
+    char buf[256];
+    while (std::fgets(buf, sizeof buf, pipe) != nullptr)
+      err += buf;
+    const int status = ::pclose(pipe);
+    EXPECT_EQ(WEXITSTATUS(status), 2) << file << ": " << err;
+    EXPECT_NE(err.find(file), std::string::npos) << err;
+    EXPECT_EQ(err.find("internal error"), std::string::npos) << err;
+  }
+  ::unlink(fifo.c_str());
 }
 
 TEST_F(Dashboard, DashboardAndGcsMoveTheSameStage) {

@@ -119,30 +119,6 @@ TEST(Comparison, TargetsRelativeToTheOracleUseItsMedian) {
   EXPECT_TRUE(found);
 }
 
-FigureValue value(double v) {
-  FigureValue f;
-  f.value = v;
-  return f;
-}
-
-TEST(Comparison, MedianOfOddAndEvenCounts) {
-  EXPECT_EQ(median_over_seeds({value(3.0), value(1.0), value(2.0)}, {1, 2, 3}).value, 2.0);
-  EXPECT_EQ(median_over_seeds({value(4.0), value(1.0), value(2.0), value(3.0)}, {1, 2, 3, 4}).value,
-            2.5);
-  // A step that never settled on most seeds: the median never settled either.
-  const double inf = std::numeric_limits<double>::infinity();
-  EXPECT_TRUE(std::isinf(median_over_seeds({value(inf), value(1.0), value(inf)}, {1, 2, 3}).value));
-}
-
-TEST(Comparison, AMedianWithAnInvalidSeedIsNotValidAndNamesIt) {
-  FigureValue bad;
-  bad.validity.fail("step: supervisor tripped");
-  const FigureValue m = median_over_seeds({value(1.0), bad, value(2.0)}, {4, 5, 6});
-  EXPECT_FALSE(m.validity.valid);
-  EXPECT_TRUE(std::isnan(m.value));
-  EXPECT_EQ(m.validity.reason, "seed 5: step: supervisor tripped");
-}
-
 TEST(Comparison, JsonHasThePrefixedMediansAndPerSeedValues) {
   const auto& r = quick_comparison();
   const nlohmann::json j = comparison_json(r);

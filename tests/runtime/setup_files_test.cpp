@@ -148,6 +148,18 @@ TEST_F(AtomicFileTest, NextWriteRemovesTheTemporaryOfAKilledWriterOnly) {
   EXPECT_EQ(read_text(path("cal.toml")), "new\n");
 }
 
+// Issue 27: a symlink planted at the temporary's name made the write go through it to the file it
+// pointed to. The link is removed, its target left as it was, and the file written.
+TEST_F(AtomicFileTest, APlantedSymlinkAtTheTemporarysNameIsNotWrittenThrough) {
+  const std::string victim = write("victim.txt", "precious\n");
+  const fs::path link = dir_ / (".cal.toml.tmp." + std::to_string(::getpid()));
+  fs::create_symlink(victim, link);
+  io::write_file_atomically(path("cal.toml"), "new\n");
+  EXPECT_EQ(read_text(victim), "precious\n");
+  EXPECT_EQ(read_text(path("cal.toml")), "new\n");
+  EXPECT_FALSE(fs::exists(fs::symlink_status(link)));
+}
+
 TEST_F(AtomicFileTest, FailureLeavesTheOldFileIntact) {
   const std::string path = write("cal.toml", "old\n");
   EXPECT_THROW(io::write_file_atomically((dir_ / "missing" / "cal.toml").string(), "x"),

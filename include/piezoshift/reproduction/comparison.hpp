@@ -125,6 +125,13 @@ struct ComparisonResult {
   std::vector<std::string> invalid_reasons() const;
 };
 
+//! The figures, their medians over the seeds and the targets, from runs already made (one
+//! SeedComparison per seed of options.seeds, in that order): compare()'s second half, apart so
+//! that the summary and its report can be checked on runs made up for the purpose.
+ComparisonResult summarize_comparison(const io::ProjectConfig& config,
+                                      const CompareOptions& options,
+                                      std::vector<SeedComparison> seeds);
+
 //! Throws std::invalid_argument on an empty seed list.
 ComparisonResult compare(const io::ProjectConfig& config, const CompareOptions& options,
                          const experiments::Progress& progress = {});
