@@ -184,6 +184,26 @@ io::Figure repeatability_figure(const SeedComparison& sc) {
   return f;
 }
 
+// The figures show the first seed on which a controller was calibrated; none when no controller
+// was on any seed (then there is nothing to draw, and the report says so). Returns that seed.
+std::vector<SeedComparison>::const_iterator draw_figures(const ComparisonResult& r,
+                                                         const fs::path& dir, ReportFiles& files) {
+  const auto drawn = std::find_if(r.seeds.begin(), r.seeds.end(), [](const SeedComparison& sc) {
+    return std::any_of(sc.runs.begin(), sc.runs.end(),
+                       [](const ControllerRun& run) { return run.calibration.valid; });
+  });
+  if (drawn == r.seeds.end())
+    return drawn;
+  const io::Figure figs[] = {step_figure(*drawn),
+                             phase_step_figure(*drawn, r.schedule.phase_step.tolerance_nm),
+                             linearity_error_figure(*drawn), repeatability_figure(*drawn)};
+  const char* const stems[] = {"compare_step_response", "compare_phase_step",
+                               "compare_linearity_error", "compare_repeatability"};
+  for (std::size_t i = 0; i < 4; ++i)
+    files.figures.push_back(*io::render(figs[i], dir / stems[i]).png);
+  return drawn;
+}
+
 }  // namespace
 
 nlohmann::json comparison_json(const ComparisonResult& r) {
@@ -251,22 +271,7 @@ ReportFiles write_comparison_report(const ComparisonResult& r, const fs::path& d
   write_text(dir / "comparison.json", comparison_json(r).dump(2) + "\n");
   files.data.push_back(dir / "comparison.json");
 
-  // The figures show the first seed on which a controller was calibrated; none when no
-  // controller was on any seed (then there is nothing to draw, and the report says so).
-  const auto drawn = std::find_if(r.seeds.begin(), r.seeds.end(), [](const SeedComparison& sc) {
-    return std::any_of(sc.runs.begin(), sc.runs.end(),
-                       [](const ControllerRun& run) { return run.calibration.valid; });
-  });
-  if (drawn != r.seeds.end()) {
-    const io::Figure figs[] = {step_figure(*drawn),
-                               phase_step_figure(*drawn, r.schedule.phase_step.tolerance_nm),
-                               linearity_error_figure(*drawn), repeatability_figure(*drawn)};
-    const char* const stems[] = {"compare_step_response", "compare_phase_step",
-                                 "compare_linearity_error", "compare_repeatability"};
-    for (std::size_t i = 0; i < 4; ++i)
-      files.figures.push_back(*io::render(figs[i], dir / stems[i]).png);
-  }
-
+  const auto drawn = draw_figures(r, dir, files);
   std::vector<Block> doc;
   auto h = [&](int level, std::string t) {
     doc.push_back({Block::kHeading, level, std::move(t), {}, {}});
