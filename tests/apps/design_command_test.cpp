@@ -56,7 +56,7 @@ TEST_F(DesignCommand, TextReportShowsTheNumbersWithUnits) {
 }
 
 TEST_F(DesignCommand, PaperTomlGivesTheSameReport) {
-  const std::string paper = PIEZOSHIFT_SOURCE_DIR "/configs/paper.toml";
+  const std::string paper = piezoshift::testing::source_dir() + "/configs/paper.toml";
   const RunResult a = run("design --json");
   const RunResult b = run("design --json --config '" + paper + "'");
   ASSERT_EQ(b.status, 0) << b.err;

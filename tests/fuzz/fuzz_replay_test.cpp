@@ -16,6 +16,7 @@
 #include <string>
 #include <vector>
 
+#include "../support/test_paths.hpp"
 #include "entry_points.hpp"
 
 namespace piezoshift::fuzz {
@@ -24,7 +25,7 @@ namespace {
 namespace fs = std::filesystem;
 
 std::vector<fs::path> inputs(const std::string& kind, const std::string& target) {
-  const fs::path dir = fs::path(PIEZOSHIFT_SOURCE_DIR) / "fuzz" / kind / target;
+  const fs::path dir = fs::path(testing::source_dir()) / "fuzz" / kind / target;
   std::vector<fs::path> files;
   if (fs::is_directory(dir))
     for (const fs::directory_entry& e : fs::directory_iterator(dir))

@@ -145,7 +145,7 @@ TEST_F(Dashboard, ANonLoopbackBindRefusesRequestsWithoutTheToken) {
 }
 
 TEST(DashboardOptions, ANonLoopbackBindWithoutATokenIsRefusedAtStartUp) {
-  const std::string cmd = std::string("'") + PIEZOSHIFT_CLI +
+  const std::string cmd = "'" + piezoshift::testing::cli_path() +
                           "' serve --port 0 --http-port 0 --http-bind 0.0.0.0 --duration-s 1 "
                           ">/dev/null 2>&1";
   const int status = std::system(cmd.c_str());
@@ -162,7 +162,7 @@ TEST(DashboardOptions, ATokenFileThatIsNotASmallRegularFileIsRefusedNamingIt) {
   ::unlink(fifo.c_str());
   ASSERT_EQ(::mkfifo(fifo.c_str(), 0600), 0);
   for (const std::string& file : {std::string("/dev/zero"), fifo}) {
-    const std::string cmd = std::string("'") + PIEZOSHIFT_CLI +
+    const std::string cmd = "'" + piezoshift::testing::cli_path() +
                             "' serve --port 0 --http-port 0 --duration-s 1 --http-token-file '" +
                             file + "' 2>&1 >/dev/null";
     FILE* pipe = ::popen(cmd.c_str(), "r");

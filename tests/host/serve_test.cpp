@@ -48,8 +48,8 @@ class Serve : public piezoshift::testing::TempDirTest {
     suite_dir_ = fs::temp_directory_path() / ("piezoshift_serve_" + std::to_string(getpid()));
     fs::create_directories(suite_dir_);
     calibration_ = (suite_dir_ / "twin.toml").string();
-    const std::string cmd = std::string("'") + PIEZOSHIFT_CLI + "' calibrate --pid paper --out '" +
-                            calibration_ + "' >/dev/null";
+    const std::string cmd = "'" + piezoshift::testing::cli_path() +
+                            "' calibrate --pid paper --out '" + calibration_ + "' >/dev/null";
     ASSERT_EQ(std::system(cmd.c_str()), 0) << cmd;
   }
   static void TearDownTestSuite() { fs::remove_all(suite_dir_); }

@@ -9,6 +9,7 @@
 #include "piezoshift/io/input_error.hpp"
 
 #include "../support/temp_dir_test.hpp"
+#include "../support/test_paths.hpp"
 
 namespace piezoshift::io {
 namespace {
@@ -36,7 +37,7 @@ bool contains(const std::string& text, const std::string& part) {
 }
 
 TEST_F(ProjectConfigTest, PaperTomlGivesExactlyTheDefaults) {
-  const ProjectConfig c = load_project_config(PIEZOSHIFT_SOURCE_DIR "/configs/paper.toml");
+  const ProjectConfig c = load_project_config(testing::source_dir() + "/configs/paper.toml");
   EXPECT_TRUE(c.design == design::DesignInputs{});
   // Spot checks, in case operator== were ever wrong.
   EXPECT_EQ(c.design.actuator.stiffness_N_per_um, 70.0);
@@ -48,7 +49,7 @@ TEST_F(ProjectConfigTest, PaperTomlGivesExactlyTheDefaults) {
 // The what-if twins docs/compare.md measures change exactly the one thing they name.
 TEST_F(ProjectConfigTest, WhatIfConfigsChangeOnlyWhatTheyName) {
   const ProjectConfig equal =
-      load_project_config(PIEZOSHIFT_SOURCE_DIR "/configs/what-if/equal-legs.toml");
+      load_project_config(testing::source_dir() + "/configs/what-if/equal-legs.toml");
   plant::TwinParams expected;
   EXPECT_NE(expected.piezo.free_stroke_scale[1], 1.0);  // the default's short leg
   expected.piezo.free_stroke_scale = {1.0, 1.0, 1.0};
@@ -56,7 +57,7 @@ TEST_F(ProjectConfigTest, WhatIfConfigsChangeOnlyWhatTheyName) {
   EXPECT_TRUE(equal.design == design::DesignInputs{});
 
   const ProjectConfig still =
-      load_project_config(PIEZOSHIFT_SOURCE_DIR "/configs/what-if/no-excitation-drift.toml");
+      load_project_config(testing::source_dir() + "/configs/what-if/no-excitation-drift.toml");
   expected = plant::TwinParams{};
   EXPECT_GT(expected.sgs.excitation_drift_ppm_rms, 0.0);
   expected.sgs.excitation_drift_ppm_rms = 0.0;

@@ -10,6 +10,8 @@
 #include "piezoshift/io/project_config.hpp"
 #include "piezoshift/plant/twin_ranges.hpp"
 
+#include "../support/test_paths.hpp"
+
 namespace piezoshift::io {
 namespace {
 
@@ -34,7 +36,7 @@ std::string error_for(const std::string& name, const std::string& text) {
 }
 
 TEST(TwinConfig, PaperTomlIsExactlyTheBuiltInTwin) {
-  const ProjectConfig c = load_project_config(PIEZOSHIFT_SOURCE_DIR "/configs/paper.toml");
+  const ProjectConfig c = load_project_config(testing::source_dir() + "/configs/paper.toml");
   EXPECT_TRUE(c.twin == plant::TwinParams{});
   EXPECT_EQ(c.twin.daq.resolution_bits, 16);
   EXPECT_EQ(c.twin.geometry.transmission_matrix[2][2], -0.2980);

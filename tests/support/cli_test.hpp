@@ -1,5 +1,5 @@
 #pragma once
-// A gtest fixture for tests that run the piezoshift program (path in PIEZOSHIFT_CLI): a fresh
+// A gtest fixture for tests that run the piezoshift program (cli_path()): a fresh
 // temporary folder per test (TempDirTest), and run() giving the exit status, stdout and stderr of
 // `piezoshift <args>` (args go through the shell: quote paths).
 #include <sys/wait.h>
@@ -10,6 +10,7 @@
 #include <gtest/gtest.h>
 
 #include "temp_dir_test.hpp"
+#include "test_paths.hpp"
 
 namespace piezoshift::testing {
 
@@ -23,8 +24,7 @@ class CliTest : public TempDirTest {
  protected:
   CliResult run(const std::string& args) const {
     const std::string err_path = path("stderr.txt");
-    const std::string cmd =
-        std::string("'") + PIEZOSHIFT_CLI + "' " + args + " 2>'" + err_path + "'";
+    const std::string cmd = "'" + cli_path() + "' " + args + " 2>'" + err_path + "'";
     CliResult r;
     FILE* pipe = ::popen(cmd.c_str(), "r");
     if (pipe == nullptr) {

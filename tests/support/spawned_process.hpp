@@ -12,6 +12,7 @@
 #include <gtest/gtest.h>
 
 #include "temp_dir_test.hpp"
+#include "test_paths.hpp"
 
 extern char** environ;
 
@@ -21,11 +22,11 @@ struct Spawned {
   pid_t pid = -1;
 };
 
-//! Starts `piezoshift <args>` (PIEZOSHIFT_CLI) with stdout and stderr to the given files.
+//! Starts `piezoshift <args>` (cli_path()) with stdout and stderr to the given files.
 inline Spawned spawn(const std::vector<std::string>& args, const std::string& out,
                      const std::string& err) {
   std::vector<char*> argv;
-  std::string prog = PIEZOSHIFT_CLI;
+  std::string prog = cli_path();
   argv.push_back(prog.data());
   std::vector<std::string> copy = args;
   for (auto& a : copy)
