@@ -166,6 +166,11 @@ void LoopRig::set_controller(const control::SemiClosedLoopParams& params) {
   runtime::HostCommand c;
   c.kind = runtime::HostCommand::Kind::kConfigure;
   command(c);
+  // The sample that acknowledges the command says whether the loop took the set.
+  const auto problem = static_cast<control::ParamsProblem>(last_.configure_problem);
+  if (problem != control::ParamsProblem::kNone)
+    throw std::invalid_argument(std::string("loop rig: the loop refused the controller: ") +
+                                control::to_string(problem));
   params_ = p;
 }
 

@@ -3,6 +3,7 @@
 #include <algorithm>
 #include <cmath>
 #include <stdexcept>
+#include <string>
 
 #include "piezoshift/io/input_error.hpp"
 
@@ -47,7 +48,10 @@ Bench::~Bench() {
 }
 
 void Bench::set_controller(const control::SemiClosedLoopParams& params) {
-  cycle_->configure(params);
+  const control::ParamsProblem problem = cycle_->try_configure(params);
+  if (problem != control::ParamsProblem::kNone)
+    throw std::invalid_argument(std::string("bench: the loop refused the controller: ") +
+                                control::to_string(problem));
 }
 
 void Bench::drive_open_loop(const Vec3& ao_V) {

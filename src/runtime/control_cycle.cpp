@@ -1,6 +1,5 @@
 #include "piezoshift/runtime/control_cycle.hpp"
 
-#include <cmath>
 #include <stdexcept>
 #include <string>
 
@@ -18,38 +17,26 @@ const char* to_string(DriveMode mode) noexcept {
   return "unknown";
 }
 
-namespace {
-
-// The improved controller's shaper taps and correction gains hold at one rate only.
-void check_improved_rate(const control::SemiClosedLoopParams& p) {
-  if (p.kind == control::ControllerKind::kImproved &&
-      std::fabs(p.improved.sample_time_s - p.sample_time_s) > 1e-9 * p.sample_time_s)
-    throw std::invalid_argument(
-        "control cycle: the improved controller was calibrated at a sample time of " +
-        std::to_string(p.improved.sample_time_s) + " s and the loop runs at " +
-        std::to_string(p.sample_time_s) + " s: calibrate it at the loop's rate");
-}
-
-}  // namespace
-
 ControlCycle::ControlCycle(const control::SemiClosedLoopParams& params,
                            const SafetyLimits& limits) {
-  if (!(params.sample_time_s > 0.0) || !std::isfinite(params.sample_time_s))
-    throw std::invalid_argument("control cycle: sample_time_s must be > 0");
-  check_improved_rate(params);
+  const control::ParamsProblem problem = control::params_problem(params, params.sample_time_s);
+  if (problem != control::ParamsProblem::kNone)
+    throw std::invalid_argument(std::string("control cycle: ") + control::to_string(problem) +
+                                " (sample time " + std::to_string(params.sample_time_s) + " s)");
   controller_.configure(params);
   supervisor_.configure(limits, params.sample_time_s, params.scaling);
 }
 
-void ControlCycle::configure(const control::SemiClosedLoopParams& params) {
-  if (std::fabs(params.sample_time_s - controller_.params().sample_time_s) >
-      1e-12 * controller_.params().sample_time_s)
-    throw std::invalid_argument(
-        "control cycle: the controller's sample time differs from the loop's");
-  check_improved_rate(params);
+control::ParamsProblem ControlCycle::try_configure(
+    const control::SemiClosedLoopParams& params) noexcept {
+  const control::ParamsProblem problem =
+      control::params_problem(params, controller_.params().sample_time_s);
+  if (problem != control::ParamsProblem::kNone)
+    return problem;
   const Vec3 held = held_command_um();
   controller_.configure(params);
   controller_.reset_to(held);
+  return problem;
 }
 
 Vec3 ControlCycle::held_command_um() const noexcept {

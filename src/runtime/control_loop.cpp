@@ -81,6 +81,7 @@ LoopResult ControlLoop::run() noexcept {
   Vec3 host_zd{};
   WaveGenerator wave;  // fixed-size; the tables are the host's (wave_generator.hpp)
   std::uint64_t applied_sequence = 0;
+  control::ParamsProblem configure_problem = control::ParamsProblem::kNone;
   const auto clear_latched_fault = [&]() noexcept {
     if (cycle_.clear_fault() && stop_requested)
       cycle_.request_stop();
@@ -141,12 +142,10 @@ LoopResult ControlLoop::run() noexcept {
           cycle_.drive(DriveMode::kActuators, cmd.zd_um);
           break;
         case HostCommand::Kind::kConfigure: {
+          // Checked here, refused without a change and reported in the samples: never thrown.
           control::SemiClosedLoopParams p{};
-          if (host->params.try_pop(p)) {
-            // The loop's period, so that configure() cannot refuse it.
-            p.sample_time_s = params_.sample_time_s;
-            cycle_.configure(p);
-          }
+          configure_problem =
+              host->params.try_pop(p) ? cycle_.try_configure(p) : control::ParamsProblem::kAbsent;
           break;
         }
       }
@@ -243,6 +242,7 @@ LoopResult ControlLoop::run() noexcept {
       h.tick = tick;
       h.t_s = static_cast<double>(ct.since_start_ns) * 1e-9;
       h.applied_sequence = applied_sequence;
+      h.configure_problem = static_cast<std::uint8_t>(configure_problem);
       h.zd_um = zd;
       h.target_um = c.target_um;
       h.sgs_V = cs.ai_V;

@@ -1,5 +1,6 @@
 // Built with -fno-exceptions -fno-rtti: proves the controller core needs neither, and that a full
 // controller tick is usable in a constant expression (so it cannot allocate).
+#include "piezoshift/control/parameter_check.hpp"
 #include "piezoshift/control/semi_closed_loop.hpp"
 
 namespace {
@@ -30,6 +31,13 @@ constexpr float first_tick_dac_V_float() {
 }
 static_assert(first_tick_dac_V_float() - kExpected < 1e-6 &&
               kExpected - first_tick_dac_V_float() < 1e-6);
+
+// The check the loop runs before it takes a parameter set is part of the core too.
+static_assert(piezoshift::control::params_problem(piezoshift::control::SemiClosedLoopParams{},
+                                                  1e-3) ==
+              piezoshift::control::ParamsProblem::kNone);
+static_assert(noexcept(
+    piezoshift::control::params_problem(piezoshift::control::SemiClosedLoopParams{}, 1e-3)));
 
 }  // namespace
 

@@ -2,6 +2,7 @@
 // one HostSample back per tick. On the closed-form FakeBackend plant and a simulated clock.
 #include <algorithm>
 #include <cmath>
+#include <limits>
 #include <vector>
 
 #include <gtest/gtest.h>
@@ -142,58 +143,110 @@ TEST(HostMode, ActuatorTargetsHoldTheSgsOnSAndAreNoZd) {
     EXPECT_NEAR(h.sgs_V[i] * 1.6, s_um[i], 0.005) << i;  // FakeBackend: sgs_V = x / 1.6 um/V
 }
 
-TEST(HostMode, NewParametersAreAppliedBetweenTwoTicksBumplessly) {
-  // On S = 5 um, then a controller with a matrix A that doubles the targets and other gains: the
-  // output does not jump at the switch (the PIDs restart from the command held), the inner loops
-  // stay on S, and the new controller asks S = A Z_d = 4 um for Z_d = 2 um.
-  HostLink* link = nullptr;
-  control::SemiClosedLoopParams p{};
-  p.matrix.a = {{{2.0, 0.0, 0.0}, {0.0, 2.0, 0.0}, {0.0, 0.0, 2.0}}};
-  p.polynomial = control::CubicPolynomial::identity();
-  p.gains.kp = 0.3;
+// Holds the PIDs on S = 5 um for 0.6 s; at tick 300 a kConfigure arrives, with `params` pushed
+// before it unless it is null.
+struct SwitchRun {
+  LoopResult result;
+  std::vector<HostSample> samples;
+  control::SemiClosedLoopParams in_force;  //!< the controller's parameters at the end
+  Vec3 targets_at_2um{};                   //!< its actuator_targets(Z_d = 2 um)
+};
+
+SwitchRun run_switch(const control::SemiClosedLoopParams* params) {
   FakeBackend daq;
   daq.configure();
   daq.activate();
   SimulatedClock clock;
-  HostLink l;
-  link = &l;
-  ASSERT_TRUE(
-      link->commands.try_push(command(HostCommand::Kind::kActuators, 1, control::filled(5.0))));
+  HostLink link;
+  EXPECT_TRUE(
+      link.commands.try_push(command(HostCommand::Kind::kActuators, 1, control::filled(5.0))));
   LoopConfig cfg;
   cfg.rate_Hz = 1000.0;
   cfg.duration_s = 0.6;
-  cfg.host = link;
+  cfg.host = &link;
   ControlLoop loop(cfg, control::SemiClosedLoopParams{}, SafetyLimits{}, daq, clock,
                    SetpointProfile::step(0.0));
   struct Switch {
     HostLink* link;
-    control::SemiClosedLoopParams params;
-  } sw{link, p};
+    const control::SemiClosedLoopParams* params;
+  } sw{&link, params};
   daq.on_tick = [](void* c) {
     auto* s = static_cast<Switch*>(c);
-    s->link->params.try_push(s->params);
+    if (s->params != nullptr)
+      s->link->params.try_push(*s->params);
     s->link->commands.try_push(command(HostCommand::Kind::kConfigure, 2));
   };
   daq.on_tick_context = &sw;
   daq.on_tick_at = 299;
-  const LoopResult result = loop.run();
-  EXPECT_FALSE(result.fault_detected) << to_string(result.fault.reason);
-  std::vector<HostSample> samples;
-  for (HostSample h{}; link->samples.try_pop(h);)
-    samples.push_back(h);
-  const HostSample& before = samples.at(299);
-  const HostSample& at = samples.at(300);
+  SwitchRun r;
+  r.result = loop.run();
+  for (HostSample h{}; link.samples.try_pop(h);)
+    r.samples.push_back(h);
+  r.in_force = loop.controller().params();
+  r.targets_at_2um = loop.controller().actuator_targets(control::filled(2.0));
+  return r;
+}
+
+TEST(HostMode, NewParametersAreAppliedBetweenTwoTicksBumplessly) {
+  // On S = 5 um, then a controller with a matrix A that doubles the targets and other gains: the
+  // output does not jump at the switch (the PIDs restart from the command held), the inner loops
+  // stay on S, and the new controller asks S = A Z_d = 4 um for Z_d = 2 um.
+  control::SemiClosedLoopParams p{};
+  p.matrix.a = {{{2.0, 0.0, 0.0}, {0.0, 2.0, 0.0}, {0.0, 0.0, 2.0}}};
+  p.polynomial = control::CubicPolynomial::identity();
+  p.gains.kp = 0.3;
+  const SwitchRun r = run_switch(&p);
+  EXPECT_FALSE(r.result.fault_detected) << to_string(r.result.fault.reason);
+  const HostSample& before = r.samples.at(299);
+  const HostSample& at = r.samples.at(300);
   EXPECT_EQ(before.applied_sequence, 1u);
   EXPECT_EQ(at.applied_sequence, 2u);
+  EXPECT_EQ(at.configure_problem, 0);
   for (std::size_t i = 0; i < 3; ++i)
     EXPECT_NEAR(at.ao_V[i], before.ao_V[i], 1e-3) << i;
-  EXPECT_EQ(loop.controller().params().gains.kp, 0.3);
-  EXPECT_NEAR(loop.controller().params().sample_time_s, 1e-3, 1e-15);  // the loop's, kept
-  EXPECT_EQ(loop.controller().actuator_targets(control::filled(2.0)), control::filled(4.0));
-  const HostSample& end = samples.at(599);
+  EXPECT_EQ(r.in_force.gains.kp, 0.3);
+  EXPECT_NEAR(r.in_force.sample_time_s, 1e-3, 1e-15);  // the loop's, kept
+  EXPECT_EQ(r.targets_at_2um, control::filled(4.0));
+  const HostSample& end = r.samples.at(599);
   EXPECT_EQ(end.actuators, 1);
   for (std::size_t i = 0; i < 3; ++i)
     EXPECT_NEAR(end.sgs_V[i] * 1.6, 5.0, 0.005) << i;
+}
+
+// Until this check, ControlCycle::configure threw std::invalid_argument for an improved
+// controller at another rate, inside the noexcept loop: std::terminate with the DACs holding.
+// Now the loop refuses the set, says why in every later sample, and runs on unchanged.
+void expect_refused_and_running(const SwitchRun& r, control::ParamsProblem problem) {
+  EXPECT_FALSE(r.result.fault_detected) << to_string(r.result.fault.reason);
+  // The loop ran to its end (0.6 s, then its ramp down).
+  ASSERT_EQ(r.samples.size(), r.result.ticks);
+  ASSERT_GE(r.samples.size(), 600u);
+  EXPECT_EQ(r.samples.at(299).configure_problem, 0);
+  for (std::size_t k = 300; k < r.samples.size(); ++k) {
+    ASSERT_EQ(r.samples[k].applied_sequence, 2u) << k;
+    ASSERT_EQ(r.samples[k].configure_problem, static_cast<std::uint8_t>(problem)) << k;
+  }
+  EXPECT_EQ(r.in_force.kind, control::ControllerKind::kPaper);  // the old controller, unchanged
+  EXPECT_EQ(r.in_force.gains.kp, control::SemiClosedLoopParams{}.gains.kp);
+  for (std::size_t i = 0; i < 3; ++i)
+    EXPECT_NEAR(r.samples.at(599).sgs_V[i] * 1.6, 5.0, 0.005) << i;  // still holding S
+}
+
+TEST(HostMode, AnImprovedControllerAtAnotherRateIsRefusedAndTheLoopRunsOn) {
+  control::SemiClosedLoopParams p{};
+  p.kind = control::ControllerKind::kImproved;
+  p.improved.sample_time_s = 1e-4;  // designed for 10 kHz; the loop runs at 1 kHz
+  expect_refused_and_running(run_switch(&p), control::ParamsProblem::kImprovedRate);
+}
+
+TEST(HostMode, ANonFiniteGainIsRefusedAndTheLoopRunsOn) {
+  control::SemiClosedLoopParams p{};
+  p.gains.ki = std::numeric_limits<double>::quiet_NaN();
+  expect_refused_and_running(run_switch(&p), control::ParamsProblem::kNotFinite);
+}
+
+TEST(HostMode, AConfigureCommandWithoutAParameterSetIsRefused) {
+  expect_refused_and_running(run_switch(nullptr), control::ParamsProblem::kAbsent);
 }
 
 HostCommand wave_start(std::uint64_t sequence, const double* values, std::uint32_t length,

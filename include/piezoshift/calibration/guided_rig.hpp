@@ -28,6 +28,8 @@ struct RigWindow {
 class GuidedRig {
  public:
   virtual ~GuidedRig() = default;
+  //! The controller from the next tick on; std::invalid_argument, the controller unchanged, when
+  //! the loop cannot run it (control::params_problem).
   virtual void set_controller(const control::SemiClosedLoopParams& params) = 0;
   virtual control::SemiClosedLoopParams controller() const = 0;
   //! Holds the stage: the PIDs alone on targets S (calibration stage 2).

@@ -4,7 +4,8 @@
 // own, in host mode, and the procedure (with the operator's prompt) in the caller's thread. They
 // talk only through the loop's lock-free host link (runtime/host_link.hpp):
 //
-//   set_controller    kConfigure + the parameter set: applied between two ticks, bumplessly
+//   set_controller    kConfigure + the parameter set: applied between two ticks, bumplessly, or
+//                     refused by the loop (the acknowledging sample's configure_problem)
 //   drive_actuators   kActuators S (the PIDs alone, stage 2)
 //   drive_points      kServoOn Z_d from open loop, kMoveTo Z_d when already on Z_d (stage 3)
 //   rest              kServoOff then kOpenLoop 0 V (the supervisor's slew limit takes it down)

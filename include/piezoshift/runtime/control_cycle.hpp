@@ -18,10 +18,11 @@
 // until clear_fault(), after which the PIDs restart from 0 V and the outputs follow them through
 // the slew limit from where the ramp left them.
 //
-// step() is real-time safe: no heap, no exceptions, no I/O. Construction and configure() are
-// set-up (they may throw std::invalid_argument on inconsistent limits).
+// step() and try_configure() are real-time safe: no heap, no exceptions, no I/O. Construction is
+// set-up (it throws std::invalid_argument on parameters or limits the loop cannot run).
 #include <cstdint>
 
+#include "piezoshift/control/parameter_check.hpp"
 #include "piezoshift/control/semi_closed_loop.hpp"
 #include "piezoshift/runtime/daq_backend.hpp"
 #include "piezoshift/runtime/safety_supervisor.hpp"
@@ -50,9 +51,10 @@ class ControlCycle {
   //! params.sample_time_s must be the loop's period (the PIDs' gains are rescaled to it).
   ControlCycle(const control::SemiClosedLoopParams& params, const SafetyLimits& limits);
 
-  //! Set-up: replaces the controller's parameters; the PIDs restart from the command the outputs
-  //! hold (bumpless). The sample time must not change.
-  void configure(const control::SemiClosedLoopParams& params);
+  //! Real-time safe. Replaces the controller's parameters when control::params_problem() finds
+  //! none at the loop's sample time, and the PIDs restart from the command the outputs hold
+  //! (bumpless); otherwise nothing changes. Returns the problem (kNone: applied).
+  control::ParamsProblem try_configure(const control::SemiClosedLoopParams& params) noexcept;
 
   //! Real-time safe. Sets what the next ticks follow; bumpless from open loop to closed loop.
   void drive(DriveMode mode, const Vec3& setpoint) noexcept;

@@ -18,9 +18,11 @@
 //                the servo is on and no fault is latched, and stops otherwise
 //   kActuators   the PIDs alone on the SGS targets S := zd_um (calibration stage 2, the guided
 //                calibration's LoopRig); bumpless from open loop; kServoOn returns to Z_d
-//   kConfigure   pops the next parameter set from `params` and makes it the controller's, with
-//                the loop's own sample time, bumplessly (ControlCycle::configure): the one safe
-//                point to change parameters is between two ticks, in the loop's thread
+//   kConfigure   pops the next parameter set from `params` and makes it the controller's,
+//                bumplessly, when the loop can run it (ControlCycle::try_configure, at the loop's
+//                sample time); otherwise nothing changes and every later sample's
+//                configure_problem says why, until the next kConfigure. The one safe point to
+//                change parameters is between two ticks, in the loop's thread
 // Every sample carries the sequence number of the last command applied, so the host knows when
 // its command has reached the loop.
 #include <cstdint>
@@ -71,6 +73,8 @@ struct HostSample {
   std::uint8_t fault_reason = 0;       //!< FaultReason as a number (0 = none)
   std::int8_t fault_channel = -1;
   std::uint8_t wave_running = 0;  //!< bit g: wave generator g runs (WaveGenerator::running_mask)
+  //! control::ParamsProblem of the last kConfigure as a number (0: applied, or none yet)
+  std::uint8_t configure_problem = 0;
 };
 
 struct HostLink {
