@@ -2,7 +2,6 @@
 
 #include <arpa/inet.h>
 #include <netinet/in.h>
-#include <netinet/tcp.h>
 #include <poll.h>
 #include <sys/socket.h>
 #include <unistd.h>
@@ -267,6 +266,7 @@ HttpServerStats HttpServer::stats() const {
   s.streams_opened = stats_.streams_opened.load(r);
   s.dropped_slow = stats_.dropped_slow.load(r);
   s.broadcast_bytes = stats_.broadcast_bytes.load(r);
+  s.accept_failures = listener_->accept_failures();
   return s;
 }
 
@@ -286,7 +286,7 @@ void HttpServer::run(const std::atomic<int>* stop_flag, int poll_interval_ms) {
     handler_.on_poll(*this);
     fds.clear();
     fds.push_back({listener_->wake_fd(), POLLIN, 0});
-    fds.push_back({listener_->fd(), POLLIN, 0});
+    fds.push_back({listener_->poll_fd(), POLLIN, 0});  // -1 while accepting is paused
     for (const Client& c : clients_) {
       short events = c.answered ? 0 : POLLIN;
       if (c.pending() > 0)
@@ -338,14 +338,9 @@ void HttpServer::run(const std::atomic<int>* stop_flag, int poll_interval_ms) {
 
 void HttpServer::accept_clients() {
   for (;;) {
-    const int fd = ::accept4(listener_->fd(), nullptr, nullptr, SOCK_NONBLOCK | SOCK_CLOEXEC);
-    if (fd < 0) {
-      if (errno == EINTR || errno == ECONNABORTED)
-        continue;
-      return;  // EAGAIN, or out of descriptors: try again next turn
-    }
-    const int one = 1;
-    ::setsockopt(fd, IPPROTO_TCP, TCP_NODELAY, &one, sizeof one);
+    const int fd = listener_->accept_client();
+    if (fd < 0)
+      return;
     Client c;
     c.fd = fd;
     c.accepted = Clock::now();

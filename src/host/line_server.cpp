@@ -2,7 +2,6 @@
 
 #include <arpa/inet.h>
 #include <netinet/in.h>
-#include <netinet/tcp.h>
 #include <poll.h>
 #include <sys/socket.h>
 #include <unistd.h>
@@ -24,9 +23,6 @@ namespace {
 
 //! Bytes taken from one client per turn: a client that floods cannot starve the others.
 constexpr std::size_t kReadChunkBytes = 64 * 1024;
-//! After accept() fails for lack of resources (EMFILE, ENOBUFS, ...), the listening socket stays
-//! readable; leave it alone this long instead of spinning on it.
-constexpr auto kAcceptPause = std::chrono::milliseconds(100);
 
 void close_fd(int& fd) noexcept {
   if (fd >= 0)
@@ -93,6 +89,7 @@ LineServerStats LineServer::stats() const {
   s.overlong_lines = stats_.overlong_lines.load(r);
   s.bytes_in = stats_.bytes_in.load(r);
   s.bytes_out = stats_.bytes_out.load(r);
+  s.accept_failures = listener_->accept_failures();
   return s;
 }
 
@@ -120,8 +117,7 @@ void LineServer::run(const std::atomic<int>* stop_flag, int poll_interval_ms) {
       // polled from the next turn on).
       fds.clear();
       fds.push_back({listener_->wake_fd(), POLLIN, 0});
-      const bool accepting = Clock::now() >= accept_paused_until_;
-      fds.push_back({accepting ? listener_->fd() : -1, POLLIN, 0});  // fd -1: ignored by poll()
+      fds.push_back({listener_->poll_fd(), POLLIN, 0});  // -1 while accepting is paused
       bool work_left = false;  // lines received but beyond last turn's budget: do not sleep
       for (const Client& c : clients_) {
         short events = wants_input(c) ? POLLIN : 0;
@@ -178,23 +174,15 @@ void LineServer::run(const std::atomic<int>* stop_flag, int poll_interval_ms) {
 
 void LineServer::accept_clients() {
   for (;;) {
-    const int fd = ::accept4(listener_->fd(), nullptr, nullptr, SOCK_NONBLOCK | SOCK_CLOEXEC);
-    if (fd < 0) {
-      if (errno == EINTR || errno == ECONNABORTED)  // ECONNABORTED: that one left already
-        continue;
-      if (!would_block(errno))
-        accept_paused_until_ = Clock::now() + kAcceptPause;
+    const int fd = listener_->accept_client();
+    if (fd < 0)
       return;
-    }
     if (clients_.size() >= limits_.max_clients) {
       // Accept and close rather than leave it in the backlog: the peer learns at once (EOF).
       stats_.refused_max_clients.fetch_add(1, std::memory_order_relaxed);
       ::close(fd);
       continue;
     }
-    // Answers are short and latency matters more than packet count.
-    const int one = 1;
-    ::setsockopt(fd, IPPROTO_TCP, TCP_NODELAY, &one, sizeof one);
     Client c;
     c.fd = fd;
     c.id = next_id_++;

@@ -1,6 +1,7 @@
 #include "piezoshift/host/tcp_listener.hpp"
 
 #include <arpa/inet.h>
+#include <netinet/tcp.h>
 #include <sys/eventfd.h>
 #include <sys/socket.h>
 #include <unistd.h>
@@ -88,6 +89,29 @@ void TcpListener::drain_wake() const noexcept {
   std::uint64_t count = 0;
   if (::read(wake_fd_, &count, sizeof count) < 0) {
     // EAGAIN: already drained.
+  }
+}
+
+int TcpListener::poll_fd() const noexcept {
+  return std::chrono::steady_clock::now() >= paused_until_ ? listen_fd_ : -1;
+}
+
+int TcpListener::accept_client() noexcept {
+  for (;;) {
+    const int fd = ::accept4(listen_fd_, nullptr, nullptr, SOCK_NONBLOCK | SOCK_CLOEXEC);
+    if (fd >= 0) {
+      // Answers are short and latency matters more than packet count.
+      const int one = 1;
+      ::setsockopt(fd, IPPROTO_TCP, TCP_NODELAY, &one, sizeof one);
+      return fd;
+    }
+    if (errno == EINTR || errno == ECONNABORTED)  // ECONNABORTED: that one left already
+      continue;
+    if (errno != EAGAIN && errno != EWOULDBLOCK) {
+      paused_until_ = std::chrono::steady_clock::now() + kAcceptPause;
+      accept_failures_.fetch_add(1, std::memory_order_relaxed);
+    }
+    return -1;
   }
 }
 

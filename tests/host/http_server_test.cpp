@@ -2,12 +2,19 @@
 // token and the Host/Origin rules hold, and event streams receive broadcasts.
 #include "piezoshift/host/http_server.hpp"
 
+#include <arpa/inet.h>
+#include <sys/socket.h>
+#include <unistd.h>
+
 #include <atomic>
+#include <chrono>
 #include <string>
 #include <thread>
+#include <vector>
 
 #include <gtest/gtest.h>
 
+#include "../support/descriptor_exhaustion.hpp"
 #include "../support/http_client.hpp"
 #include "piezoshift/io/input_error.hpp"
 
@@ -41,7 +48,7 @@ class EchoHandler : public HttpHandler {
     if (++turns % 4 == 0)
       server.broadcast("event: tick\ndata: {}\n\n");
   }
-  int turns = 0;
+  std::atomic<int> turns{0};
 };
 
 class Http : public ::testing::Test {
@@ -194,6 +201,66 @@ TEST_F(Http, StreamsReceiveEveryBroadcast) {
   EXPECT_EQ(http_status(got), 200);
   EXPECT_NE(got.find("Content-Type: text/event-stream"), std::string::npos);
   EXPECT_NE(got.find("event: tick\ndata: {}\n\n"), std::string::npos);
+}
+
+// Connections that arrive while the process has no descriptor left stay in the listen backlog,
+// so the listening socket stays readable. At ebaef31 the server polled it again at once: a busy
+// spin (one failed accept per turn) until a descriptor came free. Now it leaves the listener
+// alone for 100 ms after each failure, keeps serving the clients it has, and accepts the waiting
+// ones once descriptors are back.
+TEST_F(Http, OutOfDescriptorsItPausesAcceptingAndServesTheClientsItHas) {
+  start();
+  HttpConnection stream(server_->port());
+  stream.send("GET /stream HTTP/1.1\r\n" + host() + "\r\n");
+  std::string before;
+  ASSERT_TRUE(stream.read_some(before, 5.0));
+  ASSERT_EQ(http_status(before), 200) << before;
+  // Sockets for the clients that will wait, made while descriptors are free.
+  std::vector<int> waiting;
+  const timeval receive_timeout{5, 0};  // against a hang, not a speed assert
+  for (int i = 0; i < 3; ++i) {
+    waiting.push_back(::socket(AF_INET, SOCK_STREAM | SOCK_CLOEXEC, 0));
+    ::setsockopt(waiting.back(), SOL_SOCKET, SO_RCVTIMEO, &receive_timeout, sizeof receive_timeout);
+  }
+  sockaddr_in sa{};
+  sa.sin_family = AF_INET;
+  sa.sin_port = htons(server_->port());
+  ::inet_pton(AF_INET, "127.0.0.1", &sa.sin_addr);
+
+  std::string during;
+  int connected = 0;
+  std::uint64_t failures = 0;
+  double exhausted_s = 0.0;
+  {
+    const piezoshift::testing::DescriptorsExhausted exhausted;
+    const auto t0 = std::chrono::steady_clock::now();
+    for (int fd : waiting)  // the kernel completes these into the backlog
+      connected += ::connect(fd, reinterpret_cast<const sockaddr*>(&sa), sizeof sa) == 0 ? 1 : 0;
+    while (std::chrono::steady_clock::now() - t0 < std::chrono::milliseconds(500))
+      stream.read_some(during, 0.05);
+    failures = server_->stats().accept_failures;
+    exhausted_s = std::chrono::duration<double>(std::chrono::steady_clock::now() - t0).count();
+  }
+  EXPECT_EQ(connected, 3);
+  // It ran out (at least one failed accept) and did not spin: at most one failure per 100 ms
+  // pause, plus the first. A spinning server fails once per turn, thousands in 0.5 s.
+  EXPECT_GE(failures, 1u);
+  EXPECT_LE(static_cast<double>(failures), exhausted_s / 0.1 + 2.0)
+      << failures << " failed accepts in " << exhausted_s << " s";
+  // The stream it had kept receiving broadcasts meanwhile.
+  EXPECT_NE(during.find("event: tick"), std::string::npos);
+  // With descriptors back, the waiting clients are accepted and answered.
+  for (int fd : waiting) {
+    const std::string request = "GET / HTTP/1.1\r\n" + host() + "\r\n";
+    ASSERT_EQ(::send(fd, request.data(), request.size(), MSG_NOSIGNAL),
+              static_cast<ssize_t>(request.size()));
+    std::string answer;
+    char buf[4096];
+    for (ssize_t n; (n = ::recv(fd, buf, sizeof buf, 0)) > 0;)
+      answer.append(buf, static_cast<std::size_t>(n));
+    EXPECT_EQ(http_status(answer), 200) << answer;
+    ::close(fd);
+  }
 }
 
 }  // namespace

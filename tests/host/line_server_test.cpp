@@ -3,7 +3,10 @@
 // input and peers that vanish mid-answer, a non-reading client that must not delay another (with
 // the real GCS interpreter), address checks. SIGPIPE is deliberately NOT ignored in
 // this process: a send() without MSG_NOSIGNAL to a vanished peer would kill the test.
+#include <arpa/inet.h>
 #include <gtest/gtest.h>
+#include <sys/socket.h>
+#include <unistd.h>
 
 #include <algorithm>
 #include <atomic>
@@ -18,6 +21,7 @@
 #include <thread>
 #include <vector>
 
+#include "../support/descriptor_exhaustion.hpp"
 #include "piezoshift/host/gcs_client.hpp"
 #include "piezoshift/host/gcs_controller.hpp"
 #include "piezoshift/host/line_server.hpp"
@@ -619,6 +623,58 @@ TEST(GcsClient, SplitsAnswersAndReportsConnectionFailures) {
   auto client = server.connect();
   client->send_raw("ECHO no end");  // no LF: never answered, then idle
   EXPECT_THROW(client->read_answer(), std::runtime_error);
+}
+
+// The GCS side of the same rule as Http.OutOfDescriptorsItPausesAcceptingAndServesTheClientsItHas:
+// out of descriptors, accepting pauses 100 ms per failure (no spin), the connected client is
+// still answered, and the waiting ones are served once descriptors are back.
+TEST(LineServerLimits, OutOfDescriptorsItPausesAcceptingAndServesTheClientsItHas) {
+  TestHandler handler;
+  ServerThread st(handler);
+  auto client = st.connect();
+  ASSERT_EQ(client->query("ECHO before"), "before\n");
+  std::vector<int> waiting;
+  const timeval receive_timeout{5, 0};  // against a hang, not a speed assert
+  for (int i = 0; i < 3; ++i) {
+    waiting.push_back(::socket(AF_INET, SOCK_STREAM | SOCK_CLOEXEC, 0));
+    ::setsockopt(waiting.back(), SOL_SOCKET, SO_RCVTIMEO, &receive_timeout, sizeof receive_timeout);
+  }
+  sockaddr_in sa{};
+  sa.sin_family = AF_INET;
+  sa.sin_port = htons(st.port());
+  ::inet_pton(AF_INET, "127.0.0.1", &sa.sin_addr);
+
+  int connected = 0;
+  int answered = 0;
+  std::uint64_t failures = 0;
+  double exhausted_s = 0.0;
+  {
+    const testing::DescriptorsExhausted exhausted;
+    const auto t0 = std::chrono::steady_clock::now();
+    for (int fd : waiting)
+      connected += ::connect(fd, reinterpret_cast<const sockaddr*>(&sa), sizeof sa) == 0 ? 1 : 0;
+    while (std::chrono::steady_clock::now() - t0 < std::chrono::milliseconds(500)) {
+      answered += client->query("ECHO during") == "during\n" ? 1 : 0;
+      std::this_thread::sleep_for(std::chrono::milliseconds(20));
+    }
+    failures = st.server().stats().accept_failures;
+    exhausted_s = std::chrono::duration<double>(std::chrono::steady_clock::now() - t0).count();
+  }
+  EXPECT_EQ(connected, 3);
+  EXPECT_GE(failures, 1u);
+  EXPECT_LE(static_cast<double>(failures), exhausted_s / 0.1 + 2.0)
+      << failures << " failed accepts in " << exhausted_s << " s";
+  EXPECT_GE(answered, 1);
+  for (int fd : waiting) {
+    ASSERT_EQ(::send(fd, "ECHO back\n", 10, MSG_NOSIGNAL), 10);
+    std::string answer;
+    char buf[256];
+    for (ssize_t n;
+         answer.find('\n') == std::string::npos && (n = ::recv(fd, buf, sizeof buf, 0)) > 0;)
+      answer.append(buf, static_cast<std::size_t>(n));
+    EXPECT_EQ(answer, "back\n");
+    ::close(fd);
+  }
 }
 
 }  // namespace

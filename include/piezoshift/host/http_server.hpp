@@ -88,6 +88,8 @@ struct HttpServerStats {
   std::uint64_t streams_opened = 0;   //!< event streams started
   std::uint64_t dropped_slow = 0;     //!< readers beyond max_pending_output_bytes
   std::uint64_t broadcast_bytes = 0;  //!< bytes queued by broadcast(), all streams
+  //! accept() failed for lack of descriptors or memory; each pauses accepting for 100 ms
+  std::uint64_t accept_failures = 0;
 };
 
 class HttpServer {

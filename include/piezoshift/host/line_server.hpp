@@ -101,6 +101,8 @@ struct LineServerStats {
   std::uint64_t overlong_lines = 0;     //!< lines longer than max_line_bytes
   std::uint64_t bytes_in = 0;           //!< received from all clients
   std::uint64_t bytes_out = 0;          //!< sent (accepted by the kernel) to all clients
+  //! accept() failed for lack of descriptors or memory; each pauses accepting for 100 ms
+  std::uint64_t accept_failures = 0;
 };
 
 class LineServer {
@@ -168,7 +170,6 @@ class LineServer {
   LineHandler& handler_;
   std::unique_ptr<TcpListener> listener_;
   ClientId next_id_ = 1;
-  Clock::time_point accept_paused_until_{};  // after EMFILE & co: do not spin on the listener
   std::vector<Client> clients_;
   std::vector<char> read_buffer_;  // one recv() chunk, shared by all clients
   std::atomic<std::size_t> client_count_{0};

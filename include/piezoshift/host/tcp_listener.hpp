@@ -7,6 +7,13 @@
 //                           (127.0.0.0/8), so a server can refuse a remote bind before binding
 //   TcpListener(host, port) socket, SO_REUSEADDR (a restarted server binds again while old
 //                           connections sit in TIME_WAIT), bind, listen; port 0 takes a free port
+//   poll_fd()               the socket for poll(), or -1 (which poll() skips) for 100 ms after an
+//                           accept failed for lack of resources
+//   accept_client()         one pending connection, non-blocking, TCP_NODELAY; -1 when none is
+//                           pending or when accept() failed for lack of resources (EMFILE,
+//                           ENFILE, ENOBUFS, ENOMEM): then the connection stays in the backlog,
+//                           so the socket stays readable, and a server that polled it at once
+//                           would spin; the pause lets it serve the clients it has meanwhile
 //   wake()                  async-signal-safe: makes wake_fd() readable; errno is kept
 //   drain_wake()            after poll() reports wake_fd() readable
 //
@@ -15,6 +22,8 @@
 // descriptor.
 #include <netinet/in.h>
 
+#include <atomic>
+#include <chrono>
 #include <cstdint>
 #include <string>
 
@@ -42,6 +51,15 @@ class TcpListener {
   int wake_fd() const noexcept { return wake_fd_; }
   std::uint16_t port() const noexcept { return port_; }
 
+  //! After accept() failed for lack of resources, the listener is left alone this long.
+  static constexpr std::chrono::milliseconds kAcceptPause{100};
+  int poll_fd() const noexcept;
+  int accept_client() noexcept;
+  //! accept() failures for lack of resources so far (each starts a pause).
+  std::uint64_t accept_failures() const noexcept {
+    return accept_failures_.load(std::memory_order_relaxed);
+  }
+
   void wake() const noexcept;
   void drain_wake() const noexcept;
 
@@ -49,6 +67,8 @@ class TcpListener {
   int listen_fd_ = -1;
   int wake_fd_ = -1;
   std::uint16_t port_ = 0;
+  std::chrono::steady_clock::time_point paused_until_{};
+  std::atomic<std::uint64_t> accept_failures_{0};  // read from other threads (stats)
 };
 
 }  // namespace piezoshift::host
