@@ -89,6 +89,10 @@ int gcs(const GcsClientOptions& o) {
                    host::describe(static_cast<host::GcsError>(error)));
         return kGcsErrorExit;
       }
+      // A command that answers nothing still says it was done, on stderr: stdout keeps only
+      // the answers, for scripts.
+      if (!answers)
+        fmt::print(stderr, "piezoshift gcs: {}: done (ERR? 0)\n", printable(command));
     }
   } catch (const std::runtime_error& e) {
     throw io::InputError(e.what());

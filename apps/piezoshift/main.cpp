@@ -7,6 +7,7 @@
 #include <CLI/CLI.hpp>
 
 #include "command.hpp"
+#include "option_suggestion.hpp"
 #include "piezoshift/experiments/validity.hpp"
 #include "piezoshift/io/input_error.hpp"
 
@@ -24,7 +25,11 @@ int main(int argc, char** argv) {
   } catch (const CLI::CallForVersion& e) {
     return app.exit(e);
   } catch (const CLI::ParseError& e) {
-    app.exit(e);
+    fmt::print(stderr, "piezoshift: error: {}\n", e.what());
+    const std::string hint = piezoshift::app::option_suggestion(app, argc, argv);
+    if (!hint.empty())
+      fmt::print(stderr, "piezoshift: {}\n", hint);
+    fmt::print(stderr, "Run with --help for more information.\n");
     return piezoshift::io::kExitBadInput;
   }
 

@@ -38,9 +38,11 @@ int run(const Options& o) {
   ro.pid = o.pid == "search" ? calibration::PidChoice::kSearch : calibration::PidChoice::kPaper;
   reproduction::ReproductionResult result;
   {
-    // PID gains, matrix A, polynomial p; then travel range, step, linearity, repeatability x 2,
-    // linearity on the 0.25 um grid and downwards, for the paper's controller and the oracle
-    ProgressBar bar(3 + 2 * 7);
+    // The bar counts changes of label: PID gains, matrix A, polynomial p; for the paper's
+    // controller travel range, step, linearity, repeatability at 5 and 10 um, linearity (the
+    // 0.25 um grid and downwards: one label), phase step; the oracle's linearity with the
+    // paper's controller; the oracle's seven.
+    ProgressBar bar(3 + 7 + 1 + 7);
     result = reproduction::reproduce(config, ro, bar.callback());
   }
   const std::string label = o.config.empty() ? "built-in defaults (configs/paper.toml)" : o.config;

@@ -16,7 +16,9 @@ namespace piezoshift::app {
 inline constexpr std::uint64_t kAnyUnsigned = std::numeric_limits<std::uint64_t>::max();
 
 inline CLI::Validator whole_number(std::int64_t lo, std::uint64_t hi) {
-  const std::string range = fmt::format("a whole number in [{}, {}]", lo, hi);
+  // 2^64 - 1 rather than its 20 digits, which read as a made-up limit in --help.
+  const std::string range = hi == kAnyUnsigned ? fmt::format("a whole number in [{}, 2^64 - 1]", lo)
+                                               : fmt::format("a whole number in [{}, {}]", lo, hi);
   return CLI::Validator(
       [lo, hi, range](std::string& text) -> std::string {
         const char* first = text.data();

@@ -72,32 +72,32 @@ void read_improved(const io::ConfigFile& file, control::ImprovedParams& im) {
 std::string number_list(const double* v, std::size_t n) {
   std::string out = "[";
   for (std::size_t i = 0; i < n; ++i)
-    out += fmt::format("{}{:.17g}", i == 0 ? "" : ", ", v[i]);
+    out += fmt::format("{}{}", i == 0 ? "" : ", ", v[i]);
   return out + "]";
 }
 
 std::string format_improved(const control::ImprovedParams& im) {
   std::string out =
       "\n[improved]  # the improved controller (docs/control.md), for one loop rate\n";
-  out += fmt::format("sample_time_s = {:.17g}\n", im.sample_time_s);
+  out += fmt::format("sample_time_s = {}\n", im.sample_time_s);
   out += fmt::format("reference_delay_ticks = {}\n", im.reference_delay_ticks);
-  out += fmt::format("correction_ki = {:.17g}  # per-sample at sample_time_s\n", im.correction_ki);
-  out += fmt::format("correction_ki_max = {:.17g}\n", im.correction_ki_max);
-  out += fmt::format("correction_boost_error_um = {:.17g}\n", im.correction_boost_error_um);
-  out += fmt::format("correction_limit_um = {:.17g}\n", im.correction_limit_um);
+  out += fmt::format("correction_ki = {}  # per-sample at sample_time_s\n", im.correction_ki);
+  out += fmt::format("correction_ki_max = {}\n", im.correction_ki_max);
+  out += fmt::format("correction_boost_error_um = {}\n", im.correction_boost_error_um);
+  out += fmt::format("correction_limit_um = {}\n", im.correction_limit_um);
   out += "shaper_taps = " + number_list(im.shaper.weight.data(), im.shaper.taps) + "\n";
-  out += fmt::format("shaper_rate_um_per_s = {:.17g}\n", im.shaper.rate_um_per_s);
+  out += fmt::format("shaper_rate_um_per_s = {}\n", im.shaper.rate_um_per_s);
   for (std::size_t i = 0; i < control::kChannels; ++i) {
     const control::HysteresisCreepParams& m = im.model[i];
     out += fmt::format("\n[improved.channel{}]  # gauge um from command um\n", i + 1);
-    out += fmt::format("offset_um = {:.17g}\n", m.offset_um);
-    out += fmt::format("linear_weight = {:.17g}\n", m.linear_weight);
+    out += fmt::format("offset_um = {}\n", m.offset_um);
+    out += fmt::format("linear_weight = {}\n", m.linear_weight);
     out += "thresholds_um = " + number_list(m.threshold_um.data(), m.operators) + "\n";
     out += "weights = " + number_list(m.weight.data(), m.operators) + "\n";
     out +=
         "creep_time_constants_s = " + number_list(m.creep_time_constant_s.data(), m.creep_terms) +
         "\n";
-    out += fmt::format("creep_gain = {:.17g}\n", m.creep_gain);
+    out += fmt::format("creep_gain = {}\n", m.creep_gain);
   }
   return out;
 }
@@ -160,16 +160,16 @@ std::string format_calibration(const control::SemiClosedLoopParams& params,
   const auto& p = params.polynomial;
   const auto& a = params.matrix.a;
   out += "\n[controller]\n";
-  out += fmt::format("kp = {:.17g}  # per-sample gains, Eq. 7\n", g.kp);
-  out += fmt::format("ki = {:.17g}\n", g.ki);
-  out += fmt::format("kd = {:.17g}\n", g.kd);
-  out += fmt::format("gains_sample_time_s = {:.17g}\n", params.gains_sample_time_s);
-  out += fmt::format("p = [{:.17g}, {:.17g}, {:.17g}, {:.17g}]  # [p3, p2, p1, p0], Eq. 8, um\n",
-                     p.p3, p.p2, p.p1, p.p0);
+  out += fmt::format("kp = {}  # per-sample gains, Eq. 7\n", g.kp);
+  out += fmt::format("ki = {}\n", g.ki);
+  out += fmt::format("kd = {}\n", g.kd);
+  out += fmt::format("gains_sample_time_s = {}\n", params.gains_sample_time_s);
+  out +=
+      fmt::format("p = [{}, {}, {}, {}]  # [p3, p2, p1, p0], Eq. 8, um\n", p.p3, p.p2, p.p1, p.p0);
   out += "A = [";
   for (std::size_t r = 0; r < 3; ++r) {
-    out += fmt::format("{}[{:.17g}, {:.17g}, {:.17g}]{}", r == 0 ? "" : "     ", a[r][0], a[r][1],
-                       a[r][2], r == 2 ? "]  # S = A Z_S, Eq. 8\n" : ",\n");
+    out += fmt::format("{}[{}, {}, {}]{}", r == 0 ? "" : "     ", a[r][0], a[r][1], a[r][2],
+                       r == 2 ? "]  # S = A Z_S, Eq. 8\n" : ",\n");
   }
   if (params.kind == control::ControllerKind::kImproved) {
     out += "kind = \"improved\"\n";
@@ -178,11 +178,11 @@ std::string format_calibration(const control::SemiClosedLoopParams& params,
   if (travel_z_max_um) {
     out += "\n[travel]\n";
     out += fmt::format(
-        "z_max_um = {:.17g}  # the travel one move from rest reaches (Section 4.1's search, then "
+        "z_max_um = {}  # the travel one move from rest reaches (Section 4.1's search, then "
         "single moves)\n",
         *travel_z_max_um);
     if (travel_z_min_um)
-      out += fmt::format("z_min_um = {:.17g}  # the lowest Z a move from the top reaches\n",
+      out += fmt::format("z_min_um = {}  # the lowest Z a move from the top reaches\n",
                          *travel_z_min_um);
   }
   return out;

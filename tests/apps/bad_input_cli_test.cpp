@@ -83,6 +83,20 @@ TEST_F(BadInput, IntegerOptionsAreNotWrappedOrSaturated) {
           {"--max-overruns: 18446744073709551616 is not a whole number in [1, 1000000]"});
 }
 
+// Command-line errors carry the program's prefix like every other error, and an option the
+// command does not have gets the closest one it does (issue 34).
+TEST_F(BadInput, CommandLineErrorsNameTheProgramAndSuggestTheClosestOption) {
+  refused("compare --seeds 9-1", {"piezoshift: error: --seeds: 9-1 is not a list of distinct"});
+  refused("design --cfg x", {"piezoshift: error: ",
+                             "piezoshift: --cfg is not an option of design: did you mean "
+                             "--config?"});
+  refused("simulate --step-un 5", {"--step-un is not an option of simulate: did you mean "
+                                   "--step-um?"});
+  refused("simulate --zzzzzz 5", {"--zzzzzz is not an option of simulate\n"});
+  const CliResult help = run("simulate --help");
+  EXPECT_NE(help.out.find("a whole number in [0, 2^64 - 1]"), std::string::npos) << help.out;
+}
+
 TEST_F(BadInput, RunTimesBeyondTheLongestRunNameTheirLimit) {
   refused("run --duration-s 1e9", {"--duration-s 1000000000: must be in (0, 1000000] s"});
   refused("run --duration-s 1 --free-run --fault sgs-open@1e10",

@@ -185,6 +185,33 @@ TEST(CalibrationFile, WritesAtomicallyAndReadsBackTheSameDoubles) {
   std::filesystem::remove_all(dir);
 }
 
+// Each number is written in the shortest form that reads back to the same double (0.6, not
+// 0.59999999999999998), so a person can read the file, and nothing is lost.
+TEST(CalibrationFile, NumbersAreWrittenShortestAndReadBackBitIdentical) {
+  control::SemiClosedLoopParams p;
+  p.gains = control::PidGains{0.6, 0.2, 1.0 / 3.0};
+  p.polynomial = control::CubicPolynomial{-1.009e-4, 1e-300, 16.0, 0.1 + 0.2};
+  p.matrix.a[2][0] = -5e-324;  // the smallest subnormal
+  const std::string text = format_calibration(p, "");
+  EXPECT_NE(text.find("kp = 0.6  #"), std::string::npos) << text;
+  EXPECT_NE(text.find("ki = 0.2\n"), std::string::npos) << text;
+  EXPECT_NE(text.find("p = [-0.0001009, 1e-300, 16, 0.30000000000000004]"), std::string::npos)
+      << text;
+  const auto dir = std::filesystem::temp_directory_path() / "piezoshift_calfile_shortest";
+  std::filesystem::create_directories(dir);
+  const std::string path = (dir / "cal.toml").string();
+  write_calibration_file(path, p, "");
+  const control::SemiClosedLoopParams q = load_calibration_file(path);
+  std::filesystem::remove_all(dir);
+  EXPECT_EQ(q.gains.kp, p.gains.kp);
+  EXPECT_EQ(q.gains.kd, p.gains.kd);
+  EXPECT_EQ(q.polynomial.p3, p.polynomial.p3);
+  EXPECT_EQ(q.polynomial.p2, p.polynomial.p2);
+  EXPECT_EQ(q.polynomial.p1, p.polynomial.p1);
+  EXPECT_EQ(q.polynomial.p0, p.polynomial.p0);
+  EXPECT_EQ(q.matrix.a[2][0], p.matrix.a[2][0]);
+}
+
 // The procedure on a plant other than the default: a loose set screw (a linear 15 N/um contact
 // in place of the identified Hertz contact) takes stroke the gauges never see, so stage 2's moves
 // drive an actuator into its output limit and the supervisor trips. The calibration says so; it

@@ -451,6 +451,8 @@ TEST_F(Serve, TheGcsCommandSendsCommandsAndPrintsTheAnswersOfQueries) {
   EXPECT_EQ(wait_exit(client), 0) << slurp(path("gcs_err.txt"));
   const std::string out = slurp(path("gcs.txt"));
   EXPECT_EQ(out.rfind("> SVO Z 1\n> SVO? Z\nZ=1\n> #7\n0xB1\n> #5\n", 0), 0u) << out;
+  // A command without an answer says on stderr that it was done; stdout keeps the answers only.
+  EXPECT_EQ(slurp(path("gcs_err.txt")), "piezoshift gcs: SVO Z 1: done (ERR? 0)\n");
   // A command that fails: the ERR? after it gives the number and PI's text, exit status 3, and
   // the commands after it are not sent.
   const Spawned bad = spawn({"gcs", "--port", std::to_string(port), "MOV Z 20", "MOV Z 1"},
