@@ -1,8 +1,10 @@
 // `piezoshift simulate`: runs the digital twin (docs/twin.md) open loop or with the paper's
 // semi-closed-loop controller, through the loop `run` and `serve` ship (the simulated bench,
 // experiments/bench.hpp: DAQ read, controller, safety supervisor, DAQ write), and reports where
-// the plate ended up. A supervisor fault ends the run's control (outputs ramp to 0 V) and the
-// command exits with status 3, as `run` does.
+// the plate ended up, the target and the error. The controller is `run`'s: --calibration FILE,
+// or else the twin calibrated first by the paper's procedure (loop_setup.hpp,
+// resolve_calibration), so that the two commands agree. A supervisor fault ends the run's control
+// (outputs ramp to 0 V) and the command exits with status 3, as `run` does.
 //
 //   piezoshift simulate --open-loop-volts 10,10,10 --duration-s 2
 //   piezoshift simulate --step-um 11 --duration-s 1 --log step.csv --json
@@ -25,6 +27,7 @@
 #include <nlohmann/json.hpp>
 
 #include "command.hpp"
+#include "loop_setup.hpp"
 #include "piezoshift/control/semi_closed_loop.hpp"
 #include "piezoshift/experiments/bench.hpp"
 #include "piezoshift/io/csv_table.hpp"
@@ -48,6 +51,7 @@ using control::Vec3;
 
 struct SimulateOptions {
   std::string config_path;  // empty: the built-in twin (configs/paper.toml's values)
+  std::string calibration;  // empty: the twin calibrated first (closed loop)
   std::uint64_t seed = 1;
   double duration_s = 1.0;
   std::vector<double> open_loop_volts;
@@ -81,11 +85,15 @@ std::vector<std::string> log_columns(bool closed_loop) {
   return c;
 }
 
+Vec3 difference(const Vec3& a, const Vec3& b) {
+  return Vec3{a[0] - b[0], a[1] - b[1], a[2] - b[2]};
+}
+
 Json vec_json(const Vec3& v) {
   return Json::array({v[0], v[1], v[2]});
 }
 
-int run_simulate(const SimulateOptions& opt) {
+void check_options(const SimulateOptions& opt) {
   const int modes = (opt.open_loop_volts.empty() ? 0 : 1) + (opt.step_um ? 1 : 0) +
                     (opt.profile_path.empty() ? 0 : 1);
   if (modes != 1) {
@@ -98,52 +106,112 @@ int run_simulate(const SimulateOptions& opt) {
         fmt::format("--max-physics-steps = {} must be in [1, 1e15]", opt.max_physics_steps));
   if (!std::isfinite(opt.step_at_s) || opt.step_at_s < 0.0)
     throw io::InputError(fmt::format("--step-at-s = {} must be >= 0", opt.step_at_s));
-
-  runtime::InstallationConfig installation;
-  if (!opt.config_path.empty())
-    installation = runtime::load_installation_config(opt.config_path);
-  const io::ProjectConfig& config = installation.project;
-  const double period_s = config.twin.daq.sample_time_s;
-
-  // The supervisor (the bench's, as `run`'s, with the config's [safety]) passes 0 to 10 DAQ volts
-  // by default (0 to 150 V at the stacks); anything else would be clamped there, so it is refused.
-  const bool closed_loop = opt.open_loop_volts.empty();
-  const runtime::SafetyLimits& limits = installation.safety;
-  Vec3 open_loop{};
-  if (!closed_loop) {
-    for (std::size_t i = 0; i < 3; ++i) {
-      const double v = opt.open_loop_volts[i];
-      if (!std::isfinite(v) || v < limits.output_min_V || v > limits.output_max_V) {
-        throw io::InputError(
-            fmt::format("--open-loop-volts: V{} = {} is outside the supervisor's {} to {} V", i + 1,
-                        v, limits.output_min_V, limits.output_max_V));
-      }
-      open_loop[i] = v;
-    }
-  }
   if (opt.step_um && !std::isfinite(*opt.step_um))
     throw io::InputError("--step-um must be a finite number");
-  std::optional<runtime::SetpointProfile> profile;
-  if (!opt.profile_path.empty())
-    profile = runtime::SetpointProfile::load_csv(opt.profile_path);
+  if (!opt.calibration.empty() && !opt.open_loop_volts.empty())
+    throw io::InputError("--calibration: open loop (--open-loop-volts) runs no controller");
+}
 
-  // The cost before the start: the duration and the config's rates together.
+// The supervisor (the bench's, as `run`'s, with the config's [safety]) passes 0 to 10 DAQ volts by
+// default (0 to 150 V at the stacks); anything else would be clamped there, so it is refused.
+Vec3 open_loop_volts(const SimulateOptions& opt, const runtime::SafetyLimits& limits) {
+  Vec3 open_loop{};
+  for (std::size_t i = 0; i < 3; ++i) {
+    const double v = opt.open_loop_volts[i];
+    if (!std::isfinite(v) || v < limits.output_min_V || v > limits.output_max_V) {
+      throw io::InputError(
+          fmt::format("--open-loop-volts: V{} = {} is outside the supervisor's {} "
+                      "to {} V",
+                      i + 1, v, limits.output_min_V, limits.output_max_V));
+    }
+    open_loop[i] = v;
+  }
+  return open_loop;
+}
+
+// The cost before the start: the duration and the config's rates together.
+void check_cost(const SimulateOptions& opt, const io::ProjectConfig& config) {
   const plant::SimulationCost cost = plant::estimate_simulation_cost(config.twin, opt.duration_s);
   if (const std::string p =
           plant::simulation_budget_problem(cost, opt.max_physics_steps, "--max-physics-steps");
       !p.empty()) {
     throw io::InputError(
         fmt::format("--duration-s {} with physics_rate_Hz {} and sample_time_s {} ({}): {}",
-                    opt.duration_s, config.twin.physics_rate_Hz, period_s,
+                    opt.duration_s, config.twin.physics_rate_Hz, config.twin.daq.sample_time_s,
                     opt.config_path.empty() ? "built-in configuration" : opt.config_path, p));
   }
+}
 
-  control::SemiClosedLoopParams cp;
-  cp.sample_time_s = period_s;  // the paper's gains, re-expressed at the twin's DAQ period
-  const auto ticks = static_cast<std::uint64_t>(std::llround(opt.duration_s / period_s));
-  if (ticks < 1)
+// One log row: the tick's signals and the twin's state at its end (log_columns' order).
+void log_tick(io::CsvWriter& log, std::vector<double>& row, const experiments::Bench& bench,
+              bool closed_loop, const Vec3& zd) {
+  const plant::Twin& twin = bench.twin();
+  const runtime::CycleSample& c = bench.last_cycle();
+  const control::ControllerOutput& out = c.controller;
+  const plant::TwinTruth& s = twin.truth();
+  const plant::InterferometerReading& r = twin.interferometer();
+  row.clear();
+  row.push_back(s.time_s);
+  if (closed_loop) {
+    row.insert(row.end(), zd.begin(), zd.end());
+    row.insert(row.end(), out.target_um.begin(), out.target_um.end());
+    row.insert(row.end(), out.command_um.begin(), out.command_um.end());
+  }
+  for (const Vec3* v : std::initializer_list<const Vec3*>{
+           &c.supervisor.ao_V, &s.amplifier_V, &c.ai_V, &s.stack_elongation_um, &s.leg_um})
+    row.insert(row.end(), v->begin(), v->end());
+  row.push_back(s.plate_z_um);
+  row.push_back(s.theta_x_urad);
+  row.push_back(s.theta_y_urad);
+  row.insert(row.end(), s.points_um.begin(), s.points_um.end());
+  row.insert(row.end(), r.dynamic_um.begin(), r.dynamic_um.end());
+  if (closed_loop)
+    row.push_back(static_cast<double>(out.saturated_mask));
+  log.row(row);
+}
+
+// What the run did, for the summary.
+struct SimulateRun {
+  std::uint64_t ticks = 0;
+  double period_s = 0.0;
+  std::uint64_t saturated_ticks = 0;
+  Vec3 final_zd_um{};       // closed loop: Z_d at the last tick
+  std::string calibration;  // closed loop: where the controller came from
+};
+
+int report(const SimulateOptions& opt, const io::ProjectConfig& config,
+           const experiments::Bench& bench, const SimulateRun& run);
+
+int run_simulate(const SimulateOptions& opt) {
+  check_options(opt);
+  runtime::InstallationConfig installation;
+  if (!opt.config_path.empty())
+    installation = runtime::load_installation_config(opt.config_path);
+  const io::ProjectConfig& config = installation.project;
+  SimulateRun run;
+  run.period_s = config.twin.daq.sample_time_s;
+  const double period_s = run.period_s;
+  const bool closed_loop = opt.open_loop_volts.empty();
+  const runtime::SafetyLimits& limits = installation.safety;
+  const Vec3 open_loop = closed_loop ? Vec3{} : open_loop_volts(opt, limits);
+  std::optional<runtime::SetpointProfile> profile;
+  if (!opt.profile_path.empty())
+    profile = runtime::SetpointProfile::load_csv(opt.profile_path);
+  check_cost(opt, config);
+  run.ticks = static_cast<std::uint64_t>(std::llround(opt.duration_s / period_s));
+  if (run.ticks < 1)
     throw io::InputError(fmt::format("--duration-s = {} is shorter than one control period ({} s)",
                                      opt.duration_s, period_s));
+
+  // `run`'s controller: the file, or the twin calibrated first (open loop needs none).
+  control::SemiClosedLoopParams cp;
+  if (closed_loop) {
+    const LoopCalibration lc =
+        resolve_calibration(opt.calibration, "sim", config, opt.seed, period_s);
+    cp = lc.params;
+    run.calibration = lc.source;
+  }
+  cp.sample_time_s = period_s;  // the gains re-expressed at the twin's DAQ period
   std::unique_ptr<experiments::Bench> made;
   try {
     experiments::BenchOptions bo;
@@ -154,7 +222,6 @@ int run_simulate(const SimulateOptions& opt) {
         "{}: {}", opt.config_path.empty() ? "configuration" : opt.config_path, e.what()));
   }
   experiments::Bench& bench = *made;
-  const plant::Twin& twin = bench.twin();
 
   std::unique_ptr<io::CsvWriter> log;
   if (!opt.log_path.empty()) {
@@ -164,9 +231,8 @@ int run_simulate(const SimulateOptions& opt) {
                              opt.duration_s, period_s));
   }
 
-  std::uint64_t saturated_ticks = 0;
   std::vector<double> row;
-  for (std::uint64_t k = 0; k < ticks; ++k) {
+  for (std::uint64_t k = 0; k < run.ticks; ++k) {
     const double t = static_cast<double>(k) * period_s;
     Vec3 zd{};
     if (!closed_loop) {
@@ -181,35 +247,24 @@ int run_simulate(const SimulateOptions& opt) {
       bench.drive_points(zd);
     }
     bench.run(period_s);
-    const runtime::CycleSample& c = bench.last_cycle();
-    const control::ControllerOutput& out = c.controller;
     if (closed_loop)
-      saturated_ticks += out.saturated_mask != 0 ? 1 : 0;
-    if (log) {
-      const plant::TwinTruth& s = twin.truth();
-      const plant::InterferometerReading& r = twin.interferometer();
-      row.clear();
-      row.push_back(s.time_s);
-      if (closed_loop) {
-        row.insert(row.end(), zd.begin(), zd.end());
-        row.insert(row.end(), out.target_um.begin(), out.target_um.end());
-        row.insert(row.end(), out.command_um.begin(), out.command_um.end());
-      }
-      for (const Vec3* v : std::initializer_list<const Vec3*>{
-               &c.supervisor.ao_V, &s.amplifier_V, &c.ai_V, &s.stack_elongation_um, &s.leg_um})
-        row.insert(row.end(), v->begin(), v->end());
-      row.push_back(s.plate_z_um);
-      row.push_back(s.theta_x_urad);
-      row.push_back(s.theta_y_urad);
-      row.insert(row.end(), s.points_um.begin(), s.points_um.end());
-      row.insert(row.end(), r.dynamic_um.begin(), r.dynamic_um.end());
-      if (closed_loop)
-        row.push_back(static_cast<double>(out.saturated_mask));
-      log->row(row);
-    }
+      run.saturated_ticks += bench.last_cycle().controller.saturated_mask != 0 ? 1 : 0;
+    run.final_zd_um = zd;
+    if (log)
+      log_tick(*log, row, bench, closed_loop, zd);
   }
   if (log)
     log->close();
+  return report(opt, config, bench, run);
+}
+
+int report(const SimulateOptions& opt, const io::ProjectConfig& config,
+           const experiments::Bench& bench, const SimulateRun& run) {
+  const plant::Twin& twin = bench.twin();
+  const bool closed_loop = opt.open_loop_volts.empty();
+  const double period_s = run.period_s;
+  const std::uint64_t ticks = run.ticks;
+  const std::uint64_t saturated_ticks = run.saturated_ticks;
 
   const plant::TwinTruth& s = twin.truth();
   const plant::InterferometerReading& r = twin.interferometer();
@@ -254,6 +309,11 @@ int run_simulate(const SimulateOptions& opt) {
       j["step_um"] = *opt.step_um;
       j["step_at_s"] = opt.step_at_s;
     }
+    if (closed_loop) {
+      j["calibration"] = run.calibration;
+      j["final_zd_um"] = vec_json(run.final_zd_um);
+      j["final_error_um"] = vec_json(difference(r.dynamic_um, run.final_zd_um));
+    }
     if (!opt.log_path.empty())
       j["log_file"] = opt.log_path;
     fmt::print("{}\n", j.dump(2));
@@ -267,6 +327,13 @@ int run_simulate(const SimulateOptions& opt) {
              s.points_um[1], s.points_um[2]);
   fmt::print("  interferometer        {:10.4f} {:10.4f} {:10.4f} um\n", r.dynamic_um[0],
              r.dynamic_um[1], r.dynamic_um[2]);
+  if (closed_loop) {
+    const Vec3& zd = run.final_zd_um;
+    const Vec3 e = difference(r.dynamic_um, zd);
+    fmt::print("  target Z_d            {:10.4f} {:10.4f} {:10.4f} um\n", zd[0], zd[1], zd[2]);
+    fmt::print("  error (interf. - Z_d) {:10.4f} {:10.4f} {:10.4f} um\n", e[0], e[1], e[2]);
+    fmt::print("  controller            {}\n", run.calibration);
+  }
   fmt::print("  stack voltages        {:10.3f} {:10.3f} {:10.3f} V\n", s.amplifier_V[0],
              s.amplifier_V[1], s.amplifier_V[2]);
   if (closed_loop)
@@ -286,10 +353,14 @@ int run_simulate(const SimulateOptions& opt) {
 
 void add_simulate_command(CLI::App& app, Action& action) {
   CLI::App* cmd = app.add_subcommand(
-      "simulate", "Run the digital twin open loop or with the paper's controller (docs/twin.md)");
+      "simulate",
+      "Run the digital twin open loop or closed loop with run's controller (docs/twin.md)");
   auto opt = std::make_shared<SimulateOptions>();
   cmd->add_option("--config", opt->config_path,
                   "TOML file (configs/paper.toml's sections; absent keys keep the paper's values)");
+  cmd->add_option("--calibration", opt->calibration,
+                  "closed loop: the controller's calibration file, as `run` reads (default: the "
+                  "twin calibrated first by the paper's procedure)");
   cmd->add_option("--seed", opt->seed, "seed of the twin's random numbers (default 1)")
       ->check(whole_number(0, kAnyUnsigned));
   cmd->add_option("--duration-s", opt->duration_s, "simulated time [s] (default 1)");

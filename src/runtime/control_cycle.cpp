@@ -33,6 +33,13 @@ control::ParamsProblem ControlCycle::try_configure(
       control::params_problem(params, controller_.params().sample_time_s);
   if (problem != control::ParamsProblem::kNone)
     return problem;
+  for (std::size_t i = 0; i < params.scaling.size(); ++i) {
+    const control::SignalScaling& now = controller_.params().scaling[i];
+    const control::SignalScaling& next = params.scaling[i];
+    if (next.sgs_um_per_V != now.sgs_um_per_V || next.sgs_offset_V != now.sgs_offset_V ||
+        next.drive_V_per_um != now.drive_V_per_um || next.drive_offset_V != now.drive_offset_V)
+      return control::ParamsProblem::kScaling;
+  }
   const Vec3 held = held_command_um();
   controller_.configure(params);
   controller_.reset_to(held);
@@ -44,7 +51,7 @@ Vec3 ControlCycle::held_command_um() const noexcept {
   Vec3 u{};
   for (std::size_t i = 0; i < u.size(); ++i) {
     const control::SignalScaling& s = controller_.params().scaling[i];
-    u[i] = (ao[i] - s.drive_offset_V) / s.drive_V_per_um;
+    u[i] = s.dac_to_um(ao[i]);
   }
   return u;
 }

@@ -165,7 +165,7 @@ void SafetySupervisor::check(const SupervisorInput& in) noexcept {
       return;
     }
     const control::SignalScaling& s = scaling_[i];
-    const double u_um = (last_ao_V_[i] - s.drive_offset_V) / s.drive_V_per_um;
+    const double u_um = s.dac_to_um(last_ao_V_[i]);
     const double lo = limits_.response_gain_min * u_um - limits_.response_band_um;
     const double hi = limits_.response_gain_max * u_um + limits_.response_band_um;
     const double y = in.feedback_um[i];

@@ -105,6 +105,10 @@ TEST_F(ConnectedFilesCli, AnalyzeStepReadsRunsAndSimulatesOwnLogs) {
                 0.01)
         << log;
   }
+  // The two commands build the same controller (the twin calibrated first) and end where the
+  // other ends: before issue 34 simulate ran the paper's uncalibrated A and p, 0.3 um higher.
+  EXPECT_NEAR(mean_over(sim_log, "interferometer1_um", 0.45, 0.499),
+              mean_over(run_log, "interferometer1_um", 0.45, 0.499), 0.002);
   const CliResult missing = run("analyze step --data '" + run_log + "' --column ifm1_um");
   EXPECT_EQ(missing.status, 2);
   EXPECT_NE(missing.err.find("ifm1_um"), std::string::npos) << missing.err;

@@ -95,6 +95,8 @@ TEST(ParamsProblem, LimitsScalingAndSizes) {
             ParamsProblem::kScaling);
   EXPECT_EQ(problem_of([](SemiClosedLoopParams& p) { p.scaling[2].sgs_um_per_V = 0.0; }),
             ParamsProblem::kScaling);
+  EXPECT_EQ(problem_of([](SemiClosedLoopParams& p) { p.scaling[1].drive_V_per_um = -0.625; }),
+            ParamsProblem::kScaling);
   EXPECT_EQ(problem_of([](SemiClosedLoopParams& p) {
               p.kind = ControllerKind::kImproved;
               p.improved.shaper.taps = kMaxShaperTaps + 1;
@@ -112,6 +114,13 @@ TEST(ParamsProblem, LimitsScalingAndSizes) {
             ParamsProblem::kModelSize);
   for (int k = 1; k <= static_cast<int>(ParamsProblem::kAbsent); ++k)
     EXPECT_GT(std::string(to_string(static_cast<ParamsProblem>(k))).size(), 10u) << k;
+}
+
+TEST(SignalScaling, DacToUmInvertsUmToDac) {
+  const SignalScaling s{1.6, 0.01, 0.625, -0.02};
+  for (double u : {0.0, 1e-3, 5.0, 16.0})
+    EXPECT_NEAR(s.dac_to_um(s.um_to_dac(u)), u, 1e-14 * (1.0 + u)) << u;
+  EXPECT_NEAR(s.um_to_dac(s.dac_to_um(7.5)), 7.5, 1e-14);
 }
 
 }  // namespace

@@ -41,12 +41,19 @@ TEST_F(SimulateCommand, StepWithThePapersControllerLogsEveryTickWithUnits) {
   const auto j = nlohmann::json::parse(r.out);
   EXPECT_EQ(j["mode"], "step");
   EXPECT_EQ(j["ticks"], 500);
-  // the paper's feedforward: the points go to p(5) = 5.3585 um less two bows that a cubic fitted
-  // on the twin removes but the paper's p does not: the conditioner's (~14 nm at 2.9 V) and the
-  // Hertz contact's (the stack elongates ~38 nm more than the secant the gauge gains assume, so
-  // the gauge reaches its target with the leg short); measured 5.305 to 5.311 um
+  // As `run`: without --calibration the twin is calibrated first by the paper's procedure, so
+  // the points reach Z_d = 5 um but for the twin's noise and what creep is left after 0.5 s
+  // (measured 4.9955 to 5.0028 um). Until issue 34, simulate ran the paper's own A and p here and
+  // ended 0.31 um high (the test below keeps that case).
+  EXPECT_NE(j["calibration"].get<std::string>().find("the twin's own calibration"),
+            std::string::npos);
   for (const auto& p : j["final_true_points_um"])
-    EXPECT_NEAR(p.get<double>(), 5.3585 - 0.050, 0.03);
+    EXPECT_NEAR(p.get<double>(), 5.0, 0.02);
+  for (std::size_t i = 0; i < 3; ++i) {
+    EXPECT_EQ(j["final_zd_um"][i], 5.0);
+    EXPECT_DOUBLE_EQ(j["final_error_um"][i].get<double>(),
+                     j["final_points_um"][i].get<double>() - 5.0);
+  }
   std::ifstream in(log);
   std::string line, header;
   int rows = 0;
@@ -64,6 +71,30 @@ TEST_F(SimulateCommand, StepWithThePapersControllerLogsEveryTickWithUnits) {
   EXPECT_NE(header.find(",truth3_um,interferometer1_um,"), std::string::npos);
 }
 
+// The paper's own controller (Section 4's gains, A and p, fitted to its stage, not the twin):
+// the points go to p(5) = 5.3585 um less two bows that a cubic fitted on the twin removes but the
+// paper's p does not: the conditioner's (~14 nm at 2.9 V) and the Hertz contact's (the stack
+// elongates ~38 nm more than the secant the gauge gains assume, so the gauge reaches its target
+// with the leg short); measured 5.309 to 5.311 um.
+TEST_F(SimulateCommand, ThePapersOwnCalibrationFileLeavesTheTwinsBowsInPlace) {
+  const std::string cal = write("paper.toml",
+                                "[controller]\nkp = 0.6\nki = 0.2\nkd = 0.001\n"
+                                "p = [-0.0001009, 0.000389, 1.014, 0.2914]\n"
+                                "A = [[-0.4218, 0.6030, 0.6547], [0.3482, -0.1491, 0.6962], "
+                                "[0.6321, 0.4397, -0.2980]]\n");
+  const RunResult r =
+      run("--step-um 5 --duration-s 0.5 --seed 3 --json --calibration '" + cal + "'");
+  ASSERT_EQ(r.status, 0) << r.err;
+  const auto j = nlohmann::json::parse(r.out);
+  EXPECT_EQ(j["calibration"], cal);
+  for (const auto& p : j["final_true_points_um"])
+    EXPECT_NEAR(p.get<double>(), 5.3585 - 0.050, 0.03);
+  // Open loop runs no controller: a calibration there is refused, not ignored.
+  const RunResult open = run("--open-loop-volts 1,1,1 --calibration '" + cal + "'");
+  EXPECT_EQ(open.status, 2);
+  EXPECT_NE(open.err.find("--calibration: open loop"), std::string::npos) << open.err;
+}
+
 TEST_F(SimulateCommand, SameSeedGivesTheSameLogAndAnotherSeedDoesNot) {
   const std::string a = path("a.csv"), b = path("b.csv"), c = path("c.csv");
   ASSERT_EQ(run("--step-um 8 --duration-s 0.3 --seed 9 --log '" + a + "'").status, 0);
@@ -79,10 +110,10 @@ TEST_F(SimulateCommand, ProfileIsFollowedAsRunFollowsIt) {
   ASSERT_EQ(r.status, 0) << r.err;
   const auto j = nlohmann::json::parse(r.out);
   EXPECT_EQ(j["mode"], "profile");
-  // p(6) = 6.3676 um; the gauge's 0.1 % bow reads ~9 mV high there (~16 nm) and the Hertz
-  // contact's bow adds ~30 nm (see the step test), so the points sit ~45 nm low (6.323 to 6.324)
+  // The twin calibrated first: the points end on Z_d = 6 um (measured 6.0014 to 6.0118 um, 0.3 s
+  // after the ramp ended).
   for (const auto& p : j["final_true_points_um"])
-    EXPECT_NEAR(p.get<double>(), 6.3676 - 0.045, 0.03);
+    EXPECT_NEAR(p.get<double>(), 6.0, 0.03);
 }
 
 TEST_F(SimulateCommand, BadInputExitsTwoWithAClearMessage) {

@@ -245,6 +245,13 @@ TEST(HostMode, ANonFiniteGainIsRefusedAndTheLoopRunsOn) {
   expect_refused_and_running(run_switch(&p), control::ParamsProblem::kNotFinite);
 }
 
+// The scaling is the wiring the supervisor was set up with; a set that changes it is refused.
+TEST(HostMode, AnotherSignalScalingIsRefusedAndTheLoopRunsOn) {
+  control::SemiClosedLoopParams p{};
+  p.scaling[0].drive_V_per_um = 0.5;
+  expect_refused_and_running(run_switch(&p), control::ParamsProblem::kScaling);
+}
+
 TEST(HostMode, AConfigureCommandWithoutAParameterSetIsRefused) {
   expect_refused_and_running(run_switch(nullptr), control::ParamsProblem::kAbsent);
 }

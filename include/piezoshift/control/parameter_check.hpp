@@ -11,8 +11,10 @@
 //   kNotFinite       every gain, limit, coefficient, matrix entry, scaling and model value in use
 //                    is a finite number
 //   kOutputLimits    output_min_um < output_max_um
-//   kScaling         sgs_um_per_V and drive_V_per_um are not 0 (the loop divides by the latter to
-//                    restart its PIDs from the outputs it holds)
+//   kScaling         sgs_um_per_V and drive_V_per_um are > 0 (the loop divides by the latter to
+//                    restart its PIDs from the outputs it holds; the supervisor requires both);
+//                    ControlCycle::try_configure also refuses a scaling other than the loop's:
+//                    it is the wiring, which the supervisor was set up with
 //   kModelSize       no more shaper taps, play operators or creep terms than the controller
 //                    holds, and a reference delay of at most kMaxReferenceDelayTicks
 //
@@ -52,7 +54,7 @@ constexpr const char* to_string(ParamsProblem p) noexcept {
     case ParamsProblem::kOutputLimits:
       return "output_min_um is not below output_max_um";
     case ParamsProblem::kScaling:
-      return "a signal scaling (sgs_um_per_V or drive_V_per_um) is 0";
+      return "a signal scaling (sgs_um_per_V or drive_V_per_um) is not > 0 or not the loop's";
     case ParamsProblem::kModelSize:
       return "more shaper taps, model operators, creep terms or delay ticks than the controller "
              "holds";
@@ -137,7 +139,7 @@ constexpr ParamsProblem params_problem(const BasicSemiClosedLoopParams<T>& p,
   if (!(p.output_min_um < p.output_max_um))
     return ParamsProblem::kOutputLimits;
   for (const BasicSignalScaling<T>& s : p.scaling)
-    if (s.sgs_um_per_V == T(0) || s.drive_V_per_um == T(0))
+    if (!(s.sgs_um_per_V > T(0)) || !(s.drive_V_per_um > T(0)))
       return ParamsProblem::kScaling;
   return ParamsProblem::kNone;
 }

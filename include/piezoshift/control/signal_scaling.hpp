@@ -2,6 +2,8 @@
 // The unit conversions at the controller's two edges, so the PID works in micrometres:
 //   feedback_um = (sgs_V - sgs_offset_V) * sgs_um_per_V         SGS conditioner, 0..10 V
 //   dac_V       = drive_offset_V + u_um * drive_V_per_um        DAQ output -> amplifier (x15)
+//   u_um        = (dac_V - drive_offset_V) / drive_V_per_um     its inverse: the command that
+//                                                               produced outputs already held
 // Defaults: the conditioner spans the nominal stroke (16 um over 10 V, Table 1 and Section 4), and
 // the drive maps the nominal free stroke to the DAQ's 10 V (150 V at the stack after the x15
 // amplifier).
@@ -18,6 +20,10 @@ struct BasicSignalScaling {
 
   constexpr T sgs_to_um(T sgs_V) const noexcept { return (sgs_V - sgs_offset_V) * sgs_um_per_V; }
   constexpr T um_to_dac(T u_um) const noexcept { return drive_offset_V + u_um * drive_V_per_um; }
+  //! drive_V_per_um > 0 (control::params_problem, SafetySupervisor::configure).
+  constexpr T dac_to_um(T dac_V) const noexcept {
+    return (dac_V - drive_offset_V) / drive_V_per_um;
+  }
 };
 
 using SignalScaling = BasicSignalScaling<double>;
