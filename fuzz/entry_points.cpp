@@ -6,8 +6,8 @@
 #include <vector>
 
 #include "piezoshift/calibration/calibration_file.hpp"
+#include "piezoshift/config/project_config.hpp"
 #include "piezoshift/io/input_error.hpp"
-#include "piezoshift/io/project_config.hpp"
 #include "program.hpp"
 #include "scratch_file.hpp"
 
@@ -31,7 +31,7 @@ bool quick_design(const CLI::App& app) {
 
 void config_input(std::string_view data) {
   try {
-    io::load_project_config(scratch_file("config.toml", data));
+    config::load_project_config(scratch_file("config.toml", data));
   } catch (const io::InputError&) {
   }
 }

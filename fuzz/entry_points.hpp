@@ -14,7 +14,7 @@
 namespace piezoshift::fuzz {
 
 //! The project configuration (configs/paper.toml's format: design and twin sections), read
-//! from a file holding the input as io::load_project_config reads `--config`.
+//! from a file holding the input as config::load_project_config reads `--config`.
 void config_input(std::string_view data);
 //! Recorded data as a CSV file, through each path that reads one: `analyze linearity`,
 //! `analyze repeatability`, `analyze step`, `fit matrix` and `fit poly` (the program's own

@@ -20,10 +20,10 @@
 #include "piezoshift/calibration/guided_calibration.hpp"
 #include "piezoshift/calibration/improved_calibration.hpp"
 #include "piezoshift/calibration/loop_rig.hpp"
+#include "piezoshift/config/project_config.hpp"
 #include "piezoshift/experiments/paper_experiments.hpp"
 #include "piezoshift/io/csv_writer.hpp"
 #include "piezoshift/io/input_error.hpp"
-#include "piezoshift/io/project_config.hpp"
 #include "piezoshift/runtime/loop_clock.hpp"
 #include "piezoshift/runtime/paced_clock.hpp"
 #include "piezoshift/runtime/safety_ranges.hpp"
@@ -106,7 +106,7 @@ int run_guided(const Options& o) {
   const runtime::InstallationConfig installation =
       o.config.empty() ? runtime::InstallationConfig{}
                        : runtime::load_installation_config(o.config);
-  const io::ProjectConfig& config = installation.project;
+  const config::ProjectConfig& config = installation.project;
   calibration::GuidedOptions go;
   go.max_zero_drift_um = o.max_zero_drift_um;
   const std::vector<calibration::GuidedStep> plan = calibration::guided_plan(go);
@@ -276,7 +276,7 @@ int run_guided(const Options& o) {
 }
 
 // The improved controller (issue 12): the paper's stages for A and p, then its own models.
-int run_improved(const Options& o, const io::ProjectConfig& config) {
+int run_improved(const Options& o, const config::ProjectConfig& config) {
   if (o.pid != "paper")
     throw io::InputError("--pid search: the improved controller has no PID to search");
   control::SemiClosedLoopParams base;
@@ -339,8 +339,9 @@ int run(const Options& o) {
   }
   if (!o.interferometer.empty())
     throw io::InputError("--interferometer needs --daq (the guided calibration)");
-  const io::ProjectConfig config =
-      o.config.empty() ? io::ProjectConfig{} : runtime::load_installation_config(o.config).project;
+  const config::ProjectConfig config = o.config.empty()
+                                           ? config::ProjectConfig{}
+                                           : runtime::load_installation_config(o.config).project;
   if (o.controller == "improved")
     return run_improved(o, config);
   calibration::CalibrationOptions co;

@@ -12,7 +12,7 @@
 #include <fmt/core.h>
 
 #include "command.hpp"
-#include "piezoshift/io/project_config.hpp"
+#include "piezoshift/config/project_config.hpp"
 #include "piezoshift/reproduction/comparison.hpp"
 #include "piezoshift/reproduction/comparison_report.hpp"
 #include "piezoshift/runtime/safety_ranges.hpp"
@@ -82,8 +82,9 @@ struct Options {
 };
 
 int run(const Options& o) {
-  const io::ProjectConfig config =
-      o.config.empty() ? io::ProjectConfig{} : runtime::load_installation_config(o.config).project;
+  const config::ProjectConfig config = o.config.empty()
+                                           ? config::ProjectConfig{}
+                                           : runtime::load_installation_config(o.config).project;
   reproduction::CompareOptions co;
   co.seeds = *parse_seeds(o.seeds);  // checked by the option's validator
   co.quick = o.quick;

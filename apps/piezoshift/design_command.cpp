@@ -11,10 +11,10 @@
 #include <nlohmann/json.hpp>
 
 #include "command.hpp"
+#include "piezoshift/config/project_config.hpp"
 #include "piezoshift/design/design_evaluation.hpp"
 #include "piezoshift/design/hinge_search.hpp"
 #include "piezoshift/io/input_error.hpp"
-#include "piezoshift/io/project_config.hpp"
 #include "piezoshift/runtime/safety_ranges.hpp"
 
 namespace piezoshift::app {

@@ -27,9 +27,9 @@
 #include "piezoshift/calibration/calibration_file.hpp"
 #include "piezoshift/calibration/matrix_fit.hpp"
 #include "piezoshift/calibration/poly_fit.hpp"
+#include "piezoshift/config/project_config.hpp"
 #include "piezoshift/io/csv_table.hpp"
 #include "piezoshift/io/input_error.hpp"
-#include "piezoshift/io/project_config.hpp"
 #include "piezoshift/runtime/safety_ranges.hpp"
 
 namespace piezoshift::app {
@@ -190,8 +190,9 @@ double record_step_s(const io::CsvTable& t, const std::vector<double>& ts) {
 }
 
 int run_improved(const FitOptions& o) {
-  const io::ProjectConfig config =
-      o.config.empty() ? io::ProjectConfig{} : runtime::load_installation_config(o.config).project;
+  const config::ProjectConfig config = o.config.empty()
+                                           ? config::ProjectConfig{}
+                                           : runtime::load_installation_config(o.config).project;
   const io::CsvTable t = io::CsvTable::load(o.data_path);
   t.require_columns({"t_s", "u1_um", "u2_um", "u3_um", "sgs1_um", "sgs2_um", "sgs3_um"});
   const double sample_time_s = record_step_s(t, t.column("t_s"));

@@ -47,7 +47,7 @@ nlohmann::json safety_json(const runtime::SafetyLimits& limits) {
   return j;
 }
 
-ChosenBackend make_backend(const std::string& daq, const io::ProjectConfig& config,
+ChosenBackend make_backend(const std::string& daq, const config::ProjectConfig& config,
                            std::uint64_t seed, double rate_Hz, const std::string& config_path) {
   ChosenBackend chosen;
   if (daq == "sim") {
@@ -73,7 +73,7 @@ ChosenBackend make_backend(const std::string& daq, const io::ProjectConfig& conf
 }
 
 LoopCalibration resolve_calibration(const std::string& path, const std::string& daq,
-                                    const io::ProjectConfig& config, std::uint64_t seed,
+                                    const config::ProjectConfig& config, std::uint64_t seed,
                                     double loop_sample_time_s) {
   LoopCalibration c;
   if (!path.empty()) {

@@ -10,8 +10,8 @@
 
 #include <nlohmann/json.hpp>
 
+#include "piezoshift/config/project_config.hpp"
 #include "piezoshift/control/semi_closed_loop.hpp"
-#include "piezoshift/io/project_config.hpp"
 #include "piezoshift/runtime/daq_backend.hpp"
 #include "piezoshift/runtime/realtime.hpp"
 #include "piezoshift/runtime/safety_ranges.hpp"
@@ -41,7 +41,7 @@ nlohmann::json safety_json(const runtime::SafetyLimits& limits);
 //! "sim" (the twin of config, at rate_Hz, with seed) or "comedi[:DEVICE]". Throws io::InputError
 //! for anything else. Not configured yet. config_path: where config came from ("" built in), named
 //! in the sim backend's messages.
-ChosenBackend make_backend(const std::string& daq, const io::ProjectConfig& config,
+ChosenBackend make_backend(const std::string& daq, const config::ProjectConfig& config,
                            std::uint64_t seed, double rate_Hz, const std::string& config_path = {});
 
 //! The controller a loop runs with, and where it came from.
@@ -60,7 +60,7 @@ struct LoopCalibration {
 //! improved controller calibrated at another rate than loop_sample_time_s is refused (its shaper
 //! and correction hold at one rate only).
 LoopCalibration resolve_calibration(const std::string& path, const std::string& daq,
-                                    const io::ProjectConfig& config, std::uint64_t seed,
+                                    const config::ProjectConfig& config, std::uint64_t seed,
                                     double loop_sample_time_s);
 
 //! Set by the handlers StopSignals installs: the signal number, 0 until one arrives.

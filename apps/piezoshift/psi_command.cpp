@@ -17,9 +17,9 @@
 #include <nlohmann/json.hpp>
 
 #include "command.hpp"
+#include "piezoshift/config/project_config.hpp"
 #include "piezoshift/io/atomic_file.hpp"
 #include "piezoshift/io/input_error.hpp"
-#include "piezoshift/io/project_config.hpp"
 #include "piezoshift/psi/analysis.hpp"
 #include "piezoshift/psi/error_budget.hpp"
 #include "piezoshift/psi/npy.hpp"
@@ -273,7 +273,7 @@ int run_calibrate(const PsiOptions& o) {
 }
 
 int run_simulate(const PsiOptions& o) {
-  io::ProjectConfig config;
+  config::ProjectConfig config;
   if (!o.config.empty())
     config = runtime::load_installation_config(o.config).project;  // [safety] allowed, unused
   psi::SimulationParams p;

@@ -8,8 +8,8 @@
 #include <fmt/core.h>
 
 #include "command.hpp"
+#include "piezoshift/config/project_config.hpp"
 #include "piezoshift/io/input_error.hpp"
-#include "piezoshift/io/project_config.hpp"
 #include "piezoshift/reproduction/report.hpp"
 #include "piezoshift/reproduction/reproduction.hpp"
 #include "piezoshift/reproduction/summary.hpp"
@@ -30,8 +30,9 @@ struct Options {
 };
 
 int run(const Options& o) {
-  const io::ProjectConfig config =
-      o.config.empty() ? io::ProjectConfig{} : runtime::load_installation_config(o.config).project;
+  const config::ProjectConfig config = o.config.empty()
+                                           ? config::ProjectConfig{}
+                                           : runtime::load_installation_config(o.config).project;
   reproduction::ReproduceOptions ro;
   ro.seed = o.seed;
   ro.quick = o.quick;

@@ -25,8 +25,8 @@
 #include "command.hpp"
 #include "loop_setup.hpp"
 #include "piezoshift/calibration/calibration_file.hpp"
+#include "piezoshift/config/project_config.hpp"
 #include "piezoshift/io/input_error.hpp"
-#include "piezoshift/io/project_config.hpp"
 #include "piezoshift/runtime/control_loop.hpp"
 #include "piezoshift/runtime/csv_logger.hpp"
 #include "piezoshift/runtime/fault_injection.hpp"
@@ -134,7 +134,7 @@ int run(const RunOptions& o) {
   const runtime::InstallationConfig installation =
       o.config.empty() ? runtime::InstallationConfig{}
                        : runtime::load_installation_config(o.config);
-  const io::ProjectConfig& project = installation.project;
+  const config::ProjectConfig& project = installation.project;
   const LoopCalibration cal =
       resolve_calibration(o.calibration, o.daq, project, o.seed, 1.0 / o.rate_Hz);
   const control::SemiClosedLoopParams& params = cal.params;

@@ -25,6 +25,7 @@
 #include "dashboard_page.hpp"
 #include "loop_setup.hpp"
 #include "piezoshift/calibration/calibration_file.hpp"
+#include "piezoshift/config/project_config.hpp"
 #include "piezoshift/host/dashboard.hpp"
 #include "piezoshift/host/gcs_controller.hpp"
 #include "piezoshift/host/http_server.hpp"
@@ -33,7 +34,6 @@
 #include "piezoshift/host/stage_model.hpp"
 #include "piezoshift/io/input_error.hpp"
 #include "piezoshift/io/input_file.hpp"
-#include "piezoshift/io/project_config.hpp"
 #include "piezoshift/runtime/control_loop.hpp"
 #include "piezoshift/runtime/csv_logger.hpp"
 #include "piezoshift/runtime/fault_injection.hpp"
@@ -111,7 +111,7 @@ std::string http_token(const ServeOptions& o) {
   return token;
 }
 
-host::StageModel make_stage_model(const ServeOptions& o, const io::ProjectConfig& config,
+host::StageModel make_stage_model(const ServeOptions& o, const config::ProjectConfig& config,
                                   const control::SemiClosedLoopParams& params,
                                   const LoopCalibration& cal, const runtime::SafetyLimits& safety) {
   try {
@@ -159,7 +159,7 @@ int serve(const ServeOptions& o) {
   const runtime::InstallationConfig installation =
       o.config.empty() ? runtime::InstallationConfig{}
                        : runtime::load_installation_config(o.config);
-  const io::ProjectConfig& config = installation.project;
+  const config::ProjectConfig& config = installation.project;
   const runtime::SafetyLimits safety = loop_safety_limits(installation.safety, o.max_overruns);
   const LoopCalibration cal =
       resolve_calibration(o.calibration, o.daq, config, o.seed, 1.0 / o.rate_Hz);

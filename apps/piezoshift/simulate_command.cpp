@@ -28,12 +28,12 @@
 
 #include "command.hpp"
 #include "loop_setup.hpp"
+#include "piezoshift/config/project_config.hpp"
 #include "piezoshift/control/semi_closed_loop.hpp"
 #include "piezoshift/experiments/bench.hpp"
 #include "piezoshift/io/csv_table.hpp"
 #include "piezoshift/io/csv_writer.hpp"
 #include "piezoshift/io/input_error.hpp"
-#include "piezoshift/io/project_config.hpp"
 #include "piezoshift/plant/simulation_cost.hpp"
 #include "piezoshift/plant/twin.hpp"
 #include "piezoshift/runtime/safety_ranges.hpp"
@@ -130,7 +130,7 @@ Vec3 open_loop_volts(const SimulateOptions& opt, const runtime::SafetyLimits& li
 }
 
 // The cost before the start: the duration and the config's rates together.
-void check_cost(const SimulateOptions& opt, const io::ProjectConfig& config) {
+void check_cost(const SimulateOptions& opt, const config::ProjectConfig& config) {
   const plant::SimulationCost cost = plant::estimate_simulation_cost(config.twin, opt.duration_s);
   if (const std::string p =
           plant::simulation_budget_problem(cost, opt.max_physics_steps, "--max-physics-steps");
@@ -179,7 +179,7 @@ struct SimulateRun {
   std::string calibration;  // closed loop: where the controller came from
 };
 
-int report(const SimulateOptions& opt, const io::ProjectConfig& config,
+int report(const SimulateOptions& opt, const config::ProjectConfig& config,
            const experiments::Bench& bench, const SimulateRun& run);
 
 int run_simulate(const SimulateOptions& opt) {
@@ -187,7 +187,7 @@ int run_simulate(const SimulateOptions& opt) {
   runtime::InstallationConfig installation;
   if (!opt.config_path.empty())
     installation = runtime::load_installation_config(opt.config_path);
-  const io::ProjectConfig& config = installation.project;
+  const config::ProjectConfig& config = installation.project;
   SimulateRun run;
   run.period_s = config.twin.daq.sample_time_s;
   const double period_s = run.period_s;
@@ -258,7 +258,7 @@ int run_simulate(const SimulateOptions& opt) {
   return report(opt, config, bench, run);
 }
 
-int report(const SimulateOptions& opt, const io::ProjectConfig& config,
+int report(const SimulateOptions& opt, const config::ProjectConfig& config,
            const experiments::Bench& bench, const SimulateRun& run) {
   const plant::Twin& twin = bench.twin();
   const bool closed_loop = opt.open_loop_volts.empty();

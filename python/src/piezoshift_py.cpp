@@ -20,6 +20,7 @@
 #include "piezoshift/calibration/fit_error.hpp"
 #include "piezoshift/calibration/matrix_fit.hpp"
 #include "piezoshift/calibration/poly_fit.hpp"
+#include "piezoshift/config/project_config.hpp"
 #include "piezoshift/design/design_evaluation.hpp"
 #include "piezoshift/design/design_inputs.hpp"
 #include "piezoshift/design/flexure.hpp"
@@ -31,7 +32,6 @@
 #include "piezoshift/experiments/metrics_step_response.hpp"
 #include "piezoshift/experiments/paper_experiments.hpp"
 #include "piezoshift/io/input_error.hpp"
-#include "piezoshift/io/project_config.hpp"
 #include "piezoshift/plant/twin.hpp"
 #include "piezoshift/plant/twin_params.hpp"
 #include "piezoshift/reproduction/report.hpp"
@@ -375,10 +375,10 @@ PYBIND11_MODULE(_piezoshift, m) {
         "Why design and twin parameters cannot make a twin, or '' when they can");
 
   // ---- configuration ----------------------------------------------------------------------
-  py::class_<ps::io::ProjectConfig>(m, "ProjectConfig")
+  py::class_<ps::config::ProjectConfig>(m, "ProjectConfig")
       .def(py::init<>())
-      .PS_RW(ps::io::ProjectConfig, design)
-      .PS_RW(ps::io::ProjectConfig, twin);
+      .PS_RW(ps::config::ProjectConfig, design)
+      .PS_RW(ps::config::ProjectConfig, twin);
   // An installation's file may carry [safety] (runtime/safety_ranges.hpp): read and checked here
   // too, so that the same file loads in Python and in the CLI.
   m.def(
@@ -434,7 +434,7 @@ PYBIND11_MODULE(_piezoshift, m) {
   py::class_<pl::Twin>(m, "Twin")
       .def(py::init<const d::DesignInputs&, const pl::TwinParams&, std::uint64_t>(),
            py::arg("design"), py::arg("params"), py::arg("seed"))
-      .def(py::init([](const ps::io::ProjectConfig& c, std::uint64_t seed) {
+      .def(py::init([](const ps::config::ProjectConfig& c, std::uint64_t seed) {
              return pl::Twin(c.design, c.twin, seed);
            }),
            py::arg("config"), py::arg("seed"))
@@ -485,8 +485,8 @@ PYBIND11_MODULE(_piezoshift, m) {
       .PS_RO(Sm, window_end_s);
 
   py::class_<ex::Bench>(m, "Bench")
-      .def(py::init<const ps::io::ProjectConfig&, const Scl&, std::uint64_t>(), py::arg("config"),
-           py::arg("controller"), py::arg("seed"))
+      .def(py::init<const ps::config::ProjectConfig&, const Scl&, std::uint64_t>(),
+           py::arg("config"), py::arg("controller"), py::arg("seed"))
       .def("set_controller", &ex::Bench::set_controller, py::arg("params"))
       .def("controller_params", &ex::Bench::controller_params)
       .def("drive_open_loop", &ex::Bench::drive_open_loop, py::arg("ao_V"))
@@ -672,7 +672,7 @@ PYBIND11_MODULE(_piezoshift, m) {
   // The experiments run with the GIL released: they touch no Python object.
   m.def(
       "run_travel_range",
-      [](const ps::io::ProjectConfig& c, const Scl& p, std::uint64_t seed, const TrO& o) {
+      [](const ps::config::ProjectConfig& c, const Scl& p, std::uint64_t seed, const TrO& o) {
         py::gil_scoped_release nogil;
         return ex::run_travel_range(c, p, seed, o);
       },
@@ -680,7 +680,7 @@ PYBIND11_MODULE(_piezoshift, m) {
       py::arg_v("options", TrO{}, "TravelRangeOptions()"));
   m.def(
       "run_step_response",
-      [](const ps::io::ProjectConfig& c, const Scl& p, std::uint64_t seed, const StO& o) {
+      [](const ps::config::ProjectConfig& c, const Scl& p, std::uint64_t seed, const StO& o) {
         py::gil_scoped_release nogil;
         return ex::run_step_response(c, p, seed, o);
       },
@@ -688,7 +688,7 @@ PYBIND11_MODULE(_piezoshift, m) {
       py::arg_v("options", StO{}, "StepExperimentOptions()"));
   m.def(
       "run_linearity",
-      [](const ps::io::ProjectConfig& c, const Scl& p, std::uint64_t seed, const LiO& o) {
+      [](const ps::config::ProjectConfig& c, const Scl& p, std::uint64_t seed, const LiO& o) {
         py::gil_scoped_release nogil;
         return ex::run_linearity(c, p, seed, o);
       },
@@ -696,7 +696,7 @@ PYBIND11_MODULE(_piezoshift, m) {
       py::arg_v("options", LiO{}, "LinearityOptions()"));
   m.def(
       "run_repeatability",
-      [](const ps::io::ProjectConfig& c, const Scl& p, std::uint64_t seed, const RpO& o) {
+      [](const ps::config::ProjectConfig& c, const Scl& p, std::uint64_t seed, const RpO& o) {
         py::gil_scoped_release nogil;
         return ex::run_repeatability(c, p, seed, o);
       },
@@ -816,7 +816,7 @@ PYBIND11_MODULE(_piezoshift, m) {
       .PS_RO(CaR, polynomial);
   m.def(
       "calibrate",
-      [](const ps::io::ProjectConfig& c, const Scl& base, std::uint64_t seed, const CaO& o) {
+      [](const ps::config::ProjectConfig& c, const Scl& base, std::uint64_t seed, const CaO& o) {
         py::gil_scoped_release nogil;
         return ca::calibrate(c, base, seed, o);
       },
@@ -860,7 +860,7 @@ PYBIND11_MODULE(_piezoshift, m) {
           "summary_json() as a Python dict");
   m.def(
       "reproduce",
-      [](const ps::io::ProjectConfig& c, const RoO& o) {
+      [](const ps::config::ProjectConfig& c, const RoO& o) {
         py::gil_scoped_release nogil;
         return rp::reproduce(c, o);
       },

@@ -9,8 +9,8 @@
 #include <string>
 #include <vector>
 
+#include "piezoshift/config/project_config.hpp"
 #include "piezoshift/io/input_error.hpp"
-#include "piezoshift/io/project_config.hpp"
 #include "piezoshift/psi/analysis.hpp"
 #include "piezoshift/psi/simulation.hpp"
 #include "piezoshift/psi/unwrap.hpp"
@@ -121,7 +121,7 @@ void bind_psi(py::module_& m) {
 
   m.def(
       "psi_simulate",
-      [](const piezoshift::io::ProjectConfig& config,
+      [](const piezoshift::config::ProjectConfig& config,
          const piezoshift::control::SemiClosedLoopParams& controller, const std::string& algorithm,
          int size_px, std::uint64_t seed, const std::string& surface) {
         psi::SimulationParams p;

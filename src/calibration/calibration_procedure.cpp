@@ -16,7 +16,7 @@ CalibrationOptions CalibrationOptions::paper_gains_only() {
   return o;
 }
 
-CalibrationWithTravel calibrate_with_travel(const io::ProjectConfig& config, std::uint64_t seed,
+CalibrationWithTravel calibrate_with_travel(const config::ProjectConfig& config, std::uint64_t seed,
                                             const CalibrationOptions& options,
                                             const experiments::Progress& progress) {
   CalibrationWithTravel out;
@@ -32,7 +32,7 @@ CalibrationWithTravel calibrate_with_travel(const io::ProjectConfig& config, std
   return out;
 }
 
-CalibrationOutcome calibrate(const io::ProjectConfig& config,
+CalibrationOutcome calibrate(const config::ProjectConfig& config,
                              const control::SemiClosedLoopParams& base, std::uint64_t seed,
                              const CalibrationOptions& options,
                              const experiments::Progress& progress) {

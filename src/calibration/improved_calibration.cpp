@@ -121,7 +121,7 @@ double improved_excitation_um(double t_s) {
   return level;
 }
 
-ImprovedCalibrationOutcome calibrate_improved(const io::ProjectConfig& config,
+ImprovedCalibrationOutcome calibrate_improved(const config::ProjectConfig& config,
                                               const control::SemiClosedLoopParams& base,
                                               std::uint64_t seed,
                                               const ImprovedCalibrationOptions& options,
@@ -195,7 +195,7 @@ ImprovedCalibrationOutcome calibrate_improved(const io::ProjectConfig& config,
   return out;
 }
 
-ImprovedDesign design_improved_controller(const io::ProjectConfig& config,
+ImprovedDesign design_improved_controller(const config::ProjectConfig& config,
                                           const control::SemiClosedLoopParams& paper,
                                           const std::array<HysteresisFit, 3>& model,
                                           const PlateModeEstimate& mode,

@@ -91,7 +91,7 @@ ArxModel fit_arx(std::span<const double> u, std::span<const double> y, int na, i
   return m;
 }
 
-LoopIdentification identify_loop(const io::ProjectConfig& config,
+LoopIdentification identify_loop(const config::ProjectConfig& config,
                                  const control::SemiClosedLoopParams& controller,
                                  std::uint64_t seed, const LoopIdentificationOptions& o) {
   if (!(o.operating_um >= 0.0 && o.settle_s >= 0.0 && o.amplitude_um > 0.0 && o.duration_s > 0.0 &&

@@ -50,7 +50,7 @@ bool better(const PidTrial& a, const PidTrial& b) {
 
 }  // namespace
 
-Vec3 maximum_step_targets(const io::ProjectConfig& config,
+Vec3 maximum_step_targets(const config::ProjectConfig& config,
                           const control::SemiClosedLoopParams& base, std::uint64_t seed,
                           double step_fraction) {
   if (!(step_fraction > 0.0 && step_fraction < 1.0)) {
@@ -72,9 +72,10 @@ Vec3 maximum_step_targets(const io::ProjectConfig& config,
   return target;
 }
 
-PidTrial score_pid_gains(const io::ProjectConfig& config, const control::SemiClosedLoopParams& base,
-                         const control::PidGains& gains, const Vec3& step_target_um,
-                         std::uint64_t seed, const PidTuningOptions& options) {
+PidTrial score_pid_gains(const config::ProjectConfig& config,
+                         const control::SemiClosedLoopParams& base, const control::PidGains& gains,
+                         const Vec3& step_target_um, std::uint64_t seed,
+                         const PidTuningOptions& options) {
   control::SemiClosedLoopParams params = base;
   params.gains = gains;
   params.gains_sample_time_s = base.sample_time_s;
@@ -128,9 +129,9 @@ PidTrial score_pid_gains(const io::ProjectConfig& config, const control::SemiClo
   return trial;
 }
 
-PidTuningResult tune_pid(const io::ProjectConfig& config, const control::SemiClosedLoopParams& base,
-                         std::uint64_t seed, const PidTuningOptions& options,
-                         const experiments::Progress& progress) {
+PidTuningResult tune_pid(const config::ProjectConfig& config,
+                         const control::SemiClosedLoopParams& base, std::uint64_t seed,
+                         const PidTuningOptions& options, const experiments::Progress& progress) {
   if (options.kp_values.empty() || options.ki_values.empty() || options.kd_values.empty()) {
     throw std::invalid_argument("PID tuning: every gain needs at least one candidate value");
   }

@@ -13,7 +13,7 @@ const char* to_string(Feedback feedback) noexcept {
   return feedback == Feedback::kOracle ? "oracle" : "gauges";
 }
 
-Bench::Bench(const io::ProjectConfig& config, const control::SemiClosedLoopParams& controller,
+Bench::Bench(const config::ProjectConfig& config, const control::SemiClosedLoopParams& controller,
              std::uint64_t seed, const BenchOptions& options)
     : options_(options),
       sample_time_s_(config.twin.daq.sample_time_s),

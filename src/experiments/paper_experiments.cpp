@@ -32,7 +32,7 @@ using detail::saturation_problem;
 
 }  // namespace
 
-TravelRangeResult run_travel_range(const io::ProjectConfig& config,
+TravelRangeResult run_travel_range(const config::ProjectConfig& config,
                                    const control::SemiClosedLoopParams& controller,
                                    std::uint64_t seed, const TravelRangeOptions& o,
                                    const Progress& progress) {
@@ -129,7 +129,7 @@ TravelRangeResult run_travel_range(const io::ProjectConfig& config,
   return r;
 }
 
-StepExperimentResult run_step_response(const io::ProjectConfig& config,
+StepExperimentResult run_step_response(const config::ProjectConfig& config,
                                        const control::SemiClosedLoopParams& controller,
                                        std::uint64_t seed, const StepExperimentOptions& o,
                                        const Progress& progress) {
@@ -189,7 +189,7 @@ StepExperimentResult run_step_response(const io::ProjectConfig& config,
   return r;
 }
 
-LinearityResult run_linearity(const io::ProjectConfig& config,
+LinearityResult run_linearity(const config::ProjectConfig& config,
                               const control::SemiClosedLoopParams& controller, std::uint64_t seed,
                               const LinearityOptions& o, const Progress& progress) {
   require(o.max_um > 0.0 && o.increment_um > 0.0 && o.step_hold_s >= 1.0,
@@ -249,7 +249,7 @@ LinearityResult run_linearity(const io::ProjectConfig& config,
   return r;
 }
 
-RepeatabilityResult run_repeatability(const io::ProjectConfig& config,
+RepeatabilityResult run_repeatability(const config::ProjectConfig& config,
                                       const control::SemiClosedLoopParams& controller,
                                       std::uint64_t seed, const RepeatabilityOptions& o,
                                       const Progress& progress) {

@@ -25,7 +25,7 @@ double exposure_settling_time_s(const std::vector<double>& time_s,
   return 0.0;
 }
 
-PhaseStepResult run_phase_step(const io::ProjectConfig& config,
+PhaseStepResult run_phase_step(const config::ProjectConfig& config,
                                const control::SemiClosedLoopParams& controller, std::uint64_t seed,
                                const PhaseStepOptions& o, const Progress& progress) {
   if (!(o.wavelength_nm > 0.0 && o.start_um >= 0.0 && o.settle_s >= 0.0 && o.hold_s > 0.0 &&

@@ -12,7 +12,7 @@
 
 namespace piezoshift::psi {
 
-SimulationResult simulate_psi(const io::ProjectConfig& config,
+SimulationResult simulate_psi(const config::ProjectConfig& config,
                               const control::SemiClosedLoopParams& controller,
                               const SimulationParams& p) {
   if (const std::string e = fizeau_problem(p.fizeau); !e.empty())

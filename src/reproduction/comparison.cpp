@@ -83,12 +83,12 @@ Target target(std::string text, std::string key, double bound, bool at_least,
 constexpr double kFastSampleTime_s = 1e-4;  // 10 kHz, issue 12's second loop rate
 
 // The lambda/8 step with the loop at 10 kHz: the same controller re-expressed per sample.
-experiments::PhaseStepResult phase_step_at_10kHz(const io::ProjectConfig& config,
+experiments::PhaseStepResult phase_step_at_10kHz(const config::ProjectConfig& config,
                                                  const control::SemiClosedLoopParams& controller,
                                                  std::uint64_t seed,
                                                  const experiments::PhaseStepOptions& options,
                                                  const experiments::Progress& progress) {
-  io::ProjectConfig at = config;
+  config::ProjectConfig at = config;
   control::SemiClosedLoopParams c = controller;
   at.twin.daq.sample_time_s = c.sample_time_s = kFastSampleTime_s;
   try {
@@ -126,7 +126,7 @@ const char* controller_label(ControllerKind k) {
   return "";
 }
 
-std::vector<FigureSpec> comparison_figures(const io::ProjectConfig& config) {
+std::vector<FigureSpec> comparison_figures(const config::ProjectConfig& config) {
   using S = ExperimentSet;
   std::vector<FigureSpec> f{
       {"travel_semi_closed_um", "semi-closed-loop travel", "um",
@@ -272,14 +272,14 @@ void calibrate_or_fail(Validity& validity, const char* what, Calibrate&& calibra
 
 // The 10 kHz figures of the paper's or the improved controller: its inner loop at 10 kHz and
 // the lambda/8 step with the loop at that rate.
-void run_at_10kHz(const io::ProjectConfig& config, const control::SemiClosedLoopParams& base,
+void run_at_10kHz(const config::ProjectConfig& config, const control::SemiClosedLoopParams& base,
                   std::uint64_t seed, const Schedule& s, ControllerKind k, ControllerRun& run,
                   const experiments::Progress& progress) {
   // The paper's gains are re-expressed per sample at 10 kHz (as reproduce() does); the
   // improved controller's models are sampled at their rate, so its own procedure calibrates
   // it again there (same seeds) for the 10 kHz figures.
   control::SemiClosedLoopParams fast = run.controller;
-  io::ProjectConfig at = config;
+  config::ProjectConfig at = config;
   at.twin.daq.sample_time_s = fast.sample_time_s = kFastSampleTime_s;
   // The interferometer's dynamic mode at the loop's rate (an XL-80 samples up to 50 kHz),
   // so the improved calibration sees the plate's mode below its Nyquist frequency.
@@ -314,8 +314,8 @@ void run_at_10kHz(const io::ProjectConfig& config, const control::SemiClosedLoop
 }
 
 // The three controllers on one seed, each calibrated by its own procedure.
-SeedComparison compare_seed(const io::ProjectConfig& config, std::uint64_t seed, const Schedule& s,
-                            const experiments::Progress& progress) {
+SeedComparison compare_seed(const config::ProjectConfig& config, std::uint64_t seed,
+                            const Schedule& s, const experiments::Progress& progress) {
   control::SemiClosedLoopParams base{};
   base.sample_time_s = config.twin.daq.sample_time_s;  // as reproduce(): the DAQ's rate
   SeedComparison sc;
@@ -372,7 +372,8 @@ SeedComparison compare_seed(const io::ProjectConfig& config, std::uint64_t seed,
 
 // Issue 12's done-when criteria, as restated: absolute bounds, then bounds relative to the
 // oracle's median, then travel and the margins at the config's loop rates.
-std::vector<Target> comparison_targets(const io::ProjectConfig& config, const ComparisonResult& r) {
+std::vector<Target> comparison_targets(const config::ProjectConfig& config,
+                                       const ComparisonResult& r) {
   const auto index_of = [&](const std::string& key) -> std::size_t {
     for (std::size_t i = 0; i < r.figures.size(); ++i)
       if (r.figures[i].key == key)
@@ -438,7 +439,7 @@ std::vector<Target> comparison_targets(const io::ProjectConfig& config, const Co
 
 }  // namespace
 
-ComparisonResult summarize_comparison(const io::ProjectConfig& config,
+ComparisonResult summarize_comparison(const config::ProjectConfig& config,
                                       const CompareOptions& options,
                                       std::vector<SeedComparison> seeds) {
   if (seeds.size() != options.seeds.size())
@@ -460,7 +461,7 @@ ComparisonResult summarize_comparison(const io::ProjectConfig& config,
   return r;
 }
 
-ComparisonResult compare(const io::ProjectConfig& config, const CompareOptions& options,
+ComparisonResult compare(const config::ProjectConfig& config, const CompareOptions& options,
                          const experiments::Progress& progress) {
   if (options.seeds.empty())
     throw std::invalid_argument("compare: no seed");

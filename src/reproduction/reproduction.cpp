@@ -61,7 +61,7 @@ Schedule with_feedback(Schedule s, experiments::Feedback f) {
   return s;
 }
 
-ExperimentSet run_experiment_set(const io::ProjectConfig& config,
+ExperimentSet run_experiment_set(const config::ProjectConfig& config,
                                  const control::SemiClosedLoopParams& c, std::uint64_t seed,
                                  const Schedule& s, const experiments::Progress& progress) {
   namespace ex = experiments;
@@ -77,17 +77,17 @@ ExperimentSet run_experiment_set(const io::ProjectConfig& config,
   return r;
 }
 
-std::vector<double> inner_loop_sample_times_s(const io::ProjectConfig& config) {
+std::vector<double> inner_loop_sample_times_s(const config::ProjectConfig& config) {
   std::vector<double> rates{config.twin.daq.sample_time_s};
   if (config.twin.daq.sample_time_s != kFastSampleTime_s)
     rates.push_back(kFastSampleTime_s);
   return rates;
 }
 
-InnerLoopAnalysis analyze_inner_loop_at(const io::ProjectConfig& config,
+InnerLoopAnalysis analyze_inner_loop_at(const config::ProjectConfig& config,
                                         const control::SemiClosedLoopParams& controller,
                                         double sample_time_s, std::uint64_t seed) {
-  io::ProjectConfig at = config;
+  config::ProjectConfig at = config;
   control::SemiClosedLoopParams c = controller;
   at.twin.daq.sample_time_s = c.sample_time_s = sample_time_s;
   InnerLoopAnalysis a;
@@ -130,7 +130,7 @@ InnerLoopAnalysis analyze_inner_loop_at(const io::ProjectConfig& config,
   return a;
 }
 
-std::vector<InnerLoopAnalysis> analyze_inner_loop(const io::ProjectConfig& config,
+std::vector<InnerLoopAnalysis> analyze_inner_loop(const config::ProjectConfig& config,
                                                   const control::SemiClosedLoopParams& controller,
                                                   std::uint64_t seed) {
   const std::vector<double> rates = inner_loop_sample_times_s(config);
@@ -180,7 +180,7 @@ std::vector<std::string> ExperimentSet::invalid_reasons() const {
   return out;
 }
 
-ReproductionResult reproduce(const io::ProjectConfig& config, const ReproduceOptions& options,
+ReproductionResult reproduce(const config::ProjectConfig& config, const ReproduceOptions& options,
                              const experiments::Progress& progress) {
   const auto start = std::chrono::steady_clock::now();
   Schedule s = options.quick ? Schedule::quick() : Schedule::paper();

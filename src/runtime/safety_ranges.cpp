@@ -52,8 +52,8 @@ void read_safety_section(const io::ConfigFile& file, SafetyLimits& limits) {
 InstallationConfig load_installation_config(const std::string& path) {
   const io::ConfigFile file = io::ConfigFile::load(path);
   InstallationConfig c;
-  io::read_design_sections(file, c.project.design);
-  io::read_twin_sections(file, c.project.design, c.project.twin);
+  config::read_design_sections(file, c.project.design);
+  config::read_twin_sections(file, c.project.design, c.project.twin);
   read_safety_section(file, c.safety);
   file.reject_unknown();
   return c;

@@ -16,7 +16,7 @@ namespace {
 using control::Vec3;
 
 TEST(PidTuning, PaperGainsStepEachActuatorWithLittleOvershoot) {
-  const io::ProjectConfig config;
+  const config::ProjectConfig config;
   const control::SemiClosedLoopParams base;
   const Vec3 targets = maximum_step_targets(config, base, 7, 0.95);
   // 95 % of a stroke the SGS reads between 8 and 13 um on every leg (Eq. 1 stroke x SGS gains).
@@ -33,7 +33,7 @@ TEST(PidTuning, PaperGainsStepEachActuatorWithLittleOvershoot) {
 }
 
 TEST(PidTuning, SearchPrefersFasterAcceptableGainsAndRejectsOvershootBetweenTicks) {
-  const io::ProjectConfig config;
+  const config::ProjectConfig config;
   PidTuningOptions o;
   o.kp_values = {0.3, 0.6};
   o.ki_values = {0.05, 0.2, 0.5};
@@ -70,7 +70,7 @@ TEST(PidTuning, SearchPrefersFasterAcceptableGainsAndRejectsOvershootBetweenTick
 // Stage 2 on the twin, whose geometry and SGS gains are built from the paper's A (docs/twin.md):
 // the procedure must give that A back (the twin's fidelity target 5: +-0.05 per element).
 TEST(MatrixIdentification, RecoversThePapersMatrixFromTheTwin) {
-  const io::ProjectConfig config;
+  const config::ProjectConfig config;
   experiments::Bench bench(config, control::SemiClosedLoopParams{}, 11);
   MatrixIdentificationOptions o;
   o.repeats = 2;
@@ -94,7 +94,7 @@ TEST(MatrixIdentification, RecoversThePapersMatrixFromTheTwin) {
 TEST(MatrixIdentification, FindsThePlantsOwnMatrixWhenTheGaugeGainsDiffer) {
   const control::TransmissionMatrix paper;
   const double d[3] = {1.04, 0.97, 1.02};
-  io::ProjectConfig config;
+  config::ProjectConfig config;
   control::Mat3 truth{};
   for (std::size_t i = 0; i < 3; ++i) {
     for (std::size_t j = 0; j < 3; ++j)
@@ -136,7 +136,7 @@ TEST(MatrixIdentification, FindsThePlantsOwnMatrixWhenTheGaugeGainsDiffer) {
 // The whole chain: with the identified A and p, a desired displacement is reached at the
 // interferometer (Z_r ~ Z_d), which is what the feedforward is for.
 TEST(Calibration, IdentifiedFeedforwardMakesTheRealDisplacementTheDesiredOne) {
-  const io::ProjectConfig config;
+  const config::ProjectConfig config;
   CalibrationOptions o;
   o.pid = PidChoice::kPaper;
   o.pid_tuning.kp_values = {0.6};
@@ -217,7 +217,7 @@ TEST(CalibrationFile, NumbersAreWrittenShortestAndReadBackBitIdentical) {
 // drive an actuator into its output limit and the supervisor trips. The calibration says so; it
 // never hands on a matrix fitted to a stage that was ramping to 0 V.
 TEST(CalibrationWithTravel, APlantThePapersProcedureCannotCalibrateIsAFailureWithItsReason) {
-  io::ProjectConfig config;
+  config::ProjectConfig config;
   config.twin.contact.stiffness_N_per_um = 15.0;
   CalibrationOptions o = CalibrationOptions::paper_gains_only();
   o.matrix.repeats = 1;

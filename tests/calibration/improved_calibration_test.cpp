@@ -15,7 +15,7 @@
 namespace piezoshift::calibration {
 namespace {
 
-ImprovedCalibrationOutcome calibrated(const io::ProjectConfig& config, std::uint64_t seed) {
+ImprovedCalibrationOutcome calibrated(const config::ProjectConfig& config, std::uint64_t seed) {
   ImprovedCalibrationOptions o;
   o.paper = CalibrationOptions::paper_gains_only();
   control::SemiClosedLoopParams base;
@@ -27,7 +27,7 @@ struct PhaseSteps {
   experiments::PhaseStepResult paper, improved;
 };
 
-PhaseSteps phase_steps(const io::ProjectConfig& config, const ImprovedCalibrationOutcome& c,
+PhaseSteps phase_steps(const config::ProjectConfig& config, const ImprovedCalibrationOutcome& c,
                        std::uint64_t seed) {
   const experiments::PhaseStepOptions o;
   return {experiments::run_phase_step(config, c.static_map.controller, seed + 80, o),
@@ -37,7 +37,7 @@ PhaseSteps phase_steps(const io::ProjectConfig& config, const ImprovedCalibratio
 // Default twin, seed 1. Measured (compare's seed 1): hold jitter 0.26 nm against the paper's
 // 0.53; settling to +-1 nm in 4 ms against 80 ms; the 11 um step within 2 % in 13 ms against 36.
 TEST(ImprovedController, OnTheDefaultTwinItHoldsQuieterAndSettlesFaster) {
-  const io::ProjectConfig config;
+  const config::ProjectConfig config;
   const ImprovedCalibrationOutcome c = calibrated(config, 1);
   EXPECT_TRUE(c.shaped);
   // The piston mode, 1419 Hz, folds to 419 Hz at the interferometer's 1 kHz.
@@ -75,18 +75,18 @@ TEST(ImprovedController, OnTheDefaultTwinItHoldsQuieterAndSettlesFaster) {
 // smaller ball; other stroke spreads with faster creep. On each the calibration finds its own
 // models and mode, and the hold is quieter than the paper's controller's on that plant.
 TEST(ImprovedController, TheSameProcedureWorksOnOtherPlants) {
-  io::ProjectConfig a;
+  config::ProjectConfig a;
   a.twin.piezo.hysteresis.hysteresis_fraction = 0.15;
   a.twin.sgs.gauge_creep_fraction = 0.0004;
-  io::ProjectConfig b;
+  config::ProjectConfig b;
   b.twin.plate.payload_mass_kg = 0.5;
   b.twin.contact.ball_radius_m = 0.004;
-  io::ProjectConfig d;
+  config::ProjectConfig d;
   d.twin.piezo.free_stroke_scale = {1.05, 0.95, 1.0};
   d.twin.piezo.creep.per_decade_fraction = 0.02;
   double default_mode_Hz = 0.0;
   int k = 0;
-  for (const io::ProjectConfig* config : {&a, &b, &d}) {
+  for (const config::ProjectConfig* config : {&a, &b, &d}) {
     SCOPED_TRACE(k++);
     const ImprovedCalibrationOutcome c = calibrated(*config, 3);
     if (config == &a) {
@@ -103,7 +103,7 @@ TEST(ImprovedController, TheSameProcedureWorksOnOtherPlants) {
 }
 
 TEST(ImprovedController, CalibrationFileRoundTripsAndRefusesAnotherRate) {
-  const ImprovedCalibrationOutcome c = calibrated(io::ProjectConfig{}, 2);
+  const ImprovedCalibrationOutcome c = calibrated(config::ProjectConfig{}, 2);
   const std::string text = format_calibration(c.controller, "test");
   const io::ConfigFile file = io::ConfigFile::parse(text, "cal.toml");
   control::SemiClosedLoopParams back;

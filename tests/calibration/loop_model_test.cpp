@@ -99,7 +99,7 @@ TEST(ArxFit, RecoversAKnownModelFromItsResponse) {
 // feedback, mean of the three channels) and simulated on the three identified models with the
 // same PID law, agree to within the gauges' noise.
 TEST(LoopIdentification, TheTwinsModelPredictsTheClosedLoopStep) {
-  const io::ProjectConfig config;
+  const config::ProjectConfig config;
   control::SemiClosedLoopParams c;
   const LoopIdentification id = identify_loop(config, c, 21);
   for (const ArxModel& m : id.channel) {

@@ -8,8 +8,8 @@
 namespace piezoshift::experiments {
 namespace {
 
-io::ProjectConfig short_leg_plant() {
-  io::ProjectConfig c;
+config::ProjectConfig short_leg_plant() {
+  config::ProjectConfig c;
   c.twin.piezo.free_stroke_scale = {1.0, 0.8, 1.0};  // one stack with 80 % of its stroke
   return c;
 }
@@ -32,7 +32,7 @@ TEST(PaperExperiments, TheOracleHoldsThePlateWhereTheGaugeFedLoopCannot) {
   StepExperimentOptions o;
   o.step_um = 5.0;
   o.record_s = 0.5;
-  const io::ProjectConfig config;
+  const config::ProjectConfig config;
   const control::SemiClosedLoopParams paper{};
   const StepExperimentResult gauges = run_step_response(config, paper, 4, o);
   control::SemiClosedLoopParams oracle_params = paper;

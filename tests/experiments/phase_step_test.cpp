@@ -29,7 +29,7 @@ TEST(PhaseStep, SettlingIsTheEndOfTheLastExposureOutsideTheBand) {
 TEST(PhaseStep, TheGaugesNoiseIsInThePlateAndTheOracleIsNot) {
   control::SemiClosedLoopParams c;
   c.polynomial = control::CubicPolynomial::identity();
-  const io::ProjectConfig config;
+  const config::ProjectConfig config;
   PhaseStepOptions o;
   const PhaseStepResult gauges = run_phase_step(config, c, 81, o);
   o.bench.feedback = Feedback::kOracle;
@@ -62,7 +62,7 @@ TEST(PhaseStep, TheGaugesNoiseIsInThePlateAndTheOracleIsNot) {
 TEST(PhaseStep, AStepBeyondTheTravelIsNotValidAndAnExposureMustBeWholeTicks) {
   control::SemiClosedLoopParams c;
   c.polynomial = control::CubicPolynomial::identity();
-  const io::ProjectConfig config;
+  const config::ProjectConfig config;
   PhaseStepOptions o;
   o.start_um = 13.5;  // beyond the 12.9 um the stacks give at 150 V
   o.settle_s = 0.2;

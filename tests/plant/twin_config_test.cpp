@@ -6,14 +6,17 @@
 #include <gtest/gtest.h>
 #include <unistd.h>
 
+#include "piezoshift/config/project_config.hpp"
 #include "piezoshift/io/input_error.hpp"
-#include "piezoshift/io/project_config.hpp"
 #include "piezoshift/plant/twin_ranges.hpp"
 
 #include "../support/test_paths.hpp"
 
 namespace piezoshift::io {
 namespace {
+
+using config::load_project_config;
+using config::ProjectConfig;
 
 std::string write_temp(const std::string& name, const std::string& text) {
   const auto path = std::filesystem::temp_directory_path() /

@@ -13,14 +13,14 @@
 namespace piezoshift::psi {
 namespace {
 
-control::SemiClosedLoopParams paper_controller(const io::ProjectConfig& config) {
+control::SemiClosedLoopParams paper_controller(const config::ProjectConfig& config) {
   control::SemiClosedLoopParams cp;
   cp.sample_time_s = config.twin.daq.sample_time_s;
   return cp;
 }
 
 TEST(PsiAcquisitionTest, BenchStageStepsByLambdaOverEightAndComesOnTarget) {
-  const io::ProjectConfig config;
+  const config::ProjectConfig config;
   experiments::Bench bench(config, paper_controller(config), 3);
   BenchStage stage(bench);
   AcquisitionParams ap;
@@ -40,7 +40,7 @@ TEST(PsiSimulationTest, TwinMeasurementErrorIsSmallAndSplitsIntoStageAndCamera) 
   SimulationParams p;
   p.fizeau.width_px = p.fizeau.height_px = 96;
   p.fizeau.pupil_radius_px = 44.0;
-  const io::ProjectConfig config;
+  const config::ProjectConfig config;
   const SimulationResult r = simulate_psi(config, paper_controller(config), p);
   ASSERT_EQ(r.frames.size(), 5u);
   // the whole error stays well below a nanometre (lambda / 600) ...
@@ -57,7 +57,7 @@ TEST(PsiSimulationTest, AiaCalibratesTheTwinsSteps) {
   p.fizeau.width_px = p.fizeau.height_px = 96;
   p.fizeau.pupil_radius_px = 44.0;
   p.algorithm = Algorithm::kAia;
-  const io::ProjectConfig config;
+  const config::ProjectConfig config;
   const SimulationResult r = simulate_psi(config, paper_controller(config), p);
   const StepCalibration c =
       calibrate_steps(r.analysis.phase.steps_rad, std::numbers::pi / 2.0, 632.8);

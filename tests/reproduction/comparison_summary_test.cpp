@@ -52,7 +52,7 @@ ComparisonResult nothing_calibrated() {
     for (ControllerRun& run : seeds[s].runs)
       run.calibration.fail("calibration: made up for the test");
   }
-  return summarize_comparison(io::ProjectConfig{}, o, std::move(seeds));
+  return summarize_comparison(config::ProjectConfig{}, o, std::move(seeds));
 }
 
 TEST(ComparisonSummary, RunsThatFailedTheirCalibrationMakeEveryMeasuredMedianNotValid) {
@@ -107,7 +107,7 @@ TEST(ComparisonSummary, AFigureNotValidIsNullWithItsReasonInTheJson) {
 TEST(ComparisonSummary, OneSeedPerSeedOfTheOptionsOrItIsRefused) {
   CompareOptions o;
   o.seeds = {1, 2};
-  EXPECT_THROW(summarize_comparison(io::ProjectConfig{}, o, std::vector<SeedComparison>(1)),
+  EXPECT_THROW(summarize_comparison(config::ProjectConfig{}, o, std::vector<SeedComparison>(1)),
                std::invalid_argument);
 }
 

@@ -18,7 +18,7 @@ const ComparisonResult& quick_comparison() {
     CompareOptions o;
     o.quick = true;
     o.seeds = {1};
-    return compare(io::ProjectConfig{}, o);
+    return compare(config::ProjectConfig{}, o);
   }();
   return r;
 }
@@ -74,7 +74,7 @@ TEST(Comparison, ThePapersColumnIsReproduceOnTheSameSeed) {
   ReproduceOptions o;
   o.quick = true;
   o.seed = 1;
-  const ReproductionResult rep = reproduce(io::ProjectConfig{}, o);
+  const ReproductionResult rep = reproduce(config::ProjectConfig{}, o);
   const auto& c = quick_comparison().seeds[0];
   const auto& paper = c[ControllerKind::kPaper].set;
   EXPECT_EQ(paper.repeat_10um.metrics.repeatability_nm, rep.repeat_10um.metrics.repeatability_nm);

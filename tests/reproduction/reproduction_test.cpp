@@ -19,7 +19,7 @@ const ReproductionResult& quick_run() {
     ReproduceOptions o;
     o.quick = true;
     o.seed = 1;
-    return reproduce(io::ProjectConfig{}, o);
+    return reproduce(config::ProjectConfig{}, o);
   }();
   return r;
 }
@@ -95,7 +95,7 @@ TEST(Reproduction, IdentifiedMatrixIsThePapersAndCalibrationIsDeterministic) {
   ReproduceOptions o;
   o.quick = true;
   o.seed = 1;
-  const ReproductionResult again = reproduce(io::ProjectConfig{}, o);
+  const ReproductionResult again = reproduce(config::ProjectConfig{}, o);
   EXPECT_EQ(again.linearity.measured_um, r.linearity.measured_um);
   EXPECT_EQ(again.repeat_10um.measured_um, r.repeat_10um.measured_um);
   EXPECT_GT(r.simulated_time_s, 1000.0);

@@ -48,14 +48,14 @@ struct CalibrationWithTravel {
 };
 
 //! base supplies the sample time, limits and scaling; its gains, A and p are replaced.
-CalibrationOutcome calibrate(const io::ProjectConfig& config,
+CalibrationOutcome calibrate(const config::ProjectConfig& config,
                              const control::SemiClosedLoopParams& base, std::uint64_t seed,
                              const CalibrationOptions& options = {},
                              const experiments::Progress& progress = {});
 
 //! calibrate() at the twin's DAQ rate, then the travel. Throws io::InputError when the calibrated
 //! loop cannot track even the travel search's first level (no travel to advertise).
-CalibrationWithTravel calibrate_with_travel(const io::ProjectConfig& config, std::uint64_t seed,
+CalibrationWithTravel calibrate_with_travel(const config::ProjectConfig& config, std::uint64_t seed,
                                             const CalibrationOptions& options = {},
                                             const experiments::Progress& progress = {});
 

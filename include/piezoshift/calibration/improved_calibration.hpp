@@ -57,7 +57,7 @@ struct ImprovedDesign {
 
 //! base supplies the sample time, limits and scaling. Throws experiments::ProcedureFailed when a
 //! stage trips the supervisor, FitError when a fit fails.
-ImprovedCalibrationOutcome calibrate_improved(const io::ProjectConfig& config,
+ImprovedCalibrationOutcome calibrate_improved(const config::ProjectConfig& config,
                                               const control::SemiClosedLoopParams& base,
                                               std::uint64_t seed,
                                               const ImprovedCalibrationOptions& options = {},
@@ -68,7 +68,7 @@ ImprovedCalibrationOutcome calibrate_improved(const io::ProjectConfig& config,
 //! limits and the loop's sample time; config the amplifier's slew (its current limit into the
 //! stacks' capacitance). The shaper nulls the mode when the loop runs at the rate it was sampled
 //! at, or when it was sampled unfolded at least as fast as the loop.
-ImprovedDesign design_improved_controller(const io::ProjectConfig& config,
+ImprovedDesign design_improved_controller(const config::ProjectConfig& config,
                                           const control::SemiClosedLoopParams& paper,
                                           const std::array<HysteresisFit, 3>& model,
                                           const PlateModeEstimate& mode,

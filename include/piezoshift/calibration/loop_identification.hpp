@@ -19,8 +19,8 @@
 #include <vector>
 
 #include "piezoshift/calibration/stability_margins.hpp"
+#include "piezoshift/config/project_config.hpp"
 #include "piezoshift/control/semi_closed_loop.hpp"
-#include "piezoshift/io/project_config.hpp"
 
 namespace piezoshift::calibration {
 
@@ -61,7 +61,7 @@ struct LoopIdentification {
 
 //! On a fresh bench with `controller` (its scaling and sample time; its PIDs hold the operating
 //! point, then the loop is opened). Throws experiments::ProcedureFailed when the supervisor trips.
-LoopIdentification identify_loop(const io::ProjectConfig& config,
+LoopIdentification identify_loop(const config::ProjectConfig& config,
                                  const control::SemiClosedLoopParams& controller,
                                  std::uint64_t seed, const LoopIdentificationOptions& options = {});
 

@@ -25,9 +25,9 @@
 #include <cstdint>
 #include <vector>
 
+#include "piezoshift/config/project_config.hpp"
 #include "piezoshift/control/semi_closed_loop.hpp"
 #include "piezoshift/experiments/progress.hpp"
-#include "piezoshift/io/project_config.hpp"
 
 namespace piezoshift::calibration {
 
@@ -69,18 +69,20 @@ struct PidTuningResult {
 
 //! Scores one candidate on a fresh twin built from config and seed. base supplies everything but
 //! the gains (sample time, limits, scaling).
-PidTrial score_pid_gains(const io::ProjectConfig& config, const control::SemiClosedLoopParams& base,
-                         const control::PidGains& gains, const control::Vec3& step_target_um,
-                         std::uint64_t seed, const PidTuningOptions& options = {});
+PidTrial score_pid_gains(const config::ProjectConfig& config,
+                         const control::SemiClosedLoopParams& base, const control::PidGains& gains,
+                         const control::Vec3& step_target_um, std::uint64_t seed,
+                         const PidTuningOptions& options = {});
 
 //! S_max,i: the SGS readings at 10 V open loop (settled for 1 s), times step_fraction.
-control::Vec3 maximum_step_targets(const io::ProjectConfig& config,
+control::Vec3 maximum_step_targets(const config::ProjectConfig& config,
                                    const control::SemiClosedLoopParams& base, std::uint64_t seed,
                                    double step_fraction);
 
 //! The full grid search; throws std::invalid_argument for an empty grid or a bad option.
-PidTuningResult tune_pid(const io::ProjectConfig& config, const control::SemiClosedLoopParams& base,
-                         std::uint64_t seed, const PidTuningOptions& options = {},
+PidTuningResult tune_pid(const config::ProjectConfig& config,
+                         const control::SemiClosedLoopParams& base, std::uint64_t seed,
+                         const PidTuningOptions& options = {},
                          const experiments::Progress& progress = {});
 
 }  // namespace piezoshift::calibration

@@ -24,8 +24,8 @@
 #include <functional>
 #include <memory>
 
+#include "piezoshift/config/project_config.hpp"
 #include "piezoshift/control/semi_closed_loop.hpp"
-#include "piezoshift/io/project_config.hpp"
 #include "piezoshift/plant/twin.hpp"
 #include "piezoshift/runtime/control_cycle.hpp"
 #include "piezoshift/runtime/oracle_backend.hpp"
@@ -58,7 +58,7 @@ class Bench {
  public:
   //! Throws std::invalid_argument when the configuration cannot make a twin or the controller's
   //! sample time is not the DAQ's period.
-  Bench(const io::ProjectConfig& config, const control::SemiClosedLoopParams& controller,
+  Bench(const config::ProjectConfig& config, const control::SemiClosedLoopParams& controller,
         std::uint64_t seed, const BenchOptions& options = {});
   ~Bench();
   Bench(const Bench&) = delete;

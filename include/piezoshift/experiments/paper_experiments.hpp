@@ -35,6 +35,7 @@
 #include <cstdint>
 #include <vector>
 
+#include "piezoshift/config/project_config.hpp"
 #include "piezoshift/control/semi_closed_loop.hpp"
 #include "piezoshift/experiments/bench.hpp"
 #include "piezoshift/experiments/metrics_linearity.hpp"
@@ -42,7 +43,6 @@
 #include "piezoshift/experiments/metrics_step_response.hpp"
 #include "piezoshift/experiments/progress.hpp"
 #include "piezoshift/experiments/validity.hpp"
-#include "piezoshift/io/project_config.hpp"
 
 namespace piezoshift::experiments {
 
@@ -146,19 +146,19 @@ struct RepeatabilityResult {
   double simulated_time_s = 0.0;
 };
 
-TravelRangeResult run_travel_range(const io::ProjectConfig& config,
+TravelRangeResult run_travel_range(const config::ProjectConfig& config,
                                    const control::SemiClosedLoopParams& controller,
                                    std::uint64_t seed, const TravelRangeOptions& options = {},
                                    const Progress& progress = {});
-StepExperimentResult run_step_response(const io::ProjectConfig& config,
+StepExperimentResult run_step_response(const config::ProjectConfig& config,
                                        const control::SemiClosedLoopParams& controller,
                                        std::uint64_t seed,
                                        const StepExperimentOptions& options = {},
                                        const Progress& progress = {});
-LinearityResult run_linearity(const io::ProjectConfig& config,
+LinearityResult run_linearity(const config::ProjectConfig& config,
                               const control::SemiClosedLoopParams& controller, std::uint64_t seed,
                               const LinearityOptions& options = {}, const Progress& progress = {});
-RepeatabilityResult run_repeatability(const io::ProjectConfig& config,
+RepeatabilityResult run_repeatability(const config::ProjectConfig& config,
                                       const control::SemiClosedLoopParams& controller,
                                       std::uint64_t seed, const RepeatabilityOptions& options = {},
                                       const Progress& progress = {});

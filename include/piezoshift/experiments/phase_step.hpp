@@ -24,11 +24,11 @@
 #include <cstdint>
 #include <vector>
 
+#include "piezoshift/config/project_config.hpp"
 #include "piezoshift/control/semi_closed_loop.hpp"
 #include "piezoshift/experiments/bench.hpp"
 #include "piezoshift/experiments/progress.hpp"
 #include "piezoshift/experiments/validity.hpp"
-#include "piezoshift/io/project_config.hpp"
 
 namespace piezoshift::experiments {
 
@@ -71,7 +71,7 @@ double exposure_settling_time_s(const std::vector<double>& time_s,
                                 const std::vector<double>& value_nm, double target_nm,
                                 double tolerance_nm);
 
-PhaseStepResult run_phase_step(const io::ProjectConfig& config,
+PhaseStepResult run_phase_step(const config::ProjectConfig& config,
                                const control::SemiClosedLoopParams& controller, std::uint64_t seed,
                                const PhaseStepOptions& options, const Progress& progress = {});
 

@@ -13,8 +13,8 @@
 #include <cstdint>
 #include <vector>
 
+#include "piezoshift/config/project_config.hpp"
 #include "piezoshift/control/semi_closed_loop.hpp"
-#include "piezoshift/io/project_config.hpp"
 #include "piezoshift/psi/acquisition.hpp"
 #include "piezoshift/psi/analysis.hpp"
 #include "piezoshift/psi/fizeau_simulation.hpp"
@@ -57,7 +57,7 @@ struct SimulationResult {
 };
 
 //! Throws io::InputError for parameters out of range (naming the field).
-SimulationResult simulate_psi(const io::ProjectConfig& config,
+SimulationResult simulate_psi(const config::ProjectConfig& config,
                               const control::SemiClosedLoopParams& controller,
                               const SimulationParams& params);
 

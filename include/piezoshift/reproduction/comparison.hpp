@@ -87,7 +87,7 @@ struct FigureSpec {
 };
 
 //! The figures compare reports, in the report's order (the margins at the config's loop rates).
-std::vector<FigureSpec> comparison_figures(const io::ProjectConfig& config);
+std::vector<FigureSpec> comparison_figures(const config::ProjectConfig& config);
 
 //! The median over seeds of one figure for one controller (the mean of the middle two for an even
 //! count). Not valid when a seed's value is not: the reason names the first such seed.
@@ -128,12 +128,12 @@ struct ComparisonResult {
 //! The figures, their medians over the seeds and the targets, from runs already made (one
 //! SeedComparison per seed of options.seeds, in that order): compare()'s second half, apart so
 //! that the summary and its report can be checked on runs made up for the purpose.
-ComparisonResult summarize_comparison(const io::ProjectConfig& config,
+ComparisonResult summarize_comparison(const config::ProjectConfig& config,
                                       const CompareOptions& options,
                                       std::vector<SeedComparison> seeds);
 
 //! Throws std::invalid_argument on an empty seed list.
-ComparisonResult compare(const io::ProjectConfig& config, const CompareOptions& options,
+ComparisonResult compare(const config::ProjectConfig& config, const CompareOptions& options,
                          const experiments::Progress& progress = {});
 
 }  // namespace piezoshift::reproduction

@@ -31,9 +31,9 @@
 
 #include "piezoshift/calibration/calibration_procedure.hpp"
 #include "piezoshift/calibration/loop_identification.hpp"
+#include "piezoshift/config/project_config.hpp"
 #include "piezoshift/experiments/paper_experiments.hpp"
 #include "piezoshift/experiments/phase_step.hpp"
-#include "piezoshift/io/project_config.hpp"
 
 namespace piezoshift::reproduction {
 
@@ -102,23 +102,23 @@ Schedule with_feedback(Schedule s, experiments::Feedback f);
 
 //! Every experiment of the set with one controller, each on its own seed (the table above:
 //! seed + 10 ... seed + 80). reproduce() and compare() run their controllers through this.
-ExperimentSet run_experiment_set(const io::ProjectConfig& config,
+ExperimentSet run_experiment_set(const config::ProjectConfig& config,
                                  const control::SemiClosedLoopParams& controller,
                                  std::uint64_t seed, const Schedule& schedule,
                                  const experiments::Progress& progress = {});
 
 //! The loop rates the inner loop is analysed at: the DAQ's, and 10 kHz unless that is the DAQ's.
-std::vector<double> inner_loop_sample_times_s(const io::ProjectConfig& config);
+std::vector<double> inner_loop_sample_times_s(const config::ProjectConfig& config);
 
 //! The controller's inner loop identified at each rate of inner_loop_sample_times_s (seeds
 //! seed + 90, seed + 91), with its PID's margins on it; the controller's gains re-expressed per
 //! sample at each rate. A rate the twin cannot run at is an analysis that is not valid.
-std::vector<InnerLoopAnalysis> analyze_inner_loop(const io::ProjectConfig& config,
+std::vector<InnerLoopAnalysis> analyze_inner_loop(const config::ProjectConfig& config,
                                                   const control::SemiClosedLoopParams& controller,
                                                   std::uint64_t seed);
 //! One rate of analyze_inner_loop: the twin's DAQ and the controller's sample time set to
 //! sample_time_s, identified on seed.
-InnerLoopAnalysis analyze_inner_loop_at(const io::ProjectConfig& config,
+InnerLoopAnalysis analyze_inner_loop_at(const config::ProjectConfig& config,
                                         const control::SemiClosedLoopParams& controller,
                                         double sample_time_s, std::uint64_t seed);
 
@@ -143,7 +143,7 @@ struct ReproductionResult : ExperimentSet {
   bool valid() const { return table4_valid(); }
 };
 
-ReproductionResult reproduce(const io::ProjectConfig& config, const ReproduceOptions& options,
+ReproductionResult reproduce(const config::ProjectConfig& config, const ReproduceOptions& options,
                              const experiments::Progress& progress = {});
 
 }  // namespace piezoshift::reproduction

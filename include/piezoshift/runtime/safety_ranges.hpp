@@ -10,9 +10,9 @@
 #include <cstdint>
 #include <string>
 
+#include "piezoshift/config/project_config.hpp"
 #include "piezoshift/design/bounds.hpp"
 #include "piezoshift/io/config_file.hpp"
-#include "piezoshift/io/project_config.hpp"
 #include "piezoshift/runtime/safety_supervisor.hpp"
 
 namespace piezoshift::runtime {
@@ -61,11 +61,11 @@ void read_safety_section(const io::ConfigFile& file, SafetyLimits& limits);
 
 //! One installation's configuration: the design and twin sections and [safety].
 struct InstallationConfig {
-  io::ProjectConfig project;
+  config::ProjectConfig project;
   SafetyLimits safety;
 };
 
-//! Loads a configuration file as io::load_project_config() does, with [safety] besides.
+//! Loads a configuration file as config::load_project_config() does, with [safety] besides.
 InstallationConfig load_installation_config(const std::string& path);
 
 //! One line for start-up summaries: every limit with its unit.

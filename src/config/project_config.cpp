@@ -1,4 +1,4 @@
-#include "piezoshift/io/project_config.hpp"
+#include "piezoshift/config/project_config.hpp"
 
 #include <optional>
 #include <type_traits>
@@ -9,17 +9,17 @@
 #include "piezoshift/io/input_error.hpp"
 #include "piezoshift/plant/twin_ranges.hpp"
 
-namespace piezoshift::io {
+namespace piezoshift::config {
 
 namespace {
 
 // Reads one value of a ranges list (design_ranges.hpp, twin_ranges.hpp) from section.key.
 struct RangedReader {
-  const ConfigFile& file;
+  const io::ConfigFile& file;
 
   template <typename T>
-  void operator()(const char* section, const char* key, T& value, Bounds bounds) const {
-    const ConfigSection s = file.section(section);
+  void operator()(const char* section, const char* key, T& value, io::Bounds bounds) const {
+    const io::ConfigSection s = file.section(section);
     if constexpr (std::is_same_v<T, std::optional<double>>) {
       if (double v = 0.0; s.read(key, v, bounds))
         value = v;
@@ -31,17 +31,17 @@ struct RangedReader {
 
 }  // namespace
 
-void read_design_sections(const ConfigFile& file, design::DesignInputs& design) {
+void read_design_sections(const io::ConfigFile& file, design::DesignInputs& design) {
   design::visit_design_values(design, RangedReader{file});
   // The geometry involves two keys (one perhaps left at its default); the message names both.
   if (const std::string problem = design::hinge_geometry_problem(design.hinge); !problem.empty())
-    throw InputError(fmt::format("{}: {}", file.source(), problem));
+    throw io::InputError(fmt::format("{}: {}", file.source(), problem));
 }
 
-void read_twin_sections(const ConfigFile& file, const design::DesignInputs& design,
+void read_twin_sections(const io::ConfigFile& file, const design::DesignInputs& design,
                         plant::TwinParams& t) {
   plant::visit_twin_values(t, RangedReader{file});
-  const ConfigSection sgs = file.section("twin.sgs");
+  const io::ConfigSection sgs = file.section("twin.sgs");
   if (std::string shape; sgs.read("nonlinearity_shape", shape)) {
     if (shape == "bow")
       t.sgs.nonlinearity_shape = plant::SgsNonlinearityShape::kBow;
@@ -50,18 +50,18 @@ void read_twin_sections(const ConfigFile& file, const design::DesignInputs& desi
     else if (shape == "wave")
       t.sgs.nonlinearity_shape = plant::SgsNonlinearityShape::kWave;
     else
-      throw InputError(
+      throw io::InputError(
           fmt::format("{}: twin.sgs.nonlinearity_shape: '{}' is not one of bow, s_curve, wave",
                       file.source(), shape));
   }
 
   // What one key's bounds cannot say (rates that must divide, the contact identification, A).
   if (const std::string problem = plant::twin_params_problem(design, t); !problem.empty())
-    throw InputError(fmt::format("{}: {}", file.source(), problem));
+    throw io::InputError(fmt::format("{}: {}", file.source(), problem));
 }
 
 ProjectConfig load_project_config(const std::string& path) {
-  const ConfigFile file = ConfigFile::load(path);
+  const io::ConfigFile file = io::ConfigFile::load(path);
   ProjectConfig config;
   read_design_sections(file, config.design);
   read_twin_sections(file, config.design, config.twin);
@@ -69,4 +69,4 @@ ProjectConfig load_project_config(const std::string& path) {
   return config;
 }
 
-}  // namespace piezoshift::io
+}  // namespace piezoshift::config

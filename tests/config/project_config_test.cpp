@@ -1,4 +1,4 @@
-#include "piezoshift/io/project_config.hpp"
+#include "piezoshift/config/project_config.hpp"
 
 #include <filesystem>
 #include <fstream>
@@ -13,6 +13,10 @@
 
 namespace piezoshift::io {
 namespace {
+
+using config::load_project_config;
+using config::ProjectConfig;
+using config::read_design_sections;
 
 class ProjectConfigTest : public piezoshift::testing::TempDirTest {
  protected:

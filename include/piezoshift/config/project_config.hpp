@@ -1,5 +1,7 @@
 #pragma once
-// The project's configuration file: one TOML file, one section per parameter struct. Every key
+// The project's configuration file (module `config`, above `plant` whose parameters it reads and
+// below `runtime` and everything that builds a twin): one TOML file, one section per parameter
+// struct. Every key
 // is optional and keeps the struct's default (the paper's value) when absent; configs/paper.toml
 // spells out all of them with their sources.
 //
@@ -20,7 +22,7 @@
 #include "piezoshift/io/config_file.hpp"
 #include "piezoshift/plant/twin_params.hpp"
 
-namespace piezoshift::io {
+namespace piezoshift::config {
 
 struct ProjectConfig {
   design::DesignInputs design;  //!< [actuator], [material], [hinge], [mechanism]
@@ -36,11 +38,11 @@ ProjectConfig load_project_config(const std::string& path);
 //! [twin.lab] into twin (absent keys keep its values), with bounds; then checks design and twin
 //! together (plant::twin_params_problem: rates that must divide, the contact identification, A).
 //! Does not call reject_unknown().
-void read_twin_sections(const ConfigFile& file, const design::DesignInputs& design,
+void read_twin_sections(const io::ConfigFile& file, const design::DesignInputs& design,
                         plant::TwinParams& twin);
 
 //! Reads [actuator], [material], [hinge] and [mechanism] into design (absent keys keep its
 //! values), with bounds, and checks the hinge geometry. Does not call reject_unknown().
-void read_design_sections(const ConfigFile& file, design::DesignInputs& design);
+void read_design_sections(const io::ConfigFile& file, design::DesignInputs& design);
 
-}  // namespace piezoshift::io
+}  // namespace piezoshift::config
