@@ -215,17 +215,7 @@ TEST_F(Http, OutOfDescriptorsItPausesAcceptingAndServesTheClientsItHas) {
   std::string before;
   ASSERT_TRUE(stream.read_some(before, 5.0));
   ASSERT_EQ(http_status(before), 200) << before;
-  // Sockets for the clients that will wait, made while descriptors are free.
-  std::vector<int> waiting;
-  const timeval receive_timeout{5, 0};  // against a hang, not a speed assert
-  for (int i = 0; i < 3; ++i) {
-    waiting.push_back(::socket(AF_INET, SOCK_STREAM | SOCK_CLOEXEC, 0));
-    ::setsockopt(waiting.back(), SOL_SOCKET, SO_RCVTIMEO, &receive_timeout, sizeof receive_timeout);
-  }
-  sockaddr_in sa{};
-  sa.sin_family = AF_INET;
-  sa.sin_port = htons(server_->port());
-  ::inet_pton(AF_INET, "127.0.0.1", &sa.sin_addr);
+  piezoshift::testing::WaitingClients waiting(3, server_->port());
 
   std::string during;
   int connected = 0;
@@ -234,8 +224,7 @@ TEST_F(Http, OutOfDescriptorsItPausesAcceptingAndServesTheClientsItHas) {
   {
     const piezoshift::testing::DescriptorsExhausted exhausted;
     const auto t0 = std::chrono::steady_clock::now();
-    for (int fd : waiting)  // the kernel completes these into the backlog
-      connected += ::connect(fd, reinterpret_cast<const sockaddr*>(&sa), sizeof sa) == 0 ? 1 : 0;
+    connected = waiting.connect_all();  // the kernel completes these into the backlog
     while (std::chrono::steady_clock::now() - t0 < std::chrono::milliseconds(500))
       stream.read_some(during, 0.05);
     failures = server_->stats().accept_failures;
@@ -250,7 +239,7 @@ TEST_F(Http, OutOfDescriptorsItPausesAcceptingAndServesTheClientsItHas) {
   // The stream it had kept receiving broadcasts meanwhile.
   EXPECT_NE(during.find("event: tick"), std::string::npos);
   // With descriptors back, the waiting clients are accepted and answered.
-  for (int fd : waiting) {
+  for (int fd : waiting.fds()) {
     const std::string request = "GET / HTTP/1.1\r\n" + host() + "\r\n";
     ASSERT_EQ(::send(fd, request.data(), request.size(), MSG_NOSIGNAL),
               static_cast<ssize_t>(request.size()));
@@ -259,7 +248,6 @@ TEST_F(Http, OutOfDescriptorsItPausesAcceptingAndServesTheClientsItHas) {
     for (ssize_t n; (n = ::recv(fd, buf, sizeof buf, 0)) > 0;)
       answer.append(buf, static_cast<std::size_t>(n));
     EXPECT_EQ(http_status(answer), 200) << answer;
-    ::close(fd);
   }
 }
 

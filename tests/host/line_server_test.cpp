@@ -633,16 +633,7 @@ TEST(LineServerLimits, OutOfDescriptorsItPausesAcceptingAndServesTheClientsItHas
   ServerThread st(handler);
   auto client = st.connect();
   ASSERT_EQ(client->query("ECHO before"), "before\n");
-  std::vector<int> waiting;
-  const timeval receive_timeout{5, 0};  // against a hang, not a speed assert
-  for (int i = 0; i < 3; ++i) {
-    waiting.push_back(::socket(AF_INET, SOCK_STREAM | SOCK_CLOEXEC, 0));
-    ::setsockopt(waiting.back(), SOL_SOCKET, SO_RCVTIMEO, &receive_timeout, sizeof receive_timeout);
-  }
-  sockaddr_in sa{};
-  sa.sin_family = AF_INET;
-  sa.sin_port = htons(st.port());
-  ::inet_pton(AF_INET, "127.0.0.1", &sa.sin_addr);
+  piezoshift::testing::WaitingClients waiting(3, st.port());
 
   int connected = 0;
   int answered = 0;
@@ -651,8 +642,7 @@ TEST(LineServerLimits, OutOfDescriptorsItPausesAcceptingAndServesTheClientsItHas
   {
     const testing::DescriptorsExhausted exhausted;
     const auto t0 = std::chrono::steady_clock::now();
-    for (int fd : waiting)
-      connected += ::connect(fd, reinterpret_cast<const sockaddr*>(&sa), sizeof sa) == 0 ? 1 : 0;
+    connected = waiting.connect_all();  // the kernel completes these into the backlog
     while (std::chrono::steady_clock::now() - t0 < std::chrono::milliseconds(500)) {
       answered += client->query("ECHO during") == "during\n" ? 1 : 0;
       std::this_thread::sleep_for(std::chrono::milliseconds(20));
@@ -665,7 +655,7 @@ TEST(LineServerLimits, OutOfDescriptorsItPausesAcceptingAndServesTheClientsItHas
   EXPECT_LE(static_cast<double>(failures), exhausted_s / 0.1 + 2.0)
       << failures << " failed accepts in " << exhausted_s << " s";
   EXPECT_GE(answered, 1);
-  for (int fd : waiting) {
+  for (int fd : waiting.fds()) {
     ASSERT_EQ(::send(fd, "ECHO back\n", 10, MSG_NOSIGNAL), 10);
     std::string answer;
     char buf[256];
@@ -673,7 +663,6 @@ TEST(LineServerLimits, OutOfDescriptorsItPausesAcceptingAndServesTheClientsItHas
          answer.find('\n') == std::string::npos && (n = ::recv(fd, buf, sizeof buf, 0)) > 0;)
       answer.append(buf, static_cast<std::size_t>(n));
     EXPECT_EQ(answer, "back\n");
-    ::close(fd);
   }
 }
 
