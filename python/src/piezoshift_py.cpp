@@ -38,71 +38,19 @@
 #include "piezoshift/reproduction/reproduction.hpp"
 #include "piezoshift/reproduction/summary.hpp"
 #include "piezoshift/runtime/safety_ranges.hpp"
+#include "values.hpp"
 
 namespace py = pybind11;
 namespace ps = piezoshift;
+using piezoshift::python::Array;
+using piezoshift::python::from_numpy_1d;
+using piezoshift::python::from_numpy_n3;
+using piezoshift::python::to_numpy;
+using Scl = ps::control::SemiClosedLoopParams;
 using ps::control::Mat3;
 using ps::control::Vec3;
 
 namespace {
-
-using Array = py::array_t<double>;
-
-Array to_numpy(const std::vector<double>& v) {
-  Array a(static_cast<py::ssize_t>(v.size()));
-  std::copy(v.begin(), v.end(), a.mutable_data());
-  return a;
-}
-
-Array to_numpy(const Vec3& v) {
-  Array a(3);
-  std::copy(v.begin(), v.end(), a.mutable_data());
-  return a;
-}
-
-Array to_numpy(const Mat3& m) {
-  Array a({3, 3});
-  auto r = a.mutable_unchecked<2>();
-  for (py::ssize_t i = 0; i < 3; ++i) {
-    for (py::ssize_t j = 0; j < 3; ++j)
-      r(i, j) = m[i][j];
-  }
-  return a;
-}
-
-// n x 3 numpy array of a vector of Vec3.
-Array to_numpy(const std::vector<Vec3>& rows) {
-  Array a({static_cast<py::ssize_t>(rows.size()), py::ssize_t{3}});
-  auto r = a.mutable_unchecked<2>();
-  for (std::size_t i = 0; i < rows.size(); ++i) {
-    for (py::ssize_t j = 0; j < 3; ++j)
-      r(static_cast<py::ssize_t>(i), j) = rows[i][j];
-  }
-  return a;
-}
-
-// A 1-D float array from anything numpy can convert (lists, arrays of any dtype).
-std::vector<double> from_numpy_1d(
-    const py::array_t<double, py::array::c_style | py::array::forcecast>& a, const char* name) {
-  if (a.ndim() != 1)
-    throw ps::io::InputError(std::string(name) + ": expected a 1-D array");
-  return {a.data(), a.data() + a.size()};
-}
-
-// An n x 3 array (rows P1..P3 or S1..S3) into Vec3 rows.
-std::vector<Vec3> from_numpy_n3(
-    const py::array_t<double, py::array::c_style | py::array::forcecast>& a, const char* name) {
-  if (a.ndim() != 2 || a.shape(1) != 3) {
-    throw ps::io::InputError(std::string(name) + ": expected an n x 3 array");
-  }
-  std::vector<Vec3> rows(static_cast<std::size_t>(a.shape(0)));
-  auto r = a.unchecked<2>();
-  for (py::ssize_t i = 0; i < a.shape(0); ++i) {
-    for (py::ssize_t j = 0; j < 3; ++j)
-      rows[static_cast<std::size_t>(i)][j] = r(i, j);
-  }
-  return rows;
-}
 
 py::object json_to_python(const nlohmann::json& j) {
   return py::module_::import("json").attr("loads")(j.dump());
@@ -110,19 +58,10 @@ py::object json_to_python(const nlohmann::json& j) {
 
 }  // namespace
 
-// Field helpers: plain numbers and nested structs, Vec3/Mat3 as numpy copies, series as numpy.
-#define PS_RW(T, f) def_readwrite(#f, &T::f)
-#define PS_RO(T, f) def_readonly(#f, &T::f)
-#define PS_V3(T, f)                                 \
-  def_property(                                     \
-      #f, [](const T& s) { return to_numpy(s.f); }, \
-      [](T& s, const decltype(T::f)& v) { s.f = v; })
-#define PS_SERIES(T, f)                             \
-  def_property(                                     \
-      #f, [](const T& s) { return to_numpy(s.f); }, \
-      [](T& s, const decltype(T::f)& v) { s.f = v; })
-
 void bind_psi(py::module_& m);  // psi_py.cpp
+namespace piezoshift::python {
+void bind_control(py::module_& m);  // control_py.cpp
+}
 
 PYBIND11_MODULE(_piezoshift, m) {
   m.doc() = "piezoshift: design, digital twin, calibration and experiments (offline API)";
@@ -146,59 +85,7 @@ PYBIND11_MODULE(_piezoshift, m) {
   });
   bind_psi(m);
 
-  // ---- control (the parameters the offline API takes) -------------------------------------
-  py::class_<ps::control::PidGains>(m, "PidGains")
-      .def(py::init<>())
-      .def(py::init([](double kp, double ki, double kd) {
-             return ps::control::PidGains{kp, ki, kd};
-           }),
-           py::arg("kp"), py::arg("ki"), py::arg("kd"))
-      .PS_RW(ps::control::PidGains, kp)
-      .PS_RW(ps::control::PidGains, ki)
-      .PS_RW(ps::control::PidGains, kd);
-
-  py::class_<ps::control::CubicPolynomial>(m, "CubicPolynomial")
-      .def(py::init<>())
-      .def(py::init([](double p3, double p2, double p1, double p0) {
-             return ps::control::CubicPolynomial{p3, p2, p1, p0};
-           }),
-           py::arg("p3"), py::arg("p2"), py::arg("p1"), py::arg("p0"))
-      .PS_RW(ps::control::CubicPolynomial, p3)
-      .PS_RW(ps::control::CubicPolynomial, p2)
-      .PS_RW(ps::control::CubicPolynomial, p1)
-      .PS_RW(ps::control::CubicPolynomial, p0)
-      .def("__call__", [](const ps::control::CubicPolynomial& p, double x) { return p(x); })
-      .def("derivative", &ps::control::CubicPolynomial::derivative)
-      .def_static("identity", &ps::control::CubicPolynomial::identity);
-
-  py::class_<ps::control::TransmissionMatrix>(m, "TransmissionMatrix")
-      .def(py::init<>())
-      .def(py::init([](const Mat3& a) { return ps::control::TransmissionMatrix{a}; }), py::arg("a"))
-      .PS_V3(ps::control::TransmissionMatrix, a)
-      .def("__call__",
-           [](const ps::control::TransmissionMatrix& t, const Vec3& z) { return to_numpy(t(z)); })
-      .def_static("identity", &ps::control::TransmissionMatrix::identity);
-
-  using Scl = ps::control::SemiClosedLoopParams;
-  py::class_<Scl>(m, "SemiClosedLoopParams")
-      .def(py::init<>())
-      .PS_RW(Scl, sample_time_s)
-      .PS_RW(Scl, gains)
-      .PS_RW(Scl, gains_sample_time_s)
-      .PS_RW(Scl, output_min_um)
-      .PS_RW(Scl, output_max_um)
-      .PS_RW(Scl, deadband_um)
-      .PS_RW(Scl, derivative_filter)
-      .PS_RW(Scl, polynomial)
-      .PS_RW(Scl, matrix);
-
-  using Out = ps::control::ControllerOutput;
-  py::class_<Out>(m, "ControllerOutput")
-      .PS_V3(Out, dac_V)
-      .PS_V3(Out, target_um)
-      .PS_V3(Out, feedback_um)
-      .PS_V3(Out, command_um)
-      .PS_RO(Out, saturated_mask);
+  piezoshift::python::bind_control(m);
 
   // ---- design ---------------------------------------------------------------------------
   namespace d = ps::design;

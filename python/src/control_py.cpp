@@ -1,0 +1,144 @@
+// Bindings of the controller's parameters (include/piezoshift/control/): what the offline API
+// takes and calibration returns, the paper's controller and the improved one, with the same
+// field names as the C++ structs and as the calibration file.
+#include <pybind11/pybind11.h>
+#include <pybind11/stl.h>
+
+#include <algorithm>
+#include <string>
+#include <vector>
+
+#include "piezoshift/control/parameter_check.hpp"
+#include "piezoshift/control/semi_closed_loop.hpp"
+#include "values.hpp"
+
+namespace py = pybind11;
+namespace ps = piezoshift;
+using piezoshift::python::to_numpy;
+using ps::control::Mat3;
+using ps::control::Vec3;
+
+namespace {
+
+// The improved controller's parts. Lists (shaper taps, model operators, creep terms) are
+// fixed-size arrays with a count in C++; here they are whole lists, set at once, so that the
+// count and the values cannot disagree.
+void bind_improved(py::module_& m) {
+  namespace c = ps::control;
+  py::enum_<c::ControllerKind>(m, "ControllerKind")
+      .value("paper", c::ControllerKind::kPaper)
+      .value("improved", c::ControllerKind::kImproved);
+
+  py::class_<c::SignalScaling>(m, "SignalScaling")
+      .def(py::init<>())
+      .PS_RW(c::SignalScaling, sgs_um_per_V)
+      .PS_RW(c::SignalScaling, sgs_offset_V)
+      .PS_RW(c::SignalScaling, drive_V_per_um)
+      .PS_RW(c::SignalScaling, drive_offset_V)
+      .def("sgs_to_um", &c::SignalScaling::sgs_to_um)
+      .def("um_to_dac", &c::SignalScaling::um_to_dac)
+      .def("dac_to_um", &c::SignalScaling::dac_to_um);
+
+  py::class_<c::ShaperParams>(m, "ShaperParams")
+      .def(py::init<>())
+      .def_property(
+          "taps",
+          [](const c::ShaperParams& s) {
+            return std::vector<double>(s.weight.begin(), s.weight.begin() + s.taps);
+          },
+          [](c::ShaperParams& s, const std::vector<double>& w) {
+            if (w.empty() || w.size() > c::kMaxShaperTaps)
+              throw ps::io::InputError("taps: 1 to " + std::to_string(c::kMaxShaperTaps) +
+                                       " weights");
+            s.weight = {};
+            std::copy(w.begin(), w.end(), s.weight.begin());
+            s.taps = w.size();
+          })
+      .PS_RW(c::ShaperParams, rate_um_per_s);
+
+  py::class_<c::ImprovedParams>(m, "ImprovedParams")
+      .def(py::init<>())
+      .PS_RW(c::ImprovedParams, sample_time_s)
+      .PS_RW(c::ImprovedParams, shaper)
+      .PS_RW(c::ImprovedParams, correction_ki)
+      .PS_RW(c::ImprovedParams, correction_ki_max)
+      .PS_RW(c::ImprovedParams, correction_boost_error_um)
+      .PS_RW(c::ImprovedParams, correction_limit_um)
+      .PS_RW(c::ImprovedParams, reference_delay_ticks)
+      .PS_RW(c::ImprovedParams, headroom_fraction);
+}
+
+}  // namespace
+
+namespace piezoshift::python {
+
+void bind_control(py::module_& m) {
+  py::class_<ps::control::PidGains>(m, "PidGains")
+      .def(py::init<>())
+      .def(py::init([](double kp, double ki, double kd) {
+             return ps::control::PidGains{kp, ki, kd};
+           }),
+           py::arg("kp"), py::arg("ki"), py::arg("kd"))
+      .PS_RW(ps::control::PidGains, kp)
+      .PS_RW(ps::control::PidGains, ki)
+      .PS_RW(ps::control::PidGains, kd);
+
+  py::class_<ps::control::CubicPolynomial>(m, "CubicPolynomial")
+      .def(py::init<>())
+      .def(py::init([](double p3, double p2, double p1, double p0) {
+             return ps::control::CubicPolynomial{p3, p2, p1, p0};
+           }),
+           py::arg("p3"), py::arg("p2"), py::arg("p1"), py::arg("p0"))
+      .PS_RW(ps::control::CubicPolynomial, p3)
+      .PS_RW(ps::control::CubicPolynomial, p2)
+      .PS_RW(ps::control::CubicPolynomial, p1)
+      .PS_RW(ps::control::CubicPolynomial, p0)
+      .def("__call__", [](const ps::control::CubicPolynomial& p, double x) { return p(x); })
+      .def("derivative", &ps::control::CubicPolynomial::derivative)
+      .def_static("identity", &ps::control::CubicPolynomial::identity);
+
+  py::class_<ps::control::TransmissionMatrix>(m, "TransmissionMatrix")
+      .def(py::init<>())
+      .def(py::init([](const Mat3& a) { return ps::control::TransmissionMatrix{a}; }), py::arg("a"))
+      .PS_V3(ps::control::TransmissionMatrix, a)
+      .def("__call__",
+           [](const ps::control::TransmissionMatrix& t, const Vec3& z) { return to_numpy(t(z)); })
+      .def_static("identity", &ps::control::TransmissionMatrix::identity);
+
+  bind_improved(m);
+
+  using Scl = ps::control::SemiClosedLoopParams;
+  py::class_<Scl>(m, "SemiClosedLoopParams")
+      .def(py::init<>())
+      .PS_RW(Scl, kind)
+      .PS_RW(Scl, scaling)
+      .PS_RW(Scl, improved)
+      .def(
+          "problem",
+          [](const Scl& p, double loop_sample_time_s) {
+            return std::string(
+                ps::control::to_string(ps::control::params_problem(p, loop_sample_time_s)));
+          },
+          py::arg("loop_sample_time_s"),
+          "Why a loop at this sample time could not run these parameters; '' when it could "
+          "(control/parameter_check.hpp)")
+      .PS_RW(Scl, sample_time_s)
+      .PS_RW(Scl, gains)
+      .PS_RW(Scl, gains_sample_time_s)
+      .PS_RW(Scl, output_min_um)
+      .PS_RW(Scl, output_max_um)
+      .PS_RW(Scl, deadband_um)
+      .PS_RW(Scl, derivative_filter)
+      .PS_RW(Scl, polynomial)
+      .PS_RW(Scl, matrix);
+
+  using Out = ps::control::ControllerOutput;
+  py::class_<Out>(m, "ControllerOutput")
+      .PS_V3(Out, dac_V)
+      .PS_V3(Out, target_um)
+      .PS_V3(Out, feedback_um)
+      .PS_V3(Out, command_um)
+      .PS_RO(Out, saturated_mask);
+}
+
+}  // namespace piezoshift::python

@@ -1,0 +1,38 @@
+"""The controller's full parameters from Python: the kind, the signal scaling and the improved
+controller's parts, and the check the loop runs before it takes a parameter set."""
+import pytest
+
+import piezoshift as ps
+
+
+def test_the_papers_parameters_run_at_their_rate(controller):
+    assert controller.kind == ps.ControllerKind.paper
+    assert controller.problem(1e-3) == ""
+    assert "sample time" in controller.problem(1e-4)
+
+
+def test_an_improved_controller_runs_only_at_the_rate_it_was_designed_at(controller):
+    controller.kind = ps.ControllerKind.improved
+    assert controller.problem(1e-3) == ""
+    controller.improved.sample_time_s = 1e-4  # edits in place
+    assert controller.improved.sample_time_s == 1e-4
+    assert "improved controller" in controller.problem(1e-3)
+
+
+def test_the_scaling_is_set_whole_and_inverts(controller):
+    scaling = controller.scaling
+    assert len(scaling) == 3
+    assert scaling[0].drive_V_per_um == 0.625  # Section 4: 10 V over the 16 um stroke
+    assert scaling[0].dac_to_um(scaling[0].um_to_dac(5.0)) == pytest.approx(5.0, abs=1e-14)
+    scaling[1].drive_V_per_um = 0.0
+    controller.scaling = scaling
+    assert "scaling" in controller.problem(1e-3)
+
+
+def test_shaper_taps_are_a_whole_list(controller):
+    shaper = controller.improved.shaper
+    assert shaper.taps == [1.0]
+    shaper.taps = [0.25, 0.5, 0.25]
+    assert controller.improved.shaper.taps == [0.25, 0.5, 0.25]
+    with pytest.raises(ps.InputError, match="taps"):
+        shaper.taps = []
