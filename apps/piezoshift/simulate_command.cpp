@@ -120,9 +120,8 @@ Vec3 open_loop_volts(const SimulateOptions& opt, const runtime::SafetyLimits& li
     const double v = opt.open_loop_volts[i];
     if (!std::isfinite(v) || v < limits.output_min_V || v > limits.output_max_V) {
       throw io::InputError(
-          fmt::format("--open-loop-volts: V{} = {} is outside the supervisor's {} "
-                      "to {} V",
-                      i + 1, v, limits.output_min_V, limits.output_max_V));
+          fmt::format("--open-loop-volts: V{} = {} is outside the supervisor's {} to {} V", i + 1,
+                      v, limits.output_min_V, limits.output_max_V));
     }
     open_loop[i] = v;
   }
@@ -180,7 +179,93 @@ struct SimulateRun {
 };
 
 int report(const SimulateOptions& opt, const config::ProjectConfig& config,
-           const experiments::Bench& bench, const SimulateRun& run);
+           const experiments::Bench& bench, const SimulateRun& run) {
+  const plant::Twin& twin = bench.twin();
+  const bool closed_loop = opt.open_loop_volts.empty();
+  const double period_s = run.period_s;
+
+  const plant::TwinTruth& s = twin.truth();
+  const plant::InterferometerReading& r = twin.interferometer();
+  const plant::TwinModel& m = twin.model();
+  const Vec3& ai = bench.last_cycle().ai_V;
+  const runtime::FaultRecord& fault = bench.fault();
+  const int status = bench.faulted() ? kExitFault : 0;
+  const char* mode = !closed_loop ? "open_loop" : (opt.step_um ? "step" : "profile");
+  if (opt.json) {
+    Json j{{"mode", mode},
+           {"config_file", opt.config_path.empty() ? Json(nullptr) : Json(opt.config_path)},
+           {"seed", opt.seed},
+           {"duration_s", static_cast<double>(run.ticks) * period_s},
+           {"ticks", run.ticks},
+           {"control_period_s", period_s},
+           {"physics_rate_Hz", config.twin.physics_rate_Hz},
+           {"final_plate_z_um", s.plate_z_um},
+           {"final_theta_x_urad", s.theta_x_urad},
+           {"final_theta_y_urad", s.theta_y_urad},
+           {"final_points_um", vec_json(r.dynamic_um)},
+           {"final_points_static_um", vec_json(r.static_um)},
+           {"final_true_points_um", vec_json(s.points_um)},
+           {"final_ao_V", vec_json(s.ao_V)},
+           {"final_ai_V", vec_json(ai)},
+           {"final_amplifier_V", vec_json(s.amplifier_V)},
+           {"saturated_ticks", run.saturated_ticks},
+           {"model",
+            {{"contact_stiffness_N_per_um", m.contact_stiffness_N_per_um},
+             {"contact_identified", m.contact_identified},
+             {"mechanism_stiffness_N_per_um", m.mechanism_stiffness_N_per_um},
+             {"loaded_modes_Hz",
+              Json::array({m.loaded_modes_Hz[0], m.loaded_modes_Hz[1], m.loaded_modes_Hz[2]})},
+             {"unloaded_mechanism_Hz", m.unloaded_mechanism_Hz},
+             {"sgs_gain", vec_json(m.geometry.sgs_gain)}}}};
+    j["fault"] = bench.faulted() ? Json{{"reason", runtime::to_string(fault.reason)},
+                                        {"channel", fault.channel + 1},
+                                        {"time_s", static_cast<double>(fault.tick) * period_s},
+                                        {"value", fault.value},
+                                        {"limit", fault.limit}}
+                                 : Json(nullptr);
+    if (opt.step_um) {
+      j["step_um"] = *opt.step_um;
+      j["step_at_s"] = opt.step_at_s;
+    }
+    if (closed_loop) {
+      j["calibration"] = run.calibration;
+      j["final_zd_um"] = vec_json(run.final_zd_um);
+      j["final_error_um"] = vec_json(difference(r.dynamic_um, run.final_zd_um));
+    }
+    if (!opt.log_path.empty())
+      j["log_file"] = opt.log_path;
+    fmt::print("{}\n", j.dump(2));
+    return status;
+  }
+  fmt::print("piezoshift simulate ({}), seed {}, {} ticks of {} s\n", mode, opt.seed, run.ticks,
+             period_s);
+  fmt::print("  plate Z at O          {:10.4f} um\n", s.plate_z_um);
+  fmt::print("  tilt theta_x, theta_y {:10.3f} {:10.3f} urad\n", s.theta_x_urad, s.theta_y_urad);
+  fmt::print("  points P1..P3 (true)  {:10.4f} {:10.4f} {:10.4f} um\n", s.points_um[0],
+             s.points_um[1], s.points_um[2]);
+  fmt::print("  interferometer        {:10.4f} {:10.4f} {:10.4f} um\n", r.dynamic_um[0],
+             r.dynamic_um[1], r.dynamic_um[2]);
+  if (closed_loop) {
+    const Vec3& zd = run.final_zd_um;
+    const Vec3 e = difference(r.dynamic_um, zd);
+    fmt::print("  target Z_d            {:10.4f} {:10.4f} {:10.4f} um\n", zd[0], zd[1], zd[2]);
+    fmt::print("  error (interf. - Z_d) {:10.4f} {:10.4f} {:10.4f} um\n", e[0], e[1], e[2]);
+    fmt::print("  controller            {}\n", run.calibration);
+  }
+  fmt::print("  stack voltages        {:10.3f} {:10.3f} {:10.3f} V\n", s.amplifier_V[0],
+             s.amplifier_V[1], s.amplifier_V[2]);
+  if (closed_loop)
+    fmt::print("  saturated ticks       {:10d}\n", run.saturated_ticks);
+  if (!opt.log_path.empty())
+    fmt::print("  log                   {}\n", opt.log_path);
+  if (bench.faulted())
+    fmt::print(stderr,
+               "piezoshift: simulate: the safety supervisor tripped: {} on channel {} at {:.3f} s "
+               "(value {:g}, limit {:g}); the outputs ramped to 0 V\n",
+               runtime::to_string(fault.reason), fault.channel + 1,
+               static_cast<double>(fault.tick) * period_s, fault.value, fault.limit);
+  return status;
+}
 
 int run_simulate(const SimulateOptions& opt) {
   check_options(opt);
@@ -256,97 +341,6 @@ int run_simulate(const SimulateOptions& opt) {
   if (log)
     log->close();
   return report(opt, config, bench, run);
-}
-
-int report(const SimulateOptions& opt, const config::ProjectConfig& config,
-           const experiments::Bench& bench, const SimulateRun& run) {
-  const plant::Twin& twin = bench.twin();
-  const bool closed_loop = opt.open_loop_volts.empty();
-  const double period_s = run.period_s;
-  const std::uint64_t ticks = run.ticks;
-  const std::uint64_t saturated_ticks = run.saturated_ticks;
-
-  const plant::TwinTruth& s = twin.truth();
-  const plant::InterferometerReading& r = twin.interferometer();
-  const plant::TwinModel& m = twin.model();
-  const Vec3& ai = bench.last_cycle().ai_V;
-  const runtime::FaultRecord& fault = bench.fault();
-  const int status = bench.faulted() ? kExitFault : 0;
-  const char* mode = !closed_loop ? "open_loop" : (opt.step_um ? "step" : "profile");
-  if (opt.json) {
-    Json j{{"mode", mode},
-           {"config_file", opt.config_path.empty() ? Json(nullptr) : Json(opt.config_path)},
-           {"seed", opt.seed},
-           {"duration_s", static_cast<double>(ticks) * period_s},
-           {"ticks", ticks},
-           {"control_period_s", period_s},
-           {"physics_rate_Hz", config.twin.physics_rate_Hz},
-           {"final_plate_z_um", s.plate_z_um},
-           {"final_theta_x_urad", s.theta_x_urad},
-           {"final_theta_y_urad", s.theta_y_urad},
-           {"final_points_um", vec_json(r.dynamic_um)},
-           {"final_points_static_um", vec_json(r.static_um)},
-           {"final_true_points_um", vec_json(s.points_um)},
-           {"final_ao_V", vec_json(s.ao_V)},
-           {"final_ai_V", vec_json(ai)},
-           {"final_amplifier_V", vec_json(s.amplifier_V)},
-           {"saturated_ticks", saturated_ticks},
-           {"model",
-            {{"contact_stiffness_N_per_um", m.contact_stiffness_N_per_um},
-             {"contact_identified", m.contact_identified},
-             {"mechanism_stiffness_N_per_um", m.mechanism_stiffness_N_per_um},
-             {"loaded_modes_Hz",
-              Json::array({m.loaded_modes_Hz[0], m.loaded_modes_Hz[1], m.loaded_modes_Hz[2]})},
-             {"unloaded_mechanism_Hz", m.unloaded_mechanism_Hz},
-             {"sgs_gain", vec_json(m.geometry.sgs_gain)}}}};
-    j["fault"] = bench.faulted() ? Json{{"reason", runtime::to_string(fault.reason)},
-                                        {"channel", fault.channel + 1},
-                                        {"time_s", static_cast<double>(fault.tick) * period_s},
-                                        {"value", fault.value},
-                                        {"limit", fault.limit}}
-                                 : Json(nullptr);
-    if (opt.step_um) {
-      j["step_um"] = *opt.step_um;
-      j["step_at_s"] = opt.step_at_s;
-    }
-    if (closed_loop) {
-      j["calibration"] = run.calibration;
-      j["final_zd_um"] = vec_json(run.final_zd_um);
-      j["final_error_um"] = vec_json(difference(r.dynamic_um, run.final_zd_um));
-    }
-    if (!opt.log_path.empty())
-      j["log_file"] = opt.log_path;
-    fmt::print("{}\n", j.dump(2));
-    return status;
-  }
-  fmt::print("piezoshift simulate ({}), seed {}, {} ticks of {} s\n", mode, opt.seed, ticks,
-             period_s);
-  fmt::print("  plate Z at O          {:10.4f} um\n", s.plate_z_um);
-  fmt::print("  tilt theta_x, theta_y {:10.3f} {:10.3f} urad\n", s.theta_x_urad, s.theta_y_urad);
-  fmt::print("  points P1..P3 (true)  {:10.4f} {:10.4f} {:10.4f} um\n", s.points_um[0],
-             s.points_um[1], s.points_um[2]);
-  fmt::print("  interferometer        {:10.4f} {:10.4f} {:10.4f} um\n", r.dynamic_um[0],
-             r.dynamic_um[1], r.dynamic_um[2]);
-  if (closed_loop) {
-    const Vec3& zd = run.final_zd_um;
-    const Vec3 e = difference(r.dynamic_um, zd);
-    fmt::print("  target Z_d            {:10.4f} {:10.4f} {:10.4f} um\n", zd[0], zd[1], zd[2]);
-    fmt::print("  error (interf. - Z_d) {:10.4f} {:10.4f} {:10.4f} um\n", e[0], e[1], e[2]);
-    fmt::print("  controller            {}\n", run.calibration);
-  }
-  fmt::print("  stack voltages        {:10.3f} {:10.3f} {:10.3f} V\n", s.amplifier_V[0],
-             s.amplifier_V[1], s.amplifier_V[2]);
-  if (closed_loop)
-    fmt::print("  saturated ticks       {:10d}\n", saturated_ticks);
-  if (!opt.log_path.empty())
-    fmt::print("  log                   {}\n", opt.log_path);
-  if (bench.faulted())
-    fmt::print(stderr,
-               "piezoshift: simulate: the safety supervisor tripped: {} on channel {} at {:.3f} s "
-               "(value {:g}, limit {:g}); the outputs ramped to 0 V\n",
-               runtime::to_string(fault.reason), fault.channel + 1,
-               static_cast<double>(fault.tick) * period_s, fault.value, fault.limit);
-  return status;
 }
 
 }  // namespace

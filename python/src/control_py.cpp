@@ -20,9 +20,9 @@ using ps::control::Vec3;
 
 namespace {
 
-// The improved controller's parts. Lists (shaper taps, model operators, creep terms) are
-// fixed-size arrays with a count in C++; here they are whole lists, set at once, so that the
-// count and the values cannot disagree.
+// The improved controller's parts. The shaper's taps are a fixed-size array with a count in C++;
+// here they are one whole list, set at once, so that the count and the values cannot disagree.
+// The hysteresis and creep model (model[i]) is not bound yet.
 void bind_improved(py::module_& m) {
   namespace c = ps::control;
   py::enum_<c::ControllerKind>(m, "ControllerKind")

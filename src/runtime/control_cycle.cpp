@@ -33,13 +33,9 @@ control::ParamsProblem ControlCycle::try_configure(
       control::params_problem(params, controller_.params().sample_time_s);
   if (problem != control::ParamsProblem::kNone)
     return problem;
-  for (std::size_t i = 0; i < params.scaling.size(); ++i) {
-    const control::SignalScaling& now = controller_.params().scaling[i];
-    const control::SignalScaling& next = params.scaling[i];
-    if (next.sgs_um_per_V != now.sgs_um_per_V || next.sgs_offset_V != now.sgs_offset_V ||
-        next.drive_V_per_um != now.drive_V_per_um || next.drive_offset_V != now.drive_offset_V)
-      return control::ParamsProblem::kScaling;
-  }
+  // The scaling is the wiring the supervisor was set up with.
+  if (params.scaling != controller_.params().scaling)
+    return control::ParamsProblem::kScaling;
   const Vec3 held = held_command_um();
   controller_.configure(params);
   controller_.reset_to(held);

@@ -85,24 +85,31 @@ constexpr bool all_finite(T x, Ts... xs) noexcept {
 }
 
 template <class T>
-constexpr bool model_ok(const BasicImprovedParams<T>& im, bool& finite_values) noexcept {
+constexpr bool model_fits(const BasicImprovedParams<T>& im) noexcept {
   if (im.shaper.taps > kMaxShaperTaps || im.reference_delay_ticks > kMaxReferenceDelayTicks)
     return false;
-  finite_values = all_finite(im.sample_time_s, im.correction_ki, im.correction_ki_max,
-                             im.correction_boost_error_um, im.correction_limit_um,
-                             im.headroom_fraction, im.shaper.rate_um_per_s);
-  for (std::size_t k = 0; k < im.shaper.taps; ++k)
-    finite_values = finite_values && finite(im.shaper.weight[k]);
-  for (const BasicHysteresisCreepParams<T>& m : im.model) {
+  for (const BasicHysteresisCreepParams<T>& m : im.model)
     if (m.operators > kMaxModelOperators || m.creep_terms > kMaxCreepTerms)
       return false;
-    finite_values = finite_values && all_finite(m.offset_um, m.linear_weight, m.creep_gain);
-    for (std::size_t j = 0; j < m.operators; ++j)
-      finite_values = finite_values && all_finite(m.threshold_um[j], m.weight[j]);
-    for (std::size_t k = 0; k < m.creep_terms; ++k)
-      finite_values = finite_values && finite(m.creep_time_constant_s[k]);
-  }
   return true;
+}
+
+// The values in use only (the counts say how many); model_fits() first.
+template <class T>
+constexpr bool model_finite(const BasicImprovedParams<T>& im) noexcept {
+  bool ok = all_finite(im.sample_time_s, im.correction_ki, im.correction_ki_max,
+                       im.correction_boost_error_um, im.correction_limit_um, im.headroom_fraction,
+                       im.shaper.rate_um_per_s);
+  for (std::size_t k = 0; k < im.shaper.taps; ++k)
+    ok = ok && finite(im.shaper.weight[k]);
+  for (const BasicHysteresisCreepParams<T>& m : im.model) {
+    ok = ok && all_finite(m.offset_um, m.linear_weight, m.creep_gain);
+    for (std::size_t j = 0; j < m.operators; ++j)
+      ok = ok && all_finite(m.threshold_um[j], m.weight[j]);
+    for (std::size_t k = 0; k < m.creep_terms; ++k)
+      ok = ok && finite(m.creep_time_constant_s[k]);
+  }
+  return ok;
 }
 
 }  // namespace detail
@@ -125,16 +132,12 @@ constexpr ParamsProblem params_problem(const BasicSemiClosedLoopParams<T>& p,
   for (const BasicSignalScaling<T>& s : p.scaling)
     finite =
         finite && all_finite(s.sgs_um_per_V, s.sgs_offset_V, s.drive_V_per_um, s.drive_offset_V);
-  if (p.kind == ControllerKind::kImproved) {
-    bool model_finite = true;
-    if (!detail::model_ok(p.improved, model_finite))
-      return ParamsProblem::kModelSize;
-    finite = finite && model_finite;
-  }
-  if (!finite)
+  const bool improved = p.kind == ControllerKind::kImproved;
+  if (improved && !detail::model_fits(p.improved))
+    return ParamsProblem::kModelSize;
+  if (!finite || (improved && !detail::model_finite(p.improved)))
     return ParamsProblem::kNotFinite;
-  if (p.kind == ControllerKind::kImproved &&
-      !detail::same_time(p.improved.sample_time_s, p.sample_time_s))
+  if (improved && !detail::same_time(p.improved.sample_time_s, p.sample_time_s))
     return ParamsProblem::kImprovedRate;
   if (!(p.output_min_um < p.output_max_um))
     return ParamsProblem::kOutputLimits;

@@ -24,6 +24,8 @@ struct BasicSignalScaling {
   constexpr T dac_to_um(T dac_V) const noexcept {
     return (dac_V - drive_offset_V) / drive_V_per_um;
   }
+
+  constexpr bool operator==(const BasicSignalScaling&) const noexcept = default;
 };
 
 using SignalScaling = BasicSignalScaling<double>;
