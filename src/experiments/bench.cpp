@@ -2,6 +2,7 @@
 
 #include <algorithm>
 #include <cmath>
+#include <limits>
 #include <stdexcept>
 #include <string>
 
@@ -15,9 +16,7 @@ const char* to_string(Feedback feedback) noexcept {
 
 Bench::Bench(const config::ProjectConfig& config, const control::SemiClosedLoopParams& controller,
              std::uint64_t seed, const BenchOptions& options)
-    : options_(options),
-      sample_time_s_(config.twin.daq.sample_time_s),
-      period_ns_(std::llround(config.twin.daq.sample_time_s * 1e9)) {
+    : options_(options), sample_time_s_(config.twin.daq.sample_time_s) {
   if (std::fabs(controller.sample_time_s - sample_time_s_) > 1e-12 * sample_time_s_) {
     throw std::invalid_argument(
         "bench: the controller's sample time differs from the DAQ's period");
@@ -39,8 +38,17 @@ Bench::Bench(const config::ProjectConfig& config, const control::SemiClosedLoopP
         std::make_unique<runtime::OracleBackend>(*sim_, controller.matrix, controller.scaling);
     daq_ = oracle_.get();
   }
-  cycle_ = std::make_unique<runtime::ControlCycle>(controller, options.limits);
+  // Owner mode: the procedures drive it between ticks; it runs until the bench is destroyed and
+  // keeps running after a fault (its ramp to 0 V, then latched), as a bench left switched on.
+  runtime::LoopConfig lc;
+  lc.rate_Hz = so.rate_Hz;
+  lc.duration_s = std::numeric_limits<double>::infinity();
+  lc.stop_when_safe_after_fault = false;
+  lc.owner_drives = true;
+  loop_ = std::make_unique<runtime::ControlLoop>(lc, controller, options.limits, *daq_, clock_,
+                                                 runtime::SetpointProfile::step(0.0));
   daq_->activate();
+  loop_->start();
 }
 
 Bench::~Bench() {
@@ -48,29 +56,27 @@ Bench::~Bench() {
 }
 
 void Bench::set_controller(const control::SemiClosedLoopParams& params) {
-  const control::ParamsProblem problem = cycle_->try_configure(params);
+  const control::ParamsProblem problem = loop_->try_configure(params);
   if (problem != control::ParamsProblem::kNone)
     throw std::invalid_argument(std::string("bench: the loop refused the controller: ") +
                                 control::to_string(problem));
 }
 
 void Bench::drive_open_loop(const Vec3& ao_V) {
-  cycle_->drive(DriveMode::kOpenLoop, ao_V);
+  loop_->drive(DriveMode::kOpenLoop, ao_V);
 }
 
 void Bench::drive_actuators(const Vec3& target_um) {
-  cycle_->drive(DriveMode::kActuators, target_um);
+  loop_->drive(DriveMode::kActuators, target_um);
 }
 
 void Bench::drive_points(const Vec3& zd_um) {
-  cycle_->drive(DriveMode::kPoints, zd_um);
+  loop_->drive(DriveMode::kPoints, zd_um);
 }
 
 void Bench::tick() {
-  const auto k = static_cast<std::int64_t>(tick_);
-  const runtime::CycleTime t{tick_, k * period_ns_, period_ns_};
-  cycle_->step(*daq_, t, false);
-  ++tick_;
+  // The bench never asks the loop to stop, so the loop never ends a run on its own.
+  loop_->tick();
 }
 
 void Bench::run(double duration_s, const std::function<void(const Bench&)>& on_tick) {

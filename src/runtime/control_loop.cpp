@@ -1,5 +1,6 @@
 #include "piezoshift/runtime/control_loop.hpp"
 
+#include <algorithm>
 #include <cmath>
 #include <limits>
 #include <stdexcept>
@@ -56,232 +57,284 @@ ControlLoop::ControlLoop(const LoopConfig& config, const control::SemiClosedLoop
 }
 
 LoopResult ControlLoop::run() noexcept {
-  LoopResult result{};
+  start();
+  while (tick()) {
+  }
+  return result_;
+}
+
+void ControlLoop::start() noexcept {
+  result_ = LoopResult{};
+  result_.min_output_V = std::numeric_limits<double>::infinity();
+  result_.max_output_V = -std::numeric_limits<double>::infinity();
   cycle_.reset();
   profile_.rewind();
   stats_.clear();
-  const double period_s = params_.sample_time_s;
-  const double period_ms = period_s * 1e3;
-  result.min_output_V = std::numeric_limits<double>::infinity();
-  result.max_output_V = -std::numeric_limits<double>::infinity();
-
-  const std::int64_t start = clock_.now_ns();
-  std::int64_t deadline = start;
-  std::int64_t previous_deadline = start - period_ns_;
-  std::int64_t previous_wake = start;
-  bool previous_overran = false;
-  bool stop_requested = false;
-  Vec3 previous_ao{};
-
-  // Host mode state: servo off at 0 V until the host says otherwise. Without a host the loop
-  // follows the profile from the first tick.
-  HostLink* const host = config_.host;
-  if (host == nullptr)
+  tick_ = 0;
+  start_ns_ = clock_.now_ns();
+  deadline_ns_ = start_ns_;
+  previous_deadline_ns_ = start_ns_ - period_ns_;
+  previous_wake_ns_ = start_ns_;
+  previous_overran_ = false;
+  stop_requested_ = false;
+  done_ = false;
+  previous_ao_V_ = Vec3{};
+  // Host and owner modes: servo off at 0 V until told otherwise. The profile is followed from the
+  // first tick.
+  host_zd_um_ = Vec3{};
+  wave_ = WaveGenerator{};
+  applied_sequence_ = 0;
+  configure_problem_ = control::ParamsProblem::kNone;
+  if (config_.host == nullptr && !config_.owner_drives)
     cycle_.drive(DriveMode::kPoints, profile_.at(0.0));
-  Vec3 host_zd{};
-  WaveGenerator wave;  // fixed-size; the tables are the host's (wave_generator.hpp)
-  std::uint64_t applied_sequence = 0;
-  control::ParamsProblem configure_problem = control::ParamsProblem::kNone;
-  const auto clear_latched_fault = [&]() noexcept {
-    if (cycle_.clear_fault() && stop_requested)
-      cycle_.request_stop();
-  };
-  const SafetySupervisor& supervisor = cycle_.supervisor();
+}
 
-  for (std::uint64_t tick = 0;; ++tick) {
-    clock_.sleep_until_ns(deadline);
-    const std::int64_t wake = clock_.now_ns();
-    const CycleTime ct{tick, deadline - start, deadline - previous_deadline};
+bool ControlLoop::tick() noexcept {
+  if (done_)
+    return false;
+  clock_.sleep_until_ns(deadline_ns_);
+  const std::int64_t wake = clock_.now_ns();
+  const CycleTime ct{tick_, deadline_ns_ - start_ns_, deadline_ns_ - previous_deadline_ns_};
 
-    if (!stop_requested) {
-      if (tick >= duration_ticks_) {
-        stop_requested = true;
-        result.stop_reason = StopReason::kDuration;
-      } else if (config_.stop_signal != nullptr &&
-                 config_.stop_signal->load(std::memory_order_relaxed) != 0) {
-        stop_requested = true;
-        result.stop_reason = StopReason::kSignal;
-        result.signal = config_.stop_signal->load(std::memory_order_relaxed);
-      }
-      if (stop_requested)
-        cycle_.request_stop();
-    }
-    if (clear_requested_.exchange(false, std::memory_order_acq_rel))
+  check_stop();
+  if (clear_requested_.exchange(false, std::memory_order_acq_rel))
+    clear_latched_fault();
+  apply_host_commands();
+  choose_setpoint(ct);
+
+  const CycleSample& cs = cycle_.step(daq_, ct, previous_overran_);
+  const Vec3 zd = cs.mode == DriveMode::kPoints ? cs.setpoint : Vec3{};  // S is no Z_d
+  record_outputs(cs, zd);
+  publish_status(cs, zd, ct);
+
+  const std::int64_t end = clock_.now_ns();
+  previous_overran_ = stats_.record(deadline_ns_, wake, end, previous_wake_ns_, period_ns_);
+  push_telemetry(cs, zd, ct, wake, end);
+  push_host_sample(cs, zd, ct, wake);
+
+  ++tick_;
+  if (done(cs))
+    return false;
+  previous_wake_ns_ = wake;
+  next_deadline(end);
+  return true;
+}
+
+void ControlLoop::check_stop() noexcept {
+  if (stop_requested_)
+    return;
+  if (tick_ >= duration_ticks_) {
+    stop_requested_ = true;
+    result_.stop_reason = StopReason::kDuration;
+  } else if (config_.stop_signal != nullptr &&
+             config_.stop_signal->load(std::memory_order_relaxed) != 0) {
+    stop_requested_ = true;
+    result_.stop_reason = StopReason::kSignal;
+    result_.signal = config_.stop_signal->load(std::memory_order_relaxed);
+  }
+  if (stop_requested_)
+    cycle_.request_stop();
+}
+
+void ControlLoop::clear_latched_fault() noexcept {
+  if (cycle_.clear_fault() && stop_requested_)
+    cycle_.request_stop();
+}
+
+void ControlLoop::apply_host_commands() noexcept {
+  HostLink* const host = config_.host;
+  HostCommand cmd{};
+  for (int n = 0;
+       host != nullptr && n < HostLink::kMaxCommandsPerTick && host->commands.try_pop(cmd); ++n) {
+    applied_sequence_ = cmd.sequence;
+    ++result_.host_commands_applied;
+    apply(cmd);
+  }
+}
+
+void ControlLoop::apply(const HostCommand& cmd) noexcept {
+  const bool closed_loop = cycle_.mode() != DriveMode::kOpenLoop;
+  switch (cmd.kind) {
+    case HostCommand::Kind::kMoveTo:
+      if (closed_loop)
+        host_zd_um_ = cmd.zd_um;
+      break;
+    case HostCommand::Kind::kServoOn:
       clear_latched_fault();
-
-    HostCommand cmd{};
-    for (int n = 0;
-         host != nullptr && n < HostLink::kMaxCommandsPerTick && host->commands.try_pop(cmd); ++n) {
-      applied_sequence = cmd.sequence;
-      ++result.host_commands_applied;
-      const bool closed_loop = cycle_.mode() != DriveMode::kOpenLoop;
-      switch (cmd.kind) {
-        case HostCommand::Kind::kMoveTo:
-          if (closed_loop)
-            host_zd = cmd.zd_um;
-          break;
-        case HostCommand::Kind::kServoOn:
-          clear_latched_fault();
-          // Bumpless: each PID resumes from the command the output already holds.
-          host_zd = cmd.zd_um;
-          cycle_.drive(DriveMode::kPoints, host_zd);
-          cycle_.restart_from_outputs();
-          break;
-        case HostCommand::Kind::kServoOff:
-          clear_latched_fault();
-          cycle_.drive(DriveMode::kOpenLoop, supervisor.last_output_V());
-          break;
-        case HostCommand::Kind::kOpenLoop:
-          if (!closed_loop)
-            cycle_.drive(DriveMode::kOpenLoop, cmd.ao_V);
-          break;
-        case HostCommand::Kind::kWave:
-          wave.apply(cmd.wave, host_zd);
-          break;
-        case HostCommand::Kind::kActuators:
-          cycle_.drive(DriveMode::kActuators, cmd.zd_um);
-          break;
-        case HostCommand::Kind::kConfigure: {
-          // Checked here, refused without a change and reported in the samples: never thrown.
-          control::SemiClosedLoopParams p{};
-          configure_problem =
-              host->params.try_pop(p) ? cycle_.try_configure(p) : control::ParamsProblem::kAbsent;
-          break;
-        }
-      }
-    }
-    if (host == nullptr) {
-      cycle_.drive(DriveMode::kPoints, profile_.at(static_cast<double>(ct.since_start_ns) * 1e-9));
-    } else {
-      // The host's set-point plus its running wave generators (stopped unless the servo is on
-      // Z_d and no fault is latched).
-      const bool points = cycle_.mode() == DriveMode::kPoints;
-      const Vec3 zd = wave.next(host_zd, points && !supervisor.faulted());
-      if (points)
-        cycle_.drive(DriveMode::kPoints, zd);
-    }
-
-    const CycleSample& cs = cycle_.step(daq_, ct, previous_overran);
-    const SupervisorOutput& s = cs.supervisor;
-    const control::ControllerOutput& c = cs.controller;
-    const bool closed_loop = cs.mode != DriveMode::kOpenLoop;
-    const Vec3 zd = cs.mode == DriveMode::kPoints ? cs.setpoint : Vec3{};  // S is no Z_d
-    if (supervisor.faulted() && !result.fault_detected) {
-      result.fault_detected = true;
-      result.fault = supervisor.fault();
-    }
-
-    for (std::size_t i = 0; i < s.ao_V.size(); ++i) {
-      const double v = s.ao_V[i];
-      if (v > result.max_output_V)
-        result.max_output_V = v;
-      if (v < result.min_output_V)
-        result.min_output_V = v;
-      const double slew = std::fabs(v - previous_ao[i]) / period_ms;
-      if (slew > result.max_output_slew_V_per_ms)
-        result.max_output_slew_V_per_ms = slew;
-    }
-    previous_ao = s.ao_V;
-    result.last_sgs_V = cs.ai_V;
-    if (config_.status != nullptr) {
-      LoopStatus& st = *config_.status;
-      st.t_s.store(static_cast<double>(ct.since_start_ns) * 1e-9, std::memory_order_relaxed);
-      st.publish_vec(st.zd_um, zd);
-      st.publish_vec(st.target_um, c.target_um);
-      st.publish_vec(st.feedback_um, c.feedback_um);
-      st.state.store(static_cast<std::uint8_t>(s.state), std::memory_order_relaxed);
-      st.fault_reason.store(static_cast<std::uint8_t>(supervisor.fault().reason),
-                            std::memory_order_relaxed);
-      st.ticks.store(tick + 1, std::memory_order_relaxed);
-    }
-    if (!stop_requested && closed_loop && !supervisor.faulted()) {
-      result.controlled_end_tick = tick + 1;
-      result.end_zd_um = zd;
-      result.end_target_um = c.target_um;
-      result.end_feedback_um = c.feedback_um;
-      Vec3 truth{};
-      if (!daq_.truth(truth, result.end_interferometer_um)) {
-        const double nan = std::numeric_limits<double>::quiet_NaN();
-        result.end_interferometer_um = Vec3{nan, nan, nan};
-      }
-    }
-
-    const std::int64_t end = clock_.now_ns();
-    previous_overran = stats_.record(deadline, wake, end, previous_wake, period_ns_);
-
-    if (telemetry_ != nullptr) {
-      TelemetryRecord r{};
-      r.tick = tick;
-      r.t_s = static_cast<double>(ct.since_start_ns) * 1e-9;
-      r.zd_um = zd;
-      r.target_um = c.target_um;
-      r.sgs_V = cs.ai_V;
-      r.request_V = c.dac_V;
-      r.ao_V = s.ao_V;
-      if (!daq_.truth(r.truth_um, r.interferometer_um)) {
-        const double nan = std::numeric_limits<double>::quiet_NaN();
-        r.truth_um = Vec3{nan, nan, nan};
-        r.interferometer_um = r.truth_um;
-      }
-      r.wake_latency_us = static_cast<double>(wake - deadline) * 1e-3;
-      r.compute_us = static_cast<double>(end - wake) * 1e-3;
-      r.overrun = previous_overran ? 1 : 0;
-      r.limited = s.limited ? 1 : 0;
-      r.held = s.hold_integrators ? 1 : 0;
-      r.state = static_cast<std::uint8_t>(s.state);
-      r.fault_reason = static_cast<std::uint8_t>(supervisor.fault().reason);
-      r.fault_channel = static_cast<std::int8_t>(supervisor.fault().channel);
-      r.read_status = static_cast<std::uint8_t>(cs.read_status);
-      r.write_status = static_cast<std::uint8_t>(cs.write_status);
-      if (!telemetry_->try_push(r))
-        ++result.telemetry_dropped;
-    }
-
-    if (host != nullptr) {
-      HostSample h{};
-      h.tick = tick;
-      h.t_s = static_cast<double>(ct.since_start_ns) * 1e-9;
-      h.applied_sequence = applied_sequence;
-      h.configure_problem = static_cast<std::uint8_t>(configure_problem);
-      h.zd_um = zd;
-      h.target_um = c.target_um;
-      h.sgs_V = cs.ai_V;
-      h.ao_V = s.ao_V;
-      h.has_truth = daq_.truth(h.truth_um, h.interferometer_um) ? 1 : 0;
-      h.wake_latency_us = static_cast<double>(wake - deadline) * 1e-3;
-      h.overrun = previous_overran ? 1 : 0;
-      h.closed_loop = closed_loop && !supervisor.faulted() ? 1 : 0;
-      h.actuators = cs.mode == DriveMode::kActuators ? 1 : 0;
-      h.saturated_mask = closed_loop ? c.saturated_mask : 0;
-      h.state = static_cast<std::uint8_t>(s.state);
-      h.fault_reason = static_cast<std::uint8_t>(supervisor.fault().reason);
-      h.fault_channel = static_cast<std::int8_t>(supervisor.fault().channel);
-      h.wave_running = wave.running_mask();
-      if (!host->samples.try_push(h))
-        ++result.host_samples_dropped;
-    }
-
-    const bool safe_after_fault = supervisor.faulted() && supervisor.outputs_at_zero();
-    if (s.state == SupervisorState::kStopped ||
-        (safe_after_fault && (config_.stop_when_safe_after_fault || stop_requested))) {
-      result.ticks = tick + 1;
-      if (safe_after_fault)
-        result.stop_reason = StopReason::kFault;
+      // Bumpless: each PID resumes from the command the output already holds.
+      host_zd_um_ = cmd.zd_um;
+      cycle_.drive(DriveMode::kPoints, host_zd_um_);
+      cycle_.restart_from_outputs();
+      break;
+    case HostCommand::Kind::kServoOff:
+      clear_latched_fault();
+      cycle_.drive(DriveMode::kOpenLoop, cycle_.supervisor().last_output_V());
+      break;
+    case HostCommand::Kind::kOpenLoop:
+      if (!closed_loop)
+        cycle_.drive(DriveMode::kOpenLoop, cmd.ao_V);
+      break;
+    case HostCommand::Kind::kWave:
+      wave_.apply(cmd.wave, host_zd_um_);
+      break;
+    case HostCommand::Kind::kActuators:
+      cycle_.drive(DriveMode::kActuators, cmd.zd_um);
+      break;
+    case HostCommand::Kind::kConfigure: {
+      // Checked here, refused without a change and reported in the samples: never thrown.
+      control::SemiClosedLoopParams p{};
+      configure_problem_ = config_.host->params.try_pop(p) ? cycle_.try_configure(p)
+                                                           : control::ParamsProblem::kAbsent;
       break;
     }
+  }
+}
 
-    previous_wake = wake;
-    previous_deadline = deadline;
-    deadline += period_ns_;
-    if (end > deadline) {  // missed the next deadline: re-phase to the first slot after `end`
-      const std::int64_t skip = (end - deadline + period_ns_ - 1) / period_ns_;
-      deadline += skip * period_ns_;
-      stats_.skipped_slots += static_cast<std::uint64_t>(skip);
+void ControlLoop::choose_setpoint(const CycleTime& t) noexcept {
+  if (config_.host != nullptr) {
+    // The host's set-point plus its running wave generators (stopped unless the servo is on
+    // Z_d and no fault is latched).
+    const bool points = cycle_.mode() == DriveMode::kPoints;
+    const Vec3 zd = wave_.next(host_zd_um_, points && !cycle_.supervisor().faulted());
+    if (points)
+      cycle_.drive(DriveMode::kPoints, zd);
+  } else if (!config_.owner_drives) {
+    cycle_.drive(DriveMode::kPoints, profile_.at(static_cast<double>(t.since_start_ns) * 1e-9));
+  }
+}
+
+void ControlLoop::record_outputs(const CycleSample& cs, const Vec3& zd) noexcept {
+  const SafetySupervisor& supervisor = cycle_.supervisor();
+  if (supervisor.faulted() && !result_.fault_detected) {
+    result_.fault_detected = true;
+    result_.fault = supervisor.fault();
+  }
+  const double period_ms = params_.sample_time_s * 1e3;
+  const Vec3& ao = cs.supervisor.ao_V;
+  for (std::size_t i = 0; i < ao.size(); ++i) {
+    result_.max_output_V = std::max(result_.max_output_V, ao[i]);
+    result_.min_output_V = std::min(result_.min_output_V, ao[i]);
+    result_.max_output_slew_V_per_ms = std::max(result_.max_output_slew_V_per_ms,
+                                                std::fabs(ao[i] - previous_ao_V_[i]) / period_ms);
+  }
+  previous_ao_V_ = ao;
+  result_.last_sgs_V = cs.ai_V;
+  if (!stop_requested_ && cs.mode != DriveMode::kOpenLoop && !supervisor.faulted()) {
+    const control::ControllerOutput& c = cs.controller;
+    result_.controlled_end_tick = tick_ + 1;
+    result_.end_zd_um = zd;
+    result_.end_target_um = c.target_um;
+    result_.end_feedback_um = c.feedback_um;
+    Vec3 truth{};
+    if (!daq_.truth(truth, result_.end_interferometer_um)) {
+      const double nan = std::numeric_limits<double>::quiet_NaN();
+      result_.end_interferometer_um = Vec3{nan, nan, nan};
     }
   }
-  if (supervisor.faulted())
-    result.fault = supervisor.fault();
-  return result;
+}
+
+void ControlLoop::publish_status(const CycleSample& cs, const Vec3& zd,
+                                 const CycleTime& t) noexcept {
+  if (config_.status == nullptr)
+    return;
+  const SafetySupervisor& supervisor = cycle_.supervisor();
+  LoopStatus& st = *config_.status;
+  st.t_s.store(static_cast<double>(t.since_start_ns) * 1e-9, std::memory_order_relaxed);
+  st.publish_vec(st.zd_um, zd);
+  st.publish_vec(st.target_um, cs.controller.target_um);
+  st.publish_vec(st.feedback_um, cs.controller.feedback_um);
+  st.state.store(static_cast<std::uint8_t>(cs.supervisor.state), std::memory_order_relaxed);
+  st.fault_reason.store(static_cast<std::uint8_t>(supervisor.fault().reason),
+                        std::memory_order_relaxed);
+  st.ticks.store(tick_ + 1, std::memory_order_relaxed);
+}
+
+void ControlLoop::push_telemetry(const CycleSample& cs, const Vec3& zd, const CycleTime& t,
+                                 std::int64_t wake_ns, std::int64_t end_ns) noexcept {
+  if (telemetry_ == nullptr)
+    return;
+  const SafetySupervisor& supervisor = cycle_.supervisor();
+  const SupervisorOutput& s = cs.supervisor;
+  TelemetryRecord r{};
+  r.tick = tick_;
+  r.t_s = static_cast<double>(t.since_start_ns) * 1e-9;
+  r.zd_um = zd;
+  r.target_um = cs.controller.target_um;
+  r.sgs_V = cs.ai_V;
+  r.request_V = cs.controller.dac_V;
+  r.ao_V = s.ao_V;
+  if (!daq_.truth(r.truth_um, r.interferometer_um)) {
+    const double nan = std::numeric_limits<double>::quiet_NaN();
+    r.truth_um = Vec3{nan, nan, nan};
+    r.interferometer_um = r.truth_um;
+  }
+  r.wake_latency_us = static_cast<double>(wake_ns - deadline_ns_) * 1e-3;
+  r.compute_us = static_cast<double>(end_ns - wake_ns) * 1e-3;
+  r.overrun = previous_overran_ ? 1 : 0;
+  r.limited = s.limited ? 1 : 0;
+  r.held = s.hold_integrators ? 1 : 0;
+  r.state = static_cast<std::uint8_t>(s.state);
+  r.fault_reason = static_cast<std::uint8_t>(supervisor.fault().reason);
+  r.fault_channel = static_cast<std::int8_t>(supervisor.fault().channel);
+  r.read_status = static_cast<std::uint8_t>(cs.read_status);
+  r.write_status = static_cast<std::uint8_t>(cs.write_status);
+  if (!telemetry_->try_push(r))
+    ++result_.telemetry_dropped;
+}
+
+void ControlLoop::push_host_sample(const CycleSample& cs, const Vec3& zd, const CycleTime& t,
+                                   std::int64_t wake_ns) noexcept {
+  HostLink* const host = config_.host;
+  if (host == nullptr)
+    return;
+  const SafetySupervisor& supervisor = cycle_.supervisor();
+  const bool closed_loop = cs.mode != DriveMode::kOpenLoop;
+  HostSample h{};
+  h.tick = tick_;
+  h.t_s = static_cast<double>(t.since_start_ns) * 1e-9;
+  h.applied_sequence = applied_sequence_;
+  h.configure_problem = static_cast<std::uint8_t>(configure_problem_);
+  h.zd_um = zd;
+  h.target_um = cs.controller.target_um;
+  h.sgs_V = cs.ai_V;
+  h.ao_V = cs.supervisor.ao_V;
+  h.has_truth = daq_.truth(h.truth_um, h.interferometer_um) ? 1 : 0;
+  h.wake_latency_us = static_cast<double>(wake_ns - deadline_ns_) * 1e-3;
+  h.overrun = previous_overran_ ? 1 : 0;
+  h.closed_loop = closed_loop && !supervisor.faulted() ? 1 : 0;
+  h.actuators = cs.mode == DriveMode::kActuators ? 1 : 0;
+  h.saturated_mask = closed_loop ? cs.controller.saturated_mask : 0;
+  h.state = static_cast<std::uint8_t>(cs.supervisor.state);
+  h.fault_reason = static_cast<std::uint8_t>(supervisor.fault().reason);
+  h.fault_channel = static_cast<std::int8_t>(supervisor.fault().channel);
+  h.wave_running = wave_.running_mask();
+  if (!host->samples.try_push(h))
+    ++result_.host_samples_dropped;
+}
+
+bool ControlLoop::done(const CycleSample& cs) noexcept {
+  const SafetySupervisor& supervisor = cycle_.supervisor();
+  const bool safe_after_fault = supervisor.faulted() && supervisor.outputs_at_zero();
+  done_ = cs.supervisor.state == SupervisorState::kStopped ||
+          (safe_after_fault && (config_.stop_when_safe_after_fault || stop_requested_));
+  if (done_) {
+    result_.ticks = tick_;
+    if (safe_after_fault)
+      result_.stop_reason = StopReason::kFault;
+    if (supervisor.faulted())
+      result_.fault = supervisor.fault();
+  }
+  return done_;
+}
+
+void ControlLoop::next_deadline(std::int64_t end_ns) noexcept {
+  previous_deadline_ns_ = deadline_ns_;
+  deadline_ns_ += period_ns_;
+  if (end_ns > deadline_ns_) {  // missed the next deadline: re-phase to the first slot after E_k
+    const std::int64_t skip = (end_ns - deadline_ns_ + period_ns_ - 1) / period_ns_;
+    deadline_ns_ += skip * period_ns_;
+    stats_.skipped_slots += static_cast<std::uint64_t>(skip);
+  }
 }
 
 }  // namespace piezoshift::runtime

@@ -1,7 +1,7 @@
 #pragma once
 // The simulated lab bench: the digital twin as the `sim` DAQ backend (runtime/sim_backend.hpp),
-// closed through the one control tick every command ships (runtime/control_cycle.hpp: DAQ read,
-// controller, safety supervisor, DAQ write, with the runtime's timing contract), on a simulated
+// closed by the loop every command ships (runtime/control_loop.hpp, in owner mode: DAQ read,
+// controller, safety supervisor, DAQ write, with the backends' timing contract), on a simulated
 // clock: tick k runs at k T_s and is never late, so the bench steps as fast as the twin allows.
 // It is the engine of the offline calibration procedures and of the paper's experiments, so every
 // figure piezoshift reports comes from the loop `run` and `serve` run.
@@ -27,7 +27,8 @@
 #include "piezoshift/config/project_config.hpp"
 #include "piezoshift/control/semi_closed_loop.hpp"
 #include "piezoshift/plant/twin.hpp"
-#include "piezoshift/runtime/control_cycle.hpp"
+#include "piezoshift/runtime/control_loop.hpp"
+#include "piezoshift/runtime/loop_clock.hpp"
 #include "piezoshift/runtime/oracle_backend.hpp"
 #include "piezoshift/runtime/safety_supervisor.hpp"
 #include "piezoshift/runtime/sim_backend.hpp"
@@ -66,7 +67,9 @@ class Bench {
 
   //! Replaces the controller's parameters; the PIDs restart from the present commands.
   void set_controller(const control::SemiClosedLoopParams& params);
-  const control::SemiClosedLoopParams& controller_params() const { return cycle_->params(); }
+  const control::SemiClosedLoopParams& controller_params() const {
+    return loop_->controller().params();
+  }
 
   void drive_open_loop(const Vec3& ao_V);
   void drive_actuators(const Vec3& target_um);
@@ -80,29 +83,28 @@ class Bench {
   StaticMeasurement measure_static();
 
   const plant::Twin& twin() const { return sim_->twin(); }
-  const control::ControllerOutput& last_output() const { return cycle_->last().controller; }
+  const control::ControllerOutput& last_output() const { return loop_->last_cycle().controller; }
   //! The last tick as a whole: AI, controller, supervisor (ao_V is what went out), statuses.
-  const runtime::CycleSample& last_cycle() const { return cycle_->last(); }
-  DriveMode mode() const { return cycle_->mode(); }
+  const runtime::CycleSample& last_cycle() const { return loop_->last_cycle(); }
+  DriveMode mode() const { return loop_->mode(); }
   Feedback feedback() const { return options_.feedback; }
-  bool faulted() const { return cycle_->supervisor().faulted(); }
+  bool faulted() const { return loop_->supervisor().faulted(); }
   //! The latched fault (reason kNone when none).
-  const runtime::FaultRecord& fault() const { return cycle_->supervisor().fault(); }
+  const runtime::FaultRecord& fault() const { return loop_->supervisor().fault(); }
   double time_s() const { return sim_->twin().time_s(); }
   double sample_time_s() const { return sample_time_s_; }
-  std::uint64_t ticks() const { return tick_; }
+  std::uint64_t ticks() const { return loop_->ticks(); }
 
  private:
   void tick();
 
   BenchOptions options_;
   double sample_time_s_;
-  std::int64_t period_ns_;
   std::unique_ptr<runtime::SimBackend> sim_;
   std::unique_ptr<runtime::OracleBackend> oracle_;
   runtime::DaqBackend* daq_ = nullptr;
-  std::unique_ptr<runtime::ControlCycle> cycle_;
-  std::uint64_t tick_ = 0;
+  runtime::SimulatedClock clock_;
+  std::unique_ptr<runtime::ControlLoop> loop_;
 };
 
 }  // namespace piezoshift::experiments

@@ -1,16 +1,21 @@
 #pragma once
-// The periodic real-time loop: one tick every T = 1 / rate_Hz on absolute deadlines.
+// The periodic real-time loop, the one driver of the control tick: `run`, `serve`, `simulate`,
+// `calibrate --daq`, the guided calibration's rig and the simulated bench (the calibration
+// procedures, the paper's experiments) all step a ControlLoop. One tick every T = 1 / rate_Hz on
+// absolute deadlines; run() is start() then tick() until it returns false:
 //
-//   D_0 = start; for k = 0, 1, ...:
-//     sleep until D_k (absolute)                        W_k = wake-up
+//   start():  D_0 = now; supervisor, controller, statistics and result from the start
+//   tick():   sleep until D_k (absolute)                 W_k = wake-up
 //     stop requested (duration reached, SIGINT/SIGTERM)  -> supervisor.request_stop()
 //     clear requested (request_clear())                  -> supervisor.clear_fault(),
 //                                                           controller reset (bumpless from 0 V)
-//     host mode: apply the host's commands (host_link.hpp)
-//     Z_d = profile(k T), or the host's last move plus   (host mode with the servo off: the
-//           its running wave generators               host's open-loop volts; the generators
-//           (wave_generator.hpp)                      stop when the servo is off or a fault is
-//                                                     latched)
+//     set-point, by source:
+//       profile  Z_d = profile(k T)                         (`run`, `simulate`)
+//       host     the host's commands (host_link.hpp): its   (`serve`, the guided rig; with the
+//                last move plus its running wave           servo off the host's open-loop
+//                generators (wave_generator.hpp)           volts; the generators stop when the
+//                                                          servo is off or a fault is latched)
+//       owner    whatever drive() set between ticks      (the simulated bench)
 //     cycle.step(daq, k, overrun(k-1))                   the one control tick (control_cycle.hpp):
 //                                                        read, controller, supervisor, write
 //                                                        E_k = end of work
@@ -19,13 +24,18 @@
 //     done when the supervisor has stopped, or has faulted and the outputs are at 0 V
 //     D_{k+1} = D_k + T; if E_k > D_{k+1}: skip to the first slot after E_k (counted)
 //
-// Host mode (LoopConfig::host set, `piezoshift serve`, the guided calibration's LoopRig): the
-// loop starts with the servo off and the outputs at 0 V, and takes its set-points (Z_d, actuator
-// targets S or open-loop volts) and parameter changes from the host's commands instead of the
-// profile.
+// The timing between the loop and the plant is the DAQ backend's, the same for the board and the
+// twin (daq_backend.hpp): what tick k writes acts from tick k+1 on.
 //
-// run() is real-time safe: everything it touches is allocated by the constructor; the telemetry
-// and host pushes are lock-free ring writes that drop (and count) on a full ring.
+// Host mode (LoopConfig::host set): the loop starts with the servo off and the outputs at 0 V,
+// and takes its set-points (Z_d, actuator targets S or open-loop volts) and parameter changes
+// from the host's commands instead of the profile. Owner mode (LoopConfig::owner_drives): the
+// same start, and the set-points and parameter changes come from drive() and try_configure(),
+// called by the thread that calls tick().
+//
+// start(), tick() and run() are real-time safe: everything they touch is allocated by the
+// constructor; the telemetry and host pushes are lock-free ring writes that drop (and count) on a
+// full ring.
 #include <atomic>
 #include <cstdint>
 
@@ -40,6 +50,7 @@
 #include "piezoshift/runtime/setpoint_profile.hpp"
 #include "piezoshift/runtime/spsc_ring.hpp"
 #include "piezoshift/runtime/telemetry.hpp"
+#include "piezoshift/runtime/wave_generator.hpp"
 
 namespace piezoshift::runtime {
 
@@ -54,6 +65,8 @@ struct LoopConfig {
   HostLink* host = nullptr;
   //! When set, the latest tick is published here for a display (loop_status.hpp).
   LoopStatus* status = nullptr;
+  //! Owner mode (no host): the set-points come from drive() between ticks, not from the profile.
+  bool owner_drives = false;
 };
 
 enum class StopReason : std::uint8_t { kDuration, kSignal, kFault };
@@ -90,8 +103,23 @@ class ControlLoop {
               const SafetyLimits& limits, DaqBackend& daq, LoopClock& clock,
               SetpointProfile profile, SpscRing<TelemetryRecord>* telemetry = nullptr);
 
-  //! Runs until done (see the header comment). The backend must be active. Real-time safe.
+  //! Runs until done: start(), then tick() until it returns false. The backend must be active.
+  //! Real-time safe.
   LoopResult run() noexcept;
+  //! Starts a run (see the header comment); the clock's present time is D_0. Real-time safe.
+  void start() noexcept;
+  //! One tick; false when the run is done (result() is then final). Real-time safe.
+  bool tick() noexcept;
+  //! The run so far (final once tick() returned false).
+  const LoopResult& result() const noexcept { return result_; }
+
+  //! Owner mode, between ticks: what the next ticks follow (control_cycle.hpp's drive()).
+  void drive(DriveMode mode, const Vec3& setpoint) noexcept { cycle_.drive(mode, setpoint); }
+  //! Owner mode, between ticks: a new controller, or the problem that refused it (nothing
+  //! changes then). params.sample_time_s must be the loop's period.
+  control::ParamsProblem try_configure(const control::SemiClosedLoopParams& params) noexcept {
+    return cycle_.try_configure(params);
+  }
 
   //! Any thread: ask the loop to clear a latched fault at its next tick.
   void request_clear() noexcept { clear_requested_.store(true, std::memory_order_release); }
@@ -103,8 +131,27 @@ class ControlLoop {
   const control::SemiClosedLoopController& controller() const noexcept {
     return cycle_.controller();
   }
+  //! The last tick as a whole: AI, controller, supervisor (ao_V is what went out), statuses.
+  const CycleSample& last_cycle() const noexcept { return cycle_.last(); }
+  DriveMode mode() const noexcept { return cycle_.mode(); }
+  //! Ticks since start().
+  std::uint64_t ticks() const noexcept { return tick_; }
 
  private:
+  void check_stop() noexcept;
+  void clear_latched_fault() noexcept;
+  void apply_host_commands() noexcept;
+  void apply(const HostCommand& command) noexcept;
+  void choose_setpoint(const CycleTime& t) noexcept;
+  void record_outputs(const CycleSample& cs, const Vec3& zd) noexcept;
+  void publish_status(const CycleSample& cs, const Vec3& zd, const CycleTime& t) noexcept;
+  void push_telemetry(const CycleSample& cs, const Vec3& zd, const CycleTime& t,
+                      std::int64_t wake_ns, std::int64_t end_ns) noexcept;
+  void push_host_sample(const CycleSample& cs, const Vec3& zd, const CycleTime& t,
+                        std::int64_t wake_ns) noexcept;
+  bool done(const CycleSample& cs) noexcept;
+  void next_deadline(std::int64_t end_ns) noexcept;
+
   LoopConfig config_;
   control::SemiClosedLoopParams params_;
   std::int64_t period_ns_;
@@ -116,6 +163,24 @@ class ControlLoop {
   ControlCycle cycle_;
   LoopStats stats_;
   std::atomic<bool> clear_requested_{false};
+
+  // The run in progress (start()).
+  LoopResult result_{};
+  std::uint64_t tick_ = 0;
+  std::int64_t start_ns_ = 0;
+  std::int64_t deadline_ns_ = 0;
+  std::int64_t previous_deadline_ns_ = 0;
+  std::int64_t previous_wake_ns_ = 0;
+  bool previous_overran_ = false;
+  bool stop_requested_ = false;
+  bool done_ = false;
+  Vec3 previous_ao_V_{};
+  // Host mode: the host's Z_d, its wave generators (fixed-size; the tables are the host's),
+  // the last command applied and the last parameter change's outcome.
+  Vec3 host_zd_um_{};
+  WaveGenerator wave_;
+  std::uint64_t applied_sequence_ = 0;
+  control::ParamsProblem configure_problem_ = control::ParamsProblem::kNone;
 };
 
 }  // namespace piezoshift::runtime
