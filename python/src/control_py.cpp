@@ -8,6 +8,7 @@
 #include <string>
 #include <vector>
 
+#include "bindings.hpp"
 #include "piezoshift/control/parameter_check.hpp"
 #include "piezoshift/control/semi_closed_loop.hpp"
 #include "values.hpp"
