@@ -5,9 +5,13 @@
 #include <pybind11/stl.h>
 
 #include <algorithm>
+#include <array>
+#include <cstddef>
+#include <sstream>
 #include <string>
 #include <vector>
 
+#include "bindings.hpp"
 #include "piezoshift/control/parameter_check.hpp"
 #include "piezoshift/control/semi_closed_loop.hpp"
 #include "values.hpp"
@@ -20,11 +24,115 @@ using ps::control::Vec3;
 
 namespace {
 
+using Hc = ps::control::HysteresisCreepParams;
+
+// The first n values of a fixed-size C++ list (n beyond its size reads as all of it).
+template <std::size_t N>
+std::vector<double> head(const std::array<double, N>& a, std::size_t n) {
+  return {a.begin(), a.begin() + static_cast<std::ptrdiff_t>(std::min(n, N))};
+}
+
+// Refuses a list the controller could not hold or would misread, naming the field and the value.
+template <std::size_t N>
+void check_list(const std::vector<double>& v, const char* name, bool (*ok)(double),
+                const char* rule, bool increasing = false) {
+  if (v.size() > N)
+    throw ps::io::InputError(std::string(name) + ": at most " + std::to_string(N) +
+                             " values, not " + std::to_string(v.size()));
+  for (std::size_t i = 0; i < v.size(); ++i) {
+    if (ok(v[i]) && !(increasing && i > 0 && !(v[i] > v[i - 1])))
+      continue;
+    std::ostringstream what;
+    what << name << "[" << i << "] = " << v[i] << ": " << rule;
+    throw ps::io::InputError(what.str());
+  }
+}
+
+template <std::size_t N>
+void copy_list(std::array<double, N>& a, const std::vector<double>& v) {
+  a = {};
+  std::copy(v.begin(), v.end(), a.begin());
+}
+
+bool positive(double x) {
+  return x > 0.0;
+}
+bool non_negative(double x) {
+  return x >= 0.0;
+}
+
+void set_thresholds(Hc& p, const std::vector<double>& r) {
+  check_list<ps::control::kMaxModelOperators>(r, "threshold_um", positive,
+                                              "must be positive and increasing", true);
+  copy_list(p.threshold_um, r);
+}
+
+void set_weights(Hc& p, const std::vector<double>& w) {
+  check_list<ps::control::kMaxModelOperators>(w, "weight", non_negative,
+                                              "must be >= 0 (the model's inverse needs it)");
+  copy_list(p.weight, w);
+}
+
+// The thresholds and the weights share one count in C++ (operators): each list may be set alone
+// only with as many values as there are operators, so the two cannot disagree.
+void set_same_count(Hc& p, const std::vector<double>& v, const char* name,
+                    void (*set)(Hc&, const std::vector<double>&)) {
+  if (v.size() != p.operators)
+    throw ps::io::InputError(std::string(name) + ": " + std::to_string(v.size()) + " values for " +
+                             std::to_string(p.operators) +
+                             " operators (set_operators(threshold_um, weight) changes how many)");
+  set(p, v);
+}
+
+// One channel's hysteresis and creep model (control/hysteresis_creep_model.hpp), the improved
+// controller's feedforward. Lists with a count in C++ are whole Python lists here.
+void bind_model(py::module_& m) {
+  namespace c = ps::control;
+  py::class_<Hc>(m, "HysteresisCreepParams")
+      .def(py::init<>())
+      .PS_RW(Hc, offset_um)
+      .PS_RW(Hc, linear_weight)
+      .def_property(
+          "threshold_um", [](const Hc& p) { return head(p.threshold_um, p.operators); },
+          [](Hc& p, const std::vector<double>& r) {
+            set_same_count(p, r, "threshold_um", set_thresholds);
+          })
+      .def_property(
+          "weight", [](const Hc& p) { return head(p.weight, p.operators); },
+          [](Hc& p, const std::vector<double>& w) { set_same_count(p, w, "weight", set_weights); })
+      .def(
+          "set_operators",
+          [](Hc& p, const std::vector<double>& r, const std::vector<double>& w) {
+            if (r.size() != w.size())
+              throw ps::io::InputError("set_operators: " + std::to_string(w.size()) +
+                                       " weights for " + std::to_string(r.size()) + " thresholds");
+            Hc q = p;  // p unchanged when a list is refused
+            set_thresholds(q, r);
+            set_weights(q, w);
+            q.operators = r.size();
+            p = q;
+          },
+          py::arg("threshold_um"), py::arg("weight"),
+          "Sets the play operators' thresholds r_j [um of command] and weights w_j, as many of "
+          "each (at most 16)")
+      .def_property(
+          "creep_time_constant_s",
+          [](const Hc& p) { return head(p.creep_time_constant_s, p.creep_terms); },
+          [](Hc& p, const std::vector<double>& tau) {
+            check_list<c::kMaxCreepTerms>(tau, "creep_time_constant_s", positive,
+                                          "must be positive");
+            copy_list(p.creep_time_constant_s, tau);
+            p.creep_terms = tau.size();
+          })
+      .PS_RW(Hc, creep_gain);
+}
+
 // The improved controller's parts. The shaper's taps are a fixed-size array with a count in C++;
 // here they are one whole list, set at once, so that the count and the values cannot disagree.
-// The hysteresis and creep model (model[i]) is not bound yet.
+// The model is a list of three HysteresisCreepParams, the controller's own, as the scaling is.
 void bind_improved(py::module_& m) {
   namespace c = ps::control;
+  bind_model(m);
   py::enum_<c::ControllerKind>(m, "ControllerKind")
       .value("paper", c::ControllerKind::kPaper)
       .value("improved", c::ControllerKind::kImproved);
@@ -59,6 +167,7 @@ void bind_improved(py::module_& m) {
   py::class_<c::ImprovedParams>(m, "ImprovedParams")
       .def(py::init<>())
       .PS_RW(c::ImprovedParams, sample_time_s)
+      .PS_RW(c::ImprovedParams, model)
       .PS_RW(c::ImprovedParams, shaper)
       .PS_RW(c::ImprovedParams, correction_ki)
       .PS_RW(c::ImprovedParams, correction_ki_max)

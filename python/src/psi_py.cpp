@@ -9,6 +9,7 @@
 #include <string>
 #include <vector>
 
+#include "bindings.hpp"
 #include "piezoshift/config/project_config.hpp"
 #include "piezoshift/io/input_error.hpp"
 #include "piezoshift/psi/analysis.hpp"
@@ -96,6 +97,8 @@ psi::Analysis analyze(const std::vector<psi::Map>& frames, const psi::Mask& mask
 
 }  // namespace
 
+namespace piezoshift::python {
+
 void bind_psi(py::module_& m) {
   m.def(
       "psi_analyze",
@@ -182,3 +185,5 @@ void bind_psi(py::module_& m) {
       py::arg("surface"), py::arg("mask") = py::none(), py::arg("terms") = 37,
       "Noll Zernike coefficients (RMS of each term) over the mask's unit disk");
 }
+
+}  // namespace piezoshift::python

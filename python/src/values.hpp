@@ -20,6 +20,8 @@ using ps::control::Mat3;
 using ps::control::Vec3;
 
 using Array = py::array_t<double>;
+// What functions taking data accept: any sequence numpy converts, copied to contiguous doubles.
+using InArray = py::array_t<double, py::array::c_style | py::array::forcecast>;
 
 inline Array to_numpy(const std::vector<double>& v) {
   Array a(static_cast<py::ssize_t>(v.size()));
@@ -55,16 +57,14 @@ inline Array to_numpy(const std::vector<Vec3>& rows) {
 }
 
 // A 1-D float array from anything numpy can convert (lists, arrays of any dtype).
-inline std::vector<double> from_numpy_1d(
-    const py::array_t<double, py::array::c_style | py::array::forcecast>& a, const char* name) {
+inline std::vector<double> from_numpy_1d(const InArray& a, const char* name) {
   if (a.ndim() != 1)
     throw ps::io::InputError(std::string(name) + ": expected a 1-D array");
   return {a.data(), a.data() + a.size()};
 }
 
 // An n x 3 array (rows P1..P3 or S1..S3) into Vec3 rows.
-inline std::vector<Vec3> from_numpy_n3(
-    const py::array_t<double, py::array::c_style | py::array::forcecast>& a, const char* name) {
+inline std::vector<Vec3> from_numpy_n3(const InArray& a, const char* name) {
   if (a.ndim() != 2 || a.shape(1) != 3) {
     throw ps::io::InputError(std::string(name) + ": expected an n x 3 array");
   }
