@@ -1,14 +1,14 @@
 // The twin's cost: one control tick of the full three-leg twin (its default 20 physics steps per
-// 1 ms), alone and with the paper's controller in the loop. The counter x_real_time is simulated
+// 1 ms), alone and with the paper's controller closed through the shipping loop (the simulated
+// bench: sim backend, supervisor, ControlLoop on a simulated clock). The counter x_real_time is simulated
 // seconds per wall-clock second (docs/performance.md).
 #include <benchmark/benchmark.h>
 
-#include "piezoshift/control/semi_closed_loop.hpp"
+#include "piezoshift/experiments/bench.hpp"
 #include "piezoshift/plant/twin.hpp"
 
 namespace {
 
-using piezoshift::control::SemiClosedLoopController;
 using piezoshift::control::Vec3;
 using piezoshift::plant::Twin;
 using piezoshift::plant::TwinParams;
@@ -27,7 +27,9 @@ void BM_TwinTickOpenLoop(benchmark::State& state) {
   long k = 0;
   for (auto _ : state) {
     const double v = 1.0 + 0.5 * static_cast<double>((k++ / 200) % 16);
-    benchmark::DoNotOptimize(twin.step(Vec3{v, v, v}));
+    twin.write_ao(Vec3{v, v, v});
+    twin.advance();
+    benchmark::DoNotOptimize(twin.read_ai());
   }
   set_real_time_counter(state, twin.model().control_period_s);
 }
@@ -36,17 +38,15 @@ BENCHMARK(BM_TwinTickOpenLoop)->Arg(20000)->Arg(40000)->Arg(100000);
 // Closed loop: the paper's controller and the twin, one tick each, with Z_d stepping between
 // 1 um and 10 um every 0.5 s (steps, settling and holding, as the experiments do).
 void BM_TwinTickWithController(benchmark::State& state) {
-  Twin twin({}, {}, 1);
-  SemiClosedLoopController controller;
-  Vec3 ai{};
+  piezoshift::experiments::Bench bench({}, {}, 1);
   long k = 0;
   for (auto _ : state) {
     const double zd = (k++ / 500) % 2 == 0 ? 1.0 : 10.0;
-    const auto out = controller.update(Vec3{zd, zd, zd}, ai);
-    ai = twin.step(out.dac_V);
-    benchmark::DoNotOptimize(ai);
+    bench.drive_points(Vec3{zd, zd, zd});
+    bench.run(bench.sample_time_s());
+    benchmark::DoNotOptimize(bench.last_cycle());
   }
-  set_real_time_counter(state, twin.model().control_period_s);
+  set_real_time_counter(state, bench.sample_time_s());
 }
 BENCHMARK(BM_TwinTickWithController);
 

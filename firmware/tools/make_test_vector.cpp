@@ -89,7 +89,10 @@ int main(int argc, char** argv) {
         codes.push_back(static_cast<std::int16_t>(code));
       }
       const auto out = controller.update(Vec3{z[0], z[1], z[2]}, ai);
-      ai = twin.step(out.dac_V);
+      // The plant's own steps, the same ones tests/mcu replays against both controllers.
+      twin.write_ao(out.dac_V);
+      twin.advance();
+      ai = twin.read_ai();
     }
 
     VectorHeader h;

@@ -173,8 +173,6 @@ void bind_twin_class(py::module_& m) {
       .def("advance", &pl::Twin::advance)
       .def("read_ai", [](const pl::Twin& t) { return to_numpy(t.read_ai()); })
       .def(
-          "step", [](pl::Twin& t, const Vec3& v) { return to_numpy(t.step(v)); }, py::arg("ao_V"))
-      .def(
           "run",
           [](pl::Twin& t, const Vec3& ao_V, std::size_t ticks) {
             // Holds ao_V for `ticks` periods; returns the AI samples and the true points.

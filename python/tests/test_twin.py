@@ -16,16 +16,6 @@ def test_same_seed_same_outputs(config):
     assert a.ticks == 200 and a.time_s == pytest.approx(0.2)
 
 
-def test_step_matches_write_advance_read(config):
-    a, b = ps.Twin(config, 3), ps.Twin(config, 3)
-    for _ in range(20):
-        ya = a.step([2.0, 2.0, 2.0])
-        assert b.write_ao([2.0, 2.0, 2.0]) == ps.AoStatus.OK
-        b.advance()
-        np.testing.assert_array_equal(ya, b.read_ai())
-    np.testing.assert_array_equal(a.truth().points_um, b.truth().points_um)
-
-
 def test_converter_status(config):
     t = ps.Twin(config, 1)
     assert t.write_ao([11.0, 0.0, 0.0]) == ps.AoStatus.CLAMPED

@@ -23,6 +23,7 @@
 #include "piezoshift/control/semi_closed_loop.hpp"
 #include "piezoshift/firmware/test_vector.hpp"
 #include "piezoshift/plant/twin.hpp"
+#include "open_loop.hpp"
 
 namespace piezoshift::firmware {
 namespace {
@@ -242,8 +243,8 @@ TEST(McuFirmware, FloatAndDoubleControllersHoldTheTwinAlikeInClosedLoop) {
     const auto out_d = c_d.update(Vec3{z[0], z[1], z[2]}, ai_d);
     const auto out_f =
         c_f.update(FloatController::Vec{z[0], z[1], z[2]}, control::convert<float>(ai_f));
-    twin_d.step(out_d.dac_V);
-    twin_f.step(control::convert<double>(out_f.dac_V));
+    testing::hold_one_period(twin_d, out_d.dac_V);
+    testing::hold_one_period(twin_f, control::convert<double>(out_f.dac_V));
     if (twin_d.truth().ao_V != twin_f.truth().ao_V)
       ++dac_differs;
     for (std::size_t i = 0; i < 3; ++i) {

@@ -1,15 +1,14 @@
-// The fidelity targets, each against the paper (docs/twin.md, "Fidelity"). Target 4
-// (the mechanism's mode) is in mechanics_test.cpp.
+// The twin's open-loop fidelity targets, each against the paper (docs/twin.md, "Fidelity").
+// Target 4 (the mechanism's mode) is in mechanics_test.cpp; the closed-loop targets 5 and 6 in
+// tests/experiments/loop_fidelity_test.cpp.
 #include <algorithm>
 #include <cmath>
-#include <cstring>
 #include <vector>
 
 #include <gtest/gtest.h>
-#include <Eigen/Dense>
 
-#include "piezoshift/control/semi_closed_loop.hpp"
 #include "piezoshift/plant/twin.hpp"
+#include "open_loop.hpp"
 
 namespace piezoshift::plant {
 namespace {
@@ -20,7 +19,7 @@ using control::Vec3;
 void hold(Twin& twin, double volts, double seconds) {
   const auto ticks = static_cast<long>(std::lround(seconds / twin.model().control_period_s));
   for (long k = 0; k < ticks; ++k)
-    twin.step(Vec3{volts, volts, volts});
+    testing::hold_one_period(twin, Vec3{volts, volts, volts});
 }
 
 // Fidelity target 1, paper Section 4.1: 12.9 um (0.012931 mm) open loop at 150 V.
@@ -91,14 +90,14 @@ TEST(Fidelity3, OpenLoopHysteresisOverAFullCycleIsTenToFifteenPercent) {
   const int n = 2000;  // 2 s up, 2 s down
   std::vector<double> up_v, up_z;
   for (int k = 0; k <= n; ++k) {
-    twin.step(Vec3{10.0 * k / n, 10.0 * k / n, 10.0 * k / n});
+    testing::hold_one_period(twin, Vec3{10.0 * k / n, 10.0 * k / n, 10.0 * k / n});
     up_v.push_back(twin.truth().amplifier_V[0]);
     up_z.push_back(twin.truth().plate_z_um);
   }
   const double range = up_z.back() - up_z.front();
   double gap = 0.0;
   for (int k = n; k >= 0; --k) {
-    twin.step(Vec3{10.0 * k / n, 10.0 * k / n, 10.0 * k / n});
+    testing::hold_one_period(twin, Vec3{10.0 * k / n, 10.0 * k / n, 10.0 * k / n});
     const double v = twin.truth().amplifier_V[0];
     // the ascending branch at the same stack voltage (linear interpolation)
     const auto it = std::lower_bound(up_v.begin(), up_v.end(), v);
@@ -134,88 +133,8 @@ TEST(Fidelity3, OpenLoopCreepAfterAStepIsOneToTwoPercentPerDecade) {
   EXPECT_LE(second, 0.02);
 }
 
-// Fidelity target 5: A identified by the paper's procedure (Section 3, second step): each
-// actuator moved alone in closed loop (the PID on the SGS), the three points measured by the
-// interferometer (1 s static readings), least squares.
-TEST(Fidelity5, PapersProcedureOnTheTwinRecoversThePapersA) {
-  Twin twin({}, {}, 5);
-  control::SemiClosedLoopController controller;
-  Vec3 ai{};
-  // Holds actuator targets S (SGS um) for `settle` seconds, then returns the mean of the next
-  // whole static interferometer reading.
-  auto pose = [&](const Vec3& s, double settle) {
-    const auto ticks = static_cast<long>(std::lround((settle + 1.0) / 1e-3));
-    for (long k = 0; k < ticks; ++k)
-      ai = twin.step(controller.update_actuators(s, ai).dac_V);
-    return twin.interferometer().static_um;
-  };
-  const Vec3 base{2.0, 2.0, 2.0};
-  const Vec3 z0 = pose(base, 2.0);
-  std::vector<Vec3> ds, dz;
-  for (const double a : {3.0, 6.0}) {
-    for (std::size_t i = 0; i < 3; ++i) {
-      Vec3 s = base;
-      s[i] += a;
-      const Vec3 z = pose(s, 1.0);
-      ds.push_back({s[0] - base[0], s[1] - base[1], s[2] - base[2]});
-      dz.push_back({z[0] - z0[0], z[1] - z0[1], z[2] - z0[2]});
-      pose(base, 0.5);
-    }
-  }
-  // dS = A dZ for every pose: A^T = argmin || dZ X - dS ||
-  Eigen::MatrixXd zm(static_cast<Eigen::Index>(dz.size()), 3), sm(zm.rows(), 3);
-  for (Eigen::Index r = 0; r < zm.rows(); ++r)
-    for (Eigen::Index c = 0; c < 3; ++c) {
-      zm(r, c) = dz[static_cast<std::size_t>(r)][static_cast<std::size_t>(c)];
-      sm(r, c) = ds[static_cast<std::size_t>(r)][static_cast<std::size_t>(c)];
-    }
-  const Eigen::Matrix3d a = zm.colPivHouseholderQr().solve(sm).transpose();
-  const control::Mat3 paper = control::TransmissionMatrix{}.a;
-  double worst = 0.0;
-  for (Eigen::Index r = 0; r < 3; ++r)
-    for (Eigen::Index c = 0; c < 3; ++c) {
-      const double d = a(r, c) - paper[static_cast<std::size_t>(r)][static_cast<std::size_t>(c)];
-      EXPECT_NEAR(d, 0.0, 0.05) << "A(" << r + 1 << "," << c + 1 << ")";
-      worst = std::max(worst, std::fabs(d));
-    }
-  RecordProperty("max_abs_error", std::to_string(worst));
-  EXPECT_LT(worst, 0.01);  // what the twin actually gives: the SGS bow and noise are small
-}
-
-// Fidelity target 6: one seed, one output, bit for bit; another seed, another output.
-std::vector<double> closed_loop_record(std::uint64_t seed) {
-  Twin twin({}, {}, seed);
-  control::SemiClosedLoopController controller;
-  Vec3 ai{};
-  std::vector<double> record;
-  for (int k = 0; k < 3000; ++k) {
-    const double zd = k < 500 ? 1.0 : 9.0;
-    ai = twin.step(controller.update(Vec3{zd, zd, zd}, ai).dac_V);
-    const TwinTruth& t = twin.truth();
-    const InterferometerReading& r = twin.interferometer();
-    for (std::size_t i = 0; i < 3; ++i) {
-      record.push_back(ai[i]);
-      record.push_back(t.points_um[i]);
-      record.push_back(r.dynamic_um[i]);
-      record.push_back(r.static_um[i]);
-    }
-  }
-  return record;
-}
-
-TEST(Fidelity6, SameSeedGivesIdenticalOutputsBitForBit) {
-  const std::vector<double> a = closed_loop_record(42), b = closed_loop_record(42);
-  ASSERT_EQ(a.size(), b.size());
-  EXPECT_EQ(std::memcmp(a.data(), b.data(), a.size() * sizeof(double)), 0);
-}
-
-TEST(Fidelity6, DifferentSeedsGiveDifferentOutputs) {
-  const std::vector<double> a = closed_loop_record(42), b = closed_loop_record(43);
-  std::size_t differ = 0;
-  for (std::size_t i = 0; i < a.size(); ++i)
-    differ += a[i] != b[i] ? 1 : 0;
-  EXPECT_GT(differ, a.size() / 2);
-}
+// Targets 5 (A by the paper's procedure) and 6 (one seed, one output) close the loop: they run
+// through the loop every command ships, in tests/experiments/loop_fidelity_test.cpp.
 
 }  // namespace
 }  // namespace piezoshift::plant

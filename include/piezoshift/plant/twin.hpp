@@ -7,12 +7,13 @@
 //     -> plate pose, points P1..P3 -> interferometer (noise, resolution, drift)
 //   stack elongation -> SGS conditioner (gain, nonlinearity, filter, noise, drift) -> DAQ AI
 //
-// Stepping, as the controller sees it (one control period T_s per advance()):
+// Stepping (one control period T_s per advance()):
 //   write_ao(v)   the three AO volts, quantized, held from now on
 //   advance()     T_s of physics in substeps of h = 1 / physics_rate_Hz, then one AI sample
 //   read_ai()     the AI volts sampled at the end of the last advance()
-// so a controller that reads, computes and writes once per period sees y(k+1) from u(k): one
-// period of delay, as in the paper's xPC loop. step(v) is write_ao, advance, read_ai.
+// These are the plant's own steps, not a way to close a loop: the loop closes through the `sim`
+// DAQ backend (runtime/sim_backend.hpp), which orders them by the one timing contract every
+// backend keeps (runtime/daq_backend.hpp).
 // Truth (plate pose, point displacements, internal signals) and the interferometer's readings
 // are exposed alongside. Every random number comes from one Rng seeded at construction, drawn in
 // a fixed order, so the same seed and inputs give the same outputs bit for bit.
@@ -20,7 +21,7 @@
 // Faults: a per-channel ChannelFault (set_fault) covers what the later fault-injection work
 // needs: amplifier off, SGS open or stuck, ADC NaN or spike, a cracked stack (stiffness loss).
 //
-// Real-time safe: write_ao, advance, step, read_ai, truth, interferometer (no heap, no
+// Real-time safe: write_ao, advance, read_ai, truth, interferometer (no heap, no
 // exceptions, no I/O). Construction and set_fault are not.
 #include <array>
 #include <cstdint>
@@ -109,12 +110,6 @@ class Twin {
   void advance() noexcept;
   //! The AI volts of the last sample (zeros before the first advance()).
   const Vec3& read_ai() const noexcept { return ai_V_; }
-  //! write_ao, advance, read_ai.
-  const Vec3& step(const Vec3& ao_V) noexcept {
-    write_ao(ao_V);
-    advance();
-    return ai_V_;
-  }
 
   const TwinTruth& truth() const noexcept { return truth_; }
   const InterferometerReading& interferometer() const noexcept { return ifm_; }
