@@ -64,9 +64,9 @@ struct GcsStats {
   std::uint64_t faults = 0;          //!< supervisor faults seen
 };
 
-class GcsController final : public LineHandler {
+class GcsInterpreter final : public LineHandler {
  public:
-  GcsController(const StageModel& model, runtime::HostLink& link, double servo_cycle_s,
+  GcsInterpreter(const StageModel& model, runtime::HostLink& link, double servo_cycle_s,
                 const GcsOptions& options);
 
   void on_connect(ClientId client) override;

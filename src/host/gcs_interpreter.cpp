@@ -1,4 +1,4 @@
-#include "piezoshift/host/gcs_controller.hpp"
+#include "piezoshift/host/gcs_interpreter.hpp"
 
 #include <algorithm>
 #include <charconv>
@@ -216,7 +216,7 @@ GcsError id_lines(const std::vector<std::string_view>& args, int max, GcsError o
 
 }  // namespace
 
-GcsController::GcsController(const StageModel& model, runtime::HostLink& link, double servo_cycle_s,
+GcsInterpreter::GcsInterpreter(const StageModel& model, runtime::HostLink& link, double servo_cycle_s,
                              const GcsOptions& options)
     : model_(model),
       link_(link),
@@ -228,26 +228,26 @@ GcsController::GcsController(const StageModel& model, runtime::HostLink& link, d
   position_ = model_.pose_from_sgs(Vec3{});
 }
 
-void GcsController::on_connect(ClientId client) {
+void GcsInterpreter::on_connect(ClientId client) {
   sessions_[client] = Session{};
 }
 
-void GcsController::on_disconnect(ClientId client) {
+void GcsInterpreter::on_disconnect(ClientId client) {
   sessions_.erase(client);
 }
 
-void GcsController::fail(Session& session, GcsError error) {
+void GcsInterpreter::fail(Session& session, GcsError error) {
   ++stats_.errors;
   if (session.errors.size() < options_.error_queue_length)
     session.errors.push_back(error);
 }
 
-std::string GcsController::on_overlong_line(ClientId client) {
+std::string GcsInterpreter::on_overlong_line(ClientId client) {
   fail(sessions_[client], GcsError::kCommandTooLong);
   return {};
 }
 
-std::string GcsController::on_line(ClientId client, std::string_view line) {
+std::string GcsInterpreter::on_line(ClientId client, std::string_view line) {
   drain();
   ++stats_.lines;
   Session& session = sessions_[client];
@@ -269,11 +269,11 @@ std::string GcsController::on_line(ClientId client, std::string_view line) {
   return answer;
 }
 
-bool GcsController::is_immediate(char byte) const {
+bool GcsInterpreter::is_immediate(char byte) const {
   return byte == 5 || byte == 7 || byte == 8 || byte == 9 || byte == 24;
 }
 
-std::string GcsController::on_immediate(ClientId client, char byte) {
+std::string GcsInterpreter::on_immediate(ClientId client, char byte) {
   drain();
   ++stats_.lines;
   Session& session = sessions_[client];
@@ -293,7 +293,7 @@ std::string GcsController::on_immediate(ClientId client, char byte) {
   }
 }
 
-bool GcsController::send(Session& session, HostCommand command) {
+bool GcsInterpreter::send(Session& session, HostCommand command) {
   command.sequence = ++sequence_;
   if (!link_.commands.try_push(command)) {
     fail(session, GcsError::kCommunication);
@@ -303,20 +303,20 @@ bool GcsController::send(Session& session, HostCommand command) {
   return true;
 }
 
-void GcsController::moved() {
+void GcsInterpreter::moved() {
   move_sequence_ = sequence_;
   settled_ = {};
   motion_trigger();
 }
 
-void GcsController::motion_trigger() {
+void GcsInterpreter::motion_trigger() {
   if (trigger_ <= 1) {  // 0 (default) and 1: any command that changes the position
     recorder_.restart();
     record_from_sequence_ = sequence_;
   }
 }
 
-AxisValues GcsController::commanded() const {
+AxisValues GcsInterpreter::commanded() const {
   AxisValues c = target_;
   if (!have_sample_)
     return c;
@@ -327,7 +327,7 @@ AxisValues GcsController::commanded() const {
   return c;
 }
 
-unsigned GcsController::moving_mask() const {
+unsigned GcsInterpreter::moving_mask() const {
   unsigned mask = 0;
   for (std::size_t a = 0; a < 3; ++a) {
     const bool moving =
@@ -338,7 +338,7 @@ unsigned GcsController::moving_mask() const {
   return mask;
 }
 
-unsigned GcsController::wave_mask() const {
+unsigned GcsInterpreter::wave_mask() const {
   unsigned mask = 0;
   for (std::size_t g = 0; g < kGenerators; ++g)
     if (wave_running_[g])
@@ -346,7 +346,7 @@ unsigned GcsController::wave_mask() const {
   return mask;
 }
 
-bool GcsController::slot_free(std::size_t g) {
+bool GcsInterpreter::slot_free(std::size_t g) {
   for (int i = 0; i < 50 && last_.applied_sequence < wave_sequence_[g]; ++i) {
     std::this_thread::sleep_for(std::chrono::milliseconds(1));
     drain();
@@ -354,14 +354,14 @@ bool GcsController::slot_free(std::size_t g) {
   return last_.applied_sequence >= wave_sequence_[g];
 }
 
-bool GcsController::stop_waves(Session& s) {
+bool GcsInterpreter::stop_waves(Session& s) {
   for (std::size_t g = 0; g < kGenerators; ++g)
     if ((wave_running_[g] || wave_mode_[g] != 0) && !stop_wave(s, g))
       return false;
   return true;
 }
 
-bool GcsController::stop_wave(Session& s, std::size_t g) {
+bool GcsInterpreter::stop_wave(Session& s, std::size_t g) {
   HostCommand c{};
   c.kind = HostCommand::Kind::kWave;
   c.wave.action = runtime::WaveCommand::Action::kStop;
@@ -377,13 +377,13 @@ bool GcsController::stop_wave(Session& s, std::size_t g) {
   return true;
 }
 
-void GcsController::drain() {
+void GcsInterpreter::drain() {
   runtime::HostSample s{};
   while (link_.samples.try_pop(s))
     take(s);
 }
 
-void GcsController::take(const runtime::HostSample& s) {
+void GcsInterpreter::take(const runtime::HostSample& s) {
   if (have_sample_ && s.tick > last_.tick + 1)
     stats_.samples_missed += s.tick - last_.tick - 1;
   ++stats_.samples;
@@ -444,22 +444,22 @@ void GcsController::take(const runtime::HostSample& s) {
     observer_->on_sample(s, in);
 }
 
-bool GcsController::accepted(Session& s, GcsError error) {
+bool GcsInterpreter::accepted(Session& s, GcsError error) {
   if (error == GcsError::kNone)
     return true;
   fail(s, error);
   return false;
 }
 
-std::string GcsController::reply(Session& s, GcsError error, std::string& answer) {
+std::string GcsInterpreter::reply(Session& s, GcsError error, std::string& answer) {
   return accepted(s, error) ? std::move(answer) : std::string{};
 }
 
-void GcsController::hold_applied_volts() {
+void GcsInterpreter::hold_applied_volts() {
   open_loop_V_ = model_.open_loop_for(model_.channel_V_from_daq(last_.ao_V));
 }
 
-std::string GcsController::execute(Session& s, std::string_view name, const Args& args) {
+std::string GcsInterpreter::execute(Session& s, std::string_view name, const Args& args) {
   std::string answer;
   const auto no_args = [&]() {
     if (!args.empty()) {
@@ -633,7 +633,7 @@ std::string GcsController::execute(Session& s, std::string_view name, const Args
   return {};
 }
 
-std::string GcsController::move(Session& s, const Args& args, bool relative) {
+std::string GcsInterpreter::move(Session& s, const Args& args, bool relative) {
   std::vector<AxisValue> pairs;
   if (!accepted(s, parse_pairs(args, pairs)))
     return {};
@@ -664,7 +664,7 @@ std::string GcsController::move(Session& s, const Args& args, bool relative) {
   return {};
 }
 
-std::string GcsController::servo(Session& s, const Args& args) {
+std::string GcsInterpreter::servo(Session& s, const Args& args) {
   std::vector<AxisValue> pairs;
   if (!accepted(s, parse_pairs(args, pairs)))
     return {};
@@ -706,7 +706,7 @@ std::string GcsController::servo(Session& s, const Args& args) {
   return {};
 }
 
-std::string GcsController::open_loop(Session& s, const Args& args) {
+std::string GcsInterpreter::open_loop(Session& s, const Args& args) {
   std::vector<AxisValue> pairs;
   if (!accepted(s, parse_pairs(args, pairs)))
     return {};
@@ -739,7 +739,7 @@ std::string GcsController::open_loop(Session& s, const Args& args) {
   return {};
 }
 
-std::string GcsController::stop(Session& s, const Args& args) {
+std::string GcsInterpreter::stop(Session& s, const Args& args) {
   if (!args.empty()) {
     fail(s, GcsError::kParamCount);
     return {};
@@ -766,7 +766,7 @@ std::string GcsController::stop(Session& s, const Args& args) {
   return {};
 }
 
-std::string GcsController::recorder_config(Session& s, const Args& args) {
+std::string GcsInterpreter::recorder_config(Session& s, const Args& args) {
   if (args.size() != 3) {
     fail(s, GcsError::kParamCount);
     return {};
@@ -789,7 +789,7 @@ std::string GcsController::recorder_config(Session& s, const Args& args) {
   return {};
 }
 
-std::string GcsController::recorder_rate(Session& s, const Args& args) {
+std::string GcsInterpreter::recorder_rate(Session& s, const Args& args) {
   if (args.size() != 1) {
     fail(s, GcsError::kParamCount);
     return {};
@@ -803,7 +803,7 @@ std::string GcsController::recorder_rate(Session& s, const Args& args) {
   return {};
 }
 
-std::string GcsController::recorder_read(Session& s, const Args& args) {
+std::string GcsInterpreter::recorder_read(Session& s, const Args& args) {
   long long start = 1;
   long long count = -1;
   std::vector<int> tables;
@@ -834,7 +834,7 @@ std::string GcsController::recorder_read(Session& s, const Args& args) {
   return answer;
 }
 
-std::string GcsController::recorder_trigger(Session& s, const Args& args) {
+std::string GcsInterpreter::recorder_trigger(Session& s, const Args& args) {
   // "DRT {table} {source}" (PIPython with one trigger for all: table 0) or triples with a value.
   const std::size_t step = args.size() == 2 ? 2 : 3;
   if (args.empty() || args.size() % step != 0) {
@@ -867,7 +867,7 @@ std::string GcsController::recorder_trigger(Session& s, const Args& args) {
   return {};
 }
 
-std::string GcsController::parameters(Session& s, const Args& args) {
+std::string GcsInterpreter::parameters(Session& s, const Args& args) {
   const auto value = [this](long long id) -> std::string {
     switch (id) {
       case 0x0E000200:
@@ -908,7 +908,7 @@ std::string GcsController::parameters(Session& s, const Args& args) {
   return framed(lines);
 }
 
-std::string GcsController::velocity(Session& s, const Args& args) {
+std::string GcsInterpreter::velocity(Session& s, const Args& args) {
   std::vector<AxisValue> pairs;
   if (!accepted(s, parse_pairs(args, pairs)))
     return {};
@@ -923,7 +923,7 @@ std::string GcsController::velocity(Session& s, const Args& args) {
   return {};
 }
 
-std::string GcsController::wave_define(Session& s, const Args& args) {
+std::string GcsInterpreter::wave_define(Session& s, const Args& args) {
   if (args.size() < 3) {
     fail(s, GcsError::kParamCount);
     return {};
@@ -944,7 +944,7 @@ std::string GcsController::wave_define(Session& s, const Args& args) {
   return {};
 }
 
-std::string GcsController::wave_query(Session& s, const Args& args) {
+std::string GcsInterpreter::wave_query(Session& s, const Args& args) {
   std::vector<std::string> lines;
   const auto line = [&](int t) {
     lines.push_back(fmt::format("{} 1={}", t, waves_.values(t).size()));
@@ -1006,7 +1006,7 @@ GcsError generator_pairs(const std::vector<std::string_view>& args, std::size_t 
 
 }  // namespace
 
-std::string GcsController::wave_start(Session& s, const Args& args) {
+std::string GcsInterpreter::wave_start(Session& s, const Args& args) {
   std::vector<std::pair<std::size_t, long long>> pairs;
   if (!accepted(s, generator_pairs(args, kGenerators, pairs)))
     return {};
@@ -1107,7 +1107,7 @@ std::string GcsController::wave_start(Session& s, const Args& args) {
   return {};
 }
 
-std::string GcsController::wave_setting(Session& s, std::string_view name, const Args& args) {
+std::string GcsInterpreter::wave_setting(Session& s, std::string_view name, const Args& args) {
   if (name == "WTR") {
     // "{generator} {rate} {interpolation}" triples; generator 0: all.
     if (args.empty() || args.size() % 3 != 0) {
@@ -1166,7 +1166,7 @@ std::string GcsController::wave_setting(Session& s, std::string_view name, const
   return {};
 }
 
-std::string GcsController::wave_setting_query(Session& s, std::string_view name, const Args& args) {
+std::string GcsInterpreter::wave_setting_query(Session& s, std::string_view name, const Args& args) {
   std::string answer;
   const auto value = [&](int g) -> std::string {
     const auto i = static_cast<std::size_t>(g - 1);
@@ -1183,7 +1183,7 @@ std::string GcsController::wave_setting_query(Session& s, std::string_view name,
                answer);
 }
 
-std::string GcsController::wave_record_restart(Session& s, const Args& args) {
+std::string GcsInterpreter::wave_record_restart(Session& s, const Args& args) {
   if (!args.empty()) {
     fail(s, GcsError::kParamCount);
     return {};
