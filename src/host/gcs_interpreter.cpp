@@ -17,53 +17,7 @@ namespace piezoshift::host {
 namespace {
 
 using runtime::HostCommand;
-
-// The commands HLP? lists, with their syntax; the table in docs/gcs.md says more.
-constexpr std::string_view kHelp[] = {
-    "*IDN? - identification",
-    "CSV? - GCS syntax version",
-    "SAI? [ALL] - axis identifiers",
-    "CST? [{axis} ...] - stage type of each axis",
-    "PUN? [{axis}] - position units",
-    "HLP? - this list",
-    "ERR? - oldest queued error number (0: none), removed from the queue",
-    "SVO {axis} {0|1} ... - servo (semi-closed loop) off or on, all axes together",
-    "SVO? [{axis} ...] - servo state",
-    "MOV {axis} {position} ... - move to absolute position (servo on)",
-    "MVR {axis} {distance} ... - move relative to the target (servo on)",
-    "MOV? [{axis} ...] - target position",
-    "POS? [{axis} ...] - position from the strain gauges",
-    "ONT? [{axis} ...] - on target",
-    "VEL {axis} {velocity} ... - closed-loop velocity, stored (velocity control is off)",
-    "VEL? [{axis} ...] - velocity; VCO? [{axis} ...] - velocity control, 0",
-    "STP - stop: wave generators off, hold where the stage is (sets error 10)",
-    "#5 - moving axes as a hex bit mask; #7 - ready (0xB1); #8 - macro running (0)",
-    "#9 - running wave generators as a hex bit mask; #24 - stop all, as STP",
-    "SVA {axis} {volts} ... - open-loop value in amplifier volts (servo off)",
-    "SVA? [{axis} ...] - open-loop value",
-    "VOL? [{channel} ...] - amplifier output voltage of channel 1, 2, 3",
-    "TMN? [{axis} ...] - lower travel limit",
-    "TMX? [{axis} ...] - upper travel limit",
-    "DRC {table} {source} {option} - record option of source in table",
-    "DRC? [{table} ...] - record configuration",
-    "DRT {table} {source} [{value}] - record trigger (0, 1: motion, 2: next command, 4: now)",
-    "DRT? [{table} ...] - record trigger",
-    "RTR {cycles} - record every n-th servo cycle",
-    "RTR? - record rate in servo cycles",
-    "DRL? [{table} ...] - points recorded",
-    "DRR? [{start} [{count} [{table} ...]]] - read recorded data; TNR? - number of tables",
-    "HDR? - data recorder options, triggers and sizes",
-    "SPA? [{item} {parameter} ...] - parameter values; SEP? - the same; HPA? - parameter list",
-    "WAV {table} {X|&|+} {PNT|LIN|SIN_P} {parameters} - define wave table 1 to 8",
-    "WAV? [{table} {1} ...] - number of points of the wave table",
-    "WSL {generator} {table} ... - wave table of wave generator 1 to 3 (axis Z, U, V)",
-    "WSL? [{generator} ...] - wave table of the generator",
-    "WGC {generator} {cycles} ... - cycles to play, 0: until stopped",
-    "WGC? [{generator} ...] - cycles",
-    "WTR {generator} {rate} {0} ... - servo cycles per table point (no interpolation)",
-    "WTR? [{generator} ...] - table rate and interpolation",
-    "WGO {generator} {0|1} ... - stop or start the generator (servo on)",
-    "WGO? [{generator} ...] - start mode; WGR - restart the recording; TWG? - generators, 3"};
+constexpr std::size_t kGenerators = WaveGenerators::kGenerators;
 
 // GCS framing: every line but the last ends with a space before the LF.
 std::string framed(const std::vector<std::string>& lines) {
@@ -214,17 +168,141 @@ GcsError id_lines(const std::vector<std::string_view>& args, int max, GcsError o
   return GcsError::kNone;
 }
 
+// A "Z=..." line's value: v[a] with `digits` decimals.
+auto fixed(const AxisValues& v, int digits) {
+  return [&v, digits](std::size_t a) { return fmt::format("{:.{}f}", v[a], digits); };
+}
+
+// One "g=value" line per requested wave generator (1-based; all when none); value(g) 0-based.
+template <typename Value>
+GcsError generator_lines(const std::vector<std::string_view>& args, Value value,
+                         std::string& answer) {
+  const auto of = [&value](int g) { return value(static_cast<std::size_t>(g - 1)); };
+  return id_lines(args, static_cast<int>(kGenerators), GcsError::kWaveIndex, of, answer);
+}
+
+// "{generator} {integer} ..." pairs with generators 1..n, each at most once (`WGO 1 1 1 0` says
+// two things of one generator: refused as a syntax error, as a repeated axis is); kNone on
+// success.
+GcsError generator_pairs(const std::vector<std::string_view>& args, std::size_t n,
+                         std::vector<WaveGenerators::Setting>& out) {
+  if (args.empty() || args.size() % 2 != 0)
+    return GcsError::kParamCount;
+  for (std::size_t i = 0; i < args.size(); i += 2) {
+    long long g = 0;
+    long long v = 0;
+    if (!parse_integer(args[i], g) || !parse_integer(args[i + 1], v))
+      return GcsError::kParamSyntax;
+    if (g < 1 || g > static_cast<long long>(n))
+      return GcsError::kWaveIndex;
+    const auto index = static_cast<std::size_t>(g - 1);
+    for (const auto& [seen, value] : out) {
+      if (seen == index)
+        return GcsError::kParamSyntax;
+    }
+    out.emplace_back(index, v);
+  }
+  return GcsError::kNone;
+}
+
 }  // namespace
 
-GcsInterpreter::GcsInterpreter(const StageModel& model, runtime::HostLink& link, double servo_cycle_s,
-                             const GcsOptions& options)
+// The command lines, in docs/gcs.md's order; HLP? lists them as "{name} {syntax} - {help}".
+const GcsInterpreter::Command GcsInterpreter::kCommands[] = {
+    {"*IDN?", "", "identification", &GcsInterpreter::identification},
+    {"CSV?", "", "GCS syntax version", &GcsInterpreter::syntax_version},
+    {"SAI?", "[ALL]", "axis identifiers", &GcsInterpreter::axis_identifiers},
+    {"CST?", "[{axis} ...]", "stage type of each axis", &GcsInterpreter::stage_types},
+    {"PUN?", "[{axis} ...]", "position units", &GcsInterpreter::units},
+    {"HLP?", "", "this list", &GcsInterpreter::help},
+    {"ERR?", "", "oldest queued error number (0: none), removed from the queue",
+     &GcsInterpreter::error_number},
+    {"SVO", "{axis} {0|1} ...", "servo (semi-closed loop) off or on, all axes together",
+     &GcsInterpreter::servo},
+    {"SVO?", "[{axis} ...]", "servo state", &GcsInterpreter::servo_query},
+    {"MOV", "{axis} {position} ...", "move to absolute position (servo on)",
+     &GcsInterpreter::move_absolute},
+    {"MVR", "{axis} {distance} ...", "move relative to the target (servo on)",
+     &GcsInterpreter::move_relative},
+    {"MOV?", "[{axis} ...]", "target position", &GcsInterpreter::target_query},
+    {"POS?", "[{axis} ...]", "position from the strain gauges", &GcsInterpreter::position_query},
+    {"ONT?", "[{axis} ...]", "on target", &GcsInterpreter::on_target_query},
+    {"STP", "", "stop: wave generators off, hold where the stage is (sets error 10)",
+     &GcsInterpreter::stop},
+    {"VEL", "{axis} {velocity} ...", "closed-loop velocity, stored (velocity control is off)",
+     &GcsInterpreter::velocity},
+    {"VEL?", "[{axis} ...]", "velocity", &GcsInterpreter::velocity_query},
+    {"VCO?", "[{axis} ...]", "velocity control, 0", &GcsInterpreter::velocity_control_query},
+    {"SPA?", "[{item} {parameter} ...]", "parameter values", &GcsInterpreter::parameters},
+    {"SEP?", "[{item} {parameter} ...]", "parameter values, as SPA?", &GcsInterpreter::parameters},
+    {"HPA?", "", "parameter list", &GcsInterpreter::parameter_list},
+    {"SVA", "{axis} {volts} ...", "open-loop value in amplifier volts (servo off)",
+     &GcsInterpreter::open_loop},
+    {"SVA?", "[{axis} ...]", "open-loop value", &GcsInterpreter::open_loop_query},
+    {"VOL?", "[{channel} ...]", "amplifier output voltage of channel 1, 2, 3",
+     &GcsInterpreter::voltage_query},
+    {"TMN?", "[{axis} ...]", "lower travel limit", &GcsInterpreter::lower_limit_query},
+    {"TMX?", "[{axis} ...]", "upper travel limit", &GcsInterpreter::upper_limit_query},
+    {"DRC", "{table} {source} {option}", "record option of source in table",
+     &GcsInterpreter::recorder_config},
+    {"DRC?", "[{table} ...]", "record configuration", &GcsInterpreter::recorder_config_query},
+    {"DRT", "{table} {source} [{value}]", "record trigger (0, 1: motion, 2: next command, 4: now)",
+     &GcsInterpreter::recorder_trigger},
+    {"DRT?", "[{table} ...]", "record trigger", &GcsInterpreter::recorder_trigger_query},
+    {"RTR", "{cycles}", "record every n-th servo cycle", &GcsInterpreter::recorder_rate},
+    {"RTR?", "", "record rate in servo cycles", &GcsInterpreter::recorder_rate_query},
+    {"HDR?", "", "data recorder options, triggers and sizes", &GcsInterpreter::recorder_options},
+    {"TNR?", "", "number of record tables", &GcsInterpreter::recorder_tables},
+    {"DRL?", "[{table} ...]", "points recorded", &GcsInterpreter::recorder_length},
+    {"DRR?", "[{start} [{count} [{table} ...]]]", "read recorded data",
+     &GcsInterpreter::recorder_read},
+    {"WAV", "{table} {X|&|+} {PNT|LIN|SIN_P} {parameters}", "define wave table 1 to 8",
+     &GcsInterpreter::wave_define},
+    {"WAV?", "[{table} {1} ...]", "number of points of the wave table",
+     &GcsInterpreter::wave_query},
+    {"WSL", "{generator} {table} ...", "wave table of wave generator 1 to 3 (axis Z, U, V)",
+     &GcsInterpreter::wave_select},
+    {"WSL?", "[{generator} ...]", "wave table of the generator",
+     &GcsInterpreter::wave_select_query},
+    {"WGC", "{generator} {cycles} ...", "cycles to play, 0: until stopped",
+     &GcsInterpreter::wave_cycles},
+    {"WGC?", "[{generator} ...]", "cycles", &GcsInterpreter::wave_cycles_query},
+    {"WTR", "{generator} {rate} {0} ...", "servo cycles per table point (no interpolation)",
+     &GcsInterpreter::wave_rate},
+    {"WTR?", "[{generator} ...]", "table rate and interpolation", &GcsInterpreter::wave_rate_query},
+    {"WGO", "{generator} {0|1} ...", "stop or start the generator (servo on)",
+     &GcsInterpreter::wave_start},
+    {"WGO?", "[{generator} ...]", "start mode", &GcsInterpreter::wave_start_query},
+    {"WGR", "", "restart the recording", &GcsInterpreter::wave_record_restart},
+    {"TWG?", "", "number of wave generators, 3", &GcsInterpreter::wave_generators},
+};
+
+// The single-character commands, after the command lines in HLP?.
+const GcsInterpreter::Immediate GcsInterpreter::kImmediates[] = {
+    {5, "#5", "moving axes as a hex bit mask", &GcsInterpreter::moving_query},
+    {7, "#7", "ready (0xB1)", &GcsInterpreter::ready_query},
+    {8, "#8", "macro running (0)", &GcsInterpreter::macro_query},
+    {9, "#9", "running wave generators as a hex bit mask", &GcsInterpreter::wave_running_query},
+    {24, "#24", "stop all, as STP", &GcsInterpreter::stop},
+};
+
+std::vector<std::string_view> GcsInterpreter::command_names() {
+  std::vector<std::string_view> names;
+  for (const Command& c : kCommands)
+    names.push_back(c.name);
+  for (const Immediate& c : kImmediates)
+    names.push_back(c.name);
+  return names;
+}
+
+GcsInterpreter::GcsInterpreter(const StageModel& model, runtime::HostLink& link,
+                               double servo_cycle_s, const GcsOptions& options)
     : model_(model),
       link_(link),
       servo_cycle_s_(servo_cycle_s),
       options_(options),
       settle_samples_(static_cast<std::uint64_t>(
-          std::max(1.0, std::round(options.settle_time_s / servo_cycle_s)))),
-      slots_(std::make_unique<std::array<Slot, 2 * kGenerators>>()) {
+          std::max(1.0, std::round(options.settle_time_s / servo_cycle_s)))) {
   position_ = model_.pose_from_sgs(Vec3{});
 }
 
@@ -257,11 +335,7 @@ std::string GcsInterpreter::on_line(ClientId client, std::string_view line) {
   const std::string_view name = tokens.front();
   tokens.erase(tokens.begin());
   std::string answer = execute(session, name, tokens);
-  if (trigger_ == 2 && name != "DRT") {  // "next command": this one, then back to the default
-    recorder_.restart();
-    record_from_sequence_ = sequence_;
-    trigger_ = 0;
-  }
+  trigger_.line_done(name, sequence_);
   // A query that failed answers one empty line: a client reading up to the answer's last LF
   // never waits in vain, and finds the reason with ERR? (PIPython does so after every query).
   if (answer.empty() && name.back() == '?')
@@ -270,27 +344,33 @@ std::string GcsInterpreter::on_line(ClientId client, std::string_view line) {
 }
 
 bool GcsInterpreter::is_immediate(char byte) const {
-  return byte == 5 || byte == 7 || byte == 8 || byte == 9 || byte == 24;
+  return std::any_of(std::begin(kImmediates), std::end(kImmediates),
+                     [byte](const Immediate& c) { return c.byte == byte; });
 }
 
 std::string GcsInterpreter::on_immediate(ClientId client, char byte) {
   drain();
   ++stats_.lines;
   Session& session = sessions_[client];
-  switch (byte) {
-    case 5:
-      return fmt::format("{:X}\n", moving_mask());
-    case 7:
-      return "\xB1\n";  // ready: PI answers the byte 0xB1
-    case 8:
-      return "0\n";  // no macros
-    case 9:
-      return fmt::format("{:X}\n", wave_mask());
-    case 24:
-      return stop(session, {});
-    default:
-      return {};
+  for (const Immediate& c : kImmediates) {
+    if (c.byte == byte)
+      return (this->*c.handler)(session, {});
   }
+  return {};
+}
+
+std::string GcsInterpreter::execute(Session& s, std::string_view name, const Args& args) {
+  for (const Command& c : kCommands) {
+    if (c.name != name)
+      continue;
+    if (c.syntax.empty() && !args.empty()) {
+      fail(s, GcsError::kParamCount);
+      return {};
+    }
+    return (this->*c.handler)(s, args);
+  }
+  fail(s, GcsError::kUnknownCommand);
+  return {};
 }
 
 bool GcsInterpreter::send(Session& session, HostCommand command) {
@@ -306,14 +386,7 @@ bool GcsInterpreter::send(Session& session, HostCommand command) {
 void GcsInterpreter::moved() {
   move_sequence_ = sequence_;
   settled_ = {};
-  motion_trigger();
-}
-
-void GcsInterpreter::motion_trigger() {
-  if (trigger_ <= 1) {  // 0 (default) and 1: any command that changes the position
-    recorder_.restart();
-    record_from_sequence_ = sequence_;
-  }
+  trigger_.motion(sequence_);
 }
 
 AxisValues GcsInterpreter::commanded() const {
@@ -322,7 +395,7 @@ AxisValues GcsInterpreter::commanded() const {
     return c;
   const AxisValues live = model_.pose_from_points(last_.zd_um);
   for (std::size_t g = 0; g < kGenerators; ++g)
-    if (wave_running_[g] && last_.applied_sequence >= wave_sequence_[g])
+    if (waves_.playing(g, last_.applied_sequence))
       c[g] = live[g];
   return c;
 }
@@ -331,49 +404,35 @@ unsigned GcsInterpreter::moving_mask() const {
   unsigned mask = 0;
   for (std::size_t a = 0; a < 3; ++a) {
     const bool moving =
-        wave_running_[a] || (servo_on_ && !faulted_ && settled_[a] < settle_samples_);
+        waves_.running(a) || (servo_on_ && !faulted_ && settled_[a] < settle_samples_);
     if (moving)
       mask |= 1u << a;
   }
   return mask;
 }
 
-unsigned GcsInterpreter::wave_mask() const {
-  unsigned mask = 0;
-  for (std::size_t g = 0; g < kGenerators; ++g)
-    if (wave_running_[g])
-      mask |= 1u << g;
-  return mask;
-}
-
 bool GcsInterpreter::slot_free(std::size_t g) {
-  for (int i = 0; i < 50 && last_.applied_sequence < wave_sequence_[g]; ++i) {
+  for (int i = 0; i < 50 && !waves_.applied(g, last_.applied_sequence); ++i) {
     std::this_thread::sleep_for(std::chrono::milliseconds(1));
     drain();
   }
-  return last_.applied_sequence >= wave_sequence_[g];
+  return waves_.applied(g, last_.applied_sequence);
 }
 
 bool GcsInterpreter::stop_waves(Session& s) {
   for (std::size_t g = 0; g < kGenerators; ++g)
-    if ((wave_running_[g] || wave_mode_[g] != 0) && !stop_wave(s, g))
+    if (waves_.active(g) && !stop_wave(s, g))
       return false;
   return true;
 }
 
 bool GcsInterpreter::stop_wave(Session& s, std::size_t g) {
-  HostCommand c{};
-  c.kind = HostCommand::Kind::kWave;
-  c.wave.action = runtime::WaveCommand::Action::kStop;
-  c.wave.generator = static_cast<std::uint8_t>(g);
   const AxisValues now = commanded();
-  if (!send(s, c))
+  if (!send(s, WaveGenerators::stop_command(g)))
     return false;
-  wave_sequence_[g] = sequence_;
-  if (wave_running_[g])
+  if (waves_.running(g))
     target_[g] = now[g];  // where the loop folds it, to within the ticks until it applies this
-  wave_running_[g] = false;
-  wave_mode_[g] = 0;
+  waves_.stopped(g, sequence_);
   return true;
 }
 
@@ -405,15 +464,11 @@ void GcsInterpreter::take(const runtime::HostSample& s) {
 
   // A generator the loop reports stopped (its cycles done, WGO 0, servo off, a fault) leaves
   // its axis where the wave ended: that is the target from now on.
-  for (std::size_t g = 0; g < kGenerators; ++g) {
-    if (s.applied_sequence < wave_sequence_[g])
-      continue;
-    const bool running = ((s.wave_running >> g) & 1u) != 0;
-    if (wave_running_[g] && !running) {
-      target_[g] = model_.pose_from_points(s.zd_um)[g];
-      wave_mode_[g] = 0;
-    }
-    wave_running_[g] = running;
+  if (const unsigned finished = waves_.update(s.applied_sequence, s.wave_running); finished != 0) {
+    const AxisValues ended = model_.pose_from_points(s.zd_um);
+    for (std::size_t g = 0; g < kGenerators; ++g)
+      if (((finished >> g) & 1u) != 0)
+        target_[g] = ended[g];
   }
   const AxisValues target = commanded();
 
@@ -422,12 +477,12 @@ void GcsInterpreter::take(const runtime::HostSample& s) {
       servo_on_ && !faulted && s.closed_loop != 0 && s.applied_sequence >= move_sequence_;
   for (std::size_t a = 0; a < 3; ++a) {
     const double tol = a == 0 ? options_.on_target_tolerance_um : options_.on_target_tolerance_urad;
-    settled_[a] = counting && !wave_running_[a] && std::fabs(position_[a] - target[a]) <= tol
+    settled_[a] = counting && !waves_.running(a) && std::fabs(position_[a] - target[a]) <= tol
                       ? settled_[a] + 1
                       : 0;
   }
 
-  if (s.applied_sequence < record_from_sequence_)
+  if (!trigger_.records(s.applied_sequence))
     return;  // from before the command that started this recording took effect
   RecorderInput in{};
   in.target = target;
@@ -459,178 +514,180 @@ void GcsInterpreter::hold_applied_volts() {
   open_loop_V_ = model_.open_loop_for(model_.channel_V_from_daq(last_.ao_V));
 }
 
-std::string GcsInterpreter::execute(Session& s, std::string_view name, const Args& args) {
+std::string GcsInterpreter::identification(Session&, const Args&) {
+  return options_.identification + "\n";
+}
+
+std::string GcsInterpreter::syntax_version(Session&, const Args&) {
+  return "2.0\n";
+}
+
+std::string GcsInterpreter::axis_identifiers(Session& s, const Args& args) {
+  if (args.size() > 1 || (args.size() == 1 && args[0] != "ALL")) {
+    fail(s, GcsError::kParamSyntax);
+    return {};
+  }
+  return framed({"Z", "U", "V"});
+}
+
+std::string GcsInterpreter::stage_types(Session& s, const Args& args) {
   std::string answer;
-  const auto no_args = [&]() {
-    if (!args.empty()) {
-      fail(s, GcsError::kParamCount);
-      return false;
-    }
-    return true;
-  };
-  if (name == "*IDN?")
-    return no_args() ? options_.identification + "\n" : std::string{};
-  if (name == "CSV?")
-    return no_args() ? std::string{"2.0\n"} : std::string{};
-  if (name == "ERR?") {
-    if (!no_args())
-      return {};
-    int code = 0;
-    if (!s.errors.empty()) {
-      code = static_cast<int>(s.errors.front());
-      s.errors.pop_front();
-    }
-    return fmt::format("{}\n", code);
+  const auto stage = [](std::size_t) { return std::string{"PIEZOSHIFT_TRIPOD"}; };
+  return reply(s, axis_lines(args, stage, answer), answer);
+}
+
+std::string GcsInterpreter::units(Session& s, const Args& args) {
+  std::string answer;
+  const auto unit = [](std::size_t a) { return axis_unit(kAxes[a]); };
+  return reply(s, axis_lines(args, unit, answer), answer);
+}
+
+std::string GcsInterpreter::help(Session&, const Args&) {
+  std::vector<std::string> lines{"The following commands are valid:"};
+  for (const Command& c : kCommands) {
+    lines.push_back(c.syntax.empty() ? fmt::format("{} - {}", c.name, c.help)
+                                     : fmt::format("{} {} - {}", c.name, c.syntax, c.help));
   }
-  if (name == "HLP?") {
-    if (!no_args())
-      return {};
-    std::vector<std::string> lines{"The following commands are valid:"};
-    for (std::string_view h : kHelp)
-      lines.emplace_back(h);
-    lines.emplace_back("Axes: Z piston (um), U tip theta_x (urad), V tilt theta_y (urad)");
-    return framed(lines);
+  for (const Immediate& c : kImmediates)
+    lines.push_back(fmt::format("{} - {}", c.name, c.help));
+  lines.emplace_back("Axes: Z piston (um), U tip theta_x (urad), V tilt theta_y (urad)");
+  return framed(lines);
+}
+
+std::string GcsInterpreter::error_number(Session& s, const Args&) {
+  int code = 0;
+  if (!s.errors.empty()) {
+    code = static_cast<int>(s.errors.front());
+    s.errors.pop_front();
   }
-  if (name == "SAI?") {
-    if (args.size() > 1 || (args.size() == 1 && args[0] != "ALL")) {
-      fail(s, GcsError::kParamSyntax);
-      return {};
-    }
-    return framed({"Z", "U", "V"});
-  }
-  if (name == "PUN?")
-    return reply(s,
-                 axis_lines(
-                     args, [](std::size_t a) { return axis_unit(kAxes[a]); }, answer),
-                 answer);
-  if (name == "MOV")
-    return move(s, args, false);
-  if (name == "MVR")
-    return move(s, args, true);
-  if (name == "SVO")
-    return servo(s, args);
-  if (name == "SVA")
-    return open_loop(s, args);
-  if (name == "STP")
-    return stop(s, args);
-  const auto fixed = [](const AxisValues& v, int digits) {
-    return [&v, digits](std::size_t a) { return fmt::format("{:.{}f}", v[a], digits); };
-  };
+  return fmt::format("{}\n", code);
+}
+
+std::string GcsInterpreter::servo_query(Session& s, const Args& args) {
+  std::string answer;
+  const auto servo = [this](std::size_t) { return servo_on_ ? 1 : 0; };
+  return reply(s, axis_lines(args, servo, answer), answer);
+}
+
+std::string GcsInterpreter::target_query(Session& s, const Args& args) {
+  std::string answer;
   const AxisValues target = commanded();
-  if (name == "MOV?")
-    return reply(s, axis_lines(args, fixed(target, 6), answer), answer);
-  if (name == "POS?")
-    return reply(s, axis_lines(args, fixed(position_, 6), answer), answer);
-  if (name == "SVA?")
-    return reply(s, axis_lines(args, fixed(open_loop_V_, 4), answer), answer);
-  if (name == "TMN?")
-    return reply(s, axis_lines(args, fixed(model_.min_limits(), 6), answer), answer);
-  if (name == "TMX?")
-    return reply(s, axis_lines(args, fixed(model_.max_limits(), 6), answer), answer);
-  if (name == "SVO?") {
-    const auto servo = [this](std::size_t) { return servo_on_ ? 1 : 0; };
-    return reply(s, axis_lines(args, servo, answer), answer);
-  }
-  if (name == "ONT?") {
-    const auto on = [this](std::size_t a) { return servo_on_ && settled_[a] >= settle_samples_; };
-    return reply(s,
-                 axis_lines(
-                     args, [&](std::size_t a) { return on(a) ? 1 : 0; }, answer),
-                 answer);
-  }
-  if (name == "VOL?") {
-    const Vec3 channel_V = model_.channel_V_from_daq(last_.ao_V);
-    const auto volts = [&channel_V](int ch) {
-      return fmt::format("{:.4f}", channel_V[static_cast<std::size_t>(ch - 1)]);
-    };
-    return reply(s, id_lines(args, 3, GcsError::kParamOutOfRange, volts, answer), answer);
-  }
-  if (name == "DRC")
-    return recorder_config(s, args);
-  if (name == "DRC?") {
-    const auto table = [this](int t) { return recorder_.describe_table(t); };
-    return reply(s, id_lines(args, DataRecorder::kTables, GcsError::kNoRecordTable, table, answer),
-                 answer);
-  }
-  if (name == "RTR")
-    return recorder_rate(s, args);
-  if (name == "RTR?")
-    return no_args() ? fmt::format("{}\n", recorder_.rate()) : std::string{};
-  if (name == "TNR?")
-    return no_args() ? fmt::format("{}\n", DataRecorder::kTables) : std::string{};
-  if (name == "DRL?") {
-    const auto points = [this](int t) {
-      return recorder_.describe_table(t) != "0 0" ? recorder_.points() : 0;
-    };
-    return reply(s, id_lines(args, DataRecorder::kTables, GcsError::kNoRecordTable, points, answer),
-                 answer);
-  }
-  if (name == "DRR?")
-    return recorder_read(s, args);
-  if (name == "DRT")
-    return recorder_trigger(s, args);
-  if (name == "DRT?") {
-    const auto trigger = [this](int) { return fmt::format("{} 0", trigger_); };
-    return reply(s,
-                 id_lines(args, DataRecorder::kTables, GcsError::kNoRecordTable, trigger, answer),
-                 answer);
-  }
-  if (name == "HDR?") {
-    if (!no_args())
-      return {};
-    return framed({"#RecordOptions", "0=Nothing is recorded", "1=Commanded position of axis",
-                   "2=Actual position of axis", "3=Position error of axis",
-                   "7=Piezo voltage of output channel",
-                   "17=Sensor (strain gauge) of input channel, um of actuator stroke",
-                   "90=Interferometer position of axis (piezoshift; NaN on hardware)",
-                   "#TriggerOptions", "0=Default setting: any command changing the position",
-                   "1=Any command changing the position (MOV, MVR, SVA, SVO, STP, WGO)",
-                   "2=Next command, then the default again", "4=Immediately",
-                   "#Parameters to be set with SPA", "none: the recorder is set with DRC, DRT, RTR",
-                   "#Additional information",
-                   fmt::format("{} datarecorder tables", DataRecorder::kTables),
-                   fmt::format("{} datapoints per table", DataRecorder::kPoints), "end of help"});
-  }
-  if (name == "CST?") {
-    const auto stage = [](std::size_t) { return std::string{"PIEZOSHIFT_TRIPOD"}; };
-    return reply(s, axis_lines(args, stage, answer), answer);
-  }
-  if (name == "VEL")
-    return velocity(s, args);
-  if (name == "VEL?")
-    return reply(s, axis_lines(args, fixed(velocity_, 6), answer), answer);
-  if (name == "VCO?")
-    return reply(s,
-                 axis_lines(
-                     args, [](std::size_t) { return 0; }, answer),
-                 answer);
-  if (name == "SPA?" || name == "SEP?")
-    return parameters(s, args);
-  if (name == "HPA?") {
-    if (!no_args())
-      return {};
-    std::vector<std::string> lines;
-    for (const Parameter& p : kParameters)
-      lines.push_back(
-          fmt::format("0x{:08X}=\t0\t1\t{}\t{}\t{}", p.id, p.type, p.group, p.description));
-    return framed(lines);
-  }
-  if (name == "WAV")
-    return wave_define(s, args);
-  if (name == "WAV?")
-    return wave_query(s, args);
-  if (name == "WGO")
-    return wave_start(s, args);
-  if (name == "WSL" || name == "WGC" || name == "WTR")
-    return wave_setting(s, name, args);
-  if (name == "WSL?" || name == "WGC?" || name == "WGO?" || name == "WTR?")
-    return wave_setting_query(s, name, args);
-  if (name == "WGR")
-    return wave_record_restart(s, args);
-  if (name == "TWG?")
-    return no_args() ? fmt::format("{}\n", kGenerators) : std::string{};
-  fail(s, GcsError::kUnknownCommand);
-  return {};
+  return reply(s, axis_lines(args, fixed(target, 6), answer), answer);
+}
+
+std::string GcsInterpreter::position_query(Session& s, const Args& args) {
+  std::string answer;
+  return reply(s, axis_lines(args, fixed(position_, 6), answer), answer);
+}
+
+std::string GcsInterpreter::on_target_query(Session& s, const Args& args) {
+  std::string answer;
+  const auto on = [this](std::size_t a) {
+    return servo_on_ && settled_[a] >= settle_samples_ ? 1 : 0;
+  };
+  return reply(s, axis_lines(args, on, answer), answer);
+}
+
+std::string GcsInterpreter::moving_query(Session&, const Args&) {
+  return fmt::format("{:X}\n", moving_mask());
+}
+
+std::string GcsInterpreter::ready_query(Session&, const Args&) {
+  return "\xB1\n";  // ready: PI answers the byte 0xB1
+}
+
+std::string GcsInterpreter::macro_query(Session&, const Args&) {
+  return "0\n";  // no macros
+}
+
+std::string GcsInterpreter::velocity_query(Session& s, const Args& args) {
+  std::string answer;
+  return reply(s, axis_lines(args, fixed(velocity_, 6), answer), answer);
+}
+
+std::string GcsInterpreter::velocity_control_query(Session& s, const Args& args) {
+  std::string answer;
+  const auto off = [](std::size_t) { return 0; };
+  return reply(s, axis_lines(args, off, answer), answer);
+}
+
+std::string GcsInterpreter::parameter_list(Session&, const Args&) {
+  std::vector<std::string> lines;
+  for (const Parameter& p : kParameters)
+    lines.push_back(
+        fmt::format("0x{:08X}=\t0\t1\t{}\t{}\t{}", p.id, p.type, p.group, p.description));
+  return framed(lines);
+}
+
+std::string GcsInterpreter::open_loop_query(Session& s, const Args& args) {
+  std::string answer;
+  return reply(s, axis_lines(args, fixed(open_loop_V_, 4), answer), answer);
+}
+
+std::string GcsInterpreter::voltage_query(Session& s, const Args& args) {
+  std::string answer;
+  const Vec3 channel_V = model_.channel_V_from_daq(last_.ao_V);
+  const auto volts = [&channel_V](int ch) {
+    return fmt::format("{:.4f}", channel_V[static_cast<std::size_t>(ch - 1)]);
+  };
+  return reply(s, id_lines(args, 3, GcsError::kParamOutOfRange, volts, answer), answer);
+}
+
+std::string GcsInterpreter::lower_limit_query(Session& s, const Args& args) {
+  std::string answer;
+  const AxisValues limits = model_.min_limits();
+  return reply(s, axis_lines(args, fixed(limits, 6), answer), answer);
+}
+
+std::string GcsInterpreter::upper_limit_query(Session& s, const Args& args) {
+  std::string answer;
+  const AxisValues limits = model_.max_limits();
+  return reply(s, axis_lines(args, fixed(limits, 6), answer), answer);
+}
+
+std::string GcsInterpreter::recorder_config_query(Session& s, const Args& args) {
+  std::string answer;
+  const auto table = [this](int t) { return recorder_.describe_table(t); };
+  return reply(s, id_lines(args, DataRecorder::kTables, GcsError::kNoRecordTable, table, answer),
+               answer);
+}
+
+std::string GcsInterpreter::recorder_trigger_query(Session& s, const Args& args) {
+  std::string answer;
+  const auto trigger = [this](int) { return fmt::format("{} 0", trigger_.source()); };
+  return reply(s, id_lines(args, DataRecorder::kTables, GcsError::kNoRecordTable, trigger, answer),
+               answer);
+}
+
+std::string GcsInterpreter::recorder_rate_query(Session&, const Args&) {
+  return fmt::format("{}\n", recorder_.rate());
+}
+
+std::string GcsInterpreter::recorder_options(Session&, const Args&) {
+  return framed(
+      {"#RecordOptions", "0=Nothing is recorded", "1=Commanded position of axis",
+       "2=Actual position of axis", "3=Position error of axis", "7=Piezo voltage of output channel",
+       "17=Sensor (strain gauge) of input channel, um of actuator stroke",
+       "90=Interferometer position of axis (piezoshift; NaN on hardware)", "#TriggerOptions",
+       "0=Default setting: any command changing the position",
+       "1=Any command changing the position (MOV, MVR, SVA, SVO, STP, WGO)",
+       "2=Next command, then the default again", "4=Immediately", "#Parameters to be set with SPA",
+       "none: the recorder is set with DRC, DRT, RTR", "#Additional information",
+       fmt::format("{} datarecorder tables", DataRecorder::kTables),
+       fmt::format("{} datapoints per table", DataRecorder::kPoints), "end of help"});
+}
+
+std::string GcsInterpreter::recorder_tables(Session&, const Args&) {
+  return fmt::format("{}\n", DataRecorder::kTables);
+}
+
+std::string GcsInterpreter::recorder_length(Session& s, const Args& args) {
+  std::string answer;
+  const auto points = [this](int t) {
+    return recorder_.describe_table(t) != "0 0" ? recorder_.points() : 0;
+  };
+  return reply(s, id_lines(args, DataRecorder::kTables, GcsError::kNoRecordTable, points, answer),
+               answer);
 }
 
 std::string GcsInterpreter::move(Session& s, const Args& args, bool relative) {
@@ -642,7 +699,7 @@ std::string GcsInterpreter::move(Session& s, const Args& args, bool relative) {
     return {};
   }
   for (const AxisValue& p : pairs) {
-    if (wave_running_[p.axis]) {
+    if (waves_.running(p.axis)) {
       fail(s, GcsError::kWaveGeneratorActive);
       return {};
     }
@@ -677,7 +734,7 @@ std::string GcsInterpreter::servo(Session& s, const Args& args) {
     }
   }
   if ((on == 1.0) == servo_on_ && !faulted_) {
-    motion_trigger();  // already so; still a motion command for the recorder's trigger
+    trigger_.motion(sequence_);  // already so; still a motion command for the recorder's trigger
     return {};
   }
   HostCommand c{};
@@ -739,11 +796,7 @@ std::string GcsInterpreter::open_loop(Session& s, const Args& args) {
   return {};
 }
 
-std::string GcsInterpreter::stop(Session& s, const Args& args) {
-  if (!args.empty()) {
-    fail(s, GcsError::kParamCount);
-    return {};
-  }
+std::string GcsInterpreter::stop(Session& s, const Args&) {
   if (!stop_waves(s))
     return {};
   HostCommand c{};
@@ -841,7 +894,7 @@ std::string GcsInterpreter::recorder_trigger(Session& s, const Args& args) {
     fail(s, GcsError::kParamCount);
     return {};
   }
-  int source = trigger_;
+  int source = trigger_.source();
   for (std::size_t i = 0; i < args.size(); i += step) {
     long long table = 0;
     long long src = 0;
@@ -853,17 +906,13 @@ std::string GcsInterpreter::recorder_trigger(Session& s, const Args& args) {
       fail(s, GcsError::kNoRecordTable);
       return {};
     }
-    if (src != 0 && src != 1 && src != 2 && src != 4) {
+    if (!RecordTrigger::is_source(src)) {
       fail(s, GcsError::kParamOutOfRange);
       return {};
     }
     source = static_cast<int>(src);  // one trigger serves all tables (they share one clock)
   }
-  trigger_ = source;
-  if (trigger_ == 4) {
-    recorder_.restart();
-    record_from_sequence_ = sequence_;
-  }
+  trigger_.set_source(source, sequence_);
   return {};
 }
 
@@ -934,12 +983,6 @@ std::string GcsInterpreter::wave_define(Session& s, const Args& args) {
     return {};
   }
   const int t = static_cast<int>(std::clamp<long long>(table, -1, 1000));
-  for (std::size_t g = 0; g < kGenerators; ++g) {
-    if (wave_running_[g] && wave_table_[g] == t) {
-      fail(s, GcsError::kWaveGeneratorActive);  // its copy plays on; still, PI refuses it
-      return {};
-    }
-  }
   accepted(s, waves_.define(t, Args(args.begin() + 1, args.end())));
   return {};
 }
@@ -947,7 +990,7 @@ std::string GcsInterpreter::wave_define(Session& s, const Args& args) {
 std::string GcsInterpreter::wave_query(Session& s, const Args& args) {
   std::vector<std::string> lines;
   const auto line = [&](int t) {
-    lines.push_back(fmt::format("{} 1={}", t, waves_.values(t).size()));
+    lines.push_back(fmt::format("{} 1={}", t, waves_.tables().values(t).size()));
   };
   if (args.empty()) {
     for (int t = 1; t <= WaveTables::kTables; ++t)
@@ -978,36 +1021,71 @@ std::string GcsInterpreter::wave_query(Session& s, const Args& args) {
   return framed(lines);
 }
 
-namespace {
-
-// "{generator} {integer} ..." pairs with generators 1..n, each at most once (`WGO 1 1 1 0` says
-// two things of one generator: refused as a syntax error, as a repeated axis is); kNone on
-// success.
-GcsError generator_pairs(const std::vector<std::string_view>& args, std::size_t n,
-                         std::vector<std::pair<std::size_t, long long>>& out) {
-  if (args.empty() || args.size() % 2 != 0)
-    return GcsError::kParamCount;
-  for (std::size_t i = 0; i < args.size(); i += 2) {
-    long long g = 0;
-    long long v = 0;
-    if (!parse_integer(args[i], g) || !parse_integer(args[i + 1], v))
-      return GcsError::kParamSyntax;
-    if (g < 1 || g > static_cast<long long>(n))
-      return GcsError::kWaveIndex;
-    const auto index = static_cast<std::size_t>(g - 1);
-    for (const auto& [seen, value] : out) {
-      if (seen == index)
-        return GcsError::kParamSyntax;
-    }
-    out.emplace_back(index, v);
-  }
-  return GcsError::kNone;
+std::string GcsInterpreter::wave_select(Session& s, const Args& args) {
+  std::vector<WaveGenerators::Setting> tables;
+  if (accepted(s, generator_pairs(args, kGenerators, tables)))
+    accepted(s, waves_.select(tables));
+  return {};
 }
 
-}  // namespace
+std::string GcsInterpreter::wave_select_query(Session& s, const Args& args) {
+  std::string answer;
+  const auto table = [this](std::size_t g) { return fmt::format("{}", waves_.table(g)); };
+  return reply(s, generator_lines(args, table, answer), answer);
+}
+
+std::string GcsInterpreter::wave_cycles(Session& s, const Args& args) {
+  std::vector<WaveGenerators::Setting> cycles;
+  if (accepted(s, generator_pairs(args, kGenerators, cycles)))
+    accepted(s, waves_.set_cycles(cycles));
+  return {};
+}
+
+std::string GcsInterpreter::wave_cycles_query(Session& s, const Args& args) {
+  std::string answer;
+  const auto cycles = [this](std::size_t g) { return fmt::format("{}", waves_.cycles(g)); };
+  return reply(s, generator_lines(args, cycles, answer), answer);
+}
+
+std::string GcsInterpreter::wave_rate(Session& s, const Args& args) {
+  // "{generator} {rate} {interpolation}" triples; generator 0: all.
+  if (args.empty() || args.size() % 3 != 0) {
+    fail(s, GcsError::kParamCount);
+    return {};
+  }
+  std::vector<std::pair<std::size_t, long long>> set;
+  for (std::size_t i = 0; i < args.size(); i += 3) {
+    long long g = 0;
+    long long rate = 0;
+    long long interpolation = 0;
+    if (!parse_integer(args[i], g) || !parse_integer(args[i + 1], rate) ||
+        !parse_integer(args[i + 2], interpolation)) {
+      fail(s, GcsError::kParamSyntax);
+      return {};
+    }
+    if (g < 0 || g > static_cast<long long>(kGenerators)) {
+      fail(s, GcsError::kWaveIndex);
+      return {};
+    }
+    if (!accepted(s, WaveGenerators::check_rate(rate, interpolation)))
+      return {};
+    for (std::size_t k = 0; k < kGenerators; ++k)
+      if (g == 0 || static_cast<std::size_t>(g - 1) == k)
+        set.emplace_back(k, rate);
+  }
+  for (const auto& [g, rate] : set)
+    waves_.set_rate(g, rate);
+  return {};
+}
+
+std::string GcsInterpreter::wave_rate_query(Session& s, const Args& args) {
+  std::string answer;
+  const auto rate = [this](std::size_t g) { return fmt::format("{} 0", waves_.rate(g)); };
+  return reply(s, generator_lines(args, rate, answer), answer);
+}
 
 std::string GcsInterpreter::wave_start(Session& s, const Args& args) {
-  std::vector<std::pair<std::size_t, long long>> pairs;
+  std::vector<WaveGenerators::Setting> pairs;
   if (!accepted(s, generator_pairs(args, kGenerators, pairs)))
     return {};
   std::array<bool, kGenerators> start{};
@@ -1024,173 +1102,50 @@ std::string GcsInterpreter::wave_start(Session& s, const Args& args) {
       fail(s, GcsError::kServoOff);
       return {};
     }
-    // The range each generator will span, and the poses at the corners of that box: a move
-    // checked as a whole pose, as MOV is (the supervisor's limits hold whatever the check).
-    std::array<double, kGenerators> lo{};
-    std::array<double, kGenerators> hi{};
-    const AxisValues now = commanded();
-    for (std::size_t g = 0; g < kGenerators; ++g) {
-      lo[g] = hi[g] = target_[g];
-      if (start[g]) {
-        const int t = wave_table_[g];
-        if (t < 1 || waves_.values(t).empty()) {
-          fail(s, GcsError::kWaveNotDefined);
-          return {};
-        }
-        const auto [mn, mx] = std::minmax_element(waves_.values(t).begin(), waves_.values(t).end());
-        lo[g] = *mn;
-        hi[g] = *mx;
-      } else if (wave_running_[g]) {
-        lo[g] = wave_min_[g];
-        hi[g] = wave_max_[g];
-      } else {
-        lo[g] = hi[g] = now[g];
-      }
-    }
-    for (unsigned corner = 0; corner < 8; ++corner) {
-      AxisValues pose{};
-      for (std::size_t g = 0; g < kGenerators; ++g)
-        pose[g] = ((corner >> g) & 1u) != 0 ? hi[g] : lo[g];
-      if (!model_.reachable(pose)) {
-        fail(s, GcsError::kPositionOutOfLimits);
-        return {};
-      }
-    }
+    if (!accepted(s, waves_.check_start(start, commanded())))
+      return {};
   }
   for (const auto& [g, mode] : pairs) {
-    if (mode == 0) {
-      if ((wave_running_[g] || wave_mode_[g] != 0) && !stop_wave(s, g))
-        return {};
-      wave_mode_[g] = 0;
-      continue;
-    }
-    // The slot the loop does not read: the other one of this generator's pair, once the loop
-    // has applied this generator's last start or stop.
-    if (!slot_free(g)) {
-      fail(s, GcsError::kCommunication);
+    const bool done = mode == 0 ? !waves_.active(g) || stop_wave(s, g) : start_wave(s, g, mode);
+    if (!done)
       return {};
-    }
-    const int slot = wave_slot_[g] == static_cast<int>(2 * g) ? static_cast<int>(2 * g + 1)
-                                                              : static_cast<int>(2 * g);
-    const std::vector<double>& values = waves_.values(wave_table_[g]);
-    Slot& storage = (*slots_)[static_cast<std::size_t>(slot)];
-    std::copy(values.begin(), values.end(), storage.begin());
-    AxisValues unit{};
-    unit[g] = 1.0;
-    const Vec3 zero = model_.points_for(AxisValues{});
-    const Vec3 column = model_.points_for(unit);
-    HostCommand c{};
-    c.kind = HostCommand::Kind::kWave;
-    c.wave.action = runtime::WaveCommand::Action::kStart;
-    c.wave.generator = static_cast<std::uint8_t>(g);
-    c.wave.values = storage.data();
-    c.wave.length = static_cast<std::uint32_t>(values.size());
-    c.wave.rate = static_cast<std::uint32_t>(wave_rate_[g]);
-    c.wave.cycles = static_cast<std::uint32_t>(wave_cycles_[g]);
-    for (std::size_t i = 0; i < 3; ++i)
-      c.wave.points_per_unit[i] = column[i] - zero[i];
-    c.wave.reference = target_[g];
-    if (!send(s, c))
-      return {};
-    wave_slot_[g] = slot;
-    wave_sequence_[g] = sequence_;
-    wave_mode_[g] = mode;
-    wave_running_[g] = true;
-    const auto [mn, mx] = std::minmax_element(values.begin(), values.end());
-    wave_min_[g] = *mn;
-    wave_max_[g] = *mx;
   }
   if (any_start) {
     settled_ = {};
-    motion_trigger();
+    trigger_.motion(sequence_);
   }
   return {};
 }
 
-std::string GcsInterpreter::wave_setting(Session& s, std::string_view name, const Args& args) {
-  if (name == "WTR") {
-    // "{generator} {rate} {interpolation}" triples; generator 0: all.
-    if (args.empty() || args.size() % 3 != 0) {
-      fail(s, GcsError::kParamCount);
-      return {};
-    }
-    std::vector<std::pair<std::size_t, long long>> set;
-    for (std::size_t i = 0; i < args.size(); i += 3) {
-      long long g = 0;
-      long long rate = 0;
-      long long interpolation = 0;
-      if (!parse_integer(args[i], g) || !parse_integer(args[i + 1], rate) ||
-          !parse_integer(args[i + 2], interpolation)) {
-        fail(s, GcsError::kParamSyntax);
-        return {};
-      }
-      if (g < 0 || g > static_cast<long long>(kGenerators)) {
-        fail(s, GcsError::kWaveIndex);
-        return {};
-      }
-      if (rate < 1 || rate > 1000000 || interpolation != 0) {
-        fail(s, GcsError::kParamOutOfRange);
-        return {};
-      }
-      for (std::size_t k = 0; k < kGenerators; ++k)
-        if (g == 0 || static_cast<std::size_t>(g - 1) == k)
-          set.emplace_back(k, rate);
-    }
-    for (const auto& [g, rate] : set)
-      wave_rate_[g] = rate;
-    return {};
+bool GcsInterpreter::start_wave(Session& s, std::size_t g, long long mode) {
+  // The slot the loop does not read is free once it has applied g's last start or stop.
+  if (!slot_free(g)) {
+    fail(s, GcsError::kCommunication);
+    return false;
   }
-  std::vector<std::pair<std::size_t, long long>> pairs;
-  if (!accepted(s, generator_pairs(args, kGenerators, pairs)))
-    return {};
-  for (const auto& [g, v] : pairs) {
-    if (name == "WSL" && (v < 0 || v > WaveTables::kTables)) {
-      fail(s, GcsError::kWaveIndex);
-      return {};
-    }
-    if (name == "WGC" && (v < 0 || v > 0xFFFFFFFFLL)) {
-      fail(s, GcsError::kParamOutOfRange);
-      return {};
-    }
-    if (name == "WSL" && wave_running_[g]) {
-      fail(s, GcsError::kWaveGeneratorActive);
-      return {};
-    }
-  }
-  for (const auto& [g, v] : pairs) {
-    if (name == "WSL")
-      wave_table_[g] = static_cast<int>(v);
-    else
-      wave_cycles_[g] = v;
-  }
-  return {};
+  if (!send(s, waves_.start_command(g, target_[g])))
+    return false;
+  waves_.started(g, mode, sequence_);
+  return true;
 }
 
-std::string GcsInterpreter::wave_setting_query(Session& s, std::string_view name, const Args& args) {
+std::string GcsInterpreter::wave_start_query(Session& s, const Args& args) {
   std::string answer;
-  const auto value = [&](int g) -> std::string {
-    const auto i = static_cast<std::size_t>(g - 1);
-    if (name == "WSL?")
-      return fmt::format("{}", wave_table_[i]);
-    if (name == "WGC?")
-      return fmt::format("{}", wave_cycles_[i]);
-    if (name == "WTR?")
-      return fmt::format("{} 0", wave_rate_[i]);
-    return fmt::format("{}", wave_mode_[i]);
-  };
-  return reply(s,
-               id_lines(args, static_cast<int>(kGenerators), GcsError::kWaveIndex, value, answer),
-               answer);
+  const auto mode = [this](std::size_t g) { return fmt::format("{}", waves_.mode(g)); };
+  return reply(s, generator_lines(args, mode, answer), answer);
 }
 
-std::string GcsInterpreter::wave_record_restart(Session& s, const Args& args) {
-  if (!args.empty()) {
-    fail(s, GcsError::kParamCount);
-    return {};
-  }
-  recorder_.restart();
-  record_from_sequence_ = sequence_;
+std::string GcsInterpreter::wave_running_query(Session&, const Args&) {
+  return fmt::format("{:X}\n", waves_.running_mask());
+}
+
+std::string GcsInterpreter::wave_record_restart(Session&, const Args&) {
+  trigger_.restart(sequence_);
   return {};
+}
+
+std::string GcsInterpreter::wave_generators(Session&, const Args&) {
+  return fmt::format("{}\n", kGenerators);
 }
 
 }  // namespace piezoshift::host
