@@ -114,6 +114,8 @@ void WaveGenerators::started(std::size_t g, long long mode, std::uint64_t sequen
   mode_[g] = mode;
   running_[g] = true;
   const std::vector<double>& values = tables_.values(table_[g]);
+  if (values.empty())
+    return;  // check_start refuses an empty table (401); never read past the end regardless
   const auto [mn, mx] = std::minmax_element(values.begin(), values.end());
   min_[g] = *mn;
   max_[g] = *mx;
