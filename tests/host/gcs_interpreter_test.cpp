@@ -7,7 +7,10 @@
 #include <cmath>
 #include <cstdint>
 #include <cstdlib>
+#include <fstream>
 #include <limits>
+#include <set>
+#include <sstream>
 #include <string>
 #include <string_view>
 #include <vector>
@@ -16,6 +19,8 @@
 #include "piezoshift/host/gcs_interpreter.hpp"
 #include "piezoshift/plant/geometry.hpp"
 #include "piezoshift/runtime/safety_supervisor.hpp"
+
+#include "../support/test_paths.hpp"
 
 namespace piezoshift::host {
 namespace {
@@ -141,6 +146,52 @@ TEST_F(GcsInterpreterTest, IdentificationAndSyntaxQueries) {
   EXPECT_EQ(cmd("PUN? W"), "\n");
   EXPECT_EQ(err(), 15);
   EXPECT_EQ(err(), 0);
+}
+
+// The command names in the first column of docs/gcs.md's "## Commands" table: the first word of
+// every `code` span there ("`VEL {axis} {v} ...`, `VEL? [axes]`" names VEL and VEL?).
+std::set<std::string> documented_commands() {
+  std::ifstream in(testing::source_dir() + "/docs/gcs.md");
+  EXPECT_TRUE(in) << "docs/gcs.md";
+  std::set<std::string> names;
+  std::string line;
+  bool in_section = false;
+  while (std::getline(in, line)) {
+    if (line.rfind("## ", 0) == 0 || line.rfind("### ", 0) == 0)
+      in_section = line == "## Commands";
+    if (!in_section || line.rfind("| `", 0) != 0)
+      continue;
+    const std::string first_column = line.substr(2, line.find("` | ") + 1 - 2);
+    for (std::size_t open = first_column.find('`'); open != std::string::npos;) {
+      const std::size_t close = first_column.find('`', open + 1);
+      const std::string code = first_column.substr(open + 1, close - open - 1);
+      names.insert(code.substr(0, code.find(' ')));
+      open = first_column.find('`', close + 1);
+    }
+  }
+  return names;
+}
+
+TEST_F(GcsInterpreterTest, TheDocsListEveryCommandOfTheTableAndNoOther) {
+  const std::set<std::string> documented = documented_commands();
+  std::set<std::string> known;
+  for (std::string_view name : GcsInterpreter::command_names())
+    known.insert(std::string(name));
+  EXPECT_EQ(known.size(), 53u);  // 48 command lines and #5, #7, #8, #9, #24
+  for (const std::string& name : known)
+    EXPECT_EQ(documented.count(name), 1u) << name << " is not in docs/gcs.md's command table";
+  for (const std::string& name : documented)
+    EXPECT_EQ(known.count(name), 1u) << name << " is documented but not a command";
+  // HLP? answers one line per command, in the table's order, between its heading and the axes.
+  std::istringstream help(cmd("HLP?"));
+  std::vector<std::string> listed;
+  for (std::string l; std::getline(help, l);)
+    listed.push_back(l.substr(0, l.find(' ')));
+  ASSERT_EQ(listed.size(), GcsInterpreter::command_names().size() + 2);
+  for (std::size_t i = 0; i < GcsInterpreter::command_names().size(); ++i)
+    EXPECT_EQ(listed[i + 1], GcsInterpreter::command_names()[i]);
+  EXPECT_EQ(cmd("FOO?"), "\n");  // and a name that is in neither is still error 2
+  EXPECT_EQ(err(), 2);
 }
 
 TEST_F(GcsInterpreterTest, UnknownCommandAnswersNothingAndQueues2) {
@@ -537,8 +588,8 @@ TEST_F(GcsInterpreterTest, FaultWithServoOffCanBeClearedBySvo0) {
 // condition persists, the supervisor latches it again in the same tick, so the first sample with
 // applied_sequence >= the SVO's sequence is already kFaulted, with no running sample between.
 // The host must report that fault (-1024, SVO? 0) rather than keep reporting the servo on.
-// DISABLED: fails against GcsInterpreter::take() as written (faulted_ stays true through the SVO, so
-// `faulted && !faulted_` never fires); enable once that is fixed.
+// DISABLED: fails against GcsInterpreter::take() as written (faulted_ stays true through the SVO,
+// so `faulted && !faulted_` never fires); enable once that is fixed.
 TEST_F(GcsInterpreterTest, FaultThatRecursAsSoonAsSvoClearsItIsReported) {
   const std::uint64_t on = servo_on_at({3.0, 0.0, 0.0});
   HostSample f = at({3.0, 0.0, 0.0}, on, false);
