@@ -22,7 +22,7 @@ void config_input(std::string_view data);
 void csv_input(std::string_view data);
 //! A calibration file as `run`, `serve` and `simulate --calibration` read it.
 void calibration_input(std::string_view data);
-//! A GCS session: the input split at LF into lines fed to host::GcsController on the twin's
+//! A GCS session: the input split at LF into lines fed to host::GcsInterpreter on the twin's
 //! stage model, with a stand-in loop thread that applies every command and answers with samples.
 void gcs_input(std::string_view data);
 //! A command line, one argument per input line, parsed by the program's own CLI11 app; only

@@ -1,4 +1,4 @@
-// The GCS target: host::GcsController on the twin's stage model, fed the input's lines as
+// The GCS target: host::GcsInterpreter on the twin's stage model, fed the input's lines as
 // LineServer frames them, with a stand-in for the real-time loop on its own thread.
 #include <atomic>
 #include <chrono>
@@ -7,7 +7,7 @@
 #include <thread>
 
 #include "entry_points.hpp"
-#include "piezoshift/host/gcs_controller.hpp"
+#include "piezoshift/host/gcs_interpreter.hpp"
 #include "piezoshift/plant/geometry.hpp"
 #include "piezoshift/runtime/safety_supervisor.hpp"
 
@@ -86,7 +86,7 @@ void gcs_input(std::string_view data) {
   static const host::StageModel model(host::stage_model_params(plant::GeometryParams{}));
   constexpr std::size_t kMaxLineBytes = host::LineServerLimits{}.max_line_bytes;
   runtime::HostLink link;
-  host::GcsController gcs(model, link, 1e-3, host::GcsOptions{});
+  host::GcsInterpreter gcs(model, link, 1e-3, host::GcsOptions{});
   const StandInLoop loop(link);
   constexpr host::ClientId kClient = 1;
   gcs.on_connect(kClient);

@@ -27,7 +27,7 @@
 #include "piezoshift/calibration/calibration_file.hpp"
 #include "piezoshift/config/project_config.hpp"
 #include "piezoshift/host/dashboard.hpp"
-#include "piezoshift/host/gcs_controller.hpp"
+#include "piezoshift/host/gcs_interpreter.hpp"
 #include "piezoshift/host/http_server.hpp"
 #include "piezoshift/host/line_server.hpp"
 #include "piezoshift/host/locked_line_handler.hpp"
@@ -186,7 +186,7 @@ int serve(const ServeOptions& o) {
   gopts.settle_time_s = o.settle_s;
   gopts.identification =
       fmt::format("piezoshift, semi-closed-loop PZT phase shifter ({}), 0, 0.1.0", daq.name());
-  host::GcsController gcs(model, link, period_s, gopts);
+  host::GcsInterpreter gcs(model, link, period_s, gopts);
 
   // The dashboard shares the interpreter with the GCS thread: one mutex around it.
   std::mutex gcs_mutex;

@@ -90,7 +90,7 @@ double percentile(std::vector<double>& v, double q) {
 
 }  // namespace
 
-Dashboard::Dashboard(GcsController& gcs, std::mutex& gcs_mutex, std::string_view page,
+Dashboard::Dashboard(GcsInterpreter& gcs, std::mutex& gcs_mutex, std::string_view page,
                      const DashboardOptions& options)
     : gcs_(gcs), mutex_(gcs_mutex), page_(page), options_(options) {
   stride_ = static_cast<std::size_t>(

@@ -23,7 +23,7 @@
 
 #include "../support/descriptor_exhaustion.hpp"
 #include "piezoshift/host/gcs_client.hpp"
-#include "piezoshift/host/gcs_controller.hpp"
+#include "piezoshift/host/gcs_interpreter.hpp"
 #include "piezoshift/host/line_server.hpp"
 #include "piezoshift/host/locked_line_handler.hpp"
 #include "piezoshift/io/input_error.hpp"
@@ -447,7 +447,7 @@ class TurnCountingHandler final : public LineHandler {
 TEST(LineServerClients, NonReadingDrrFloodDoesNotDelayAnotherClientsPos) {
   const StageModel model(stage_model_params(plant::GeometryParams{}));
   runtime::HostLink link;
-  GcsController gcs(model, link, 1e-3, GcsOptions{});
+  GcsInterpreter gcs(model, link, 1e-3, GcsOptions{});
   // 2048 ticks recorded in tables 1 and 2 (the defaults), pushed as the loop would: each DRR? is
   // ~28 kB, above the 16 KiB output high-water mark, so one answer throttles its client.
   for (std::uint64_t k = 0; k < 2048; ++k) {

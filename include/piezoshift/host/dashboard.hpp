@@ -15,7 +15,7 @@
 //             |(W_k - W_k-1) - T| = |latency_k - latency_k-1|, as runtime/period_stats.hpp),
 //             overruns, and the real-time privileges granted
 //   controls  POST /api/command {"commands": ["SVO Z 1 U 1 V 1", "MOV Z 5"]}: each line goes
-//             through GcsController::on_line on the dashboard's own GCS session, then ERR?; the
+//             through GcsInterpreter::on_line on the dashboard's own GCS session, then ERR?; the
 //             first error stops the list and is answered with its GCS number and text. So every
 //             limit and error of GCS applies unchanged.
 // The mutex is the one the GCS thread holds around the interpreter (LockedLineHandler); the HTTP
@@ -29,7 +29,7 @@
 #include <string_view>
 #include <vector>
 
-#include "piezoshift/host/gcs_controller.hpp"
+#include "piezoshift/host/gcs_interpreter.hpp"
 #include "piezoshift/host/http_server.hpp"
 #include "piezoshift/host/sample_observer.hpp"
 
@@ -57,13 +57,13 @@ class Dashboard final : public HttpHandler, public SampleObserver {
  public:
   //! page: the HTML served at "/" (the embedded bundle). The dashboard opens a GCS session on gcs
   //! (under mutex); gcs must outlive it.
-  Dashboard(GcsController& gcs, std::mutex& gcs_mutex, std::string_view page,
+  Dashboard(GcsInterpreter& gcs, std::mutex& gcs_mutex, std::string_view page,
             const DashboardOptions& options);
   ~Dashboard() override;
   Dashboard(const Dashboard&) = delete;
   Dashboard& operator=(const Dashboard&) = delete;
 
-  //! GCS thread, with gcs_mutex held (GcsController::drain through LockedLineHandler).
+  //! GCS thread, with gcs_mutex held (GcsInterpreter::drain through LockedLineHandler).
   void on_sample(const runtime::HostSample& sample, const RecorderInput& derived) override;
 
   //! HTTP thread.
@@ -101,7 +101,7 @@ class Dashboard final : public HttpHandler, public SampleObserver {
   //! Under the mutex: a query on the dashboard's session, its answer lines.
   std::vector<std::string> query(std::string_view line);
 
-  GcsController& gcs_;
+  GcsInterpreter& gcs_;
   std::mutex& mutex_;
   std::string page_;
   DashboardOptions options_;

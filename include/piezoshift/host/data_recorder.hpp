@@ -12,8 +12,9 @@
 //                 90 interferometer position of axis s (piezoshift: the twin's XL-80; NaN on
 //                    hardware, which has no interferometer on line)
 //               Options 1, 2, 3, 7 and 17 are PI's numbers for these signals.
-//   trigger     recording restarts from point 1 on every motion command (MOV, MVR, SVA, SVO,
-//               STP) and whenever DRC or RTR changes the set-up; it stops when kPoints are held.
+//   trigger     recording restarts from point 1 whenever DRC or RTR changes the set-up, and as
+//               DRT's trigger says (record_trigger.hpp; by default on every motion command);
+//               it stops when kPoints are held.
 //   DRR?        GCS's data form: "# KEY = value" header lines ending with "# END_HEADER", then one
 //               line per point, columns separated by a space (SEPARATOR = 32).
 // Not thread-safe: the server's one network thread owns it.

@@ -2,6 +2,8 @@
 // The GCS 2.0 command interpreter of `piezoshift serve` (docs/gcs.md has the command table): it
 // turns command lines into HostCommands for the real-time loop and answers queries from the
 // loop's HostSamples. It runs on the server's one network thread (LineHandler), never on the loop.
+// One table of commands (name, syntax, help, handler) serves the dispatch and HLP?; the wave
+// generators (WaveGenerators) and the recorder's trigger (RecordTrigger) are classes of their own.
 //
 //   per client   an error queue: a failed command queues its GCS error number; a failed set
 //                command answers nothing, a failed query (name ending in '?') one empty line,
@@ -21,17 +23,14 @@
 //                client's queue gets -1024; SVO (either value) clears the fault
 //   STP, #24     stop the wave generators and hold where the stage is (servo on: MOV? :=
 //                POS?; off: the volts applied); queue error 10 for the client that sent it
-//   wave gen.    generator g (1..3) plays the table WSL gives it (WaveTables) into axis g
-//                (Z, U, V) in closed loop: WGO copies the table into a slot of fixed storage
-//                and hands the slot to the loop (runtime/wave_generator.hpp has the lifetime
-//                rule); while it runs, MOV?, recorder option 1 and ONT? follow the wave
+//   wave gen.    generator g (1..3) plays the table WSL gives it into axis g (Z, U, V) in
+//                closed loop (wave_generators.hpp); while it runs, MOV?, recorder option 1 and
+//                ONT? follow the wave
 //   recorder     a motion command (and WGO, WGR) restarts the recording from the first sample
-//                whose tick applied it (HostSample::applied_sequence), so a recording is
-//                aligned to the tick the command took effect
+//                whose tick applied it (record_trigger.hpp)
 // Sample drops (the host thread stalled for > 4 s) are counted, never blocking the loop.
 #include <cstdint>
 #include <deque>
-#include <memory>
 #include <string>
 #include <string_view>
 #include <unordered_map>
@@ -40,9 +39,10 @@
 #include "piezoshift/host/data_recorder.hpp"
 #include "piezoshift/host/gcs_error.hpp"
 #include "piezoshift/host/line_server.hpp"
+#include "piezoshift/host/record_trigger.hpp"
 #include "piezoshift/host/sample_observer.hpp"
 #include "piezoshift/host/stage_model.hpp"
-#include "piezoshift/host/wave_tables.hpp"
+#include "piezoshift/host/wave_generators.hpp"
 #include "piezoshift/runtime/host_link.hpp"
 
 namespace piezoshift::host {
@@ -64,10 +64,10 @@ struct GcsStats {
   std::uint64_t faults = 0;          //!< supervisor faults seen
 };
 
-class GcsController final : public LineHandler {
+class GcsInterpreter final : public LineHandler {
  public:
-  GcsController(const StageModel& model, runtime::HostLink& link, double servo_cycle_s,
-                const GcsOptions& options);
+  GcsInterpreter(const StageModel& model, runtime::HostLink& link, double servo_cycle_s,
+                 const GcsOptions& options);
 
   void on_connect(ClientId client) override;
   void on_disconnect(ClientId client) override;
@@ -84,11 +84,33 @@ class GcsController final : public LineHandler {
   //! Also hands every sample to observer (null: none) after the recorder.
   void set_sample_observer(SampleObserver* observer) noexcept { observer_ = observer; }
 
+  //! The names of every command the interpreter knows, as HLP? lists them: the command lines'
+  //! (`MOV`, `POS?`, ...) and the single-character commands' (`#5`, ..., `#24`).
+  static std::vector<std::string_view> command_names();
+
  private:
   using Args = std::vector<std::string_view>;
   struct Session {
     std::deque<GcsError> errors;
   };
+  //! Returns the answer (empty for set commands) or fails the session.
+  using Handler = std::string (GcsInterpreter::*)(Session&, const Args&);
+  //! A command line. An empty syntax takes no arguments (24 otherwise, before the handler).
+  struct Command {
+    std::string_view name;
+    std::string_view syntax;  //!< the arguments, as HLP? shows them
+    std::string_view help;    //!< one line
+    Handler handler;
+  };
+  //! A single-character command: the control byte alone (#5 is the byte 5).
+  struct Immediate {
+    char byte;
+    std::string_view name;
+    std::string_view help;
+    Handler handler;
+  };
+  static const Command kCommands[];
+  static const Immediate kImmediates[];
 
   std::string execute(Session& session, std::string_view name, const Args& args);
   void fail(Session& session, GcsError error);
@@ -106,31 +128,69 @@ class GcsController final : public LineHandler {
   AxisValues commanded() const;
   //! Bit a: axis a not on target or its generator running, or its command not applied yet.
   unsigned moving_mask() const;
-  unsigned wave_mask() const;
   //! Stops every generator (STP, #24); false (52 queued) when the ring is full.
   bool stop_waves(Session& s);
   //! Stops generator g (it holds where it is); false (52 queued) when the ring is full.
   bool stop_wave(Session& s, std::size_t g);
+  //! Waits (at most ~50 ms, draining samples) until the loop has applied generator g's last
+  //! start or stop, so that the slot it no longer reads may be written.
+  bool slot_free(std::size_t g);
+  //! Starts generator g (WGO g 1); false with the error queued.
+  bool start_wave(Session& s, std::size_t g, long long mode);
 
-  // Commands; each returns the answer (empty for set commands) or fails the session.
-  std::string move(Session& s, const Args& args, bool relative);
+  // The commands (kCommands), in docs/gcs.md's order.
+  std::string identification(Session& s, const Args& args);
+  std::string syntax_version(Session& s, const Args& args);
+  std::string axis_identifiers(Session& s, const Args& args);
+  std::string stage_types(Session& s, const Args& args);
+  std::string units(Session& s, const Args& args);
+  std::string help(Session& s, const Args& args);
+  std::string error_number(Session& s, const Args& args);
   std::string servo(Session& s, const Args& args);
-  std::string open_loop(Session& s, const Args& args);
+  std::string servo_query(Session& s, const Args& args);
+  std::string move_absolute(Session& s, const Args& args) { return move(s, args, false); }
+  std::string move_relative(Session& s, const Args& args) { return move(s, args, true); }
+  std::string move(Session& s, const Args& args, bool relative);
+  std::string target_query(Session& s, const Args& args);
+  std::string position_query(Session& s, const Args& args);
+  std::string on_target_query(Session& s, const Args& args);
   std::string stop(Session& s, const Args& args);
-  std::string recorder_config(Session& s, const Args& args);
-  std::string recorder_rate(Session& s, const Args& args);
-  std::string recorder_read(Session& s, const Args& args);
-  std::string recorder_trigger(Session& s, const Args& args);
-  std::string parameters(Session& s, const Args& args);
+  std::string moving_query(Session& s, const Args& args);
+  std::string ready_query(Session& s, const Args& args);
+  std::string macro_query(Session& s, const Args& args);
   std::string velocity(Session& s, const Args& args);
+  std::string velocity_query(Session& s, const Args& args);
+  std::string velocity_control_query(Session& s, const Args& args);
+  std::string parameters(Session& s, const Args& args);
+  std::string parameter_list(Session& s, const Args& args);
+  std::string open_loop(Session& s, const Args& args);
+  std::string open_loop_query(Session& s, const Args& args);
+  std::string voltage_query(Session& s, const Args& args);
+  std::string lower_limit_query(Session& s, const Args& args);
+  std::string upper_limit_query(Session& s, const Args& args);
+  std::string recorder_config(Session& s, const Args& args);
+  std::string recorder_config_query(Session& s, const Args& args);
+  std::string recorder_trigger(Session& s, const Args& args);
+  std::string recorder_trigger_query(Session& s, const Args& args);
+  std::string recorder_rate(Session& s, const Args& args);
+  std::string recorder_rate_query(Session& s, const Args& args);
+  std::string recorder_options(Session& s, const Args& args);
+  std::string recorder_tables(Session& s, const Args& args);
+  std::string recorder_length(Session& s, const Args& args);
+  std::string recorder_read(Session& s, const Args& args);
   std::string wave_define(Session& s, const Args& args);
   std::string wave_query(Session& s, const Args& args);
+  std::string wave_select(Session& s, const Args& args);
+  std::string wave_select_query(Session& s, const Args& args);
+  std::string wave_cycles(Session& s, const Args& args);
+  std::string wave_cycles_query(Session& s, const Args& args);
+  std::string wave_rate(Session& s, const Args& args);
+  std::string wave_rate_query(Session& s, const Args& args);
   std::string wave_start(Session& s, const Args& args);
-  //! WSL, WGC, WTR: "{generator} {value} ..." pairs (WTR: {generator} {rate} {interpolation}).
-  std::string wave_setting(Session& s, std::string_view name, const Args& args);
-  //! WSL?, WGC?, WGO?, WTR?: "{generator}=..." lines.
-  std::string wave_setting_query(Session& s, std::string_view name, const Args& args);
+  std::string wave_start_query(Session& s, const Args& args);
+  std::string wave_running_query(Session& s, const Args& args);
   std::string wave_record_restart(Session& s, const Args& args);
+  std::string wave_generators(Session& s, const Args& args);
 
   const StageModel& model_;
   runtime::HostLink& link_;
@@ -139,6 +199,7 @@ class GcsController final : public LineHandler {
   std::uint64_t settle_samples_;
   std::unordered_map<ClientId, Session> sessions_;
   DataRecorder recorder_;
+  RecordTrigger trigger_{recorder_};
   SampleObserver* observer_ = nullptr;
   GcsStats stats_;
 
@@ -156,30 +217,8 @@ class GcsController final : public LineHandler {
   AxisValues target_{};
   AxisValues open_loop_V_{};
   std::array<std::uint64_t, 3> settled_{};
-  std::uint64_t record_from_sequence_ = 0;  // record samples whose tick applied this command
-  int trigger_ = 0;                         // DRT source (0 and 1: motion commands)
-  std::array<double, 3> velocity_{};        // VEL, stored (velocity control is off, VCO? 0)
-
-  // Wave generators, one per axis. The slots are fixed storage the loop reads (two per
-  // generator: the one playing and the one the next WGO fills); allocated once, here.
-  static constexpr std::size_t kGenerators = 3;
-  using Slot = std::array<double, WaveTables::kPoints>;
-  WaveTables waves_;
-  std::unique_ptr<std::array<Slot, 2 * kGenerators>> slots_;
-  std::array<int, kGenerators> wave_table_{1, 2, 3};        // WSL
-  std::array<long long, kGenerators> wave_cycles_{};        // WGC, 0: until stopped
-  std::array<long long, kGenerators> wave_rate_{1, 1, 1};   // WTR
-  std::array<long long, kGenerators> wave_mode_{};          // WGO, as last set
-  std::array<int, kGenerators> wave_slot_{-1, -1, -1};      // the slot last handed over
-  std::array<std::uint64_t, kGenerators> wave_sequence_{};  // the last start/stop sent
-  std::array<bool, kGenerators> wave_running_{};            // as the loop last said
-  std::array<double, kGenerators> wave_min_{};              // range of the table playing
-  std::array<double, kGenerators> wave_max_{};
-  //! Waits (at most ~50 ms, draining samples) until the loop has applied generator g's last
-  //! start or stop, so that the slot it no longer reads may be written.
-  bool slot_free(std::size_t g);
-  //! Restarts the recording for a motion command when the trigger (DRT) says so.
-  void motion_trigger();
+  std::array<double, 3> velocity_{};  // VEL, stored (velocity control is off, VCO? 0)
+  WaveGenerators waves_{model_};      // one per axis
 };
 
 }  // namespace piezoshift::host

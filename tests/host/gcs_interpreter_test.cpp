@@ -7,15 +7,20 @@
 #include <cmath>
 #include <cstdint>
 #include <cstdlib>
+#include <fstream>
 #include <limits>
+#include <set>
+#include <sstream>
 #include <string>
 #include <string_view>
 #include <vector>
 
 #include "piezoshift/control/semi_closed_loop.hpp"
-#include "piezoshift/host/gcs_controller.hpp"
+#include "piezoshift/host/gcs_interpreter.hpp"
 #include "piezoshift/plant/geometry.hpp"
 #include "piezoshift/runtime/safety_supervisor.hpp"
+
+#include "../support/test_paths.hpp"
 
 namespace piezoshift::host {
 namespace {
@@ -50,9 +55,9 @@ std::string failed_answer(std::string_view line) {
   return name.back() == '?' ? "\n" : "";
 }
 
-class GcsControllerTest : public ::testing::Test {
+class GcsInterpreterTest : public ::testing::Test {
  protected:
-  explicit GcsControllerTest(const GcsOptions& options = GcsOptions{})
+  explicit GcsInterpreterTest(const GcsOptions& options = GcsOptions{})
       : model_(twin_params()), gcs_(model_, link_, 1e-3, options) {
     gcs_.on_connect(1);
     gcs_.on_connect(2);
@@ -114,11 +119,11 @@ class GcsControllerTest : public ::testing::Test {
 
   StageModel model_;
   runtime::HostLink link_;
-  GcsController gcs_;
+  GcsInterpreter gcs_;
   std::uint64_t tick_ = 0;
 };
 
-TEST_F(GcsControllerTest, IdentificationAndSyntaxQueries) {
+TEST_F(GcsInterpreterTest, IdentificationAndSyntaxQueries) {
   EXPECT_EQ(cmd("*IDN?"), GcsOptions{}.identification + "\n");
   EXPECT_EQ(cmd("CSV?"), "2.0\n");
   EXPECT_EQ(cmd("SAI?"), "Z \nU \nV\n");
@@ -143,7 +148,53 @@ TEST_F(GcsControllerTest, IdentificationAndSyntaxQueries) {
   EXPECT_EQ(err(), 0);
 }
 
-TEST_F(GcsControllerTest, UnknownCommandAnswersNothingAndQueues2) {
+// The command names in the first column of docs/gcs.md's "## Commands" table: the first word of
+// every `code` span there ("`VEL {axis} {v} ...`, `VEL? [axes]`" names VEL and VEL?).
+std::set<std::string> documented_commands() {
+  std::ifstream in(testing::source_dir() + "/docs/gcs.md");
+  EXPECT_TRUE(in) << "docs/gcs.md";
+  std::set<std::string> names;
+  std::string line;
+  bool in_section = false;
+  while (std::getline(in, line)) {
+    if (line.rfind("## ", 0) == 0 || line.rfind("### ", 0) == 0)
+      in_section = line == "## Commands";
+    if (!in_section || line.rfind("| `", 0) != 0)
+      continue;
+    const std::string first_column = line.substr(2, line.find("` | ") + 1 - 2);
+    for (std::size_t open = first_column.find('`'); open != std::string::npos;) {
+      const std::size_t close = first_column.find('`', open + 1);
+      const std::string code = first_column.substr(open + 1, close - open - 1);
+      names.insert(code.substr(0, code.find(' ')));
+      open = first_column.find('`', close + 1);
+    }
+  }
+  return names;
+}
+
+TEST_F(GcsInterpreterTest, TheDocsListEveryCommandOfTheTableAndNoOther) {
+  const std::set<std::string> documented = documented_commands();
+  std::set<std::string> known;
+  for (std::string_view name : GcsInterpreter::command_names())
+    known.insert(std::string(name));
+  EXPECT_EQ(known.size(), 53u);  // 48 command lines and #5, #7, #8, #9, #24
+  for (const std::string& name : known)
+    EXPECT_EQ(documented.count(name), 1u) << name << " is not in docs/gcs.md's command table";
+  for (const std::string& name : documented)
+    EXPECT_EQ(known.count(name), 1u) << name << " is documented but not a command";
+  // HLP? answers one line per command, in the table's order, between its heading and the axes.
+  std::istringstream help(cmd("HLP?"));
+  std::vector<std::string> listed;
+  for (std::string l; std::getline(help, l);)
+    listed.push_back(l.substr(0, l.find(' ')));
+  ASSERT_EQ(listed.size(), GcsInterpreter::command_names().size() + 2);
+  for (std::size_t i = 0; i < GcsInterpreter::command_names().size(); ++i)
+    EXPECT_EQ(listed[i + 1], GcsInterpreter::command_names()[i]);
+  EXPECT_EQ(cmd("FOO?"), "\n");  // and a name that is in neither is still error 2
+  EXPECT_EQ(err(), 2);
+}
+
+TEST_F(GcsInterpreterTest, UnknownCommandAnswersNothingAndQueues2) {
   EXPECT_EQ(cmd("FOO 1 2"), "");
   EXPECT_EQ(cmd("mov Z 1"), "");  // GCS commands are upper case
   EXPECT_EQ(err(), 2);
@@ -152,14 +203,14 @@ TEST_F(GcsControllerTest, UnknownCommandAnswersNothingAndQueues2) {
   EXPECT_EQ(err(), 0);
 }
 
-TEST_F(GcsControllerTest, BlankLinesAreIgnored) {
+TEST_F(GcsInterpreterTest, BlankLinesAreIgnored) {
   EXPECT_EQ(cmd(""), "");
   EXPECT_EQ(cmd(" \t "), "");
   EXPECT_EQ(err(), 0);
   EXPECT_TRUE(commands().empty());
 }
 
-TEST_F(GcsControllerTest, GarbageBytesAreAnUnknownCommand) {
+TEST_F(GcsInterpreterTest, GarbageBytesAreAnUnknownCommand) {
   EXPECT_EQ(cmd(std::string_view("\0\xff\xfe", 3)), "");
   EXPECT_EQ(cmd(std::string_view("MOV\0 Z 1", 8)), "");
   EXPECT_EQ(cmd("\r"), "");
@@ -170,7 +221,7 @@ TEST_F(GcsControllerTest, GarbageBytesAreAnUnknownCommand) {
   EXPECT_TRUE(commands().empty());
 }
 
-TEST_F(GcsControllerTest, PositionComesFromTheGauges) {
+TEST_F(GcsInterpreterTest, PositionComesFromTheGauges) {
   feed(at({3.0, 12.0, -8.0}, 0, false));
   EXPECT_EQ(cmd("POS?"), "Z=3.000000 \nU=12.000000 \nV=-8.000000\n");
   EXPECT_EQ(cmd("POS? U"), "U=12.000000\n");
@@ -181,7 +232,7 @@ TEST_F(GcsControllerTest, PositionComesFromTheGauges) {
   EXPECT_EQ(err(), 15);
 }
 
-TEST_F(GcsControllerTest, ServoOnStartsWhereTheGaugesAre) {
+TEST_F(GcsInterpreterTest, ServoOnStartsWhereTheGaugesAre) {
   const AxisValues pose{3.0, 12.0, -8.0};
   feed(at(pose, 0, false));
   EXPECT_EQ(cmd("SVO Z 1"), "");
@@ -199,7 +250,7 @@ TEST_F(GcsControllerTest, ServoOnStartsWhereTheGaugesAre) {
   EXPECT_EQ(gcs_.stats().commands_sent, 1u);
 }
 
-TEST_F(GcsControllerTest, ServoOffHoldsTheAppliedVolts) {
+TEST_F(GcsInterpreterTest, ServoOffHoldsTheAppliedVolts) {
   servo_on_at({3.0, 0.0, 0.0});
   HostSample s = at({3.0, 0.0, 0.0}, 1, true);
   // Channels (40, 33, 17) V at the amplifier = open-loop (Z 30, U 10, V 8), see the stage model.
@@ -216,7 +267,7 @@ TEST_F(GcsControllerTest, ServoOffHoldsTheAppliedVolts) {
   EXPECT_EQ(err(), 0);
 }
 
-TEST_F(GcsControllerTest, MoveSendsThePointsOfThePose) {
+TEST_F(GcsInterpreterTest, MoveSendsThePointsOfThePose) {
   const std::uint64_t on = servo_on_at({3.0, 12.0, -8.0});
   EXPECT_EQ(cmd("MOV Z 5"), "");
   HostCommand c = only_command();
@@ -241,7 +292,7 @@ TEST_F(GcsControllerTest, MoveSendsThePointsOfThePose) {
   EXPECT_EQ(err(), 0);
 }
 
-TEST_F(GcsControllerTest, OnTargetAfterTheSettleTime) {
+TEST_F(GcsInterpreterTest, OnTargetAfterTheSettleTime) {
   servo_on_at({3.0, 12.0, -8.0});
   EXPECT_EQ(cmd("MOV Z 5"), "");
   const HostCommand c = only_command();
@@ -273,11 +324,11 @@ TEST_F(GcsControllerTest, OnTargetAfterTheSettleTime) {
   EXPECT_EQ(err(), 0);
 }
 
-TEST_F(GcsControllerTest, SettleTimeFollowsTheOption) {
+TEST_F(GcsInterpreterTest, SettleTimeFollowsTheOption) {
   GcsOptions o;
   o.settle_time_s = 0.025;
   runtime::HostLink link;
-  GcsController gcs(model_, link, 5e-3, o);  // 0.025 s / 5 ms = 5 samples
+  GcsInterpreter gcs(model_, link, 5e-3, o);  // 0.025 s / 5 ms = 5 samples
   gcs.on_connect(7);
   HostSample s = at({4.0, 0.0, 0.0}, 0, false);
   link.samples.try_push(s);
@@ -292,7 +343,7 @@ TEST_F(GcsControllerTest, SettleTimeFollowsTheOption) {
   EXPECT_EQ(gcs.on_line(7, "ONT? Z"), "Z=1\n");
 }
 
-TEST_F(GcsControllerTest, MoveErrors) {
+TEST_F(GcsInterpreterTest, MoveErrors) {
   // Servo off: 5.
   feed(at({3.0, 0.0, 0.0}, 0, false));
   EXPECT_EQ(cmd("MOV Z 5"), "");
@@ -329,7 +380,7 @@ TEST_F(GcsControllerTest, MoveErrors) {
   EXPECT_EQ(err(), 0);
 }
 
-TEST_F(GcsControllerTest, ServoErrors) {
+TEST_F(GcsInterpreterTest, ServoErrors) {
   for (const char* line : {"SVO Z 1 U 0", "SVO Z 2", "SVO Z -1", "SVO Z 0.5"}) {
     EXPECT_EQ(cmd(line), "") << line;
     EXPECT_EQ(err(), 17) << line;
@@ -342,7 +393,7 @@ TEST_F(GcsControllerTest, ServoErrors) {
   EXPECT_EQ(cmd("SVO?"), "Z=0 \nU=0 \nV=0\n");
 }
 
-TEST_F(GcsControllerTest, OpenLoopMixesIntoTheChannels) {
+TEST_F(GcsInterpreterTest, OpenLoopMixesIntoTheChannels) {
   feed(at({0.0, 0.0, 0.0}, 0, false));
   // Channels = Z (1,1,1) + U (1,-1/2,-1/2) + V (0,1,-1) = (40, 33, 17) V; DAQ volts / 15.
   EXPECT_EQ(cmd("SVA Z 30 U 10 V 8"), "");
@@ -375,7 +426,7 @@ TEST_F(GcsControllerTest, OpenLoopMixesIntoTheChannels) {
   EXPECT_TRUE(commands().empty());
 }
 
-TEST_F(GcsControllerTest, VoltageQuery) {
+TEST_F(GcsInterpreterTest, VoltageQuery) {
   HostSample s = at({0.0, 0.0, 0.0}, 0, false);
   s.ao_V = {1.0, 2.0, 3.0};
   feed(s);
@@ -389,7 +440,7 @@ TEST_F(GcsControllerTest, VoltageQuery) {
   EXPECT_EQ(err(), 1);
 }
 
-TEST_F(GcsControllerTest, TravelLimitQueries) {
+TEST_F(GcsInterpreterTest, TravelLimitQueries) {
   EXPECT_EQ(cmd("TMN? Z"), "Z=0.000000\n");
   EXPECT_EQ(cmd("TMX? Z"), "Z=11.500000\n");
   const std::string tmx = cmd("TMX?");
@@ -401,7 +452,7 @@ TEST_F(GcsControllerTest, TravelLimitQueries) {
   EXPECT_NEAR(std::stod(tmn.substr(2)), model_.min_limits()[2], 1e-6);
 }
 
-TEST_F(GcsControllerTest, StopHoldsWhereTheStageIsAndQueues10ForItsClient) {
+TEST_F(GcsInterpreterTest, StopHoldsWhereTheStageIsAndQueues10ForItsClient) {
   const std::uint64_t on = servo_on_at({3.0, 12.0, -8.0});
   EXPECT_EQ(cmd("MOV Z 8"), "");
   only_command();
@@ -420,7 +471,7 @@ TEST_F(GcsControllerTest, StopHoldsWhereTheStageIsAndQueues10ForItsClient) {
   EXPECT_EQ(err(), 24);
 }
 
-TEST_F(GcsControllerTest, StopWithServoOffHoldsTheVolts) {
+TEST_F(GcsInterpreterTest, StopWithServoOffHoldsTheVolts) {
   HostSample s = at({2.0, 0.0, 0.0}, 0, false);
   s.ao_V = {2.0, 2.5, 3.0};
   feed(s);
@@ -435,14 +486,14 @@ TEST_F(GcsControllerTest, StopWithServoOffHoldsTheVolts) {
   EXPECT_EQ(err(2), 10);
 }
 
-TEST_F(GcsControllerTest, OverlongLineQueues3) {
+TEST_F(GcsInterpreterTest, OverlongLineQueues3) {
   EXPECT_EQ(gcs_.on_overlong_line(1), "");
   EXPECT_EQ(err(2), 0);
   EXPECT_EQ(err(1), 3);
   EXPECT_EQ(err(1), 0);
 }
 
-TEST_F(GcsControllerTest, ErrorQueuesArePerClientAndBounded) {
+TEST_F(GcsInterpreterTest, ErrorQueuesArePerClientAndBounded) {
   EXPECT_EQ(cmd("MOV Q 1", 1), "");
   for (int i = 0; i < 20; ++i)
     EXPECT_EQ(cmd("FOO", 1), "");
@@ -465,14 +516,14 @@ TEST_F(GcsControllerTest, ErrorQueuesArePerClientAndBounded) {
   EXPECT_EQ(err(3), 0);
 }
 
-class ShortQueueTest : public GcsControllerTest {
+class ShortQueueTest : public GcsInterpreterTest {
  protected:
   static GcsOptions options() {
     GcsOptions o;
     o.error_queue_length = 2;
     return o;
   }
-  ShortQueueTest() : GcsControllerTest(options()) {}
+  ShortQueueTest() : GcsInterpreterTest(options()) {}
 };
 
 TEST_F(ShortQueueTest, QueueLengthIsTheOption) {
@@ -484,7 +535,7 @@ TEST_F(ShortQueueTest, QueueLengthIsTheOption) {
   EXPECT_EQ(err(), 0);
 }
 
-TEST_F(GcsControllerTest, FaultSwitchesTheServoOffForEveryClient) {
+TEST_F(GcsInterpreterTest, FaultSwitchesTheServoOffForEveryClient) {
   const std::uint64_t on = servo_on_at({3.0, 0.0, 0.0});
   HostSample f = at({3.0, 0.0, 0.0}, on, false);
   f.state = static_cast<std::uint8_t>(runtime::SupervisorState::kFaulted);
@@ -524,7 +575,7 @@ TEST_F(GcsControllerTest, FaultSwitchesTheServoOffForEveryClient) {
   EXPECT_EQ(gcs_.stats().faults, 2u);
 }
 
-TEST_F(GcsControllerTest, FaultWithServoOffCanBeClearedBySvo0) {
+TEST_F(GcsInterpreterTest, FaultWithServoOffCanBeClearedBySvo0) {
   HostSample f = at({1.0, 0.0, 0.0}, 0, false);
   f.state = static_cast<std::uint8_t>(runtime::SupervisorState::kFaulted);
   feed(f);
@@ -537,9 +588,9 @@ TEST_F(GcsControllerTest, FaultWithServoOffCanBeClearedBySvo0) {
 // condition persists, the supervisor latches it again in the same tick, so the first sample with
 // applied_sequence >= the SVO's sequence is already kFaulted, with no running sample between.
 // The host must report that fault (-1024, SVO? 0) rather than keep reporting the servo on.
-// DISABLED: fails against GcsController::take() as written (faulted_ stays true through the SVO, so
-// `faulted && !faulted_` never fires); enable once that is fixed.
-TEST_F(GcsControllerTest, FaultThatRecursAsSoonAsSvoClearsItIsReported) {
+// DISABLED: fails against GcsInterpreter::take() as written (faulted_ stays true through the SVO,
+// so `faulted && !faulted_` never fires); enable once that is fixed.
+TEST_F(GcsInterpreterTest, FaultThatRecursAsSoonAsSvoClearsItIsReported) {
   const std::uint64_t on = servo_on_at({3.0, 0.0, 0.0});
   HostSample f = at({3.0, 0.0, 0.0}, on, false);
   f.state = static_cast<std::uint8_t>(runtime::SupervisorState::kFaulted);
@@ -553,7 +604,7 @@ TEST_F(GcsControllerTest, FaultThatRecursAsSoonAsSvoClearsItIsReported) {
   EXPECT_EQ(err(), -1024);
 }
 
-TEST_F(GcsControllerTest, NonFiniteGaugeRefusesServoOn) {
+TEST_F(GcsInterpreterTest, NonFiniteGaugeRefusesServoOn) {
   HostSample s = at({1.0, 0.0, 0.0}, 0, false);
   s.sgs_V[1] = std::numeric_limits<double>::quiet_NaN();
   feed(s);
@@ -563,7 +614,7 @@ TEST_F(GcsControllerTest, NonFiniteGaugeRefusesServoOn) {
   EXPECT_EQ(cmd("SVO?"), "Z=0 \nU=0 \nV=0\n");
 }
 
-TEST_F(GcsControllerTest, CommandRingFullQueues52) {
+TEST_F(GcsInterpreterTest, CommandRingFullQueues52) {
   servo_on_at({3.0, 0.0, 0.0});
   // The loop is not taking commands: the ring holds kCommandCapacity.
   for (std::size_t i = 0; i < runtime::HostLink::kCommandCapacity; ++i) {
@@ -576,7 +627,7 @@ TEST_F(GcsControllerTest, CommandRingFullQueues52) {
   EXPECT_EQ(commands().size(), runtime::HostLink::kCommandCapacity);
 }
 
-TEST_F(GcsControllerTest, RecorderSetUpCommands) {
+TEST_F(GcsInterpreterTest, RecorderSetUpCommands) {
   EXPECT_EQ(cmd("DRC?"), "1=Z 1 \n2=Z 2 \n3=0 0 \n4=0 0 \n5=0 0 \n6=0 0 \n7=0 0 \n8=0 0\n");
   EXPECT_EQ(cmd("DRC 3 1 17"), "");
   EXPECT_EQ(cmd("DRC 4 U 3"), "");
@@ -602,7 +653,7 @@ TEST_F(GcsControllerTest, RecorderSetUpCommands) {
   EXPECT_EQ(cmd("RTR?"), "2\n");
 }
 
-TEST_F(GcsControllerTest, RecorderRecordsTheLoopsSamples) {
+TEST_F(GcsInterpreterTest, RecorderRecordsTheLoopsSamples) {
   const std::uint64_t on = servo_on_at({3.0, 12.0, -8.0});
   EXPECT_EQ(cmd("DRC 3 1 17"), "");  // sensor of channel 1, um
   EXPECT_EQ(cmd("DRC 4 2 7"), "");   // amplifier output of channel 2, V
@@ -661,7 +712,7 @@ TEST_F(GcsControllerTest, RecorderRecordsTheLoopsSamples) {
   EXPECT_EQ(err(), 0);
 }
 
-TEST_F(GcsControllerTest, AFailedQueryAnswersOneEmptyLineAndASetCommandNothing) {
+TEST_F(GcsInterpreterTest, AFailedQueryAnswersOneEmptyLineAndASetCommandNothing) {
   EXPECT_EQ(cmd("FOO?"), "\n");
   EXPECT_EQ(cmd("POS? W"), "\n");
   EXPECT_EQ(cmd("FOO"), "");
@@ -671,7 +722,7 @@ TEST_F(GcsControllerTest, AFailedQueryAnswersOneEmptyLineAndASetCommandNothing) 
   EXPECT_EQ(err(), 0);
 }
 
-TEST_F(GcsControllerTest, SingleCharacterCommands) {
+TEST_F(GcsInterpreterTest, SingleCharacterCommands) {
   for (char c : {'\x05', '\x07', '\x08', '\x09', '\x18'})
     EXPECT_TRUE(gcs_.is_immediate(c)) << int(c);
   EXPECT_FALSE(gcs_.is_immediate('M'));
@@ -695,7 +746,7 @@ TEST_F(GcsControllerTest, SingleCharacterCommands) {
   EXPECT_EQ(err(2), 0);
 }
 
-TEST_F(GcsControllerTest, StageParametersAndRecorderHelp) {
+TEST_F(GcsInterpreterTest, StageParametersAndRecorderHelp) {
   EXPECT_EQ(cmd("CST?"), "Z=PIEZOSHIFT_TRIPOD \nU=PIEZOSHIFT_TRIPOD \nV=PIEZOSHIFT_TRIPOD\n");
   EXPECT_EQ(cmd("SPA? 1 0x0E000200"), "1 0x0E000200=0.001\n");
   EXPECT_EQ(cmd("SPA? Z 0x16000200 Z 0x16000300"), "Z 0x16000200=65536 \nZ 0x16000300=8\n");
@@ -723,7 +774,7 @@ TEST_F(GcsControllerTest, StageParametersAndRecorderHelp) {
   EXPECT_EQ(err(), 0);
 }
 
-TEST_F(GcsControllerTest, WaveTablesAndGeneratorSettings) {
+TEST_F(GcsInterpreterTest, WaveTablesAndGeneratorSettings) {
   EXPECT_EQ(cmd("WAV 1 X PNT 1 3 0.5 1.5 2.5"), "");
   EXPECT_EQ(cmd("WAV 1 & PNT 1 2 3.5 4.5"), "");
   EXPECT_EQ(cmd("WAV? 1 1"), "1 1=5\n");
@@ -757,7 +808,7 @@ TEST_F(GcsControllerTest, WaveTablesAndGeneratorSettings) {
   EXPECT_EQ(cmd("WAV? 1 1"), "1 1=5\n");  // the failed definitions left it as it was
 }
 
-TEST_F(GcsControllerTest, WaveGeneratorHandsAFixedSlotToTheLoopAndFollowsItsSamples) {
+TEST_F(GcsInterpreterTest, WaveGeneratorHandsAFixedSlotToTheLoopAndFollowsItsSamples) {
   const std::uint64_t on = servo_on_at({3.0, 0.0, 0.0});
   // One generator twice in one WGO is refused before anything starts (found by fuzzing: a start
   // then a stop of a generator without a table reached the table's empty range).
@@ -819,7 +870,7 @@ TEST_F(GcsControllerTest, WaveGeneratorHandsAFixedSlotToTheLoopAndFollowsItsSamp
   (void)on;
 }
 
-TEST_F(GcsControllerTest, CountsSamplesAndDrops) {
+TEST_F(GcsInterpreterTest, CountsSamplesAndDrops) {
   HostSample s = at({1.0, 0.0, 0.0}, 0, false);
   for (std::uint64_t tick : {0u, 1u, 2u, 6u, 7u}) {
     s.tick = tick;
