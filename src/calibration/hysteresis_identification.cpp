@@ -49,9 +49,12 @@ Eigen::VectorXd creep_regressor(const Eigen::VectorXd& h, const HysteresisCreepP
   return z;
 }
 
-HysteresisFit fit_with_creep_from(std::span<const double> command_um,
-                                  std::span<const double> gauge_um, double sample_time_s,
-                                  const HysteresisFitOptions& o, double threshold_phase) {
+std::size_t min_fit_rows(const HysteresisFitOptions& o) {
+  return 20 * (o.operators + 4) + o.max_delay_ticks;
+}
+
+void check_fit_input(std::span<const double> command_um, std::span<const double> gauge_um,
+                     double sample_time_s, const HysteresisFitOptions& o) {
   if (command_um.size() != gauge_um.size())
     throw FitError(fmt::format("hysteresis fit: {} commands but {} gauge readings",
                                command_um.size(), gauge_um.size()));
@@ -62,11 +65,15 @@ HysteresisFit fit_with_creep_from(std::span<const double> command_um,
       !(o.creep_shortest_s > 0.0) || !(o.creep_longest_s >= o.creep_shortest_s) ||
       o.creep_terms_per_decade < 1 || !(sample_time_s > 0.0))
     throw FitError("hysteresis fit: invalid options");
-  const std::size_t min_rows = 20 * (o.operators + 4) + o.max_delay_ticks;
+  const std::size_t min_rows = min_fit_rows(o);
   if (command_um.size() < min_rows)
     throw FitError(
         fmt::format("hysteresis fit: {} samples, at least {} needed", command_um.size(), min_rows));
+}
 
+// The model's fixed grid, no weights yet: operators evenly spaced over the command span (shifted
+// by threshold_phase of a spacing), creep time constants per decade from creep_shortest_s.
+HysteresisCreepParams model_grid(const HysteresisFitOptions& o, double threshold_phase) {
   HysteresisCreepParams base{};
   base.operators = o.operators;
   for (std::size_t j = 0; j < o.operators; ++j)
@@ -81,111 +88,173 @@ HysteresisFit fit_with_creep_from(std::span<const double> command_um,
     base.creep_time_constant_s[m] =
         o.creep_shortest_s *
         std::pow(10.0, static_cast<double>(m) / static_cast<double>(o.creep_terms_per_decade));
+  return base;
+}
 
-  const Eigen::MatrixXd s_all = play_outputs(command_um, base);
-  // Rows kept: not within exclude_after_jump_s of a jump of the command (by the row's own u).
+// Rows kept: not within exclude_after_jump_s of a jump of the command (by the row's own u).
+std::vector<char> quiet_samples(std::span<const double> command_um, double sample_time_s,
+                                const HysteresisFitOptions& o) {
   std::vector<char> quiet(command_um.size(), 1);
-  {
-    const auto hold = static_cast<std::size_t>(std::ceil(o.exclude_after_jump_s / sample_time_s));
-    std::size_t since = hold;
-    for (std::size_t k = 0; k < command_um.size(); ++k) {
-      if (k > 0 && std::fabs(command_um[k] - command_um[k - 1]) > o.jump_um)
-        since = 0;
-      quiet[k] = since >= hold ? 1 : 0;
-      ++since;
-    }
+  const auto hold = static_cast<std::size_t>(std::ceil(o.exclude_after_jump_s / sample_time_s));
+  std::size_t since = hold;
+  for (std::size_t k = 0; k < command_um.size(); ++k) {
+    if (k > 0 && std::fabs(command_um[k] - command_um[k - 1]) > o.jump_um)
+      since = 0;
+    quiet[k] = since >= hold ? 1 : 0;
+    ++since;
   }
+  return quiet;
+}
+
+// What the fit at every delay shares.
+struct FitProblem {
+  std::span<const double> command_um;
+  std::span<const double> gauge_um;
+  double sample_time_s;
+  const HysteresisFitOptions& o;
+  HysteresisCreepParams base;  //!< model_grid()
+  Eigen::MatrixXd s_all;       //!< the operators' outputs on the whole command
+  std::vector<char> quiet;     //!< quiet_samples()
+  std::size_t min_rows;
+};
+
+// The samples fitted at one delay: y_k is the gauge D ticks after the command u_k.
+struct DelayedSamples {
+  Eigen::VectorXd u, y;
+  std::vector<Eigen::Index> rows;  //!< the quiet ones
+};
+
+DelayedSamples delayed_samples(const FitProblem& f, std::size_t d) {
+  const auto n = static_cast<Eigen::Index>(f.command_um.size() - d);
+  const auto di = static_cast<Eigen::Index>(d);
+  DelayedSamples s{Eigen::VectorXd(n), Eigen::VectorXd(n), {}};
+  for (Eigen::Index k = 0; k < n; ++k) {
+    s.y(k) = f.gauge_um[static_cast<std::size_t>(k + di)];
+    s.u(k) = f.command_um[static_cast<std::size_t>(k)];
+  }
+  for (Eigen::Index k = 0; k < n; ++k)
+    if (f.quiet[static_cast<std::size_t>(k)] != 0)
+      s.rows.push_back(k);
+  if (s.rows.size() < f.min_rows)
+    throw FitError(fmt::format("hysteresis fit: {} quiet samples, at least {} needed",
+                               s.rows.size(), f.min_rows));
+  return s;
+}
+
+// The fixed columns (1, u, the operators) on the rows fitted, compressed once.
+CompressedLeastSquares fixed_columns(const FitProblem& f, const DelayedSamples& s) {
+  Eigen::MatrixXd B(static_cast<Eigen::Index>(s.rows.size()), 2 + f.o.operators);
+  Eigen::VectorXd y_rows(static_cast<Eigen::Index>(s.rows.size()));
+  for (std::size_t r = 0; r < s.rows.size(); ++r) {
+    const auto ri = static_cast<Eigen::Index>(r);
+    B(ri, 0) = 1.0;
+    B(ri, 1) = s.u(s.rows[r]);
+    for (std::size_t j = 0; j < f.o.operators; ++j)
+      B(ri, static_cast<Eigen::Index>(2 + j)) = f.s_all(s.rows[r], static_cast<Eigen::Index>(j));
+    y_rows(ri) = s.y(s.rows[r]);
+  }
+  return CompressedLeastSquares(B, y_rows);
+}
+
+// The creep column on the rows fitted: the creep regressor run on p's hysteresis.
+Eigen::VectorXd creep_column(const FitProblem& f, const DelayedSamples& s,
+                             const HysteresisCreepParams& p) {
+  Eigen::VectorXd h = p.linear_weight * s.u;
+  for (std::size_t j = 0; j < f.o.operators; ++j)
+    h += p.weight[j] * f.s_all.col(static_cast<Eigen::Index>(j)).head(s.u.size());
+  const Eigen::VectorXd z = creep_regressor(h, p, f.sample_time_s);
+  Eigen::VectorXd z_rows(static_cast<Eigen::Index>(s.rows.size()));
+  for (std::size_t r = 0; r < s.rows.size(); ++r)
+    z_rows(static_cast<Eigen::Index>(r)) = z(s.rows[r]);
+  return z_rows;
+}
+
+// Least squares on 1, u, the kept operators (and z when not empty), dropping the operator with
+// the most negative weight until none is negative; kept is left with the operators kept.
+LeastSquaresSolution solve_non_negative(const CompressedLeastSquares& ls,
+                                        std::vector<std::size_t>& kept,
+                                        const Eigen::VectorXd& z_rows) {
+  for (;;) {
+    std::vector<std::size_t> cols{0, 1};
+    for (const std::size_t j : kept)
+      cols.push_back(2 + j);
+    LeastSquaresSolution sol = ls.solve(cols, z_rows);
+    std::size_t worst = kept.size();
+    double worst_w = 0.0;
+    for (std::size_t j = 0; j < kept.size(); ++j)
+      if (sol.x(static_cast<Eigen::Index>(2 + j)) < worst_w) {
+        worst_w = sol.x(static_cast<Eigen::Index>(2 + j));
+        worst = j;
+      }
+    if (worst == kept.size())
+      return sol;
+    kept.erase(kept.begin() + static_cast<std::ptrdiff_t>(worst));
+  }
+}
+
+HysteresisFit fit_at_delay(const FitProblem& f, std::size_t d) {
+  const DelayedSamples s = delayed_samples(f, d);
+  const CompressedLeastSquares ls = fixed_columns(f, s);
+  LeastSquaresSolution sol;
+  HysteresisCreepParams p = f.base;
+  std::size_t dropped = 0;
+  std::vector<std::size_t> kept;
+  // Pass 0 without creep; then the creep regressor run on the previous pass's hysteresis, and
+  // all together again, max_creep_passes times or until the creep gain settles (the creep is
+  // bilinear in the weights and its gain; each pass is the exact least squares given the last
+  // pass's h).
+  for (std::size_t pass = 0; pass <= f.o.max_creep_passes; ++pass) {
+    Eigen::VectorXd z_rows;
+    if (pass > 0)
+      z_rows = creep_column(f, s, p);
+    // Pass 1 keeps the operators pass 0 kept; a later pass starts from all again (an operator
+    // dropped while the creep was missing may be needed once it is modelled).
+    if (pass != 1) {
+      kept.resize(f.o.operators);
+      for (std::size_t j = 0; j < f.o.operators; ++j)
+        kept[j] = j;
+    }
+    sol = solve_non_negative(ls, kept, z_rows);
+    const double last_gain = p.creep_gain;
+    p = f.base;
+    p.offset_um = sol.x(0);
+    p.linear_weight = sol.x(1);
+    p.weight = {};
+    for (std::size_t j = 0; j < kept.size(); ++j)
+      p.weight[kept[j]] = sol.x(static_cast<Eigen::Index>(2 + j));
+    p.creep_gain = pass > 0 ? sol.x(sol.x.size() - 1) : 0.0;
+    dropped = f.o.operators - kept.size();
+    if (pass > 1 && std::fabs(p.creep_gain - last_gain) <= f.o.creep_gain_tolerance)
+      break;
+  }
+  HysteresisFit fit;
+  fit.params = p;
+  fit.delay_ticks = d;
+  fit.rms_residual_um = sol.rms;
+  fit.operators_dropped = dropped;
+  fit.samples_fitted = s.rows.size();
+  return fit;
+}
+
+HysteresisFit fit_with_creep_from(std::span<const double> command_um,
+                                  std::span<const double> gauge_um, double sample_time_s,
+                                  const HysteresisFitOptions& o, double threshold_phase) {
+  check_fit_input(command_um, gauge_um, sample_time_s, o);
+  const HysteresisCreepParams base = model_grid(o, threshold_phase);
+  const FitProblem problem{command_um,
+                           gauge_um,
+                           sample_time_s,
+                           o,
+                           base,
+                           play_outputs(command_um, base),
+                           quiet_samples(command_um, sample_time_s, o),
+                           min_fit_rows(o)};
   HysteresisFit best;
   best.rms_residual_um = std::numeric_limits<double>::infinity();
   for (std::size_t d = 0; d <= o.max_delay_ticks; ++d) {
-    const auto n = static_cast<Eigen::Index>(command_um.size() - d);
-    const auto di = static_cast<Eigen::Index>(d);
-    Eigen::VectorXd y(n);
-    Eigen::VectorXd u(n);
-    for (Eigen::Index k = 0; k < n; ++k) {
-      y(k) = gauge_um[static_cast<std::size_t>(k + di)];
-      u(k) = command_um[static_cast<std::size_t>(k)];
-    }
-    std::vector<Eigen::Index> rows;
-    for (Eigen::Index k = 0; k < n; ++k)
-      if (quiet[static_cast<std::size_t>(k)] != 0)
-        rows.push_back(k);
-    if (rows.size() < min_rows)
-      throw FitError(fmt::format("hysteresis fit: {} quiet samples, at least {} needed",
-                                 rows.size(), min_rows));
-    // The fixed columns (1, u, the operators) on the rows fitted, compressed once.
-    Eigen::MatrixXd B(static_cast<Eigen::Index>(rows.size()), 2 + o.operators);
-    Eigen::VectorXd y_rows(static_cast<Eigen::Index>(rows.size()));
-    for (std::size_t r = 0; r < rows.size(); ++r) {
-      const auto ri = static_cast<Eigen::Index>(r);
-      B(ri, 0) = 1.0;
-      B(ri, 1) = u(rows[r]);
-      for (std::size_t j = 0; j < o.operators; ++j)
-        B(ri, static_cast<Eigen::Index>(2 + j)) = s_all(rows[r], static_cast<Eigen::Index>(j));
-      y_rows(ri) = y(rows[r]);
-    }
-    const CompressedLeastSquares ls(B, y_rows);
-    LeastSquaresSolution sol;
-    HysteresisCreepParams p = base;
-    std::size_t dropped = 0;
-    std::vector<std::size_t> kept;
-    // Pass 0 without creep; then the creep regressor run on the previous pass's hysteresis, and
-    // all together again, max_creep_passes times or until the creep gain settles (the creep is
-    // bilinear in the weights and its gain; each pass is the exact least squares given the last
-    // pass's h).
-    for (std::size_t pass = 0; pass <= o.max_creep_passes; ++pass) {
-      Eigen::VectorXd z_rows;
-      if (pass > 0) {
-        Eigen::VectorXd h = p.linear_weight * u;
-        for (std::size_t j = 0; j < o.operators; ++j)
-          h += p.weight[j] * s_all.col(static_cast<Eigen::Index>(j)).head(n);
-        const Eigen::VectorXd z = creep_regressor(h, p, sample_time_s);
-        z_rows.resize(static_cast<Eigen::Index>(rows.size()));
-        for (std::size_t r = 0; r < rows.size(); ++r)
-          z_rows(static_cast<Eigen::Index>(r)) = z(rows[r]);
-      }
-      // Pass 1 keeps the operators pass 0 kept; a later pass starts from all again (an operator
-      // dropped while the creep was missing may be needed once it is modelled).
-      if (pass != 1) {
-        kept.resize(o.operators);
-        for (std::size_t j = 0; j < o.operators; ++j)
-          kept[j] = j;
-      }
-      for (;;) {
-        std::vector<std::size_t> cols{0, 1};
-        for (const std::size_t j : kept)
-          cols.push_back(2 + j);
-        sol = ls.solve(cols, z_rows);
-        std::size_t worst = kept.size();
-        double worst_w = 0.0;
-        for (std::size_t j = 0; j < kept.size(); ++j)
-          if (sol.x(static_cast<Eigen::Index>(2 + j)) < worst_w) {
-            worst_w = sol.x(static_cast<Eigen::Index>(2 + j));
-            worst = j;
-          }
-        if (worst == kept.size())
-          break;
-        kept.erase(kept.begin() + static_cast<std::ptrdiff_t>(worst));
-      }
-      const double last_gain = p.creep_gain;
-      p = base;
-      p.offset_um = sol.x(0);
-      p.linear_weight = sol.x(1);
-      p.weight = {};
-      for (std::size_t j = 0; j < kept.size(); ++j)
-        p.weight[kept[j]] = sol.x(static_cast<Eigen::Index>(2 + j));
-      p.creep_gain = pass > 0 ? sol.x(sol.x.size() - 1) : 0.0;
-      dropped = o.operators - kept.size();
-      if (pass > 1 && std::fabs(p.creep_gain - last_gain) <= o.creep_gain_tolerance)
-        break;
-    }
-    if (sol.rms < best.rms_residual_um) {
-      best.params = p;
-      best.delay_ticks = d;
-      best.rms_residual_um = sol.rms;
-      best.operators_dropped = dropped;
-      best.samples_fitted = rows.size();
-    }
+    const HysteresisFit fit = fit_at_delay(problem, d);
+    if (fit.rms_residual_um < best.rms_residual_um)
+      best = fit;
   }
   if (!(best.params.linear_weight > 0.0))
     throw FitError("hysteresis fit: the gauges do not follow the command (slope <= 0)");

@@ -25,96 +25,128 @@ double exposure_settling_time_s(const std::vector<double>& time_s,
   return 0.0;
 }
 
-PhaseStepResult run_phase_step(const config::ProjectConfig& config,
-                               const control::SemiClosedLoopParams& controller, std::uint64_t seed,
-                               const PhaseStepOptions& o, const Progress& progress) {
+namespace {
+
+void check_options(const PhaseStepOptions& o) {
   if (!(o.wavelength_nm > 0.0 && o.start_um >= 0.0 && o.settle_s >= 0.0 && o.hold_s > 0.0 &&
         o.record_s > 0.0 && o.exposure_s > 0.0 && o.tolerance_nm > 0.0 &&
         o.target_tolerance_nm > 0.0))
     throw std::invalid_argument("phase step: every duration, length and tolerance must be > 0");
-  PhaseStepResult r;
-  r.step_nm = o.step_nm();
-  const double z0_um = o.start_um;
-  const double z1_um = z0_um + 1e-3 * r.step_nm;
-  Bench bench(config, controller, seed, o.bench);
-  const double ts = bench.sample_time_s();
-  const double periods = o.exposure_s / ts;
+}
+
+// Control periods per exposure; refused unless the exposure is a whole number of them.
+std::size_t periods_per_exposure(const PhaseStepOptions& o, double sample_time_s) {
+  const double periods = o.exposure_s / sample_time_s;
   const auto per_exposure = static_cast<std::size_t>(std::llround(periods));
   if (per_exposure < 1 || std::fabs(periods - static_cast<double>(per_exposure)) > 1e-6)
     throw std::invalid_argument(fmt::format(
         "phase step: the exposure ({:g} s) must be a whole number of control periods ({:g} s)",
-        o.exposure_s, ts));
+        o.exposure_s, sample_time_s));
+  return per_exposure;
+}
 
-  // One run: settle, hold (its exposure means' trend line gives the level before), then drive
-  // to target_um and record.
-  struct Run {
-    std::vector<double> time_s, mean_nm;
-    double hold_jitter_nm_rms = 0.0;
-  };
-  const auto run_once = [&](Bench& on, double target_um, Run& run) {
-    on.drive_points(Vec3{z0_um, z0_um, z0_um});
-    on.run(o.settle_s);
+// One exposure mean per tick: a boxcar over the last per_exposure period averages of the plate's
+// true position.
+class ExposureWindow {
+ public:
+  explicit ExposureWindow(std::size_t per_exposure) : per_exposure_(per_exposure) {}
 
-    // One exposure mean per tick: a boxcar over the last per_exposure period averages.
-    std::deque<double> window;
-    double window_sum = 0.0;
-    const auto exposure_mean_nm = [&](const Bench& b) {
-      const double v = 1e3 * b.twin().truth().period_avg_mean_points_um;
-      window.push_back(v);
-      window_sum += v;
-      if (window.size() > per_exposure) {
-        window_sum -= window.front();
-        window.pop_front();
-      }
-      return window_sum / static_cast<double>(window.size());
-    };
-
-    // The hold: exposure means (once the window is full) and their least-squares line.
-    std::vector<double> hold_t, hold_v;
-    const double t_hold = on.time_s();
-    on.run(o.hold_s, [&](const Bench& b) {
-      const double v = exposure_mean_nm(b);
-      if (window.size() == per_exposure) {
-        hold_t.push_back(b.time_s() - t_hold);
-        hold_v.push_back(v);
-      }
-    });
-    const double n = static_cast<double>(hold_t.size());
-    double mt = 0.0, mv = 0.0;
-    for (std::size_t k = 0; k < hold_t.size(); ++k) {
-      mt += hold_t[k] / n;
-      mv += hold_v[k] / n;
+  //! Adds this tick's period average; returns the mean over the window [nm].
+  double add(const Bench& b) {
+    const double v = 1e3 * b.twin().truth().period_avg_mean_points_um;
+    window_.push_back(v);
+    sum_ += v;
+    if (window_.size() > per_exposure_) {
+      sum_ -= window_.front();
+      window_.pop_front();
     }
-    double stt = 0.0, stv = 0.0;
-    for (std::size_t k = 0; k < hold_t.size(); ++k) {
-      stt += (hold_t[k] - mt) * (hold_t[k] - mt);
-      stv += (hold_t[k] - mt) * (hold_v[k] - mv);
-    }
-    const double slope = stt > 0.0 ? stv / stt : 0.0;
-    double ss = 0.0;
-    for (std::size_t k = 0; k < hold_t.size(); ++k) {
-      const double e = hold_v[k] - (mv + slope * (hold_t[k] - mt));
-      ss += e * e;
-    }
-    run.hold_jitter_nm_rms = hold_t.size() > 2 ? std::sqrt(ss / (n - 2.0)) : 0.0;
-    const double t_step = on.time_s();
-    const double level_nm = mv + slope * (t_step - t_hold - mt);
-    if (target_um != z0_um)
-      if (const std::string sat = detail::saturation_problem(on, z0_um); !sat.empty())
-        r.validity.fail(sat + " before the step");
-    on.drive_points(Vec3{target_um, target_um, target_um});
-    on.run(o.record_s, [&](const Bench& b) {
-      run.time_s.push_back(b.time_s() - t_step);
-      run.mean_nm.push_back(exposure_mean_nm(b) - level_nm);
-    });
-  };
+    return sum_ / static_cast<double>(window_.size());
+  }
+  bool full() const { return window_.size() == per_exposure_; }
 
-  Run stepped;
-  run_once(bench, z1_um, stepped);
-  r.time_s = stepped.time_s;
-  r.exposure_mean_nm = stepped.mean_nm;
-  r.hold_jitter_nm_rms = stepped.hold_jitter_nm_rms;
-  r.simulated_time_s = bench.time_s();
+ private:
+  std::size_t per_exposure_;
+  std::deque<double> window_;
+  double sum_ = 0.0;
+};
+
+// The hold's exposure means about their least-squares line (drift is not jitter).
+struct HoldTrend {
+  double mean_t_s = 0.0, mean_nm = 0.0, slope_nm_per_s = 0.0;
+  double jitter_nm_rms = 0.0;  //!< rms of the residuals, n - 2 degrees of freedom
+
+  double at(double t_s) const { return mean_nm + slope_nm_per_s * (t_s - mean_t_s); }
+};
+
+HoldTrend hold_trend(const std::vector<double>& t_s, const std::vector<double>& v_nm) {
+  HoldTrend h;
+  const double n = static_cast<double>(t_s.size());
+  double mt = 0.0, mv = 0.0;
+  for (std::size_t k = 0; k < t_s.size(); ++k) {
+    mt += t_s[k] / n;
+    mv += v_nm[k] / n;
+  }
+  double stt = 0.0, stv = 0.0;
+  for (std::size_t k = 0; k < t_s.size(); ++k) {
+    stt += (t_s[k] - mt) * (t_s[k] - mt);
+    stv += (t_s[k] - mt) * (v_nm[k] - mv);
+  }
+  const double slope = stt > 0.0 ? stv / stt : 0.0;
+  double ss = 0.0;
+  for (std::size_t k = 0; k < t_s.size(); ++k) {
+    const double e = v_nm[k] - (mv + slope * (t_s[k] - mt));
+    ss += e * e;
+  }
+  h.mean_t_s = mt;
+  h.mean_nm = mv;
+  h.slope_nm_per_s = slope;
+  h.jitter_nm_rms = t_s.size() > 2 ? std::sqrt(ss / (n - 2.0)) : 0.0;
+  return h;
+}
+
+struct Run {
+  std::vector<double> time_s, mean_nm;
+  double hold_jitter_nm_rms = 0.0;
+};
+
+// One run: settle at start_um, hold (its exposure means' trend line gives the level before),
+// then drive to target_um and record. A PID at its limit before a step fails validity.
+Run run_once(Bench& on, const PhaseStepOptions& o, std::size_t per_exposure, double target_um,
+             Validity& validity) {
+  const double z0_um = o.start_um;
+  on.drive_points(Vec3{z0_um, z0_um, z0_um});
+  on.run(o.settle_s);
+  ExposureWindow window(per_exposure);
+
+  // The hold: exposure means (once the window is full) and their least-squares line.
+  std::vector<double> hold_t, hold_v;
+  const double t_hold = on.time_s();
+  on.run(o.hold_s, [&](const Bench& b) {
+    const double v = window.add(b);
+    if (window.full()) {
+      hold_t.push_back(b.time_s() - t_hold);
+      hold_v.push_back(v);
+    }
+  });
+  const HoldTrend trend = hold_trend(hold_t, hold_v);
+  Run run;
+  run.hold_jitter_nm_rms = trend.jitter_nm_rms;
+  const double t_step = on.time_s();
+  const double level_nm = trend.at(t_step - t_hold);
+  if (target_um != z0_um)
+    if (const std::string sat = detail::saturation_problem(on, z0_um); !sat.empty())
+      validity.fail(sat + " before the step");
+  on.drive_points(Vec3{target_um, target_um, target_um});
+  on.run(o.record_s, [&](const Bench& b) {
+    run.time_s.push_back(b.time_s() - t_step);
+    run.mean_nm.push_back(window.add(b) - level_nm);
+  });
+  return run;
+}
+
+// The stepped run's settling time and final error, and whether it made the step asked for.
+void judge_step(PhaseStepResult& r, const Bench& bench, const PhaseStepOptions& o,
+                std::size_t per_exposure, double z1_um) {
   r.settling_time_s =
       exposure_settling_time_s(r.time_s, r.exposure_mean_nm, r.step_nm, o.tolerance_nm);
   const std::size_t tail = std::min<std::size_t>(10 * per_exposure, r.exposure_mean_nm.size());
@@ -129,13 +161,16 @@ PhaseStepResult run_phase_step(const config::ProjectConfig& config,
     r.validity.fail(fmt::format(
         "the phase step did not reach its target: {:.2f} nm for {:.2f} nm (tolerance {:g} nm)",
         final_nm, r.step_nm, o.target_tolerance_nm));
+}
 
-  // The same run without the step: the twin's noise and drift do not depend on the drive, so
-  // the difference is the controller's own step (the excitation drift scales with position:
-  // 79 nm in 5 um changes it by 1.6 %, well below the figures' resolution).
+// The same run without the step: the twin's noise and drift do not depend on the drive, so
+// the difference is the controller's own step (the excitation drift scales with position:
+// 79 nm in 5 um changes it by 1.6 %, well below the figures' resolution).
+void compare_with_still_run(PhaseStepResult& r, const config::ProjectConfig& config,
+                            const control::SemiClosedLoopParams& controller, std::uint64_t seed,
+                            const PhaseStepOptions& o, std::size_t per_exposure) {
   Bench still_bench(config, controller, seed, o.bench);
-  Run still;
-  run_once(still_bench, z0_um, still);
+  const Run still = run_once(still_bench, o, per_exposure, o.start_um, r.validity);
   r.simulated_time_s += still_bench.time_s();
   detail::check_fault(still_bench, r.validity, "during the phase step's run without the step");
   r.still_exposure_mean_nm = still.mean_nm;
@@ -145,6 +180,27 @@ PhaseStepResult run_phase_step(const config::ProjectConfig& config,
     r.still_wander_nm = std::max(r.still_wander_nm, std::fabs(still.mean_nm[k]));
   }
   r.own_settling_time_s = exposure_settling_time_s(r.time_s, own, r.step_nm, o.tolerance_nm);
+}
+
+}  // namespace
+
+PhaseStepResult run_phase_step(const config::ProjectConfig& config,
+                               const control::SemiClosedLoopParams& controller, std::uint64_t seed,
+                               const PhaseStepOptions& o, const Progress& progress) {
+  check_options(o);
+  PhaseStepResult r;
+  r.step_nm = o.step_nm();
+  const double z1_um = o.start_um + 1e-3 * r.step_nm;
+  Bench bench(config, controller, seed, o.bench);
+  const std::size_t per_exposure = periods_per_exposure(o, bench.sample_time_s());
+
+  const Run stepped = run_once(bench, o, per_exposure, z1_um, r.validity);
+  r.time_s = stepped.time_s;
+  r.exposure_mean_nm = stepped.mean_nm;
+  r.hold_jitter_nm_rms = stepped.hold_jitter_nm_rms;
+  r.simulated_time_s = bench.time_s();
+  judge_step(r, bench, o, per_exposure, z1_um);
+  compare_with_still_run(r, config, controller, seed, o, per_exposure);
   if (progress)
     progress(1, 1, "phase step");
   return r;

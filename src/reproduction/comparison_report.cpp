@@ -204,6 +204,110 @@ std::vector<SeedComparison>::const_iterator draw_figures(const ComparisonResult&
   return drawn;
 }
 
+// One CSV per controller: a row per seed, a column per figure it measures.
+void write_per_seed_data(const ComparisonResult& r, const fs::path& dir, ReportFiles& files) {
+  for (ControllerKind k : kControllerKinds) {
+    std::vector<std::size_t> cols;
+    std::vector<std::string> names{"seed"};
+    for (std::size_t i = 0; i < r.figures.size(); ++i) {
+      if (r.figures[i].of(r.seeds.front()[k]).measured) {
+        cols.push_back(i);
+        names.push_back(r.figures[i].key);
+      }
+    }
+    const fs::path path = dir / fmt::format("per_seed_{}.csv", controller_key(k));
+    io::CsvWriter w(path.string(), names, 9);
+    for (const SeedComparison& sc : r.seeds) {
+      std::vector<double> row{static_cast<double>(sc.seed)};
+      for (std::size_t i : cols) {
+        const FigureValue f = r.figures[i].of(sc[k]);
+        row.push_back(f.validity.valid ? f.value : std::numeric_limits<double>::quiet_NaN());
+      }
+      w.row(row);
+    }
+    w.close();
+    files.data.push_back(path);
+  }
+}
+
+void introduction(Document& doc, const ComparisonResult& r, const std::string& config_label) {
+  std::string seeds;
+  for (const std::uint64_t s : r.options.seeds)
+    seeds += (seeds.empty() ? "" : ", ") + std::to_string(s);
+  doc.heading(1, "The paper's controller, the improved one and the oracle, side by side");
+  doc.paragraph(fmt::format(
+      "Each controller calibrated by its own procedure on the digital twin, then the same "
+      "experiments through the loop that ships, on the same seeds: {}. {} schedule, "
+      "configuration: {}. {:.0f} s of simulated time in {:.1f} s of wall time. Every number is "
+      "the median over the seeds; a figure that is not valid on one seed is not valid here.",
+      seeds, r.options.quick ? "Quick (shortened)" : "The paper's full", config_label,
+      r.simulated_time_s, r.wall_time_s));
+}
+
+void medians_section(Document& doc, const ComparisonResult& r) {
+  doc.heading(2, "Medians over the seeds");
+  std::vector<std::vector<std::string>> rows{{"figure", "paper's controller", "improved controller",
+                                              "oracle (plate feedback: impossible on hardware)"}};
+  for (std::size_t i = 0; i < r.figures.size(); ++i) {
+    std::vector<std::string> row{r.figures[i].label};
+    for (ControllerKind k : kControllerKinds)
+      row.push_back(value_text(r.medians[i][idx(k)], r.figures[i].unit));
+    rows.push_back(std::move(row));
+  }
+  doc.table(std::move(rows));
+  doc.paragraph(
+      "The oracle is the paper's loop with its calibrated gains and A, fed the plate's true point "
+      "displacements instead of the strain gauges (so with no cubic to correct): the floor no "
+      "controller fed by the gauges can beat. It has no margins of its own (the paper's PID).");
+}
+
+void targets_section(Document& doc, const ComparisonResult& r) {
+  doc.heading(2, "Issue 12's targets, on the improved controller's medians");
+  std::vector<std::vector<std::string>> rows{{"target", "bound", "improved (median)", "met"}};
+  for (const Target& t : r.targets) {
+    rows.push_back(
+        {t.text, t.bound_text,
+         t.improved.measured ? value_text(t.improved, t.unit) : "not measured by compare",
+         !t.improved.measured ? "-"
+         : t.met              ? "yes"
+                              : "no"});
+  }
+  doc.table(std::move(rows));
+}
+
+// drawn: the seed draw_figures() drew, or r.seeds.end() when none.
+void figures_section(Document& doc, const ComparisonResult& r,
+                     std::vector<SeedComparison>::const_iterator drawn) {
+  if (drawn != r.seeds.end()) {
+    doc.heading(2, fmt::format("Figures (seed {})", drawn->seed));
+    doc.image("The 11 um step of the three controllers", "compare_step_response.png");
+    doc.image("The lambda/8 phase step on 1 ms exposure means", "compare_phase_step.png");
+    doc.image("Linearity error curves", "compare_linearity_error.png");
+    doc.image("Repeatability histograms at 5 and 10 um", "compare_repeatability.png");
+  } else {
+    doc.heading(2, "Figures");
+    doc.paragraph("None: no controller was calibrated on any seed, so no experiment ran.");
+  }
+}
+
+void per_seed_section(Document& doc, const ComparisonResult& r, const ReportFiles& files) {
+  doc.heading(2, "Per seed");
+  std::vector<std::vector<std::string>> rows{{"seed", "figure", "paper", "improved", "oracle"}};
+  for (const SeedComparison& sc : r.seeds) {
+    for (const FigureSpec& f : r.figures) {
+      std::vector<std::string> row{std::to_string(sc.seed), f.label};
+      for (ControllerKind k : kControllerKinds)
+        row.push_back(value_text(f.of(sc[k]), f.unit));
+      rows.push_back(std::move(row));
+    }
+  }
+  doc.table(std::move(rows));
+  std::string list;
+  for (const auto& f : files.data)
+    list += f.filename().string() + "  ";
+  doc.paragraph("Data beside this report (CSV: one row per seed, nan where not valid): " + list);
+}
+
 }  // namespace
 
 nlohmann::json comparison_json(const ComparisonResult& r) {
@@ -244,114 +348,22 @@ ReportFiles write_comparison_report(const ComparisonResult& r, const fs::path& d
                                     const std::string& config_label) {
   create_report_folder(dir);
   ReportFiles files;
-
-  // One CSV per controller: a row per seed, a column per figure it measures.
-  for (ControllerKind k : kControllerKinds) {
-    std::vector<std::size_t> cols;
-    std::vector<std::string> names{"seed"};
-    for (std::size_t i = 0; i < r.figures.size(); ++i) {
-      if (r.figures[i].of(r.seeds.front()[k]).measured) {
-        cols.push_back(i);
-        names.push_back(r.figures[i].key);
-      }
-    }
-    const fs::path path = dir / fmt::format("per_seed_{}.csv", controller_key(k));
-    io::CsvWriter w(path.string(), names, 9);
-    for (const SeedComparison& sc : r.seeds) {
-      std::vector<double> row{static_cast<double>(sc.seed)};
-      for (std::size_t i : cols) {
-        const FigureValue f = r.figures[i].of(sc[k]);
-        row.push_back(f.validity.valid ? f.value : std::numeric_limits<double>::quiet_NaN());
-      }
-      w.row(row);
-    }
-    w.close();
-    files.data.push_back(path);
-  }
+  write_per_seed_data(r, dir, files);
   write_text(dir / "comparison.json", comparison_json(r).dump(2) + "\n");
   files.data.push_back(dir / "comparison.json");
-
   const auto drawn = draw_figures(r, dir, files);
-  std::vector<Block> doc;
-  auto h = [&](int level, std::string t) {
-    doc.push_back({Block::kHeading, level, std::move(t), {}, {}});
-  };
-  auto p = [&](std::string t) { doc.push_back({Block::kParagraph, 0, std::move(t), {}, {}}); };
-  auto table = [&](std::vector<std::vector<std::string>> rows) {
-    doc.push_back({Block::kTable, 0, {}, std::move(rows), {}});
-  };
-  auto image = [&](std::string caption, std::string path) {
-    doc.push_back({Block::kImage, 0, std::move(caption), {}, std::move(path)});
-  };
-  std::string seeds;
-  for (const std::uint64_t s : r.options.seeds)
-    seeds += (seeds.empty() ? "" : ", ") + std::to_string(s);
 
-  h(1, "The paper's controller, the improved one and the oracle, side by side");
-  p(fmt::format(
-      "Each controller calibrated by its own procedure on the digital twin, then the same "
-      "experiments through the loop that ships, on the same seeds: {}. {} schedule, "
-      "configuration: {}. {:.0f} s of simulated time in {:.1f} s of wall time. Every number is "
-      "the median over the seeds; a figure that is not valid on one seed is not valid here.",
-      seeds, r.options.quick ? "Quick (shortened)" : "The paper's full", config_label,
-      r.simulated_time_s, r.wall_time_s));
-  h(2, "Medians over the seeds");
-  std::vector<std::vector<std::string>> rows{{"figure", "paper's controller", "improved controller",
-                                              "oracle (plate feedback: impossible on hardware)"}};
-  for (std::size_t i = 0; i < r.figures.size(); ++i) {
-    std::vector<std::string> row{r.figures[i].label};
-    for (ControllerKind k : kControllerKinds)
-      row.push_back(value_text(r.medians[i][idx(k)], r.figures[i].unit));
-    rows.push_back(std::move(row));
-  }
-  table(std::move(rows));
-  p("The oracle is the paper's loop with its calibrated gains and A, fed the plate's true point "
-    "displacements instead of the strain gauges (so with no cubic to correct): the floor no "
-    "controller fed by the gauges can beat. It has no margins of its own (the paper's PID).");
-
-  h(2, "Issue 12's targets, on the improved controller's medians");
-  std::vector<std::vector<std::string>> trows{{"target", "bound", "improved (median)", "met"}};
-  for (const Target& t : r.targets) {
-    trows.push_back(
-        {t.text, t.bound_text,
-         t.improved.measured ? value_text(t.improved, t.unit) : "not measured by compare",
-         !t.improved.measured ? "-"
-         : t.met              ? "yes"
-                              : "no"});
-  }
-  table(std::move(trows));
-
-  if (drawn != r.seeds.end()) {
-    h(2, fmt::format("Figures (seed {})", drawn->seed));
-    image("The 11 um step of the three controllers", "compare_step_response.png");
-    image("The lambda/8 phase step on 1 ms exposure means", "compare_phase_step.png");
-    image("Linearity error curves", "compare_linearity_error.png");
-    image("Repeatability histograms at 5 and 10 um", "compare_repeatability.png");
-  } else {
-    h(2, "Figures");
-    p("None: no controller was calibrated on any seed, so no experiment ran.");
-  }
-
-  h(2, "Per seed");
-  std::vector<std::vector<std::string>> srows{{"seed", "figure", "paper", "improved", "oracle"}};
-  for (const SeedComparison& sc : r.seeds) {
-    for (const FigureSpec& f : r.figures) {
-      std::vector<std::string> row{std::to_string(sc.seed), f.label};
-      for (ControllerKind k : kControllerKinds)
-        row.push_back(value_text(f.of(sc[k]), f.unit));
-      srows.push_back(std::move(row));
-    }
-  }
-  table(std::move(srows));
-  std::string list;
-  for (const auto& f : files.data)
-    list += f.filename().string() + "  ";
-  p("Data beside this report (CSV: one row per seed, nan where not valid): " + list);
+  Document doc;
+  introduction(doc, r, config_label);
+  medians_section(doc, r);
+  targets_section(doc, r);
+  figures_section(doc, r, drawn);
+  per_seed_section(doc, r, files);
 
   files.markdown = dir / "comparison.md";
   files.html = dir / "comparison.html";
-  write_text(files.markdown, to_markdown(doc));
-  write_text(files.html, to_html(doc, "piezoshift compare"));
+  write_text(files.markdown, to_markdown(doc.blocks));
+  write_text(files.html, to_html(doc.blocks, "piezoshift compare"));
   return files;
 }
 

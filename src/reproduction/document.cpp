@@ -2,6 +2,7 @@
 
 #include <fstream>
 #include <system_error>
+#include <utility>
 
 #include <fmt/core.h>
 
@@ -34,6 +35,26 @@ std::string html_escape(const std::string& s) {
 }
 
 }  // namespace
+
+void Document::heading(int level, std::string text) {
+  blocks.push_back({Block::kHeading, level, std::move(text), {}, {}});
+}
+
+void Document::paragraph(std::string text) {
+  blocks.push_back({Block::kParagraph, 0, std::move(text), {}, {}});
+}
+
+void Document::code(std::string text) {
+  blocks.push_back({Block::kCode, 0, std::move(text), {}, {}});
+}
+
+void Document::table(std::vector<std::vector<std::string>> rows) {
+  blocks.push_back({Block::kTable, 0, {}, std::move(rows), {}});
+}
+
+void Document::image(std::string caption, std::string path) {
+  blocks.push_back({Block::kImage, 0, std::move(caption), {}, std::move(path)});
+}
 
 std::string to_markdown(const std::vector<Block>& blocks) {
   std::string out;

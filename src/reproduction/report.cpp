@@ -219,15 +219,9 @@ void write_data(const ReproductionResult& r, const fs::path& dir, ReportFiles& f
   files.data.push_back(dir / "calibration.toml");
 }
 
-}  // namespace
-
-ReportFiles write_report(const ReproductionResult& r, const fs::path& dir,
-                         const std::string& config_label) {
-  create_report_folder(dir);
-  ReportFiles files;
-  write_data(r, dir, files);
-
-  // Figures 10 to 12.
+// Figures 10 to 12 and the phase step, and the inner loop's Bode plot when a loop rate was
+// analysed; returns whether it was.
+bool write_figures(const ReproductionResult& r, const fs::path& dir, ReportFiles& files) {
   experiments::StepResponseOptions so;
   so.band_pct = r.step.metrics.band_pct;
   so.band_nm = r.step.metrics.band_nm;
@@ -251,25 +245,62 @@ ReportFiles write_report(const ReproductionResult& r, const fs::path& dir,
                                     [](const InnerLoopAnalysis& a) { return a.validity.valid; });
   if (any_loop)
     files.figures.push_back(*io::render(inner_loop_figure(r), dir / "inner_loop_bode").png);
+  return any_loop;
+}
 
-  const auto& cal = r.calibration;
-  const auto& step = r.step.metrics;
-  const control::SemiClosedLoopParams paper{};
-  std::vector<Block> doc;
-  auto h = [&](int level, std::string t) {
-    doc.push_back({Block::kHeading, level, std::move(t), {}, {}});
-  };
-  auto p = [&](std::string t) { doc.push_back({Block::kParagraph, 0, std::move(t), {}, {}}); };
-  auto code = [&](std::string t) { doc.push_back({Block::kCode, 0, std::move(t), {}, {}}); };
-  auto table = [&](std::vector<std::vector<std::string>> rows) {
-    doc.push_back({Block::kTable, 0, {}, std::move(rows), {}});
-  };
-  auto image = [&](std::string caption, std::string path) {
-    doc.push_back({Block::kImage, 0, std::move(caption), {}, std::move(path)});
-  };
+// A cell whose experiment is not valid says so, never a number.
+std::string valid_or(const experiments::Validity& v, std::string text) {
+  return v.valid ? text : "NOT VALID: " + v.reason;
+}
 
-  h(1, "Reproduction of Li et al. (2017) on the piezoshift digital twin");
-  p(fmt::format(
+std::string travel_cell(const ExperimentSet& e) {
+  return valid_or(e.travel.validity,
+                  fmt::format("{:.2f} um @open loop; {:.1f} um @semi-closed loop",
+                              e.travel.open_loop_um, e.travel.semi_closed_um));
+}
+
+std::string step_cell(const ExperimentSet& e) {
+  return valid_or(
+      e.step.validity,
+      fmt::format("{} @{:g} um (+-2 %); {} to +-10 nm", seconds(e.step.metrics.settling_time_pct_s),
+                  e.step.desired_um.back(), seconds(e.step.metrics.settling_time_abs_s)));
+}
+
+std::string linearity_cell(const ExperimentSet& e) {
+  return valid_or(e.linearity.validity, fmt::format("{:.3f} % (zero-end); {:.3f} % (best fit)",
+                                                    e.linearity.metrics.linearity_zero_end_pct,
+                                                    e.linearity.metrics.linearity_best_fit_pct));
+}
+
+std::string repeat_cell(const ExperimentSet& e) {
+  return valid_or(e.repeat_5um.validity,
+                  fmt::format("{:.2f} nm @5 um (n = {})", e.repeat_5um.metrics.repeatability_nm,
+                              e.repeat_5um.metrics.n)) +
+         "; " +
+         valid_or(e.repeat_10um.validity,
+                  fmt::format("{:.2f} nm @10 um (n = {})", e.repeat_10um.metrics.repeatability_nm,
+                              e.repeat_10um.metrics.n));
+}
+
+// Zero-end / best-fit linearity of one sweep.
+std::string sweep_cell(const experiments::LinearityResult& l) {
+  return valid_or(l.validity, fmt::format("{:.3f} % / {:.3f} %", l.metrics.linearity_zero_end_pct,
+                                          l.metrics.linearity_best_fit_pct));
+}
+
+std::vector<std::string> sweep_row(const char* name, const experiments::LinearityResult& paper,
+                                   const experiments::LinearityResult& oracle) {
+  return {name, sweep_cell(paper), sweep_cell(oracle)};
+}
+
+std::string margin_text(double value, const char* unit, double at_Hz) {
+  return std::isfinite(value) ? fmt::format("{:.1f} {} at {:.1f} Hz", value, unit, at_Hz)
+                              : std::string("none (no crossover)");
+}
+
+void introduction(Document& doc, const ReproductionResult& r, const std::string& config_label) {
+  doc.heading(1, "Reproduction of Li et al. (2017) on the piezoshift digital twin");
+  doc.paragraph(fmt::format(
       "The paper's calibration and its four experiments (Sections 3 and 4), run on the digital "
       "twin of the paper's hardware through the same controller code that runs on a real bench. "
       "Seed {}, {} schedule, PID gains: {}, configuration: {}. {:.0f} s of simulated time in "
@@ -278,156 +309,135 @@ ReportFiles write_report(const ReproductionResult& r, const fs::path& dir,
       r.options.pid == calibration::PidChoice::kPaper ? "the paper's (kp 0.6, ki 0.2, kd 0.001)"
                                                       : "the stage-1 search's",
       config_label, r.simulated_time_s, r.wall_time_s));
+}
 
-  h(2, "Table 4: results");
-  // A cell whose experiment is not valid says so, never a number.
-  const auto valid_or = [](const experiments::Validity& v, std::string text) {
-    return v.valid ? text : "NOT VALID: " + v.reason;
-  };
-  const auto travel_cell = [&](const ExperimentSet& e) {
-    return valid_or(e.travel.validity,
-                    fmt::format("{:.2f} um @open loop; {:.1f} um @semi-closed loop",
-                                e.travel.open_loop_um, e.travel.semi_closed_um));
-  };
-  const auto step_cell = [&](const ExperimentSet& e) {
-    return valid_or(e.step.validity, fmt::format("{} @{:g} um (+-2 %); {} to +-10 nm",
-                                                 seconds(e.step.metrics.settling_time_pct_s),
-                                                 e.step.desired_um.back(),
-                                                 seconds(e.step.metrics.settling_time_abs_s)));
-  };
-  const auto linearity_cell = [&](const ExperimentSet& e) {
-    return valid_or(e.linearity.validity, fmt::format("{:.3f} % (zero-end); {:.3f} % (best fit)",
-                                                      e.linearity.metrics.linearity_zero_end_pct,
-                                                      e.linearity.metrics.linearity_best_fit_pct));
-  };
-  const auto repeat_cell = [&](const ExperimentSet& e) {
-    return valid_or(e.repeat_5um.validity,
-                    fmt::format("{:.2f} nm @5 um (n = {})", e.repeat_5um.metrics.repeatability_nm,
-                                e.repeat_5um.metrics.n)) +
-           "; " +
-           valid_or(e.repeat_10um.validity,
-                    fmt::format("{:.2f} nm @10 um (n = {})", e.repeat_10um.metrics.repeatability_nm,
-                                e.repeat_10um.metrics.n));
-  };
-  table({{"", "Travel range", "Step response", "Linearity", "Repeatability (1 sigma)"},
-         {"This paper", "12.9 um @open loop; 11.5 um @semi-closed loop", "<0.3 s @11 um", "0.21 %",
-          "2 nm @5 um; 3 nm @10 um"},
-         {"Twin, the paper's controller (this run)", travel_cell(r), step_cell(r),
-          linearity_cell(r), repeat_cell(r)},
-         {"Twin, oracle (plate feedback: impossible on hardware)", travel_cell(r.oracle),
-          step_cell(r.oracle), linearity_cell(r.oracle), repeat_cell(r.oracle)},
-         {"S315.10 (PI)", "12 um @open loop", "-", "2 % - 4 %", "-"},
-         {"NPS-Z-15H (Queensgate)", "15 um @closed loop", "-", "0.02 %", "-"}});
+// Table 4 beside the paper's and the commercial stages' rows, what was not valid, the step's
+// details.
+void results_section(Document& doc, const ReproductionResult& r) {
+  doc.heading(2, "Table 4: results");
+  doc.table({{"", "Travel range", "Step response", "Linearity", "Repeatability (1 sigma)"},
+             {"This paper", "12.9 um @open loop; 11.5 um @semi-closed loop", "<0.3 s @11 um",
+              "0.21 %", "2 nm @5 um; 3 nm @10 um"},
+             {"Twin, the paper's controller (this run)", travel_cell(r), step_cell(r),
+              linearity_cell(r), repeat_cell(r)},
+             {"Twin, oracle (plate feedback: impossible on hardware)", travel_cell(r.oracle),
+              step_cell(r.oracle), linearity_cell(r.oracle), repeat_cell(r.oracle)},
+             {"S315.10 (PI)", "12 um @open loop", "-", "2 % - 4 %", "-"},
+             {"NPS-Z-15H (Queensgate)", "15 um @closed loop", "-", "0.02 %", "-"}});
   const std::vector<std::string> invalid = r.invalid_reasons();
   if (invalid.empty()) {
-    p("Every experiment of the paper's controller is valid: no supervisor trip, no PID at its "
-      "output limit where a value was measured, every target reached and the step settled.");
+    doc.paragraph(
+        "Every experiment of the paper's controller is valid: no supervisor trip, no PID at its "
+        "output limit where a value was measured, every target reached and the step settled.");
   } else {
     std::string text =
         "NOT VALID: the following experiments of the paper's controller did not "
         "measure what they claim, so their numbers above are not results:";
     for (const std::string& why : invalid)
       text += "\n- " + why;
-    code(text);
+    doc.code(text);
   }
   for (const std::string& why : r.oracle.invalid_reasons())
-    p("Oracle not valid: " + why);
-  p(fmt::format(
+    doc.paragraph("Oracle not valid: " + why);
+  const auto& step = r.step.metrics;
+  doc.paragraph(fmt::format(
       "Step response details: rise time (10-90 %) {}, overshoot {:.2f} % at the interferometer's "
       "1 kHz samples and {:.2f} % on the true plate between them, step {:.3f} um.",
       seconds(step.rise_time_s), step.overshoot_pct, r.step.truth_overshoot_pct, step.step_um));
-  p("The oracle is the same loop, the same gains and A, fed the plate's true point displacements "
-    "instead of the strain gauges (and so with no cubic to correct): the floor no controller fed "
-    "by the gauges can beat.");
-  h(3, "Linearity beyond the paper's protocol");
-  const auto lin_cell = [&](const experiments::LinearityResult& l) {
-    return valid_or(l.validity, fmt::format("{:.3f} % / {:.3f} %", l.metrics.linearity_zero_end_pct,
-                                            l.metrics.linearity_best_fit_pct));
-  };
-  const auto lin_row = [&](const char* name, const experiments::LinearityResult& a,
-                           const experiments::LinearityResult& b) {
-    return std::vector<std::string>{name, lin_cell(a), lin_cell(b)};
-  };
-  table({{"sweep (zero-end / best fit)", "paper's controller", "oracle"},
-         lin_row("0 to 11 um in 1 um, upwards (the paper's)", r.linearity, r.oracle.linearity),
-         lin_row("0 to 11 um in 0.25 um, upwards (levels the calibration never saw)",
+  doc.paragraph(
+      "The oracle is the same loop, the same gains and A, fed the plate's true point displacements "
+      "instead of the strain gauges (and so with no cubic to correct): the floor no controller fed "
+      "by the gauges can beat.");
+}
+
+void linearity_section(Document& doc, const ReproductionResult& r) {
+  doc.heading(3, "Linearity beyond the paper's protocol");
+  doc.table(
+      {{"sweep (zero-end / best fit)", "paper's controller", "oracle"},
+       sweep_row("0 to 11 um in 1 um, upwards (the paper's)", r.linearity, r.oracle.linearity),
+       sweep_row("0 to 11 um in 0.25 um, upwards (levels the calibration never saw)",
                  r.linearity_grid, r.oracle.linearity_grid),
-         lin_row("11 to 1 um in 1 um, downwards", r.linearity_down, r.oracle.linearity_down),
-         {"the paper's, without the cubic (p = identity)", lin_cell(r.linearity_without_cubic),
-          "-"}});
-  p(fmt::format(
+       sweep_row("11 to 1 um in 1 um, downwards", r.linearity_down, r.oracle.linearity_down),
+       {"the paper's, without the cubic (p = identity)", sweep_cell(r.linearity_without_cubic),
+        "-"}});
+  doc.paragraph(fmt::format(
       "Without the cubic the semi-closed loop's own nonlinearity (the SGS conditioner's bow and "
       "the ball contact, both outside what the gauges' PID can see) reads {}; the paper measured "
       "0.21 % with its cubic. With the cubic the twin's error is its noise and drift: with those "
       "off, the same sweep reads about 0.002 % (docs/twin.md).",
-      lin_cell(r.linearity_without_cubic)));
+      sweep_cell(r.linearity_without_cubic)));
+}
 
-  h(3, "Phase step (beyond the paper)");
-  const auto ps_cell = [&](const experiments::PhaseStepResult& e, const std::string& v) {
-    return valid_or(e.validity, v);
-  };
-  const auto ps_row = [&](const char* name, auto value) {
-    return std::vector<std::string>{name, ps_cell(r.phase_step, value(r.phase_step)),
-                                    ps_cell(r.oracle.phase_step, value(r.oracle.phase_step))};
+void phase_step_section(Document& doc, const ReproductionResult& r) {
+  doc.heading(3, "Phase step (beyond the paper)");
+  const auto row = [&](const char* name, auto value) {
+    return std::vector<std::string>{
+        name, valid_or(r.phase_step.validity, value(r.phase_step)),
+        valid_or(r.oracle.phase_step.validity, value(r.oracle.phase_step))};
   };
   using PS = experiments::PhaseStepResult;
-  table({{"lambda/8 step at 5 um", "paper's controller", "oracle"},
-         ps_row("hold jitter, 1 ms exposure means (rms)",
-                [](const PS& e) { return fmt::format("{:.2f} nm", e.hold_jitter_nm_rms); }),
-         ps_row("settled to +-1 nm after", [](const PS& e) { return seconds(e.settling_time_s); }),
-         ps_row("final error",
-                [](const PS& e) { return fmt::format("{:.2f} nm", e.final_error_nm); })});
-  p(fmt::format(
+  doc.table(
+      {{"lambda/8 step at 5 um", "paper's controller", "oracle"},
+       row("hold jitter, 1 ms exposure means (rms)",
+           [](const PS& e) { return fmt::format("{:.2f} nm", e.hold_jitter_nm_rms); }),
+       row("settled to +-1 nm after", [](const PS& e) { return seconds(e.settling_time_s); }),
+       row("final error", [](const PS& e) { return fmt::format("{:.2f} nm", e.final_error_nm); })});
+  doc.paragraph(fmt::format(
       "What a phase-shifting measurement needs: a {:.1f} nm step (pi/2 at 632.8 nm) judged on the "
       "plate's true position averaged over each 1 ms camera exposure. The jitter is what the "
       "loop feeds of the gauges' noise into the plate while it holds; the settling time is when "
       "every later exposure stays within +-1 nm of the target, within {:g} ms.",
       r.phase_step.step_nm, 1e3 * r.schedule.phase_step.record_s));
-  image("Phase step", "phase_step.png");
+  doc.image("Phase step", "phase_step.png");
+}
 
-  h(3, "Inner loop: the identified plant and the PID's stability margins");
-  std::vector<std::vector<std::string>> loop_rows{{"loop rate", "actuator", "plant gain u -> y",
-                                                   "model residual (rms)", "gain margin",
-                                                   "phase margin"}};
-  const auto margin_text = [](double value, const char* unit, double at_Hz) {
-    return std::isfinite(value) ? fmt::format("{:.1f} {} at {:.1f} Hz", value, unit, at_Hz)
-                                : std::string("none (no crossover)");
-  };
+// Per loop rate and actuator: the identified plant and the calibrated PID's margins on it.
+void inner_loop_section(Document& doc, const ReproductionResult& r, bool any_loop) {
+  doc.heading(3, "Inner loop: the identified plant and the PID's stability margins");
+  std::vector<std::vector<std::string>> rows{{"loop rate", "actuator", "plant gain u -> y",
+                                              "model residual (rms)", "gain margin",
+                                              "phase margin"}};
   for (const InnerLoopAnalysis& a : r.inner_loop) {
     if (!a.validity.valid) {
-      loop_rows.push_back({fmt::format("{:g} kHz", 1e-3 / a.sample_time_s), "-",
-                           "not available: " + a.validity.reason, "", "", ""});
+      rows.push_back({fmt::format("{:g} kHz", 1e-3 / a.sample_time_s), "-",
+                      "not available: " + a.validity.reason, "", "", ""});
       continue;
     }
     for (std::size_t i = 0; i < 3; ++i) {
       const auto& m = a.margins[i];
       const auto& model = a.plant.channel[i];
-      loop_rows.push_back({fmt::format("{:g} kHz", 1e-3 / a.sample_time_s),
-                           fmt::format("{}", i + 1), fmt::format("{:.3f}", model.dc_gain()),
-                           fmt::format("{:.1f} nm", 1e3 * model.rms_residual_um),
-                           margin_text(m.gain_margin_dB, "dB", m.phase_crossover_Hz),
-                           margin_text(m.phase_margin_deg, "deg", m.gain_crossover_Hz)});
+      rows.push_back({fmt::format("{:g} kHz", 1e-3 / a.sample_time_s), fmt::format("{}", i + 1),
+                      fmt::format("{:.3f}", model.dc_gain()),
+                      fmt::format("{:.1f} nm", 1e3 * model.rms_residual_um),
+                      margin_text(m.gain_margin_dB, "dB", m.phase_crossover_Hz),
+                      margin_text(m.phase_margin_deg, "deg", m.gain_crossover_Hz)});
     }
   }
-  table(loop_rows);
-  p("Each actuator's plant, from the PID's output (um of command) to its gauge (um), identified by "
-    "least squares (ARX, 3 poles, 4 delayed inputs) from +-80 nm pseudo-random steps around 5 um, "
-    "through the loop that ships, so its delays are the real ones; the 10 kHz row runs the twin's "
-    "DAQ at 0.1 ms with the same gains re-expressed per sample. The margins are those of the "
-    "calibrated PID on that model (calibration/stability_margins.hpp).");
+  doc.table(rows);
+  doc.paragraph(
+      "Each actuator's plant, from the PID's output (um of command) to its gauge (um), identified "
+      "by least squares (ARX, 3 poles, 4 delayed inputs) from +-80 nm pseudo-random steps around "
+      "5 um, through the loop that ships, so its delays are the real ones; the 10 kHz row runs "
+      "the twin's DAQ at 0.1 ms with the same gains re-expressed per sample. The margins are "
+      "those of the calibrated PID on that model (calibration/stability_margins.hpp).");
   if (any_loop)
-    image("Inner loop Bode plot", "inner_loop_bode.png");
+    doc.image("Inner loop Bode plot", "inner_loop_bode.png");
+}
 
-  h(2, "Calibration");
-  h(3, "Stage 1: PID gains");
-  p(
+// The three calibration stages: PID gains, A and p, each beside the paper's.
+void calibration_section(Document& doc, const ReproductionResult& r) {
+  const auto& cal = r.calibration;
+  const control::SemiClosedLoopParams paper{};
+  doc.heading(2, "Calibration");
+  doc.heading(3, "Stage 1: PID gains");
+  doc.paragraph(
       fmt::format("Each actuator stepped alone (inner loop) to 95 % of what its SGS reads at 10 V "
                   "open loop: {:.3f}, {:.3f}, {:.3f} um. Scores are the worst of the three "
                   "actuators; a candidate is acceptable with overshoot <= 1 %, settled to +-2 % "
                   "within the record and a steady-state error <= 5 nm. {} candidates searched.",
                   cal.pid.step_target_um[0], cal.pid.step_target_um[1], cal.pid.step_target_um[2],
                   cal.pid.trials.size()));
-  table(
+  doc.table(
       {{"gains", "kp / ki / kd", "overshoot", "settling (2 %)", "steady-state error", "acceptable"},
        trial_row("paper", cal.pid.paper),
        trial_row("search best", cal.pid.best),
@@ -436,46 +446,70 @@ ReportFiles write_report(const ReproductionResult& r, const fs::path& dir,
                                  cal.pid.paper.gains.kd == cal.controller.gains.kd
                              ? cal.pid.paper
                              : cal.pid.best)});
-  h(3, "Stage 2: transmission matrix A");
-  p(
+  doc.heading(3, "Stage 2: transmission matrix A");
+  doc.paragraph(
       fmt::format("{} poses (each actuator moved alone by {:g} um from {:g} um, in closed loop), "
                   "least squares: rms residual {:.4f} um, cond(A) = {:.3f}.",
                   cal.matrix.fit.poses, r.schedule.calibration.matrix.move_um,
                   r.schedule.calibration.matrix.base_um, cal.matrix.fit.rms_residual_um,
                   cal.matrix.fit.condition_number));
-  code("identified A:\n" + matrix_text(cal.controller.matrix.a) + "\n\npaper's A:\n" +
-       matrix_text(paper.matrix.a));
-  h(3, "Stage 3: cubic polynomial p");
-  p(fmt::format(
+  doc.code("identified A:\n" + matrix_text(cal.controller.matrix.a) + "\n\npaper's A:\n" +
+           matrix_text(paper.matrix.a));
+  doc.heading(3, "Stage 3: cubic polynomial p");
+  doc.paragraph(fmt::format(
       "{} equally spaced commands over 0 to {:g} um, {} of them left out with a PID at "
       "its limit; rms residual {:.4f} um.",
       r.schedule.calibration.polynomial.points, r.schedule.calibration.polynomial.max_um,
       cal.polynomial.saturated_points, cal.polynomial.fit.rms_residual_um));
-  code("fitted: " + poly_text(cal.controller.polynomial) +
-       "\npaper:  " + poly_text(paper.polynomial));
-  p("The paper's A and p describe its own stage; the twin's are identified from the twin by the "
-    "same procedure, so they agree where the twin's geometry and sensors follow the paper's and "
-    "differ where the paper's stage had effects the twin does not model (docs/twin.md).");
+  doc.code("fitted: " + poly_text(cal.controller.polynomial) +
+           "\npaper:  " + poly_text(paper.polynomial));
+  doc.paragraph(
+      "The paper's A and p describe its own stage; the twin's are identified from the twin by the "
+      "same procedure, so they agree where the twin's geometry and sensors follow the paper's and "
+      "differ where the paper's stage had effects the twin does not model (docs/twin.md).");
+}
 
-  h(2, "Figures");
-  image("Figure 10: step response", "fig10_step_response.png");
-  image("Figure 11: linearity, (a) displacement, (b) error", "fig11_linearity.png");
-  image("Figure 12: repeatability at 5 and 10 um", "fig12_repeatability.png");
+void figures_and_files_section(Document& doc, const ReportFiles& files) {
+  doc.heading(2, "Figures");
+  doc.image("Figure 10: step response", "fig10_step_response.png");
+  doc.image("Figure 11: linearity, (a) displacement, (b) error", "fig11_linearity.png");
+  doc.image("Figure 12: repeatability at 5 and 10 um", "fig12_repeatability.png");
 
-  h(2, "Files");
+  doc.heading(2, "Files");
   std::string list;
   for (const auto& f : files.data)
     list += f.filename().string() + "  ";
-  p("Data beside this report (CSV columns carry their units; `piezoshift fit` and `piezoshift "
-    "analyze` read them): " +
-    list);
-  p("To watch the stage live: `piezoshift serve --daq sim --http-port 8080`, then open "
-    "http://127.0.0.1:8080/ (docs/dashboard.md).");
+  doc.paragraph(
+      "Data beside this report (CSV columns carry their units; `piezoshift fit` and `piezoshift "
+      "analyze` read them): " +
+      list);
+  doc.paragraph(
+      "To watch the stage live: `piezoshift serve --daq sim --http-port 8080`, then open "
+      "http://127.0.0.1:8080/ (docs/dashboard.md).");
+}
+
+}  // namespace
+
+ReportFiles write_report(const ReproductionResult& r, const fs::path& dir,
+                         const std::string& config_label) {
+  create_report_folder(dir);
+  ReportFiles files;
+  write_data(r, dir, files);
+  const bool any_loop = write_figures(r, dir, files);
+
+  Document doc;
+  introduction(doc, r, config_label);
+  results_section(doc, r);
+  linearity_section(doc, r);
+  phase_step_section(doc, r);
+  inner_loop_section(doc, r, any_loop);
+  calibration_section(doc, r);
+  figures_and_files_section(doc, files);
 
   files.markdown = dir / "report.md";
   files.html = dir / "report.html";
-  write_text(files.markdown, to_markdown(doc));
-  write_text(files.html, to_html(doc, "piezoshift reproduction"));
+  write_text(files.markdown, to_markdown(doc.blocks));
+  write_text(files.html, to_html(doc.blocks, "piezoshift reproduction"));
   return files;
 }
 

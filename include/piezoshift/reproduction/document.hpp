@@ -15,6 +15,18 @@ struct Block {
   std::string path;                            //!< image, relative to the document
 };
 
+//! A report's blocks appended in reading order, one call per block, so a report writer reads as
+//! its outline.
+struct Document {
+  std::vector<Block> blocks;
+
+  void heading(int level, std::string text);
+  void paragraph(std::string text);
+  void code(std::string text);
+  void table(std::vector<std::vector<std::string>> rows);
+  void image(std::string caption, std::string path);
+};
+
 std::string to_markdown(const std::vector<Block>& blocks);
 //! A standalone page; text is escaped.
 std::string to_html(const std::vector<Block>& blocks, const std::string& title);
