@@ -1,7 +1,7 @@
 // The twin's cost: one control tick of the full three-leg twin (its default 20 physics steps per
 // 1 ms), alone and with the paper's controller closed through the shipping loop (the simulated
-// bench: sim backend, supervisor, ControlLoop on a simulated clock). The counter x_real_time is simulated
-// seconds per wall-clock second (docs/performance.md).
+// bench: sim backend, supervisor, ControlLoop on a simulated clock). The counter x_real_time is
+// simulated seconds per wall-clock second (docs/performance.md).
 #include <benchmark/benchmark.h>
 
 #include "piezoshift/experiments/bench.hpp"

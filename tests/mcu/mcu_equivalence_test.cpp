@@ -23,7 +23,6 @@
 #include "piezoshift/control/semi_closed_loop.hpp"
 #include "piezoshift/firmware/test_vector.hpp"
 #include "piezoshift/plant/twin.hpp"
-#include "open_loop.hpp"
 
 namespace piezoshift::firmware {
 namespace {
@@ -243,8 +242,10 @@ TEST(McuFirmware, FloatAndDoubleControllersHoldTheTwinAlikeInClosedLoop) {
     const auto out_d = c_d.update(Vec3{z[0], z[1], z[2]}, ai_d);
     const auto out_f =
         c_f.update(FloatController::Vec{z[0], z[1], z[2]}, control::convert<float>(ai_f));
-    testing::hold_one_period(twin_d, out_d.dac_V);
-    testing::hold_one_period(twin_f, control::convert<double>(out_f.dac_V));
+    twin_d.write_ao(out_d.dac_V);
+    twin_d.advance();
+    twin_f.write_ao(control::convert<double>(out_f.dac_V));
+    twin_f.advance();
     if (twin_d.truth().ao_V != twin_f.truth().ao_V)
       ++dac_differs;
     for (std::size_t i = 0; i < 3; ++i) {

@@ -10,13 +10,13 @@
 
 #include <gtest/gtest.h>
 
+#include "open_loop.hpp"
 #include "piezoshift/plant/flicker.hpp"
 #include "piezoshift/plant/interferometer.hpp"
 #include "piezoshift/plant/lab_environment.hpp"
 #include "piezoshift/plant/random.hpp"
 #include "piezoshift/plant/twin.hpp"
 #include "piezoshift/plant/twin_model.hpp"
-#include "open_loop.hpp"
 
 namespace piezoshift::plant {
 namespace {

@@ -7,8 +7,8 @@
 
 #include <gtest/gtest.h>
 
-#include "piezoshift/plant/twin.hpp"
 #include "open_loop.hpp"
+#include "piezoshift/plant/twin.hpp"
 
 namespace piezoshift::plant {
 namespace {

@@ -5,10 +5,10 @@
 
 #include <gtest/gtest.h>
 
+#include "open_loop.hpp"
 #include "piezoshift/control/vec3.hpp"
 #include "piezoshift/plant/random.hpp"
 #include "piezoshift/plant/twin.hpp"
-#include "open_loop.hpp"
 
 namespace piezoshift::plant {
 namespace {
