@@ -4,6 +4,7 @@
 #include <algorithm>
 #include <cstdio>
 #include <filesystem>
+#include <functional>
 #include <iostream>
 #include <memory>
 #include <optional>
@@ -15,17 +16,20 @@
 #include "command.hpp"
 #include "improved_summary.hpp"
 #include "loop_setup.hpp"
+#include "loop_stack.hpp"
 #include "piezoshift/calibration/calibration_file.hpp"
 #include "piezoshift/calibration/calibration_procedure.hpp"
 #include "piezoshift/calibration/guided_calibration.hpp"
+#include "piezoshift/calibration/guided_rig.hpp"
+#include "piezoshift/calibration/guided_session.hpp"
 #include "piezoshift/calibration/improved_calibration.hpp"
+#include "piezoshift/calibration/interferometer_source.hpp"
 #include "piezoshift/calibration/loop_rig.hpp"
 #include "piezoshift/config/project_config.hpp"
+#include "piezoshift/experiments/bench.hpp"
 #include "piezoshift/experiments/paper_experiments.hpp"
 #include "piezoshift/io/csv_writer.hpp"
 #include "piezoshift/io/input_error.hpp"
-#include "piezoshift/runtime/loop_clock.hpp"
-#include "piezoshift/runtime/paced_clock.hpp"
 #include "piezoshift/runtime/safety_ranges.hpp"
 #include "progress_bar.hpp"
 #include "whole_number.hpp"
@@ -73,7 +77,7 @@ void print_fits(const control::SemiClosedLoopParams& controller,
 
 // The guided calibration: the poses through the one control tick, the readings from the
 // operator, a log file or the twin's interferometer, the session recorded beside --out.
-int run_guided(const Options& o) {
+void check_guided_options(const Options& o) {
   if (o.pid != "paper")
     throw io::InputError(
         "--pid search: the guided calibration keeps the paper's gains (the search scores the "
@@ -102,7 +106,147 @@ int run_guided(const Options& o) {
   if (!(o.max_zero_drift_um > 0.0))
     throw io::InputError(
         fmt::format("--max-zero-drift-um {}: must be a positive length", o.max_zero_drift_um));
+}
 
+// The session to continue: the one recorded in session_file for the same plan (unless
+// --restart), else a new one.
+calibration::GuidedSession open_session(const Options& o, const std::string& session_file,
+                                        const std::string& plan_text, std::size_t steps) {
+  calibration::GuidedSession session{plan_text, steps, {}};
+  if (o.restart)
+    return session;
+  if (auto loaded = calibration::load_guided_session(session_file)) {
+    if (loaded->plan != plan_text || loaded->steps != steps)
+      throw io::InputError(fmt::format(
+          "{}: this session was recorded for \"{}\", not \"{}\": give --restart to discard it",
+          session_file, loaded->plan, plan_text));
+    session = std::move(*loaded);
+    fmt::print(stderr, "resuming {}: {} of {} steps recorded\n", session_file,
+               session.readings.size(), steps);
+  }
+  return session;
+}
+
+std::unique_ptr<calibration::InterferometerSource> make_source(
+    const std::string& ifm, const std::function<void(const std::string&)>& say) {
+  if (ifm == "prompt")
+    return std::make_unique<calibration::PromptSource>(std::cin, say);
+  if (ifm == "sim")
+    return std::make_unique<calibration::TwinSource>();
+  return std::make_unique<calibration::LogFileSource>(ifm.substr(5));
+}
+
+// The rigs the two stages run on: on --daq sim the twin on a simulated clock (stage 2 on
+// seed + 1, stage 3 on seed + 2, as `calibrate` on the twin); otherwise one rig on the
+// real-time loop (the shared loop stack) in a thread of its own, for both stages.
+class GuidedRigs {
+ public:
+  GuidedRigs(const Options& o, const runtime::InstallationConfig& installation,
+             const control::SemiClosedLoopParams& base) {
+    const config::ProjectConfig& config = installation.project;
+    const double window_s = config.twin.interferometer.static_average_s;
+    if (o.daq == "sim") {
+      bench2_ = std::make_unique<experiments::Bench>(config, base, o.seed + 1);
+      bench3_ = std::make_unique<experiments::Bench>(config, base, o.seed + 2);
+      bench_rig2_ = std::make_unique<calibration::BenchRig>(*bench2_, window_s);
+      bench_rig3_ = std::make_unique<calibration::BenchRig>(*bench3_, window_s, bench_rig2_.get());
+      rig2_ = bench_rig2_.get();
+      rig3_ = bench_rig3_.get();
+      return;
+    }
+    LoopStackOptions so;
+    so.daq = o.daq == "sim-rt" ? "sim" : o.daq;
+    so.rate_Hz = 1.0 / base.sample_time_s;
+    so.seed = o.seed + 1;
+    so.config_path = o.config;
+    so.clock = o.free_run ? StackClock::kPaced : StackClock::kRealTime;
+    stack_ = std::make_unique<LoopStack>(so, config);  // names a device it cannot open
+    calibration::LoopRigOptions lo;
+    lo.rate_Hz = so.rate_Hz;
+    lo.window_s = window_s;
+    // An interferometer log is stamped by the wall clock: real-time windows are in Unix time.
+    lo.unix_time = stack_->clock().real_time();
+    signals_.emplace();  // Ctrl-C ramps the stage to 0 V instead of leaving it driven
+    lo.stop_signal = &g_stop_signal;
+    loop_rig_ = std::make_unique<calibration::LoopRig>(
+        stack_->daq(), stack_->clock(), stack_->paced(), base,
+        loop_safety_limits(installation.safety, std::nullopt), lo);
+    for (const std::string& refusal : loop_rig_->realtime().refusals)
+      fmt::print(stderr, "piezoshift: warning: the loop runs without real-time treatment: {}\n",
+                 refusal);
+    rig2_ = loop_rig_.get();
+    rig3_ = loop_rig_.get();
+  }
+
+  calibration::GuidedRig& stage2() { return *rig2_; }
+  calibration::GuidedRig& stage3() { return *rig3_; }
+  //! The real-time loop's rig, or null on the simulated bench.
+  calibration::LoopRig* loop_rig() { return loop_rig_.get(); }
+
+ private:
+  std::optional<StopSignals> signals_;  // outlives the loop: Ctrl-C during its ramp is harmless
+  std::unique_ptr<experiments::Bench> bench2_, bench3_;
+  std::unique_ptr<calibration::BenchRig> bench_rig2_, bench_rig3_;
+  std::unique_ptr<LoopStack> stack_;
+  std::unique_ptr<calibration::LoopRig> loop_rig_;
+  calibration::GuidedRig* rig2_ = nullptr;
+  calibration::GuidedRig* rig3_ = nullptr;
+};
+
+struct FitDataFiles {
+  std::string poses;
+  std::string points;
+};
+
+// The data of the two fits, in the formats `fit matrix|poly --data` read (docs/files.md), so that
+// A and p can be fitted again from them (or from a part of them).
+FitDataFiles write_fit_data(const std::string& out, const calibration::GuidedOutcome& r,
+                            const std::string& session_file) {
+  const std::filesystem::path folder = std::filesystem::path(out).parent_path();
+  const FitDataFiles files{(folder / "matrix_poses.csv").string(),
+                           (folder / "polynomial_points.csv").string()};
+  io::CsvWriter poses(files.poses, {"s1_um", "s2_um", "s3_um", "z1_um", "z2_um", "z3_um"}, 9);
+  poses.comment(
+      fmt::format("guided calibration stage 2: poses (dS, dZ), session {}", session_file));
+  for (std::size_t k = 0; k < r.matrix.ds_um.size(); ++k) {
+    const control::Vec3& ds = r.matrix.ds_um[k];
+    const control::Vec3& dz = r.matrix.dz_um[k];
+    poses.row({ds[0], ds[1], ds[2], dz[0], dz[1], dz[2]});
+  }
+  poses.close();
+  io::CsvWriter points(files.points, {"command_um", "measured_um"}, 9);
+  points.comment(
+      fmt::format("guided calibration stage 3: commands and readings, session {}", session_file));
+  for (std::size_t k = 0; k < r.polynomial.command_um.size(); ++k)
+    points.row({r.polynomial.command_um[k], r.polynomial.measured_um[k]});
+  points.close();
+  return files;
+}
+
+nlohmann::json guided_json(const Options& o, const calibration::GuidedOutcome& r,
+                           const FitDataFiles& files, const std::string& session_file,
+                           std::size_t steps) {
+  nlohmann::json j;
+  j["calibration_file"] = o.out;
+  j["session_file"] = session_file;
+  j["matrix_poses_file"] = files.poses;
+  j["polynomial_points_file"] = files.points;
+  j["readings_taken"] = r.taken;
+  j["steps"] = steps;
+  const auto& g = r.controller.gains;
+  const auto& p = r.controller.polynomial;
+  j["pid_gains"] = {{"kp", g.kp}, {"ki", g.ki}, {"kd", g.kd}};
+  j["A"] = matrix_json(r.controller.matrix.a);
+  j["p"] = {p.p3, p.p2, p.p1, p.p0};
+  j["A_rms_residual_um"] = r.matrix.fit.rms_residual_um;
+  j["condition_number"] = r.matrix.fit.condition_number;
+  j["p_rms_residual_um"] = r.polynomial.fit.rms_residual_um;
+  j["p_skipped_commands"] = r.polynomial.saturated_points;
+  return j;
+}
+
+int run_guided(const Options& o) {
+  check_guided_options(o);
   const runtime::InstallationConfig installation =
       o.config.empty() ? runtime::InstallationConfig{}
                        : runtime::load_installation_config(o.config);
@@ -116,18 +260,7 @@ int run_guided(const Options& o) {
       "3: {} commands to {:g} um",
       o.daq, o.seed, o.config.empty() ? "built-in defaults" : o.config, go.matrix.repeats,
       go.matrix.base_um, go.matrix.move_um, go.polynomial.points, go.polynomial.max_um);
-  calibration::GuidedSession session{plan_text, plan.size(), {}};
-  if (!o.restart) {
-    if (auto loaded = calibration::load_guided_session(session_file)) {
-      if (loaded->plan != plan_text || loaded->steps != plan.size())
-        throw io::InputError(fmt::format(
-            "{}: this session was recorded for \"{}\", not \"{}\": give --restart to discard it",
-            session_file, loaded->plan, plan_text));
-      session = std::move(*loaded);
-      fmt::print(stderr, "resuming {}: {} of {} steps recorded\n", session_file,
-                 session.readings.size(), plan.size());
-    }
-  }
+  calibration::GuidedSession session = open_session(o, session_file, plan_text, plan.size());
 
   // The controller the twin calibration starts from: the DAQ's rate, the paper's gains.
   control::SemiClosedLoopParams base;
@@ -137,74 +270,20 @@ int run_guided(const Options& o) {
     fmt::print(stderr, "{}", text);
     std::fflush(stderr);
   };
-  std::unique_ptr<calibration::InterferometerSource> source;
-  if (ifm == "prompt") {
-    source = std::make_unique<calibration::PromptSource>(std::cin, say);
-  } else if (ifm == "sim") {
-    source = std::make_unique<calibration::TwinSource>();
-  } else {
-    source = std::make_unique<calibration::LogFileSource>(ifm.substr(5));
-  }
+  const std::unique_ptr<calibration::InterferometerSource> source =
+      make_source(o.interferometer, say);
   calibration::GuidedIo gio{*source, say, [&session_file](const calibration::GuidedSession& s) {
                               calibration::save_guided_session(session_file, s);
                             }};
   // Written before the stage moves: a folder that cannot take the session is found now.
   calibration::save_guided_session(session_file, session);
-  // The rigs: on --daq sim, the twin on a simulated clock (stage 2 on seed + 1, stage 3 on
-  // seed + 2, as `calibrate` on the twin); otherwise one rig on the real-time loop in a thread of
-  // its own, for both stages.
-  std::optional<StopSignals> signals;  // outlives the loop: Ctrl-C during its ramp is harmless
-  std::unique_ptr<experiments::Bench> bench2, bench3;
-  std::unique_ptr<calibration::BenchRig> bench_rig2, bench_rig3;
-  std::unique_ptr<runtime::DaqBackend> daq;
-  std::unique_ptr<runtime::LoopClock> clock;
-  std::unique_ptr<calibration::LoopRig> loop_rig;
-  calibration::GuidedRig* rig2 = nullptr;
-  calibration::GuidedRig* rig3 = nullptr;
-  const double window_s = config.twin.interferometer.static_average_s;
-  if (sim) {
-    bench2 = std::make_unique<experiments::Bench>(config, base, o.seed + 1);
-    bench3 = std::make_unique<experiments::Bench>(config, base, o.seed + 2);
-    bench_rig2 = std::make_unique<calibration::BenchRig>(*bench2, window_s);
-    bench_rig3 = std::make_unique<calibration::BenchRig>(*bench3, window_s, bench_rig2.get());
-    rig2 = bench_rig2.get();
-    rig3 = bench_rig3.get();
-  } else {
-    const double rate_Hz = 1.0 / base.sample_time_s;
-    check_loop_rate(rate_Hz);
-    ChosenBackend chosen =
-        make_backend(sim_rt ? "sim" : o.daq, config, o.seed + 1, rate_Hz, o.config);
-    daq = std::move(chosen.backend);
-    daq->configure();  // comedi: names the device it cannot open, or says it is not built in
-    runtime::PacedClock* paced = nullptr;
-    if (o.free_run) {
-      auto c = std::make_unique<runtime::PacedClock>();
-      paced = c.get();
-      clock = std::move(c);
-    } else {
-      clock = std::make_unique<runtime::MonotonicClock>();
-    }
-    calibration::LoopRigOptions lo;
-    lo.rate_Hz = rate_Hz;
-    lo.window_s = window_s;
-    // An interferometer log is stamped by the wall clock: real-time windows are in Unix time.
-    lo.unix_time = clock->real_time();
-    signals.emplace();  // Ctrl-C ramps the stage to 0 V instead of leaving it driven
-    lo.stop_signal = &g_stop_signal;
-    loop_rig = std::make_unique<calibration::LoopRig>(
-        *daq, *clock, paced, base, loop_safety_limits(installation.safety, std::nullopt), lo);
-    for (const std::string& refusal : loop_rig->realtime().refusals)
-      fmt::print(stderr, "piezoshift: warning: the loop runs without real-time treatment: {}\n",
-                 refusal);
-    rig2 = loop_rig.get();
-    rig3 = loop_rig.get();
-  }
+  GuidedRigs rigs(o, installation, base);
 
   const calibration::GuidedOutcome r =
-      calibration::run_guided_calibration(*rig2, *rig3, base, session, gio, go);
+      calibration::run_guided_calibration(rigs.stage2(), rigs.stage3(), base, session, gio, go);
   std::optional<runtime::LoopResult> loop_result;
-  if (loop_rig)
-    loop_result = loop_rig->stop();  // the stage at rest at 0 V before anything is written
+  if (rigs.loop_rig())
+    loop_result = rigs.loop_rig()->stop();  // the stage at rest at 0 V before anything is written
   if (!r.complete)
     throw io::InputError(fmt::format(
         "{} ended: {} of {} steps are recorded in {}; run the same command again to resume",
@@ -214,48 +293,12 @@ int run_guided(const Options& o) {
       o.out, r.controller,
       fmt::format("piezoshift calibration, identified by the guided `piezoshift calibrate` on {} "
                   "with the interferometer from {}\nseed {}, configuration: {}, session: {}",
-                  o.daq, ifm, o.seed, o.config.empty() ? "built-in defaults" : o.config,
-                  session_file));
-  // The data of the two fits, in the formats `fit matrix|poly --data` read (docs/files.md), so
-  // that A and p can be fitted again from them (or from a part of them).
-  const std::filesystem::path folder = std::filesystem::path(o.out).parent_path();
-  const std::string poses_file = (folder / "matrix_poses.csv").string();
-  const std::string points_file = (folder / "polynomial_points.csv").string();
-  {
-    io::CsvWriter w(poses_file, {"s1_um", "s2_um", "s3_um", "z1_um", "z2_um", "z3_um"}, 9);
-    w.comment(fmt::format("guided calibration stage 2: poses (dS, dZ), session {}", session_file));
-    for (std::size_t k = 0; k < r.matrix.ds_um.size(); ++k) {
-      const control::Vec3& ds = r.matrix.ds_um[k];
-      const control::Vec3& dz = r.matrix.dz_um[k];
-      w.row({ds[0], ds[1], ds[2], dz[0], dz[1], dz[2]});
-    }
-    w.close();
-  }
-  {
-    io::CsvWriter w(points_file, {"command_um", "measured_um"}, 9);
-    w.comment(
-        fmt::format("guided calibration stage 3: commands and readings, session {}", session_file));
-    for (std::size_t k = 0; k < r.polynomial.command_um.size(); ++k)
-      w.row({r.polynomial.command_um[k], r.polynomial.measured_um[k]});
-    w.close();
-  }
-  const auto& p = r.controller.polynomial;
+                  o.daq, o.interferometer, o.seed,
+                  o.config.empty() ? "built-in defaults" : o.config, session_file));
+  const FitDataFiles files = write_fit_data(o.out, r, session_file);
+  const calibration::LoopRig* loop_rig = rigs.loop_rig();
   if (o.json) {
-    nlohmann::json j;
-    j["calibration_file"] = o.out;
-    j["session_file"] = session_file;
-    j["matrix_poses_file"] = poses_file;
-    j["polynomial_points_file"] = points_file;
-    j["readings_taken"] = r.taken;
-    j["steps"] = plan.size();
-    const auto& g = r.controller.gains;
-    j["pid_gains"] = {{"kp", g.kp}, {"ki", g.ki}, {"kd", g.kd}};
-    j["A"] = matrix_json(r.controller.matrix.a);
-    j["p"] = {p.p3, p.p2, p.p1, p.p0};
-    j["A_rms_residual_um"] = r.matrix.fit.rms_residual_um;
-    j["condition_number"] = r.matrix.fit.condition_number;
-    j["p_rms_residual_um"] = r.polynomial.fit.rms_residual_um;
-    j["p_skipped_commands"] = r.polynomial.saturated_points;
+    nlohmann::json j = guided_json(o, r, files, session_file, plan.size());
     if (loop_rig) {
       const runtime::LoopStats& st = loop_rig->loop_stats();
       j["loop"] = {{"ticks", loop_result->ticks},
@@ -271,7 +314,7 @@ int run_guided(const Options& o) {
   if (loop_rig)
     fmt::print("loop     {} ticks, {} overruns (at most {} in a row)\n", loop_result->ticks,
                loop_rig->loop_stats().overruns, loop_rig->loop_stats().max_consecutive_overruns);
-  fmt::print("written: {}, {}, {} (session: {})\n", o.out, poses_file, points_file, session_file);
+  fmt::print("written: {}, {}, {} (session: {})\n", o.out, files.poses, files.points, session_file);
   return 0;
 }
 

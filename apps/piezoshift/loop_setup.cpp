@@ -9,7 +9,6 @@
 #include "piezoshift/calibration/calibration_file.hpp"
 #include "piezoshift/calibration/calibration_procedure.hpp"
 #include "piezoshift/io/input_error.hpp"
-#include "piezoshift/runtime/comedi_backend.hpp"
 #include "piezoshift/runtime/safety_ranges.hpp"
 
 namespace piezoshift::app {
@@ -45,31 +44,6 @@ nlohmann::json safety_json(const runtime::SafetyLimits& limits) {
   runtime::visit_safety_limits(limits, [&](const char*, const char* key, const auto& value,
                                            design::Bounds) { j[key] = value; });
   return j;
-}
-
-ChosenBackend make_backend(const std::string& daq, const config::ProjectConfig& config,
-                           std::uint64_t seed, double rate_Hz, const std::string& config_path) {
-  ChosenBackend chosen;
-  if (daq == "sim") {
-    runtime::SimOptions so;
-    so.design = config.design;
-    so.twin = config.twin;
-    so.seed = seed;
-    so.rate_Hz = rate_Hz;
-    if (!config_path.empty())
-      so.source = config_path;
-    auto s = std::make_unique<runtime::SimBackend>(so);
-    chosen.sim = s.get();
-    chosen.backend = std::move(s);
-  } else if (daq == "comedi" || daq.rfind("comedi:", 0) == 0) {
-    runtime::ComediOptions co;
-    if (daq.size() > 7)
-      co.device = daq.substr(7);
-    chosen.backend = std::make_unique<runtime::ComediBackend>(co);
-  } else {
-    throw io::InputError(fmt::format("--daq '{}': expected sim or comedi:/dev/comediN", daq));
-  }
-  return chosen;
 }
 
 LoopCalibration resolve_calibration(const std::string& path, const std::string& daq,

@@ -1,7 +1,8 @@
 #pragma once
-// Set-up shared by the commands that run the real-time loop (`run`, `serve`): the DAQ backend
-// chosen by --daq, the SIGINT/SIGTERM handlers that stop the loop through its safe ramp, and the
-// real-time request with its one warning.
+// Set-up shared by the commands that run the real-time loop (`run`, `serve`, `calibrate --daq`;
+// the stack itself: loop_stack.hpp): the loop rate and safety limits from the options, the
+// controller's calibration, the SIGINT/SIGTERM handlers that stop the loop through its safe ramp,
+// and the real-time request with its one warning.
 #include <atomic>
 #include <cstdint>
 #include <memory>
@@ -12,18 +13,11 @@
 
 #include "piezoshift/config/project_config.hpp"
 #include "piezoshift/control/semi_closed_loop.hpp"
-#include "piezoshift/runtime/daq_backend.hpp"
 #include "piezoshift/runtime/realtime.hpp"
 #include "piezoshift/runtime/safety_ranges.hpp"
 #include "piezoshift/runtime/safety_supervisor.hpp"
-#include "piezoshift/runtime/sim_backend.hpp"
 
 namespace piezoshift::app {
-
-struct ChosenBackend {
-  std::unique_ptr<runtime::DaqBackend> backend;
-  runtime::SimBackend* sim = nullptr;  //!< the same object when it is the twin, else null
-};
 
 //! Throws io::InputError naming --rate-hz unless 1000 <= rate_Hz <= 10000 (the paper's 1 kHz to
 //! the DAQ's practical limit, docs/runtime.md).
@@ -37,12 +31,6 @@ runtime::SafetyLimits loop_safety_limits(const runtime::SafetyLimits& installati
 
 //! The limits as a JSON object, one member per [safety] key.
 nlohmann::json safety_json(const runtime::SafetyLimits& limits);
-
-//! "sim" (the twin of config, at rate_Hz, with seed) or "comedi[:DEVICE]". Throws io::InputError
-//! for anything else. Not configured yet. config_path: where config came from ("" built in), named
-//! in the sim backend's messages.
-ChosenBackend make_backend(const std::string& daq, const config::ProjectConfig& config,
-                           std::uint64_t seed, double rate_Hz, const std::string& config_path = {});
 
 //! The controller a loop runs with, and where it came from.
 struct LoopCalibration {

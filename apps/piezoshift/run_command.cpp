@@ -24,6 +24,7 @@
 
 #include "command.hpp"
 #include "loop_setup.hpp"
+#include "loop_stack.hpp"
 #include "piezoshift/calibration/calibration_file.hpp"
 #include "piezoshift/config/project_config.hpp"
 #include "piezoshift/io/input_error.hpp"
@@ -119,114 +120,42 @@ nlohmann::json vec_json(const Vec3& v) {
   return a;
 }
 
-int run(const RunOptions& o) {
-  check_loop_rate(o.rate_Hz);
-  if (!(o.duration_s > 0.0) || o.duration_s > kMaxRunDurationS)
-    throw io::InputError(
-        fmt::format("--duration-s {}: must be in (0, {}] s", o.duration_s, kMaxRunDurationS));
+// What a run did, as the JSON summary reports it.
+struct RunRecord {
+  const RunOptions& options;
+  LoopStack& stack;
+  const ControlLoop& loop;
+  const LoopResult& result;
+  const SafetyLimits& limits;
+  const RealtimeReport& realtime;
+};
 
-  SetpointProfile profile = !o.profile.empty() ? SetpointProfile::load_csv(o.profile)
-                                               : SetpointProfile::step(o.step_um.value_or(0.0));
-  std::vector<FaultSpec> faults;
-  for (const std::string& f : o.faults)
-    faults.push_back(parse_fault_spec(f));
-
-  const runtime::InstallationConfig installation =
-      o.config.empty() ? runtime::InstallationConfig{}
-                       : runtime::load_installation_config(o.config);
-  const config::ProjectConfig& project = installation.project;
-  const LoopCalibration cal =
-      resolve_calibration(o.calibration, o.daq, project, o.seed, 1.0 / o.rate_Hz);
-  const control::SemiClosedLoopParams& params = cal.params;
-  if (o.step_um && cal.travel_z_max_um && *o.step_um > *cal.travel_z_max_um)
-    throw io::InputError(
-        fmt::format("--step-um {}: beyond the calibrated semi-closed-loop "
-                    "travel, {} um ({})",
-                    *o.step_um, *cal.travel_z_max_um, cal.source));
-
-  // The backend.
-  const bool comedi = o.daq.rfind("comedi", 0) == 0;
-  if (comedi && !faults.empty())
-    throw io::InputError("--fault needs --daq sim (faults are injected into the twin)");
-  if (comedi && o.free_run)
-    throw io::InputError("--free-run needs --daq sim (hardware runs in real time)");
-  ChosenBackend chosen = make_backend(o.daq, project, o.seed, o.rate_Hz, o.config);
-  std::unique_ptr<DaqBackend> hardware = std::move(chosen.backend);
-  SimBackend* sim = chosen.sim;
-  hardware->configure();  // comedi: names the device it cannot open (exit 2)
-
-  std::unique_ptr<LoopClock> clock;
-  if (o.free_run)
-    clock = std::make_unique<SimulatedClock>();
-  else
-    clock = std::make_unique<MonotonicClock>();
-  const std::int64_t period_ns = std::llround(1e9 / o.rate_Hz);
-
-  std::unique_ptr<FaultInjectingBackend> injector;
-  DaqBackend* daq = hardware.get();
-  if (!faults.empty()) {
-    injector = std::make_unique<FaultInjectingBackend>(*hardware, *clock, period_ns, faults,
-                                                       FaultInjectionParams{}, sim);
-    daq = injector.get();
-  }
-
-  std::unique_ptr<CsvLogger> logger;
-  if (!o.log.empty()) {
-    CsvLoggerOptions lo;
-    lo.path = o.log;
-    lo.with_truth = sim != nullptr;
-    logger = std::make_unique<CsvLogger>(lo);
-  }
-
-  LoopConfig config;
-  config.rate_Hz = o.rate_Hz;
-  config.duration_s = o.duration_s;
-  config.stop_signal = &g_stop_signal;
-  LoopStatus live;
-  const bool show_live = ::isatty(STDERR_FILENO) == 1 && !o.free_run;
-  if (show_live)
-    config.status = &live;
-  const SafetyLimits limits = loop_safety_limits(installation.safety, o.max_overruns);
-  if (!o.json)
-    fmt::print("safety: {}\n", describe(limits));
-  ControlLoop loop(config, params, limits, *daq, *clock, std::move(profile),
-                   logger ? &logger->ring() : nullptr);
-
-  StopSignals signals;
-  if (logger)
-    logger->start();  // before the real-time request: the logging thread stays a normal thread
-  std::optional<LiveStatus> status_line;  // likewise: it must not inherit the loop's priority
-  if (show_live)
-    status_line.emplace(live);
-  RealtimeReport rt;
-  if (clock->real_time())
-    rt = request_realtime_or_warn(o.cpu);
-
-  daq->activate();
-  const LoopResult r = loop.run();
-  status_line.reset();  // clears its line before the summary
-  daq->deactivate();
-  if (logger)
-    logger->stop();
-
-  // Summary.
-  const LoopStats& st = loop.stats();
+// The tick the first fault was injected on, when the supervisor's fault came after it.
+std::optional<std::uint64_t> injected_before_fault(const RunRecord& run) {
+  const FaultInjectingBackend* injector = run.stack.injector();
+  const LoopResult& r = run.result;
   const std::uint64_t injected =
       injector ? injector->first_injected_tick() : FaultInjectingBackend::kNotYet;
-  const bool has_latency =
-      r.fault_detected && injected != FaultInjectingBackend::kNotYet && r.fault.tick >= injected;
-  std::string stop_reason = to_string(r.stop_reason);
-  if (r.stop_reason == StopReason::kSignal)
-    stop_reason = signal_name(r.signal);
+  if (r.fault_detected && injected != FaultInjectingBackend::kNotYet && r.fault.tick >= injected)
+    return injected;
+  return std::nullopt;
+}
 
+std::string stop_reason_of(const LoopResult& r) {
+  return r.stop_reason == StopReason::kSignal ? std::string(signal_name(r.signal))
+                                              : std::string(to_string(r.stop_reason));
+}
+
+// The tracking error S - SGS the PIDs saw at the end of the controlled part.
+Vec3 end_tracking_um(const LoopResult& r) {
+  Vec3 tracking{};
+  for (std::size_t i = 0; i < 3; ++i)
+    tracking[i] = r.end_target_um[i] - r.end_feedback_um[i];
+  return tracking;
+}
+
+nlohmann::json timing_json(const LoopStats& st) {
   nlohmann::json j;
-  j["daq"] = hardware->name();
-  j["rate_Hz"] = o.rate_Hz;
-  j["sample_time_s"] = static_cast<double>(period_ns) * 1e-9;
-  j["clock"] = o.free_run ? "free-run" : "realtime";
-  j["duration_s"] = o.duration_s;
-  j["ticks"] = r.ticks;
-  j["stop_reason"] = stop_reason;
   j["period_error_p50_us"] = us(st.period_error.percentile_ns(0.5));
   j["period_error_p99_us"] = us(st.period_error.percentile_ns(0.99));
   j["period_error_p999_us"] = us(st.period_error.percentile_ns(0.999));
@@ -241,10 +170,11 @@ int run(const RunOptions& o) {
   j["overruns"] = st.overruns;
   j["max_consecutive_overruns"] = st.max_consecutive_overruns;
   j["skipped_slots"] = st.skipped_slots;
-  j["realtime"] = {{"sched_fifo", rt.fifo},
-                   {"mlockall", rt.memory_locked},
-                   {"cpu", rt.cpu >= 0 ? nlohmann::json(rt.cpu) : nlohmann::json(nullptr)},
-                   {"refused", rt.refusals}};
+  return j;
+}
+
+void add_fault_json(nlohmann::json& j, const RunRecord& run) {
+  const LoopResult& r = run.result;
   j["fault_detected"] = r.fault_detected;
   j["fault_reason"] = r.fault_detected ? nlohmann::json(to_string(r.fault.reason)) : nullptr;
   j["fault_tick"] = r.fault_detected ? nlohmann::json(r.fault.tick) : nullptr;
@@ -254,6 +184,7 @@ int run(const RunOptions& o) {
   j["fault_value"] = r.fault_detected ? nlohmann::json(r.fault.value) : nullptr;
   j["fault_limit"] = r.fault_detected ? nlohmann::json(r.fault.limit) : nullptr;
   nlohmann::json injected_list = nlohmann::json::array();
+  const FaultInjectingBackend* injector = run.stack.injector();
   for (std::size_t i = 0; injector && i < injector->faults().size(); ++i) {
     const FaultSpec& f = injector->faults()[i];
     const std::uint64_t t = injector->injected_tick(i);
@@ -265,79 +196,176 @@ int run(const RunOptions& o) {
           t != FaultInjectingBackend::kNotYet ? nlohmann::json(t) : nlohmann::json(nullptr)}});
   }
   j["faults_injected"] = injected_list;
+  const std::optional<std::uint64_t> injected = injected_before_fault(run);
   j["detect_latency_ticks"] =
-      has_latency ? nlohmann::json(r.fault.tick - injected) : nlohmann::json(nullptr);
-  j["safety"] = safety_json(limits);
-  j["max_output_V"] = r.max_output_V;
-  j["min_output_V"] = r.min_output_V;
-  j["max_output_slew_V_per_ms"] = r.max_output_slew_V_per_ms;
-  // Where the controlled part ended (before the ramp to 0 V): the position the SGS report, the
-  // tracking error S - SGS the PIDs saw, and on the twin its interferometer.
-  Vec3 tracking{};
-  double worst_tracking_um = 0.0;
-  for (std::size_t i = 0; i < 3; ++i) {
-    tracking[i] = r.end_target_um[i] - r.end_feedback_um[i];
-    worst_tracking_um = std::max(worst_tracking_um, std::fabs(tracking[i]));
-  }
+      injected ? nlohmann::json(r.fault.tick - *injected) : nlohmann::json(nullptr);
+}
+
+// Where the controlled part ended (before the ramp to 0 V): the position the SGS report, the
+// tracking error S - SGS the PIDs saw, and on the twin its interferometer.
+void add_end_json(nlohmann::json& j, const RunRecord& run) {
+  const LoopResult& r = run.result;
   const bool has_end = r.controlled_end_tick > 0;
   const auto or_null = [has_end](const Vec3& v) {
     return has_end ? vec_json(v) : nlohmann::json(nullptr);
   };
   j["final_time_s"] = has_end ? nlohmann::json(static_cast<double>(r.controlled_end_tick) *
-                                               static_cast<double>(period_ns) * 1e-9)
+                                               static_cast<double>(run.stack.period_ns()) * 1e-9)
                               : nlohmann::json(nullptr);
   j["final_setpoint_um"] = or_null(r.end_zd_um);
   j["final_target_um"] = or_null(r.end_target_um);
   j["final_sgs_um"] = or_null(r.end_feedback_um);
-  j["final_tracking_error_um"] = or_null(tracking);
+  j["final_tracking_error_um"] = or_null(end_tracking_um(r));
   j["final_interferometer_um"] = or_null(r.end_interferometer_um);
+}
+
+nlohmann::json run_json(const RunRecord& run) {
+  const RunOptions& o = run.options;
+  const LoopResult& r = run.result;
+  const RealtimeReport& rt = run.realtime;
+  const runtime::CsvLogger* logger = run.stack.logger();
+  nlohmann::json j;
+  j["daq"] = run.stack.name();
+  j["rate_Hz"] = o.rate_Hz;
+  j["sample_time_s"] = static_cast<double>(run.stack.period_ns()) * 1e-9;
+  j["clock"] = o.free_run ? "free-run" : "realtime";
+  j["duration_s"] = o.duration_s;
+  j["ticks"] = r.ticks;
+  j["stop_reason"] = stop_reason_of(r);
+  j.update(timing_json(run.loop.stats()));
+  j["realtime"] = {{"sched_fifo", rt.fifo},
+                   {"mlockall", rt.memory_locked},
+                   {"cpu", rt.cpu >= 0 ? nlohmann::json(rt.cpu) : nlohmann::json(nullptr)},
+                   {"refused", rt.refusals}};
+  add_fault_json(j, run);
+  j["safety"] = safety_json(run.limits);
+  j["max_output_V"] = r.max_output_V;
+  j["min_output_V"] = r.min_output_V;
+  j["max_output_slew_V_per_ms"] = r.max_output_slew_V_per_ms;
+  add_end_json(j, run);
   j["log"] = {{"path", o.log.empty() ? nlohmann::json(nullptr) : nlohmann::json(o.log)},
               {"records_written", logger ? logger->records_written() : 0},
               {"records_dropped", r.telemetry_dropped},
               {"error", logger && !logger->error().empty() ? nlohmann::json(logger->error())
                                                            : nlohmann::json(nullptr)}};
+  return j;
+}
 
-  if (o.json) {
-    fmt::print("{}\n", j.dump(2));
-  } else {
-    fmt::print("run: {} at {} Hz ({} clock), {} ticks, stopped by {}\n", hardware->name(),
-               o.rate_Hz, o.free_run ? "free-running" : "real-time", r.ticks, stop_reason);
-    fmt::print("period error   p50 {:.1f} us  p99 {:.1f} us  p99.9 {:.1f} us  max {:.1f} us\n",
-               us(st.period_error.percentile_ns(0.5)), us(st.period_error.percentile_ns(0.99)),
-               us(st.period_error.percentile_ns(0.999)), us(st.period_error.max_ns()));
-    fmt::print("compute time   p50 {:.1f} us  p99 {:.1f} us  max {:.1f} us\n",
-               us(st.compute.percentile_ns(0.5)), us(st.compute.percentile_ns(0.99)),
-               us(st.compute.max_ns()));
-    fmt::print("overruns       {} (longest run {})\n", st.overruns, st.max_consecutive_overruns);
-    fmt::print("outputs        max {:.3f} V, max slew {:.3f} V/ms\n", r.max_output_V,
-               r.max_output_slew_V_per_ms);
-    if (has_end) {
-      fmt::print(
-          "final position Z_d {:.4f} {:.4f} {:.4f} um, SGS {:.4f} {:.4f} {:.4f} um{}\n",
-          r.end_zd_um[0], r.end_zd_um[1], r.end_zd_um[2], r.end_feedback_um[0],
-          r.end_feedback_um[1], r.end_feedback_um[2],
-          std::isfinite(r.end_interferometer_um[0])
-              ? fmt::format(", interferometer {:.4f} {:.4f} {:.4f} um", r.end_interferometer_um[0],
-                            r.end_interferometer_um[1], r.end_interferometer_um[2])
-              : std::string());
-      fmt::print("tracking error S - SGS {:+.1f} {:+.1f} {:+.1f} nm (worst {:.1f} nm)\n",
-                 tracking[0] * 1e3, tracking[1] * 1e3, tracking[2] * 1e3, worst_tracking_um * 1e3);
-    }
-    if (r.fault_detected) {
-      fmt::print(
-          "FAULT          {} at tick {}{} (value {:.4g}, limit {:.4g}){}\n",
-          to_string(r.fault.reason), r.fault.tick,
-          r.fault.channel >= 0 ? fmt::format(" on channel {}", r.fault.channel + 1) : "",
-          r.fault.value, r.fault.limit,
-          has_latency ? fmt::format(", {} ticks after injection", r.fault.tick - injected) : "");
-    } else {
-      fmt::print("faults         none\n");
-    }
-    if (logger) {
-      fmt::print("log            {} ({} records{})\n", o.log, logger->records_written(),
-                 r.telemetry_dropped ? fmt::format(", {} DROPPED", r.telemetry_dropped) : "");
-    }
+void print_run(const RunRecord& run) {
+  const RunOptions& o = run.options;
+  const LoopResult& r = run.result;
+  const LoopStats& st = run.loop.stats();
+  fmt::print("run: {} at {} Hz ({} clock), {} ticks, stopped by {}\n", run.stack.name(), o.rate_Hz,
+             o.free_run ? "free-running" : "real-time", r.ticks, stop_reason_of(r));
+  fmt::print("period error   p50 {:.1f} us  p99 {:.1f} us  p99.9 {:.1f} us  max {:.1f} us\n",
+             us(st.period_error.percentile_ns(0.5)), us(st.period_error.percentile_ns(0.99)),
+             us(st.period_error.percentile_ns(0.999)), us(st.period_error.max_ns()));
+  fmt::print("compute time   p50 {:.1f} us  p99 {:.1f} us  max {:.1f} us\n",
+             us(st.compute.percentile_ns(0.5)), us(st.compute.percentile_ns(0.99)),
+             us(st.compute.max_ns()));
+  fmt::print("overruns       {} (longest run {})\n", st.overruns, st.max_consecutive_overruns);
+  fmt::print("outputs        max {:.3f} V, max slew {:.3f} V/ms\n", r.max_output_V,
+             r.max_output_slew_V_per_ms);
+  if (r.controlled_end_tick > 0) {
+    const Vec3 tracking = end_tracking_um(r);
+    double worst_tracking_um = 0.0;
+    for (const double e : tracking)
+      worst_tracking_um = std::max(worst_tracking_um, std::fabs(e));
+    fmt::print(
+        "final position Z_d {:.4f} {:.4f} {:.4f} um, SGS {:.4f} {:.4f} {:.4f} um{}\n",
+        r.end_zd_um[0], r.end_zd_um[1], r.end_zd_um[2], r.end_feedback_um[0], r.end_feedback_um[1],
+        r.end_feedback_um[2],
+        std::isfinite(r.end_interferometer_um[0])
+            ? fmt::format(", interferometer {:.4f} {:.4f} {:.4f} um", r.end_interferometer_um[0],
+                          r.end_interferometer_um[1], r.end_interferometer_um[2])
+            : std::string());
+    fmt::print("tracking error S - SGS {:+.1f} {:+.1f} {:+.1f} nm (worst {:.1f} nm)\n",
+               tracking[0] * 1e3, tracking[1] * 1e3, tracking[2] * 1e3, worst_tracking_um * 1e3);
   }
+  if (r.fault_detected) {
+    const std::optional<std::uint64_t> injected = injected_before_fault(run);
+    fmt::print("FAULT          {} at tick {}{} (value {:.4g}, limit {:.4g}){}\n",
+               to_string(r.fault.reason), r.fault.tick,
+               r.fault.channel >= 0 ? fmt::format(" on channel {}", r.fault.channel + 1) : "",
+               r.fault.value, r.fault.limit,
+               injected ? fmt::format(", {} ticks after injection", r.fault.tick - *injected) : "");
+  } else {
+    fmt::print("faults         none\n");
+  }
+  if (const runtime::CsvLogger* logger = run.stack.logger()) {
+    fmt::print("log            {} ({} records{})\n", o.log, logger->records_written(),
+               r.telemetry_dropped ? fmt::format(", {} DROPPED", r.telemetry_dropped) : "");
+  }
+}
+
+LoopStackOptions stack_options(const RunOptions& o) {
+  LoopStackOptions so;
+  so.daq = o.daq;
+  so.rate_Hz = o.rate_Hz;
+  so.seed = o.seed;
+  so.config_path = o.config;
+  so.clock = o.free_run ? StackClock::kFreeRun : StackClock::kRealTime;
+  so.faults = o.faults;
+  so.log = o.log;
+  return so;
+}
+
+int run(const RunOptions& o) {
+  check_loop_rate(o.rate_Hz);
+  if (!(o.duration_s > 0.0) || o.duration_s > kMaxRunDurationS)
+    throw io::InputError(
+        fmt::format("--duration-s {}: must be in (0, {}] s", o.duration_s, kMaxRunDurationS));
+  SetpointProfile profile = !o.profile.empty() ? SetpointProfile::load_csv(o.profile)
+                                               : SetpointProfile::step(o.step_um.value_or(0.0));
+  const runtime::InstallationConfig installation =
+      o.config.empty() ? runtime::InstallationConfig{}
+                       : runtime::load_installation_config(o.config);
+  const config::ProjectConfig& project = installation.project;
+  // The stack first: a bad --fault, --daq or device is named before the twin's calibration runs.
+  LoopStack stack(stack_options(o), project);
+  const LoopCalibration cal =
+      resolve_calibration(o.calibration, o.daq, project, o.seed, 1.0 / o.rate_Hz);
+  if (o.step_um && cal.travel_z_max_um && *o.step_um > *cal.travel_z_max_um)
+    throw io::InputError(
+        fmt::format("--step-um {}: beyond the calibrated semi-closed-loop "
+                    "travel, {} um ({})",
+                    *o.step_um, *cal.travel_z_max_um, cal.source));
+
+  LoopConfig config;
+  config.rate_Hz = o.rate_Hz;
+  config.duration_s = o.duration_s;
+  config.stop_signal = &g_stop_signal;
+  LoopStatus live;
+  const bool show_live = ::isatty(STDERR_FILENO) == 1 && !o.free_run;
+  if (show_live)
+    config.status = &live;
+  const SafetyLimits limits = loop_safety_limits(installation.safety, o.max_overruns);
+  if (!o.json)
+    fmt::print("safety: {}\n", describe(limits));
+  ControlLoop loop(config, cal.params, limits, stack.daq(), stack.clock(), std::move(profile),
+                   stack.telemetry());
+
+  StopSignals signals;
+  stack.start_logging();  // before the real-time request: the logging thread stays normal
+  std::optional<LiveStatus> status_line;  // likewise: it must not inherit the loop's priority
+  if (show_live)
+    status_line.emplace(live);
+  RealtimeReport rt;
+  if (stack.clock().real_time())
+    rt = request_realtime_or_warn(o.cpu);
+
+  stack.daq().activate();
+  const LoopResult r = loop.run();
+  status_line.reset();  // clears its line before the summary
+  stack.daq().deactivate();
+  stack.stop_logging();
+
+  const RunRecord record{o, stack, loop, r, limits, rt};
+  if (o.json)
+    fmt::print("{}\n", run_json(record).dump(2));
+  else
+    print_run(record);
+  const runtime::CsvLogger* logger = stack.logger();
   if (logger && !logger->error().empty())
     fmt::print(stderr, "piezoshift: error: log {}: {}\n", o.log, logger->error());
   return r.fault_detected ? kExitFault : 0;

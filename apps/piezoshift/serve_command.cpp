@@ -24,6 +24,7 @@
 #include "command.hpp"
 #include "dashboard_page.hpp"
 #include "loop_setup.hpp"
+#include "loop_stack.hpp"
 #include "piezoshift/calibration/calibration_file.hpp"
 #include "piezoshift/config/project_config.hpp"
 #include "piezoshift/host/dashboard.hpp"
@@ -131,7 +132,7 @@ host::StageModel make_stage_model(const ServeOptions& o, const config::ProjectCo
   }
 }
 
-int serve(const ServeOptions& o) {
+void check_serve_options(const ServeOptions& o) {
   check_loop_rate(o.rate_Hz);
   check(o.duration_s > 0.0, fmt::format("--duration-s {}: must be > 0 s", o.duration_s));
   check(o.port >= 0 && o.port <= 65535, fmt::format("--port {}: must be 0 to 65535", o.port));
@@ -151,188 +152,215 @@ int serve(const ServeOptions& o) {
         fmt::format("--http-port {}: must be 0 to 65535", o.http_port));
   check(o.http_max_clients >= 1 && o.http_max_clients <= 256,
         fmt::format("--http-max-clients {}: must be 1 to 256", o.http_max_clients));
-  const std::string token = http_token(o);
-  std::vector<runtime::FaultSpec> faults;
-  for (const std::string& f : o.faults)
-    faults.push_back(runtime::parse_fault_spec(f));
+}
 
+LoopStackOptions stack_options(const ServeOptions& o) {
+  LoopStackOptions so;
+  so.daq = o.daq;
+  so.rate_Hz = o.rate_Hz;
+  so.seed = o.seed;
+  so.config_path = o.config;
+  so.faults = o.faults;
+  so.log = o.log;
+  return so;
+}
+
+host::GcsOptions gcs_options(const ServeOptions& o, const std::string& daq_name) {
+  host::GcsOptions g;
+  g.on_target_tolerance_um = o.on_target_um;
+  g.on_target_tolerance_urad = o.on_target_urad;
+  g.settle_time_s = o.settle_s;
+  g.identification =
+      fmt::format("piezoshift, semi-closed-loop PZT phase shifter ({}), 0, 0.1.0", daq_name);
+  return g;
+}
+
+// The network side: the GCS interpreter behind the line server, and with --http-port the
+// dashboard behind the HTTP server, sharing the interpreter under one mutex.
+class Network {
+ public:
+  Network(const ServeOptions& o, const host::StageModel& model, runtime::HostLink& link,
+          double period_s, const std::string& daq_name, const std::string& token)
+      : gcs_(model, link, period_s, gcs_options(o, daq_name)), locked_gcs_(gcs_, gcs_mutex_) {
+    if (o.http_port >= 0) {
+      host::DashboardOptions dopts;
+      dopts.loop_rate_Hz = o.rate_Hz;
+      dopts.daq_name = daq_name;
+      dashboard_ = std::make_unique<host::Dashboard>(gcs_, gcs_mutex_, dashboard_page(), dopts);
+      gcs_.set_sample_observer(dashboard_.get());
+      host::HttpServerOptions hopts;
+      hopts.host = o.http_bind;
+      hopts.port = static_cast<std::uint16_t>(o.http_port);
+      hopts.token = token;
+      hopts.max_clients = static_cast<std::size_t>(o.http_max_clients);
+      http_ = std::make_unique<host::HttpServer>(hopts, *dashboard_);  // binds now
+    }
+    host::ListenAddress address;
+    address.host = o.bind;
+    address.port = static_cast<std::uint16_t>(o.port);
+    address.allow_remote = o.allow_remote;
+    host::LineServerLimits limits;
+    limits.max_clients = static_cast<std::size_t>(o.max_clients);
+    limits.max_line_bytes = static_cast<std::size_t>(o.max_line_bytes);
+    limits.idle_timeout_s = o.idle_timeout_s;
+    server_ = std::make_unique<host::LineServer>(
+        address, limits, dashboard_ ? static_cast<host::LineHandler&>(locked_gcs_) : gcs_);
+  }
+  ~Network() { stop(); }
+  Network(const Network&) = delete;
+  Network& operator=(const Network&) = delete;
+
+  // Starts the servers' threads: before the real-time request, so they stay normal threads. A
+  // server that fails stops the loop through its ramp (g_stop_signal); stop() rethrows it.
+  void start() {
+    line_thread_ = std::thread([this] { serve_until_stopped(*server_, line_error_); });
+    if (http_)
+      http_thread_ = std::thread([this] { serve_until_stopped(*http_, http_error_); });
+  }
+  // Stops and joins both servers, then rethrows the first failure of either.
+  void stop() {
+    server_->stop();
+    if (line_thread_.joinable())
+      line_thread_.join();
+    if (http_) {
+      http_->stop();
+      if (http_thread_.joinable())
+        http_thread_.join();
+    }
+  }
+  void rethrow_failure() const {
+    if (line_error_)
+      std::rethrow_exception(line_error_);
+    if (http_error_)
+      std::rethrow_exception(http_error_);
+  }
+
+  const host::GcsInterpreter& gcs() const { return gcs_; }
+  host::Dashboard* dashboard() { return dashboard_.get(); }
+  const host::LineServer& server() const { return *server_; }
+  const host::HttpServer* http() const { return http_.get(); }
+
+ private:
+  template <typename Server>
+  static void serve_until_stopped(Server& server, std::exception_ptr& error) {
+    try {
+      server.run(&g_stop_signal);
+    } catch (...) {
+      error = std::current_exception();
+      g_stop_signal.store(kNetworkFailed);
+    }
+  }
+
+  host::GcsInterpreter gcs_;
+  std::mutex gcs_mutex_;
+  host::LockedLineHandler locked_gcs_;
+  std::unique_ptr<host::Dashboard> dashboard_;
+  std::unique_ptr<host::HttpServer> http_;
+  std::unique_ptr<host::LineServer> server_;
+  std::thread line_thread_, http_thread_;
+  std::exception_ptr line_error_, http_error_;
+};
+
+void print_serve_summary(const ServeOptions& o, Network& net, const std::string& daq_name,
+                         const runtime::ControlLoop& loop, const runtime::LoopResult& r,
+                         const runtime::SafetyLimits& safety, const runtime::RealtimeReport& rt) {
+  const host::GcsStats& gs = net.gcs().stats();
+  const host::LineServerStats ns = net.server().stats();
+  const runtime::LoopStats& st = loop.stats();
+  std::string stop_reason = runtime::to_string(r.stop_reason);
+  if (r.stop_reason == runtime::StopReason::kSignal)
+    stop_reason = signal_name(r.signal);
+  if (!o.json) {
+    fmt::print(
+        "serve: {} ticks, stopped by {}; {} clients ({} refused), {} lines, {} GCS errors, {} "
+        "faults, {} samples dropped, {} overruns\n",
+        r.ticks, stop_reason, ns.accepted, ns.refused_max_clients, gs.lines, gs.errors, gs.faults,
+        r.host_samples_dropped, st.overruns);
+    return;
+  }
+  nlohmann::json j;
+  j["daq"] = daq_name;
+  j["rate_Hz"] = o.rate_Hz;
+  j["ticks"] = r.ticks;
+  j["stop_reason"] = stop_reason;
+  j["overruns"] = st.overruns;
+  const auto us = [](std::int64_t t_ns) { return static_cast<double>(t_ns) * 1e-3; };
+  j["period_error_p50_us"] = us(st.period_error.percentile_ns(0.5));
+  j["period_error_p99_us"] = us(st.period_error.percentile_ns(0.99));
+  j["period_error_max_us"] = us(st.period_error.max_ns());
+  j["wake_latency_p50_us"] = us(st.wake_latency.percentile_ns(0.5));
+  j["wake_latency_p99_us"] = us(st.wake_latency.percentile_ns(0.99));
+  j["wake_latency_max_us"] = us(st.wake_latency.max_ns());
+  j["realtime"] = {{"sched_fifo", rt.fifo}, {"mlockall", rt.memory_locked}};
+  j["faults"] = gs.faults;
+  j["clients_accepted"] = ns.accepted;
+  j["clients_refused"] = ns.refused_max_clients;
+  j["clients_dropped_slow"] = ns.disconnected_slow;
+  j["clients_dropped_idle"] = ns.disconnected_idle;
+  j["command_lines"] = gs.lines;
+  j["gcs_errors"] = gs.errors;
+  j["loop_commands_applied"] = r.host_commands_applied;
+  j["samples_dropped"] = r.host_samples_dropped;
+  j["max_output_slew_V_per_ms"] = r.max_output_slew_V_per_ms;
+  j["safety"] = safety_json(safety);
+  if (const host::HttpServer* http = net.http()) {
+    const host::HttpServerStats hs = http->stats();
+    j["http"] = {
+        {"requests", hs.requests},         {"refused", hs.refused},
+        {"unauthorised", hs.unauthorised}, {"streams_opened", hs.streams_opened},
+        {"dropped_slow", hs.dropped_slow}, {"events_sent", net.dashboard()->events_sent()}};
+  }
+  fmt::print("{}\n", j.dump(2));
+}
+
+int serve(const ServeOptions& o) {
+  check_serve_options(o);
+  const std::string token = http_token(o);
   const runtime::InstallationConfig installation =
       o.config.empty() ? runtime::InstallationConfig{}
                        : runtime::load_installation_config(o.config);
   const config::ProjectConfig& config = installation.project;
   const runtime::SafetyLimits safety = loop_safety_limits(installation.safety, o.max_overruns);
+  // The stack first: a bad --fault, --daq or device is named before the twin's calibration runs.
+  LoopStack stack(stack_options(o), config);
   const LoopCalibration cal =
       resolve_calibration(o.calibration, o.daq, config, o.seed, 1.0 / o.rate_Hz);
-  const control::SemiClosedLoopParams& params = cal.params;
-  const host::StageModel model = make_stage_model(o, config, params, cal, safety);
+  const host::StageModel model = make_stage_model(o, config, cal.params, cal, safety);
 
-  ChosenBackend chosen = make_backend(o.daq, config, o.seed, o.rate_Hz, o.config);
-  check(faults.empty() || chosen.sim != nullptr,
-        "--fault needs --daq sim (faults are injected into the twin)");
-  runtime::MonotonicClock clock;
-  const std::int64_t period_ns = std::llround(1e9 / o.rate_Hz);
-  std::unique_ptr<runtime::FaultInjectingBackend> injector;
-  if (!faults.empty())
-    injector = std::make_unique<runtime::FaultInjectingBackend>(
-        *chosen.backend, clock, period_ns, faults, runtime::FaultInjectionParams{}, chosen.sim);
-  runtime::DaqBackend& daq = injector ? *injector : *chosen.backend;
-  daq.configure();  // comedi: names the device it cannot open (exit 2)
-
-  const double period_s = static_cast<double>(period_ns) * 1e-9;
   runtime::HostLink link;
-  host::GcsOptions gopts;
-  gopts.on_target_tolerance_um = o.on_target_um;
-  gopts.on_target_tolerance_urad = o.on_target_urad;
-  gopts.settle_time_s = o.settle_s;
-  gopts.identification =
-      fmt::format("piezoshift, semi-closed-loop PZT phase shifter ({}), 0, 0.1.0", daq.name());
-  host::GcsInterpreter gcs(model, link, period_s, gopts);
-
-  // The dashboard shares the interpreter with the GCS thread: one mutex around it.
-  std::mutex gcs_mutex;
-  host::LockedLineHandler locked_gcs(gcs, gcs_mutex);
-  std::unique_ptr<host::Dashboard> dashboard;
-  std::unique_ptr<host::HttpServer> http;
-  if (o.http_port >= 0) {
-    host::DashboardOptions dopts;
-    dopts.loop_rate_Hz = o.rate_Hz;
-    dopts.daq_name = daq.name();
-    dashboard = std::make_unique<host::Dashboard>(gcs, gcs_mutex, dashboard_page(), dopts);
-    gcs.set_sample_observer(dashboard.get());
-    host::HttpServerOptions hopts;
-    hopts.host = o.http_bind;
-    hopts.port = static_cast<std::uint16_t>(o.http_port);
-    hopts.token = token;
-    hopts.max_clients = static_cast<std::size_t>(o.http_max_clients);
-    http = std::make_unique<host::HttpServer>(hopts, *dashboard);  // binds now
-  }
-
-  host::ListenAddress address;
-  address.host = o.bind;
-  address.port = static_cast<std::uint16_t>(o.port);
-  address.allow_remote = o.allow_remote;
-  host::LineServerLimits limits;
-  limits.max_clients = static_cast<std::size_t>(o.max_clients);
-  limits.max_line_bytes = static_cast<std::size_t>(o.max_line_bytes);
-  limits.idle_timeout_s = o.idle_timeout_s;
-  host::LineServer server(address, limits,
-                          dashboard ? static_cast<host::LineHandler&>(locked_gcs) : gcs);
-
-  std::unique_ptr<runtime::CsvLogger> logger;
-  if (!o.log.empty()) {
-    runtime::CsvLoggerOptions lo;
-    lo.path = o.log;
-    lo.with_truth = chosen.sim != nullptr;
-    logger = std::make_unique<runtime::CsvLogger>(lo);
-  }
-
+  const std::string daq_name = stack.daq().name();
+  Network net(o, model, link, static_cast<double>(stack.period_ns()) * 1e-9, daq_name, token);
   runtime::LoopConfig lc;
   lc.rate_Hz = o.rate_Hz;
   lc.duration_s = o.duration_s;
   lc.stop_signal = &g_stop_signal;
   lc.stop_when_safe_after_fault = false;  // a client clears faults (SVO)
   lc.host = &link;
-  runtime::ControlLoop loop(lc, params, safety, daq, clock, runtime::SetpointProfile::step(0.0),
-                            logger ? &logger->ring() : nullptr);
+  runtime::ControlLoop loop(lc, cal.params, safety, stack.daq(), stack.clock(),
+                            runtime::SetpointProfile::step(0.0), stack.telemetry());
 
   StopSignals signals;
-  if (logger)
-    logger->start();
-  // The network thread starts before the real-time request, so it stays a normal thread.
-  std::exception_ptr network_error;
-  std::thread network([&] {
-    try {
-      server.run(&g_stop_signal);
-    } catch (...) {
-      network_error = std::current_exception();
-      g_stop_signal.store(kNetworkFailed);
-    }
-  });
-  std::exception_ptr http_error;
-  std::thread http_thread;
-  if (http) {
-    http_thread = std::thread([&] {
-      try {
-        http->run(&g_stop_signal);
-      } catch (...) {
-        http_error = std::current_exception();
-        g_stop_signal.store(kNetworkFailed);
-      }
-    });
+  stack.start_logging();
+  net.start();  // before the real-time request: the network threads stay normal threads
+  if (const host::HttpServer* http = net.http())
     fmt::print("piezoshift serve: dashboard on http://{}:{}/{}\n", o.http_bind, http->port(),
                token.empty() ? "" : " (token required)");
-  }
-  fmt::print("piezoshift serve: GCS 2.0 on {}:{}, loop at {:g} Hz on {}\n", o.bind, server.port(),
-             o.rate_Hz, daq.name());
+  fmt::print("piezoshift serve: GCS 2.0 on {}:{}, loop at {:g} Hz on {}\n", o.bind,
+             net.server().port(), o.rate_Hz, daq_name);
   fmt::print("piezoshift serve: safety ({}): {}\n",
              o.config.empty() ? "built in" : o.config + " [safety]", runtime::describe(safety));
   std::fflush(stdout);
   const runtime::RealtimeReport rt = request_realtime_or_warn(o.cpu);
-  if (dashboard)
+  if (host::Dashboard* dashboard = net.dashboard())
     dashboard->set_realtime({true, rt.fifo, rt.memory_locked, rt.cpu});
 
-  daq.activate();
+  stack.daq().activate();
   const runtime::LoopResult r = loop.run();
-  daq.deactivate();
-  server.stop();
-  network.join();
-  if (http) {
-    http->stop();
-    http_thread.join();
-  }
-  if (logger)
-    logger->stop();
-  if (network_error)
-    std::rethrow_exception(network_error);
-  if (http_error)
-    std::rethrow_exception(http_error);
-
-  const host::GcsStats& gs = gcs.stats();
-  const host::LineServerStats ns = server.stats();
-  const runtime::LoopStats& st = loop.stats();
-  std::string stop_reason = runtime::to_string(r.stop_reason);
-  if (r.stop_reason == runtime::StopReason::kSignal)
-    stop_reason = signal_name(r.signal);
-  if (o.json) {
-    nlohmann::json j;
-    j["daq"] = daq.name();
-    j["rate_Hz"] = o.rate_Hz;
-    j["ticks"] = r.ticks;
-    j["stop_reason"] = stop_reason;
-    j["overruns"] = st.overruns;
-    const auto us = [](std::int64_t t_ns) { return static_cast<double>(t_ns) * 1e-3; };
-    j["period_error_p50_us"] = us(st.period_error.percentile_ns(0.5));
-    j["period_error_p99_us"] = us(st.period_error.percentile_ns(0.99));
-    j["period_error_max_us"] = us(st.period_error.max_ns());
-    j["wake_latency_p50_us"] = us(st.wake_latency.percentile_ns(0.5));
-    j["wake_latency_p99_us"] = us(st.wake_latency.percentile_ns(0.99));
-    j["wake_latency_max_us"] = us(st.wake_latency.max_ns());
-    j["realtime"] = {{"sched_fifo", rt.fifo}, {"mlockall", rt.memory_locked}};
-    j["faults"] = gs.faults;
-    j["clients_accepted"] = ns.accepted;
-    j["clients_refused"] = ns.refused_max_clients;
-    j["clients_dropped_slow"] = ns.disconnected_slow;
-    j["clients_dropped_idle"] = ns.disconnected_idle;
-    j["command_lines"] = gs.lines;
-    j["gcs_errors"] = gs.errors;
-    j["loop_commands_applied"] = r.host_commands_applied;
-    j["samples_dropped"] = r.host_samples_dropped;
-    j["max_output_slew_V_per_ms"] = r.max_output_slew_V_per_ms;
-    j["safety"] = safety_json(safety);
-    if (http) {
-      const host::HttpServerStats hs = http->stats();
-      j["http"] = {{"requests", hs.requests},         {"refused", hs.refused},
-                   {"unauthorised", hs.unauthorised}, {"streams_opened", hs.streams_opened},
-                   {"dropped_slow", hs.dropped_slow}, {"events_sent", dashboard->events_sent()}};
-    }
-    fmt::print("{}\n", j.dump(2));
-  } else {
-    fmt::print(
-        "serve: {} ticks, stopped by {}; {} clients ({} refused), {} lines, {} GCS errors, {} "
-        "faults, {} samples dropped, {} overruns\n",
-        r.ticks, stop_reason, ns.accepted, ns.refused_max_clients, gs.lines, gs.errors, gs.faults,
-        r.host_samples_dropped, st.overruns);
-  }
+  stack.daq().deactivate();
+  net.stop();
+  stack.stop_logging();
+  net.rethrow_failure();
+  print_serve_summary(o, net, daq_name, loop, r, safety, rt);
   return 0;
 }
 
