@@ -36,3 +36,18 @@ def test_shaper_taps_are_a_whole_list(controller):
     assert controller.improved.shaper.taps == [0.25, 0.5, 0.25]
     with pytest.raises(ps.InputError, match="taps"):
         shaper.taps = []
+
+
+def test_a_calibration_is_checked_as_its_file_is_at_load(controller, tmp_path):
+    # The loop's floor above, and the calibration's list (controller_ranges.hpp): ranges, p, A,
+    # and gains stable on the nominal inner loop.
+    assert ps.controller_problem(controller) == ""
+    assert ps.controller_problem(controller, 1e-4) == ""
+    gains = controller.gains
+    gains.kp, gains.ki, gains.kd = 5.0, 3.0, 2.0
+    controller.gains = gains
+    assert "unstable on the nominal inner loop" in ps.controller_problem(controller)
+    path = str(tmp_path / "unstable.toml")
+    ps.write_calibration_file(path, controller)
+    with pytest.raises(ps.InputError, match="unstable.toml"):
+        ps.load_calibration_file(path)

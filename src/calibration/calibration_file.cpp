@@ -8,6 +8,7 @@
 
 #include <fmt/core.h>
 
+#include "piezoshift/calibration/controller_ranges.hpp"
 #include "piezoshift/io/atomic_file.hpp"
 #include "piezoshift/io/config_file.hpp"
 #include "piezoshift/io/input_error.hpp"
@@ -21,52 +22,52 @@ namespace {
   throw io::InputError(fmt::format("{}: [{}] {}: {}", file.source(), section, key, why));
 }
 
+// Reads each number of the field list (controller_ranges.hpp) that the file holds, within its
+// range; a required one must be there, a list sharing its count with another must match it.
+class FieldReader {
+ public:
+  explicit FieldReader(const io::ConfigFile& file) : file_(file) {}
+
+  void operator()(std::string_view section, std::string_view key, double& v, const io::Bounds& b,
+                  std::string_view note) const {
+    if (!file_.section(section).read(key, v, b) && note.starts_with("required"))
+      fail(file_, section, key, fmt::format("missing ({})", note));
+  }
+  void operator()(std::string_view section, std::string_view key, std::size_t& v,
+                  const io::Bounds& b, std::string_view) const {
+    auto whole = static_cast<std::int64_t>(v);
+    if (file_.section(section).read(key, whole, b))
+      v = static_cast<std::size_t>(whole);
+  }
+  template <class Count>
+  void operator()(std::string_view section, std::string_view key, const ListField<double, Count>& f,
+                  const io::Bounds& b, std::string_view) const {
+    std::vector<double> values;
+    const bool present = file_.section(section).read(key, values, f.capacity, b);
+    if (f.same_count_as != nullptr && values.size() != *f.count)
+      fail(file_, section, key,
+           fmt::format("{} {} for {} {}", values.size(), key, *f.count, f.same_count_as));
+    if (!present)
+      return;
+    *f.count = values.size();
+    for (std::size_t i = 0; i < f.capacity; ++i)
+      f.values[i] = i < values.size() ? values[i] : 0.0;
+  }
+
+ private:
+  const io::ConfigFile& file_;
+};
+
 void read_improved(const io::ConfigFile& file, control::ImprovedParams& im) {
-  const io::ConfigSection s = file.section("improved");
-  if (!s.read("sample_time_s", im.sample_time_s, io::Bounds::positive()))
-    fail(file, "improved", "sample_time_s", "missing (kind = \"improved\" needs [improved])");
-  std::int64_t delay = static_cast<std::int64_t>(im.reference_delay_ticks);
-  s.read("reference_delay_ticks", delay,
-         io::Bounds::closed(0.0, static_cast<double>(control::kMaxReferenceDelayTicks)));
-  im.reference_delay_ticks = static_cast<std::size_t>(delay);
-  s.read("correction_ki", im.correction_ki, io::Bounds::closed(0.0, 1.0));
-  s.read("correction_ki_max", im.correction_ki_max, io::Bounds::closed(0.0, 1.0));
-  s.read("correction_boost_error_um", im.correction_boost_error_um, io::Bounds::non_negative());
-  s.read("correction_limit_um", im.correction_limit_um, io::Bounds::positive());
-  std::vector<double> taps;
-  if (s.read("shaper_taps", taps, control::kMaxShaperTaps, io::Bounds::closed(0.0, 1.0))) {
-    im.shaper.taps = taps.size();
-    im.shaper.weight = {};
-    double sum = 0.0;
-    for (std::size_t i = 0; i < taps.size(); ++i)
-      sum += im.shaper.weight[i] = taps[i];
-    if (std::fabs(sum - 1.0) > 1e-9)
-      fail(file, "improved", "shaper_taps", fmt::format("must sum to 1 (they sum to {})", sum));
-  }
-  s.read("shaper_rate_um_per_s", im.shaper.rate_um_per_s, io::Bounds::positive());
-  for (std::size_t i = 0; i < control::kChannels; ++i) {
-    const std::string name = fmt::format("improved.channel{}", i + 1);
-    const io::ConfigSection c = file.section(name);
-    control::HysteresisCreepParams& m = im.model[i];
-    c.read("offset_um", m.offset_um, io::Bounds::closed(-100.0, 100.0));
-    if (!c.read("linear_weight", m.linear_weight, io::Bounds::closed(1e-3, 100.0)))
-      fail(file, name, "linear_weight", "missing");
-    std::vector<double> r, w, tau;
-    c.read("thresholds_um", r, control::kMaxModelOperators, io::Bounds::positive());
-    c.read("weights", w, control::kMaxModelOperators, io::Bounds::closed(0.0, 100.0));
-    if (r.size() != w.size())
-      fail(file, name, "weights", fmt::format("{} weights for {} thresholds", w.size(), r.size()));
-    m.operators = r.size();
-    for (std::size_t j = 0; j < r.size(); ++j) {
-      m.threshold_um[j] = r[j];
-      m.weight[j] = w[j];
-    }
-    c.read("creep_time_constants_s", tau, control::kMaxCreepTerms, io::Bounds::positive());
-    m.creep_terms = tau.size();
-    for (std::size_t k = 0; k < tau.size(); ++k)
-      m.creep_time_constant_s[k] = tau[k];
-    c.read("creep_gain", m.creep_gain, io::Bounds::closed(-0.05, 0.05));
-  }
+  const FieldReader reader(file);
+  visit_improved_fields(im, reader);
+  double sum = 0.0;
+  for (std::size_t i = 0; i < im.shaper.taps; ++i)
+    sum += im.shaper.weight[i];
+  if (std::fabs(sum - 1.0) > 1e-9)
+    fail(file, "improved", "shaper_taps", fmt::format("must sum to 1 (they sum to {})", sum));
+  for (std::size_t i = 0; i < control::kChannels; ++i)
+    visit_model_fields(im.model[i], model_section(i), reader);
 }
 
 std::string number_list(const double* v, std::size_t n) {
@@ -76,28 +77,39 @@ std::string number_list(const double* v, std::size_t n) {
   return out + "]";
 }
 
+// Writes each number of the field list, in its order, with its comment (shortest round-trip
+// form: the reader gets the same double back).
+class FieldWriter {
+ public:
+  explicit FieldWriter(std::string& out) : out_(out) {}
+
+  template <class Value>
+  void operator()(std::string_view, std::string_view key, const Value& v, const io::Bounds&,
+                  std::string_view note) const {
+    out_ += fmt::format("{} = {}{}\n", key, v, comment(note));
+  }
+  template <class Count>
+  void operator()(std::string_view, std::string_view key, const ListField<const double, Count>& f,
+                  const io::Bounds&, std::string_view note) const {
+    out_ += fmt::format("{} = {}{}\n", key, number_list(f.values, *f.count), comment(note));
+  }
+
+ private:
+  static std::string comment(std::string_view note) {
+    return note.empty() || note.starts_with("required") ? std::string()
+                                                        : fmt::format("  # {}", note);
+  }
+  std::string& out_;
+};
+
 std::string format_improved(const control::ImprovedParams& im) {
   std::string out =
       "\n[improved]  # the improved controller (docs/control.md), for one loop rate\n";
-  out += fmt::format("sample_time_s = {}\n", im.sample_time_s);
-  out += fmt::format("reference_delay_ticks = {}\n", im.reference_delay_ticks);
-  out += fmt::format("correction_ki = {}  # per-sample at sample_time_s\n", im.correction_ki);
-  out += fmt::format("correction_ki_max = {}\n", im.correction_ki_max);
-  out += fmt::format("correction_boost_error_um = {}\n", im.correction_boost_error_um);
-  out += fmt::format("correction_limit_um = {}\n", im.correction_limit_um);
-  out += "shaper_taps = " + number_list(im.shaper.weight.data(), im.shaper.taps) + "\n";
-  out += fmt::format("shaper_rate_um_per_s = {}\n", im.shaper.rate_um_per_s);
+  const FieldWriter writer(out);
+  visit_improved_fields(im, writer);
   for (std::size_t i = 0; i < control::kChannels; ++i) {
-    const control::HysteresisCreepParams& m = im.model[i];
-    out += fmt::format("\n[improved.channel{}]  # gauge um from command um\n", i + 1);
-    out += fmt::format("offset_um = {}\n", m.offset_um);
-    out += fmt::format("linear_weight = {}\n", m.linear_weight);
-    out += "thresholds_um = " + number_list(m.threshold_um.data(), m.operators) + "\n";
-    out += "weights = " + number_list(m.weight.data(), m.operators) + "\n";
-    out +=
-        "creep_time_constants_s = " + number_list(m.creep_time_constant_s.data(), m.creep_terms) +
-        "\n";
-    out += fmt::format("creep_gain = {}\n", m.creep_gain);
+    out += fmt::format("\n[{}]  # gauge um from command um\n", model_section(i));
+    visit_model_fields(im.model[i], model_section(i), writer);
   }
   return out;
 }
@@ -105,11 +117,8 @@ std::string format_improved(const control::ImprovedParams& im) {
 }  // namespace
 
 void read_controller_section(const io::ConfigFile& file, control::SemiClosedLoopParams& params) {
+  visit_controller_fields(params, FieldReader(file));
   const io::ConfigSection c = file.section("controller");
-  c.read("kp", params.gains.kp, io::Bounds::non_negative());
-  c.read("ki", params.gains.ki, io::Bounds::non_negative());
-  c.read("kd", params.gains.kd, io::Bounds::non_negative());
-  c.read("gains_sample_time_s", params.gains_sample_time_s, io::Bounds::positive());
   std::array<double, 4> p{params.polynomial.p3, params.polynomial.p2, params.polynomial.p1,
                           params.polynomial.p0};
   if (c.read("p", p))
@@ -139,6 +148,8 @@ control::SemiClosedLoopParams load_calibration_file(const std::string& path,
   const bool has_min =
       file.section("travel").read("z_min_um", z_min_um, io::Bounds::non_negative());
   file.reject_unknown();
+  if (const std::string why = controller_problem(params, own_sample_time_s(params)); !why.empty())
+    throw io::InputError(fmt::format("{}: {}", path, why));
   if (has_min && has_max && !(z_min_um < z_max_um))
     throw io::InputError(fmt::format("{}: [travel] z_min_um = {} must be below z_max_um = {}", path,
                                      z_min_um, z_max_um));
@@ -156,14 +167,10 @@ std::string format_calibration(const control::SemiClosedLoopParams& params,
   std::istringstream lines(header);
   for (std::string line; std::getline(lines, line);)
     out += "# " + line + "\n";
-  const auto& g = params.gains;
   const auto& p = params.polynomial;
   const auto& a = params.matrix.a;
   out += "\n[controller]\n";
-  out += fmt::format("kp = {}  # per-sample gains, Eq. 7\n", g.kp);
-  out += fmt::format("ki = {}\n", g.ki);
-  out += fmt::format("kd = {}\n", g.kd);
-  out += fmt::format("gains_sample_time_s = {}\n", params.gains_sample_time_s);
+  visit_controller_fields(params, FieldWriter(out));
   out +=
       fmt::format("p = [{}, {}, {}, {}]  # [p3, p2, p1, p0], Eq. 8, um\n", p.p3, p.p2, p.p1, p.p0);
   out += "A = [";

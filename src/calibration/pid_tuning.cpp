@@ -6,6 +6,7 @@
 #include <limits>
 #include <stdexcept>
 
+#include "piezoshift/calibration/controller_ranges.hpp"
 #include "piezoshift/experiments/bench.hpp"
 #include "piezoshift/experiments/metrics_step_response.hpp"
 
@@ -122,7 +123,9 @@ PidTrial score_pid_gains(const config::ProjectConfig& config,
   }
   trial.faulted = bench.faulted();
   trial.simulated_time_s = bench.time_s();
-  trial.acceptable = !trial.faulted && w.overshoot_pct <= options.max_overshoot_pct &&
+  trial.nominal_gain_margin_dB = nominal_gain_margin_dB(params);
+  trial.acceptable = trial.nominal_gain_margin_dB > 0.0 && !trial.faulted &&
+                     w.overshoot_pct <= options.max_overshoot_pct &&
                      trial.plate_overshoot_pct <= options.max_overshoot_pct &&
                      std::isfinite(w.settling_time_s) &&
                      w.steady_state_error_nm <= options.max_steady_state_error_nm;

@@ -11,7 +11,9 @@
 //       steady_state_error_nm |mean(y) - S| over the last steady_window_s
 //     on the plate, between ticks (the twin's physics-rate truth, mean of P1..P3):
 //       plate_overshoot_pct   100 max(0, max z - z_inf) / |z_inf - z_0|
-// A candidate is acceptable when the supervisor did not trip, every actuator's and the plate's
+// A candidate is acceptable when its gains are stable on the nominal inner loop (the check every
+// calibration file passes at load, controller_ranges.hpp), the supervisor did not trip, every
+// actuator's and the plate's
 // overshoot is <= max_overshoot_pct ("little or even no overshoot"), it settled within the
 // record and the steady-state error is <= max_steady_state_error_nm. (An actuator stepped alone
 // scores a different loop: the plate couples the legs, and the overshoot the single-leg score
@@ -43,6 +45,9 @@ struct PidTrial {
   PidScore worst{};                  //!< element-wise worst over the three actuators
   double plate_overshoot_pct = 0.0;  //!< the plate between ticks (physics-rate truth)
   bool faulted = false;              //!< the supervisor tripped during the step
+  //! On the nominal inner loop (controller_ranges.hpp): <= 0 dB is a set a calibration file may
+  //! not hold, so it is never acceptable.
+  double nominal_gain_margin_dB = 0.0;
   bool acceptable = false;
   double simulated_time_s = 0.0;
 };

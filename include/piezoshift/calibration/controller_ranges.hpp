@@ -1,0 +1,125 @@
+#pragma once
+// Every number of the controller's parameters a calibration file holds, with its range, in one
+// list (as runtime/safety_ranges.hpp is for [safety]): the file's reader and writer
+// (calibration_file.hpp) walk it, and controller_problem() below, which every command that loads
+// a calibration and the Python bindings use, checks it. The list is the file's order:
+//
+//   [controller]           kp, ki, kd (per sample, Eq. 7), gains_sample_time_s;
+//                          then p, A and kind, which are checked as a whole below
+//   [improved]             sample_time_s (required), reference_delay_ticks, correction_ki,
+//                          correction_ki_max, correction_boost_error_um, correction_limit_um,
+//                          shaper_taps (a list, summing to 1), shaper_rate_um_per_s
+//   [improved.channelN]    offset_um, linear_weight (required), thresholds_um, weights (a list
+//                          as long as thresholds_um), creep_time_constants_s, creep_gain
+//
+// Beyond each number's range, controller_problem() refuses what would make the stage report
+// nonsense or the loop unstable (issue 27's findings):
+//   p          a coefficient that is not finite, or a cubic that does not rise over the stroke
+//              (p'(z) > 0 on [0, 16] um: an all-zero p maps every Z_d to p0)
+//   A          an entry that is not finite or is subnormal (POS? answered -nan), or an A whose
+//              2-norm condition number exceeds kMaxMatrixCondition (an all-zero or singular A
+//              cannot be inverted for the positions the gauges show)
+//   gains      PIDs that are unstable on the nominal inner loop: the plant a gain G in (0, 1]
+//              (gauge um per um of command: a stack delivers at most the free stroke the signal
+//              scaling is made for, control.md) behind the DAQ contract's two ticks of delay,
+//              P(z) = G z^-2; the loop C(z) P(z) must keep a gain margin > 0 dB at G = 1, i.e.
+//              stay stable for every G up to 1. The nominal plant has no dynamics of its own,
+//              so this refuses what cannot be stable, not everything that is not: the identified
+//              loop's margins (loop_identification.hpp) say how far a stable set is from the edge.
+//   loop       what the loop itself refuses at its own sample time (control/parameter_check.hpp)
+#include <cstddef>
+#include <string>
+#include <string_view>
+
+#include "piezoshift/control/semi_closed_loop.hpp"
+#include "piezoshift/io/config_file.hpp"
+
+namespace piezoshift::calibration {
+
+//! Largest 2-norm condition number of A a calibration may hold. The paper's A (Eq. 8) has 1.03;
+//! a tripod whose A reaches 100 turns 1 nm of gauge noise into up to 100 nm of computed position.
+inline constexpr double kMaxMatrixCondition = 100.0;
+
+//! A list of numbers held in a fixed array and a count (the controller holds no heap).
+template <class Value, class Count>
+struct ListField {
+  Value* values;
+  Count* count;
+  std::size_t capacity;
+  //! The list whose count this one shares (weights: thresholds_um), or null.
+  const char* same_count_as = nullptr;
+};
+template <class Value, class Count>
+ListField(Value*, Count*, std::size_t) -> ListField<Value, Count>;
+template <class Value, class Count>
+ListField(Value*, Count*, std::size_t, const char*) -> ListField<Value, Count>;
+
+//! Calls, in the file's order, visit(section, key, field, bounds, note) for each number: field is
+//! a double&, a std::size_t& (a whole number) or a ListField (each element within bounds); note
+//! is the writer's comment ("" none) or, for a required key, starts with "required". Const or not.
+template <class Params, class Visit>
+void visit_controller_fields(Params& p, Visit&& visit) {
+  using B = io::Bounds;
+  visit("controller", "kp", p.gains.kp, B::non_negative(), "per-sample gains, Eq. 7");
+  visit("controller", "ki", p.gains.ki, B::non_negative(), "");
+  visit("controller", "kd", p.gains.kd, B::non_negative(), "");
+  visit("controller", "gains_sample_time_s", p.gains_sample_time_s, B::positive(), "");
+}
+
+//! [improved]'s numbers, as visit_controller_fields.
+template <class Improved, class Visit>
+void visit_improved_fields(Improved& im, Visit&& visit) {
+  using B = io::Bounds;
+  visit("improved", "sample_time_s", im.sample_time_s, B::positive(),
+        "required when kind = \"improved\"");
+  visit("improved", "reference_delay_ticks", im.reference_delay_ticks,
+        B::closed(0.0, static_cast<double>(control::kMaxReferenceDelayTicks)), "");
+  visit("improved", "correction_ki", im.correction_ki, B::closed(0.0, 1.0),
+        "per-sample at sample_time_s");
+  visit("improved", "correction_ki_max", im.correction_ki_max, B::closed(0.0, 1.0), "");
+  visit("improved", "correction_boost_error_um", im.correction_boost_error_um, B::non_negative(),
+        "");
+  visit("improved", "correction_limit_um", im.correction_limit_um, B::positive(), "");
+  visit("improved", "shaper_taps",
+        ListField{im.shaper.weight.data(), &im.shaper.taps, control::kMaxShaperTaps},
+        B::closed(0.0, 1.0), "");
+  visit("improved", "shaper_rate_um_per_s", im.shaper.rate_um_per_s, B::positive(), "");
+}
+
+//! One [improved.channelN]'s numbers (section: its name), as visit_controller_fields.
+template <class Model, class Visit>
+void visit_model_fields(Model& m, std::string_view section, Visit&& visit) {
+  using B = io::Bounds;
+  visit(section, "offset_um", m.offset_um, B::closed(-100.0, 100.0), "");
+  visit(section, "linear_weight", m.linear_weight, B::closed(1e-3, 100.0), "required");
+  visit(section, "thresholds_um",
+        ListField{m.threshold_um.data(), &m.operators, control::kMaxModelOperators}, B::positive(),
+        "");
+  visit(section, "weights",
+        ListField{m.weight.data(), &m.operators, control::kMaxModelOperators, "thresholds_um"},
+        B::closed(0.0, 100.0), "");
+  visit(section, "creep_time_constants_s",
+        ListField{m.creep_time_constant_s.data(), &m.creep_terms, control::kMaxCreepTerms},
+        B::positive(), "");
+  visit(section, "creep_gain", m.creep_gain, B::closed(-0.05, 0.05), "");
+}
+
+//! The section of channel i (0-based): "improved.channel1" ...
+std::string model_section(std::size_t channel);
+
+//! The first problem of params as a calibration for a loop at loop_sample_time_s (see the header
+//! comment), naming the field; "" when there is none. params.sample_time_s is not read: the
+//! loop sets it.
+std::string controller_problem(const control::SemiClosedLoopParams& params,
+                               double loop_sample_time_s);
+
+//! The sample time a calibration is made for when no loop is named: the improved controller's
+//! design rate, else the rate the gains were tuned at.
+double own_sample_time_s(const control::SemiClosedLoopParams& params);
+
+//! The gain margin (dB) of the PIDs, at params.sample_time_s, on the nominal inner loop at G = 1
+//! (header comment): > 0 when stable for every G in (0, 1]; +infinity when the phase never
+//! reaches -180 deg.
+double nominal_gain_margin_dB(const control::SemiClosedLoopParams& params);
+
+}  // namespace piezoshift::calibration

@@ -1,0 +1,209 @@
+// The controller's field list (calibration/controller_ranges.hpp): the calibration file's reader
+// and writer walk it (every number read back bit for bit), and controller_problem() refuses what
+// would make the stage report nonsense or the loop unstable (issue 27), naming the field.
+#include <cmath>
+#include <cstring>
+#include <limits>
+#include <random>
+#include <string>
+#include <vector>
+
+#include <gtest/gtest.h>
+
+#include "piezoshift/calibration/calibration_file.hpp"
+#include "piezoshift/calibration/controller_ranges.hpp"
+#include "piezoshift/io/input_error.hpp"
+#include "temp_dir_test.hpp"
+
+namespace piezoshift::calibration {
+namespace {
+
+using control::SemiClosedLoopParams;
+
+// Every number the list visits, in order, as (section.key[i], value).
+struct Collect {
+  std::vector<std::pair<std::string, double>> values;
+  void operator()(std::string_view section, std::string_view key, const double& v,
+                  const io::Bounds&, std::string_view) {
+    values.emplace_back(fmt(section, key, -1), v);
+  }
+  void operator()(std::string_view section, std::string_view key, const std::size_t& v,
+                  const io::Bounds&, std::string_view) {
+    values.emplace_back(fmt(section, key, -1), static_cast<double>(v));
+  }
+  template <class Value, class Count>
+  void operator()(std::string_view section, std::string_view key, const ListField<Value, Count>& f,
+                  const io::Bounds&, std::string_view) {
+    for (std::size_t i = 0; i < *f.count; ++i)
+      values.emplace_back(fmt(section, key, static_cast<int>(i)), f.values[i]);
+  }
+  static std::string fmt(std::string_view section, std::string_view key, int i) {
+    return std::string(section) + "." + std::string(key) +
+           (i >= 0 ? "[" + std::to_string(i) + "]" : "");
+  }
+};
+
+std::vector<std::pair<std::string, double>> all_numbers(const SemiClosedLoopParams& p) {
+  Collect c;
+  visit_controller_fields(p, c);
+  visit_improved_fields(p.improved, c);
+  for (std::size_t i = 0; i < control::kChannels; ++i)
+    visit_model_fields(p.improved.model[i], model_section(i), c);
+  return c.values;
+}
+
+// An improved controller with every list filled and every number an awkward double in range.
+SemiClosedLoopParams awkward_improved(std::uint64_t seed) {
+  std::mt19937_64 rng(seed);
+  std::uniform_real_distribution<double> u(0.0, 1.0);
+  SemiClosedLoopParams p;
+  p.kind = control::ControllerKind::kImproved;
+  p.gains = {0.3 + 0.1 * u(rng), 0.05 + 0.05 * u(rng), 0.001 * u(rng)};
+  p.gains_sample_time_s = 1e-3;
+  control::ImprovedParams& im = p.improved;
+  im.sample_time_s = 1e-3;
+  im.reference_delay_ticks = 3;
+  im.correction_ki = 0.03 * u(rng);
+  im.correction_ki_max = 0.3 * u(rng);
+  im.correction_boost_error_um = 0.02 * u(rng);
+  im.correction_limit_um = 1.0 + u(rng);
+  im.shaper.taps = 3;
+  im.shaper.weight = {};
+  im.shaper.weight[0] = 0.25;
+  im.shaper.weight[1] = 0.5;
+  im.shaper.weight[2] = 0.25;
+  im.shaper.rate_um_per_s = 1e3 * (1.0 + u(rng));
+  for (control::HysteresisCreepParams& m : im.model) {
+    m.offset_um = u(rng) - 0.5;
+    m.linear_weight = 0.8 + 0.4 * u(rng);
+    m.operators = 5;
+    for (std::size_t j = 0; j < m.operators; ++j) {
+      m.threshold_um[j] = 0.1 * static_cast<double>(j + 1) + 0.01 * u(rng);
+      m.weight[j] = u(rng) / 3.0;
+    }
+    m.creep_terms = 4;
+    for (std::size_t k = 0; k < m.creep_terms; ++k)
+      m.creep_time_constant_s[k] = std::pow(10.0, static_cast<double>(k)) * (1.0 + u(rng));
+    m.creep_gain = 0.01 * (u(rng) - 0.5);
+  }
+  return p;
+}
+
+class ControllerFile : public testing::TempDirTest {};
+
+TEST_F(ControllerFile, EveryNumberOfTheListReadsBackBitForBit) {
+  for (std::uint64_t seed = 1; seed <= 5; ++seed) {
+    const SemiClosedLoopParams p = awkward_improved(seed);
+    ASSERT_EQ(controller_problem(p, own_sample_time_s(p)), "") << "seed " << seed;
+    const std::string file = path("cal.toml");
+    write_calibration_file(file, p, "test");
+    const SemiClosedLoopParams q = load_calibration_file(file);
+    const auto a = all_numbers(p), b = all_numbers(q);
+    // 4 controller numbers, 8 improved ones (3 taps), per channel 2 + 5 + 5 + 4 + 1.
+    ASSERT_EQ(a.size(), 4U + 7U + 3U + 3U * 17U);
+    ASSERT_EQ(a.size(), b.size());
+    for (std::size_t i = 0; i < a.size(); ++i) {
+      EXPECT_EQ(a[i].first, b[i].first);
+      EXPECT_EQ(std::memcmp(&a[i].second, &b[i].second, sizeof(double)), 0)
+          << a[i].first << ": " << a[i].second << " read back as " << b[i].second;
+    }
+  }
+}
+
+// Each number of the list set outside its range is named; the reader's own range check (the same
+// list) names the file as well.
+TEST_F(ControllerFile, EachNumberOutsideItsRangeIsNamed) {
+  struct Case {
+    const char* key;
+    void (*spoil)(SemiClosedLoopParams&);
+  };
+  const Case cases[] = {
+      {"kp", [](SemiClosedLoopParams& p) { p.gains.kp = -0.1; }},
+      {"gains_sample_time_s", [](SemiClosedLoopParams& p) { p.gains_sample_time_s = 0.0; }},
+      {"correction_ki", [](SemiClosedLoopParams& p) { p.improved.correction_ki = 1.5; }},
+      {"shaper_taps[1]", [](SemiClosedLoopParams& p) { p.improved.shaper.weight[1] = -0.5; }},
+      {"linear_weight", [](SemiClosedLoopParams& p) { p.improved.model[2].linear_weight = 1e-4; }},
+      {"thresholds_um[0]",
+       [](SemiClosedLoopParams& p) { p.improved.model[0].threshold_um[0] = 0; }},
+      {"creep_gain", [](SemiClosedLoopParams& p) { p.improved.model[1].creep_gain = 0.1; }},
+  };
+  for (const Case& c : cases) {
+    SemiClosedLoopParams p = awkward_improved(7);
+    c.spoil(p);
+    const std::string why = controller_problem(p, own_sample_time_s(p));
+    EXPECT_NE(why.find(c.key), std::string::npos) << c.key << ": " << why;
+  }
+  // Through the file: written as text, refused at load naming file, section and key.
+  const std::string file = write(
+      "bad.toml", "[controller]\nkp = 0.6\nki = -0.2\nkd = 0.001\ngains_sample_time_s = 1e-3\n");
+  try {
+    load_calibration_file(file);
+    ADD_FAILURE() << "a negative ki was accepted";
+  } catch (const io::InputError& e) {
+    EXPECT_NE(std::string(e.what()).find("bad.toml"), std::string::npos) << e.what();
+    EXPECT_NE(std::string(e.what()).find("ki"), std::string::npos) << e.what();
+  }
+}
+
+TEST(ControllerProblem, ThePapersControllerAtOneAndTenKilohertzIsAccepted) {
+  const SemiClosedLoopParams paper;
+  EXPECT_EQ(controller_problem(paper, 1e-3), "");
+  EXPECT_EQ(controller_problem(paper, 1e-4), "");  // gains rescaled: kp 0.6, ki 0.02, kd 0.01
+}
+
+TEST(ControllerProblem, ACubicThatDoesNotRiseOverTheStrokeIsRefused) {
+  SemiClosedLoopParams p;
+  p.polynomial = {0.0, 0.0, 0.0, 0.0};  // every Z_d -> 0
+  EXPECT_NE(controller_problem(p, 1e-3).find("[controller] p"), std::string::npos);
+  // Rising at 0 but falling before 16 um: p'(z) = 1 - 0.01 z^2 is negative past 10 um.
+  p.polynomial = {-0.01 / 3.0, 0.0, 1.0, 0.0};
+  EXPECT_NE(controller_problem(p, 1e-3).find("must rise"), std::string::npos);
+  p.polynomial = {0.0, 0.0, 1.0, std::numeric_limits<double>::quiet_NaN()};
+  EXPECT_NE(controller_problem(p, 1e-3).find("not a finite number"), std::string::npos);
+}
+
+TEST(ControllerProblem, AnAThatIsSubnormalSingularOrIllConditionedIsRefused) {
+  SemiClosedLoopParams p;
+  p.matrix.a = {};
+  EXPECT_NE(controller_problem(p, 1e-3).find("condition number"), std::string::npos);
+  p.matrix.a = {{{1e-310, 0, 0}, {0, 1e-310, 0}, {0, 0, 1e-310}}};  // POS? answered -nan
+  EXPECT_NE(controller_problem(p, 1e-3).find("not a finite, normal number"), std::string::npos);
+  p.matrix.a = {{{1, 0, 0}, {0, 1, 0}, {0, 0, 0.5 / kMaxMatrixCondition}}};  // cond = 200
+  EXPECT_NE(controller_problem(p, 1e-3).find("condition number 200"), std::string::npos);
+  p.matrix.a = {{{1, 0, 0}, {0, 1, 0}, {0, 0, 2.0 / kMaxMatrixCondition}}};  // cond = 50
+  EXPECT_EQ(controller_problem(p, 1e-3), "");
+}
+
+// The nominal loop's gain margin against an independent evaluation (a Python script on a
+// 200 000-point linear grid, unwrapped phase, the incremental PID's C(z) times z^-2): the paper's
+// gains 2.99 dB at 1 kHz and 4.15 dB at 10 kHz; kp 1, ki 0.5, kd 0.01: -2.19 dB.
+TEST(ControllerProblem, NominalGainMarginMatchesAnIndependentEvaluation) {
+  SemiClosedLoopParams p;
+  p.sample_time_s = 1e-3;
+  EXPECT_NEAR(nominal_gain_margin_dB(p), 2.99, 0.01);
+  p.sample_time_s = 1e-4;
+  EXPECT_NEAR(nominal_gain_margin_dB(p), 4.15, 0.01);
+  p.sample_time_s = 1e-3;
+  p.gains = {1.0, 0.5, 0.01};
+  EXPECT_NEAR(nominal_gain_margin_dB(p), -2.19, 0.01);
+}
+
+// Issue 27: kp 5, ki 3, kd 2 ran with the plate swinging between 2.3 and 7.0 um and no fault.
+TEST_F(ControllerFile, GainsOutsideTheStableRegionAreRefusedAtLoad) {
+  SemiClosedLoopParams p;
+  p.gains = {5.0, 3.0, 2.0};
+  EXPECT_NE(controller_problem(p, 1e-3).find("unstable on the nominal inner loop"),
+            std::string::npos);
+  const std::string file = path("unstable.toml");
+  write_calibration_file(file, p, "test");
+  try {
+    load_calibration_file(file);
+    ADD_FAILURE() << "kp 5, ki 3, kd 2 was accepted";
+  } catch (const io::InputError& e) {
+    EXPECT_NE(std::string(e.what()).find("unstable.toml"), std::string::npos) << e.what();
+    EXPECT_NE(std::string(e.what()).find("kp = 5, ki = 3, kd = 2"), std::string::npos) << e.what();
+  }
+}
+
+}  // namespace
+}  // namespace piezoshift::calibration
