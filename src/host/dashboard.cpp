@@ -54,6 +54,8 @@ const char* fault_sentence(runtime::FaultReason reason) {
       return "the DAQ write failed";
     case R::kOutputNotFinite:
       return "the controller's output is not a number";
+    case R::kOscillation:
+      return "the loop oscillates: its tracking error keeps reversing with the target steady";
   }
   return "unknown";
 }

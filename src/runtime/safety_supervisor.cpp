@@ -24,6 +24,8 @@ const char* to_string(FaultReason reason) noexcept {
       return "tracking";
     case FaultReason::kResponse:
       return "response";
+    case FaultReason::kOscillation:
+      return "oscillation";
     case FaultReason::kSaturation:
       return "saturation";
     case FaultReason::kOverruns:
@@ -62,6 +64,49 @@ std::uint64_t ticks_for(double seconds, double sample_time_s) {
 }
 }  // namespace
 
+bool ReversalCounter::update(std::uint64_t tick, double error, double target, double band,
+                             std::uint32_t needed, std::uint64_t window_ticks) noexcept {
+  if (!started_) {
+    started_ = true;
+    extreme_ = error;
+    target_at_reversal_ = target;
+    return false;
+  }
+  if (direction_ == 0) {  // the first swing of `band` sets the direction; it is no reversal
+    if (std::fabs(error - extreme_) >= band) {
+      direction_ = error > extreme_ ? +1 : -1;
+      extreme_ = error;
+    }
+    return false;
+  }
+  // Follow the extreme in the present direction; a swing of `band` back from it is a reversal.
+  bool reversed = false;
+  if (direction_ > 0 && error > extreme_) {
+    extreme_ = error;
+  } else if (direction_ < 0 && error < extreme_) {
+    extreme_ = error;
+  } else if (std::fabs(error - extreme_) >= band) {
+    reversed = true;
+    direction_ = error > extreme_ ? +1 : -1;
+    extreme_ = error;
+  }
+  if (!reversed)
+    return false;
+  // A target that moved is a commanded motion (a step, a wave), not an oscillation: start again.
+  if (std::fabs(target - target_at_reversal_) >= band)
+    count_ = 0;
+  target_at_reversal_ = target;
+  ticks_[next_] = tick;
+  next_ = (next_ + 1) % kMaxOscillationReversals;
+  if (count_ < kMaxOscillationReversals)
+    ++count_;
+  if (needed < 2 || count_ < needed)
+    return false;
+  const std::uint32_t oldest =
+      (next_ + kMaxOscillationReversals - needed) % kMaxOscillationReversals;
+  return tick - ticks_[oldest] <= window_ticks;
+}
+
 void SafetySupervisor::configure(
     const SafetyLimits& limits, double sample_time_s,
     const std::array<control::SignalScaling, control::kChannels>& scaling) {
@@ -80,6 +125,7 @@ void SafetySupervisor::configure(
   tracking_ticks_ = ticks_for(limits.tracking_time_s, sample_time_s);
   response_ticks_ = ticks_for(limits.response_time_s, sample_time_s);
   saturation_ticks_ = ticks_for(limits.saturation_time_s, sample_time_s);
+  oscillation_ticks_ = ticks_for(limits.oscillation_time_s, sample_time_s);
   reset();
 }
 
@@ -92,6 +138,8 @@ void SafetySupervisor::reset() noexcept {
   tracking_count_ = {};
   response_count_ = {};
   saturation_count_ = {};
+  for (ReversalCounter& r : reversals_)
+    r.reset();
 }
 
 double SafetySupervisor::jump_limit_V(std::size_t i, double period_s) const noexcept {
@@ -181,6 +229,14 @@ void SafetySupervisor::check(const SupervisorInput& in) noexcept {
       latch(FaultReason::kSaturation, k, ch, last_ao_V_[i], limits_.output_max_V);
       return;
     }
+    if (!in.closed_loop) {
+      reversals_[i].reset();
+    } else if (reversals_[i].update(k, error, in.target_um[i], limits_.oscillation_band_um,
+                                    limits_.oscillation_reversals, oscillation_ticks_)) {
+      latch(FaultReason::kOscillation, k, ch, limits_.oscillation_reversals,
+            limits_.oscillation_reversals);
+      return;
+    }
   }
 }
 
@@ -241,6 +297,8 @@ bool SafetySupervisor::clear_fault() noexcept {
   tracking_count_ = {};
   response_count_ = {};
   saturation_count_ = {};
+  for (ReversalCounter& r : reversals_)
+    r.reset();
   return true;
 }
 

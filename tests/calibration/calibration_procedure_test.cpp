@@ -189,9 +189,9 @@ TEST(CalibrationFile, WritesAtomicallyAndReadsBackTheSameDoubles) {
 // 0.59999999999999998), so a person can read the file, and nothing is lost.
 TEST(CalibrationFile, NumbersAreWrittenShortestAndReadBackBitIdentical) {
   control::SemiClosedLoopParams p;
-  p.gains = control::PidGains{0.6, 0.2, 1.0 / 3.0};
+  p.gains = control::PidGains{0.6, 0.2, 1.0 / 3000.0};  // no short decimal; stable (kd 1/3 is not)
   p.polynomial = control::CubicPolynomial{-1.009e-4, 1e-300, 16.0, 0.1 + 0.2};
-  p.matrix.a[2][0] = -5e-324;  // the smallest subnormal
+  p.matrix.a[2][0] = -2.2250738585072014e-308;  // the smallest normal (a subnormal is refused)
   const std::string text = format_calibration(p, "");
   EXPECT_NE(text.find("kp = 0.6  #"), std::string::npos) << text;
   EXPECT_NE(text.find("ki = 0.2\n"), std::string::npos) << text;

@@ -27,7 +27,7 @@ TEST(SafetyRanges, DefaultsAreInRangeAndEveryLimitIsListed) {
   int n = 0;
   SafetyLimits l;
   visit_safety_limits(l, [&](const char*, const char*, auto&, design::Bounds) { ++n; });
-  EXPECT_EQ(n, 19);  // every field of SafetyLimits
+  EXPECT_EQ(n, 22);  // every field of SafetyLimits
 }
 
 TEST(SafetyRanges, SectionSetsLimitsAndRefusesOutOfRangeAndContradictions) {

@@ -356,5 +356,60 @@ TEST(SafetySupervisor, OpenLoopHasNoTrackingOrSaturationRule) {
   EXPECT_EQ(dead.fault().reason, FaultReason::kResponse);
 }
 
+// The oscillation rule's counter on made-up errors: a reversal is a swing of the band back from
+// the last extreme; eight within the window, with the target steady, trip it.
+TEST(ReversalCounter, EightReversalsOfASteadyTargetWithinTheWindowTrip) {
+  ReversalCounter c;
+  // A square wave of +-0.3 um about 0 (swings of 0.6 um >= the 0.5 um band), 2 ticks per level:
+  // the first swing sets the direction, each later one is a reversal.
+  std::uint64_t tripped_at = 0;
+  for (std::uint64_t k = 0; k < 100 && tripped_at == 0; ++k) {
+    const double e = (k / 2) % 2 == 0 ? 0.3 : -0.3;
+    if (c.update(k, e, 5.0, 0.5, 8, 100))
+      tripped_at = k;
+  }
+  // Levels change at ticks 2, 4, 6, ...: the change at 2 sets the direction, 4 .. 18 are
+  // reversals 1 .. 8.
+  EXPECT_EQ(tripped_at, 18U);
+}
+
+TEST(ReversalCounter, SwingsBelowTheBandOrSpreadBeyondTheWindowDoNotTrip) {
+  ReversalCounter small, slow;
+  for (std::uint64_t k = 0; k < 1000; ++k) {
+    ASSERT_FALSE(small.update(k, (k / 2) % 2 == 0 ? 0.2 : -0.2, 5.0, 0.5, 8, 100)) << k;
+    // 0.6 um swings every 20 ticks: 8 reversals span 140 ticks > 100.
+    ASSERT_FALSE(slow.update(k, (k / 20) % 2 == 0 ? 0.3 : -0.3, 5.0, 0.5, 8, 100)) << k;
+  }
+}
+
+TEST(ReversalCounter, AMovingTargetIsACommandedMotionNotAnOscillation) {
+  ReversalCounter c;
+  // The same error, but the target jumps by 1 um at each level (a wave the loop lags).
+  for (std::uint64_t k = 0; k < 1000; ++k) {
+    const bool high = (k / 2) % 2 == 0;
+    ASSERT_FALSE(c.update(k, high ? 0.3 : -0.3, high ? 5.0 : 6.0, 0.5, 8, 100)) << k;
+  }
+}
+
+TEST(SafetySupervisor, AnOscillatingTrackingErrorLatchesOscillation) {
+  SafetySupervisor s = make();
+  const double ao = 3.5 / 0.9117 * 0.625;
+  SupervisorInput in = steady(0, ao);
+  std::uint64_t k = 0;
+  for (; k < 200 && !s.faulted(); ++k) {
+    in.tick = k;
+    // y swings +-0.4 um about S every 2 ticks (the limit cycle kp 5, ki 3, kd 2 ran in, issue 27,
+    // swung 2.4 um at 250 Hz); |S - y| stays below the tracking rule's 1 um.
+    const double y = 3.5 + ((k / 2) % 2 == 0 ? 0.4 : -0.4);
+    in.feedback_um = control::filled(y);
+    in.target_um = control::filled(3.5);
+    s.update(in);
+  }
+  ASSERT_TRUE(s.faulted());
+  EXPECT_EQ(s.fault().reason, FaultReason::kOscillation);
+  EXPECT_EQ(s.fault().tick, 18U);  // as the counter's test: the eighth reversal
+  EXPECT_STREQ(to_string(s.fault().reason), "oscillation");
+}
+
 }  // namespace
 }  // namespace piezoshift::runtime

@@ -47,6 +47,10 @@ void visit_safety_limits(Limits& l, Visit&& visit) {
   visit("safety", "saturation_time_s", l.saturation_time_s, B::above(0.0, 60.0));
   visit("safety", "max_consecutive_overruns", l.max_consecutive_overruns,
         B::closed(1, kMaxConsecutiveOverruns));
+  visit("safety", "oscillation_band_um", l.oscillation_band_um, B::above(0.0, 100.0));
+  visit("safety", "oscillation_reversals", l.oscillation_reversals,
+        B::closed(2, kMaxOscillationReversals));
+  visit("safety", "oscillation_time_s", l.oscillation_time_s, B::above(0.0, 60.0));
 }
 
 //! The first limit outside its range, or a pair that contradicts itself (output_min_V <

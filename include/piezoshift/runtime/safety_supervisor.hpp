@@ -26,6 +26,12 @@
 //       closed loop only:
 //       output at output_max_V for saturation_time_s                           -> saturation
 //         (the loop has lost authority: the target is out of reach)
+//       closed loop only:
+//       oscillation_reversals reversals of the tracking error S - y within oscillation_time_s,
+//       each a swing of at least oscillation_band_um, with S steady between them (it moved less
+//       than the band since the previous reversal)                             -> oscillation
+//         (an unstable loop: the slew limit holds it in a limit cycle that stays inside the
+//          tracking band on average, so `tracking` never sees it)
 //   outputs:
 //     desired   = running ? controller request : 0 V         (fault or stop: ramp to 0)
 //     clamped   = clamp(desired, output_min_V, output_max_V)
@@ -86,6 +92,13 @@ struct SafetyLimits {
   double response_band_um = 0.8;    //!< absolute band around the window
   double response_time_s = 0.02;    //!< must persist this long (slewing and ringing settle)
   double saturation_time_s = 0.05;  //!< output pinned at output_max_V this long
+  //! A swing of S - y this large between two turning points is a reversal. Ten times the
+  //! settled error's range with the paper's gains (< 0.02 um); a phase step (79 nm) is smaller.
+  double oscillation_band_um = 0.5;
+  //! Reversals within oscillation_time_s that trip `oscillation`: four cycles. A stable loop's
+  //! step rings at most three times beyond the band (kp 1, ki 0.5, kd 0.01 on the twin).
+  std::uint32_t oscillation_reversals = 8;
+  double oscillation_time_s = 0.1;  //!< the window the reversals must fall in
 
   //! Consecutive ticks that missed their next deadline.
   std::uint32_t max_consecutive_overruns = 3;
@@ -104,6 +117,7 @@ enum class FaultReason : std::uint8_t {
   kDaqRead,
   kDaqWrite,
   kOutputNotFinite,
+  kOscillation,  //!< appended: the logs' numbers of the others stay
 };
 
 //! Stable names for logs and JSON ("sgs-rail", ...); "none" for kNone.
@@ -140,6 +154,29 @@ struct SupervisorOutput {
   bool hold_integrators = false;  //!< freeze the controller's integral terms next tick
   bool limited = false;           //!< an output limit or the slew limit acted
   SupervisorState state = SupervisorState::kRunning;
+};
+
+//! Largest oscillation_reversals (the counter's fixed ring).
+inline constexpr std::uint32_t kMaxOscillationReversals = 64;
+
+//! The turning points of one channel's tracking error, with hysteresis: a reversal is a swing of
+//! at least `band` back from the last extreme. Fixed-size, real-time safe.
+class ReversalCounter {
+ public:
+  //! Feeds one tick's error and target; true when this tick completed `needed` reversals within
+  //! `window_ticks` with the target steady between them.
+  bool update(std::uint64_t tick, double error, double target, double band, std::uint32_t needed,
+              std::uint64_t window_ticks) noexcept;
+  void reset() noexcept { *this = ReversalCounter{}; }
+
+ private:
+  int direction_ = 0;  // +1 rising towards a peak, -1 falling towards a trough, 0 not yet known
+  double extreme_ = 0.0;
+  bool started_ = false;
+  double target_at_reversal_ = 0.0;
+  std::uint32_t count_ = 0;  // reversals in the ring (at most kMaxOscillationReversals)
+  std::uint32_t next_ = 0;   // where the next reversal's tick goes
+  std::array<std::uint64_t, kMaxOscillationReversals> ticks_{};
 };
 
 class SafetySupervisor {
@@ -193,6 +230,8 @@ class SafetySupervisor {
   std::array<std::uint64_t, control::kChannels> tracking_count_{};
   std::array<std::uint64_t, control::kChannels> response_count_{};
   std::array<std::uint64_t, control::kChannels> saturation_count_{};
+  std::uint64_t oscillation_ticks_ = 100;
+  std::array<ReversalCounter, control::kChannels> reversals_{};
 };
 
 }  // namespace piezoshift::runtime
