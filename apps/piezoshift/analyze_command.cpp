@@ -11,7 +11,6 @@
 // with gnuplot (PNG, or SVG for a .svg name) and keeps its .gp script and .dat data beside it.
 #include <algorithm>
 #include <cmath>
-#include <filesystem>
 #include <memory>
 #include <string>
 #include <vector>
@@ -57,10 +56,6 @@ auto with_file(const std::string& path, F&& metric) {
 int draw(const AnalyzeOptions& o, const io::Figure& figure) {
   if (o.plot_path.empty())
     return 0;
-  // A folder is not a figure's name: it was `internal error: plot: empty output name` (issue 27).
-  if (!std::filesystem::path(o.plot_path).has_filename())
-    throw io::InputError(fmt::format("--plot {}: names a folder; give a file, e.g. {}figure.png",
-                                     o.plot_path, o.plot_path));
   io::Figure f = figure;
   const bool svg = o.plot_path.size() > 4 && o.plot_path.ends_with(".svg");
   f.png = !svg;
@@ -226,9 +221,18 @@ void add_analyze_command(CLI::App& app, Action& action) {
       ->capture_default_str()
       ->check(whole_number(1, experiments::kMaxMedianWindow));
 
-  lin->callback([&action, o] { action = [o] { return run_linearity(*o); }; });
-  rep->callback([&action, o] { action = [o] { return run_repeatability(*o); }; });
-  step->callback([&action, o] { action = [o] { return run_step(*o); }; });
+  // A --plot that cannot be drawn (a folder, a folder that takes no file: issue 27) is refused
+  // before the data is read, not after the metrics are printed.
+  const auto checked = [o](int (*run)(const AnalyzeOptions&)) {
+    return [o, run] {
+      if (!o->plot_path.empty())
+        io::check_output_path(o->plot_path, "--plot");
+      return run(*o);
+    };
+  };
+  lin->callback([&action, checked] { action = checked(run_linearity); });
+  rep->callback([&action, checked] { action = checked(run_repeatability); });
+  step->callback([&action, checked] { action = checked(run_step); });
 }
 
 }  // namespace piezoshift::app

@@ -1,6 +1,8 @@
 #include "piezoshift/host/data_recorder.hpp"
 
-#include <fmt/core.h>
+#include <fmt/format.h>
+
+#include <iterator>
 
 namespace piezoshift::host {
 
@@ -134,54 +136,75 @@ std::string DataRecorder::name(const Table& t) const {
   }
 }
 
-GcsError DataRecorder::read(long long start, long long count, const std::vector<int>& tables,
-                            double servo_cycle_s, std::string& answer) const {
-  answer.clear();
-  std::vector<int> chosen = tables;
-  if (chosen.empty()) {
+GcsError DataRecorder::choose(const std::vector<int>& tables, std::vector<int>& chosen) const {
+  chosen.clear();
+  if (tables.empty()) {
     for (int t = 1; t <= kTables; ++t)
       if (tables_[static_cast<std::size_t>(t - 1)].option != 0)
         chosen.push_back(t);
+    return chosen.empty() ? GcsError::kTableDeactivated : GcsError::kNone;
   }
-  for (int t : chosen) {
+  // Each table at most once (as a repeated axis or wave generator is refused), so an answer has
+  // at most kTables columns however long the list.
+  std::array<bool, kTables> named{};
+  for (int t : tables) {
     if (!table_exists(t))
       return GcsError::kNoRecordTable;
-    if (tables_[static_cast<std::size_t>(t - 1)].option == 0)
+    const auto i = static_cast<std::size_t>(t - 1);
+    if (tables_[i].option == 0)
       return GcsError::kTableDeactivated;
+    if (named[i])
+      return GcsError::kParamSyntax;
+    named[i] = true;
+    chosen.push_back(t);
   }
-  if (chosen.empty())
-    return GcsError::kTableDeactivated;
+  return GcsError::kNone;
+}
+
+GcsError DataRecorder::read(long long start, long long count, const std::vector<int>& tables,
+                            double servo_cycle_s, std::string& answer) const {
+  answer.clear();
+  std::vector<int> chosen;
+  if (const GcsError e = choose(tables, chosen); e != GcsError::kNone)
+    return e;
   if (start < 1)
     return GcsError::kParamOutOfRange;
+  // Compared as what is left after start, never as start + count: any long long is safe.
   const auto held = static_cast<long long>(rows_.size());
-  if (start > held + 1 || (count >= 0 && start - 1 + count > held))
+  if (start > held + 1 || (count >= 0 && count > held - (start - 1)))
     return GcsError::kNotEnoughData;
   const long long n = count < 0 ? held - (start - 1) : count;
+  // n <= kPoints and chosen.size() <= kTables here, so the answer is at most kMaxAnswerBytes;
+  // checked before one byte of it is made.
+  const auto rows = static_cast<std::size_t>(n);
+  if (rows > kPoints || chosen.size() > static_cast<std::size_t>(kTables))
+    return GcsError::kParamOutOfRange;
 
-  std::vector<std::string> lines;
-  lines.push_back("# REM piezoshift data recorder");
-  lines.push_back("# VERSION = 1");
-  lines.push_back("# TYPE = 1");
-  lines.push_back("# SEPARATOR = 32");
-  lines.push_back(fmt::format("# DIM = {}", chosen.size()));
-  lines.push_back(fmt::format("# SAMPLE_TIME = {:.9g}", servo_cycle_s * rate_));
-  lines.push_back(fmt::format("# NDATA = {}", n));
+  std::vector<std::string> header;
+  header.push_back("# REM piezoshift data recorder");
+  header.push_back("# VERSION = 1");
+  header.push_back("# TYPE = 1");
+  header.push_back("# SEPARATOR = 32");
+  header.push_back(fmt::format("# DIM = {}", chosen.size()));
+  header.push_back(fmt::format("# SAMPLE_TIME = {:.9g}", servo_cycle_s * rate_));
+  header.push_back(fmt::format("# NDATA = {}", n));
   for (std::size_t c = 0; c < chosen.size(); ++c)
-    lines.push_back(
+    header.push_back(
         fmt::format("# NAME{} = {}", c, name(tables_[static_cast<std::size_t>(chosen[c] - 1)])));
-  lines.push_back("# END_HEADER");
-  for (long long r = start - 1; r < start - 1 + n; ++r) {
-    std::string line;
+  header.push_back("# END_HEADER");
+  answer.reserve(kHeaderBytes + rows * chosen.size() * kValueBytes);
+  for (std::size_t l = 0; l < header.size(); ++l)
+    answer += header[l] + (l + 1 < header.size() || rows > 0 ? " \n" : "\n");
+  const auto first = static_cast<std::size_t>(start - 1);
+  for (std::size_t r = first; r < first + rows; ++r) {
     for (std::size_t c = 0; c < chosen.size(); ++c) {
       if (c > 0)
-        line += ' ';
-      line += fmt::format(
-          "{:.9g}", rows_[static_cast<std::size_t>(r)][static_cast<std::size_t>(chosen[c] - 1)]);
+        answer += ' ';
+      fmt::format_to(std::back_inserter(answer), "{:.9g}",
+                     rows_[r][static_cast<std::size_t>(chosen[c] - 1)]);
     }
-    lines.push_back(std::move(line));
+    answer += r + 1 < first + rows ? " \n" : "\n";
   }
-  for (std::size_t l = 0; l < lines.size(); ++l)
-    answer += lines[l] + (l + 1 < lines.size() ? " \n" : "\n");
   return GcsError::kNone;
 }
 

@@ -874,7 +874,9 @@ std::string GcsInterpreter::recorder_read(Session& s, const Args& args) {
         return {};
       }
       count = v;
-    } else {
+    } else if (tables.size() <= static_cast<std::size_t>(DataRecorder::kTables)) {
+      // More than kTables names hold a repeat or a table that does not exist, which the first
+      // kTables + 1 already show: a longer list costs no memory (every name is still parsed).
       tables.push_back(static_cast<int>(std::clamp<long long>(v, -1, 1000)));
     }
   }

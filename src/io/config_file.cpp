@@ -77,6 +77,11 @@ struct ConfigFileImpl {
     const char* reason;
   };
 
+  // prefix."key" as the file spells it, for a key whose name holds a dot.
+  static std::string quoted(const std::string& prefix, std::string_view key) {
+    return fmt::format("{}{}\"{}\"", prefix, prefix.empty() ? "" : ".", key);
+  }
+
   // A table nobody asked for is one unknown section (its keys are not listed one by one); inside
   // a section asked for, every key not read is unknown. Empty unknown tables count too.
   void collect_unknown(const toml::table& t, const std::string& prefix,
@@ -84,6 +89,17 @@ struct ConfigFileImpl {
     for (const auto& [k, node] : t) {
       const std::string path =
           prefix.empty() ? std::string(k.str()) : prefix + "." + std::string(k.str());
+      // A quoted key with a dot ("twin.daq.sample_time_s" = 1) is one key of that name, which no
+      // read() asks for (they look keys up one table at a time), though its dotted path is that
+      // of a real setting: refused by itself, not passed as the setting it spells (issue 27).
+      if (k.str().find('.') != std::string_view::npos) {
+        out.push_back({quoted(prefix, k.str()), node.source(),
+                       node.is_table() ? "unknown section: a quoted name with a dot is one name; "
+                                         "write its parts unquoted ([a.b], not [\"a.b\"])"
+                                       : "unknown key: a quoted name with a dot is one key; "
+                                         "write its parts unquoted (a.b = 1, not \"a.b\" = 1)"});
+        continue;
+      }
       if (used.count(path))
         continue;
       if (node.is_table() && sections.count(path)) {

@@ -1,5 +1,6 @@
 #include "piezoshift/io/csv_table.hpp"
 
+#include <algorithm>
 #include <charconv>
 #include <cmath>
 
@@ -67,55 +68,83 @@ bool parse_finite_double(std::string_view cell, double& value) {
 }
 
 CsvTable CsvTable::load(const std::string& path) {
-  return parse(read_input_file(path, kMaxDataFileBytes), path);
+  return from_text(read_input_file(path, kMaxDataFileBytes), path);
 }
 
 CsvTable CsvTable::parse(std::string_view text, const std::string& source_name) {
+  return from_text(std::string(text), source_name);
+}
+
+void CsvTable::read_header(std::string_view line, std::size_t line_no) {
+  // Counted before it is split, so a line of millions of commas costs no memory.
+  const auto fields = static_cast<std::size_t>(std::count(line.begin(), line.end(), ',')) + 1;
+  if (fields > kMaxColumns) {
+    throw InputError(fmt::format("{}:{}: the header has {} fields, more than the limit of {}",
+                                 source_, line_no, fields, kMaxColumns));
+  }
+  header_ = split_fields(line);
+  for (std::size_t i = 0; i < header_.size(); ++i) {
+    std::string& name = header_[i];
+    if (name.size() >= 2 && name.front() == '"' && name.back() == '"')
+      name = std::string(trim(std::string_view(name).substr(1, name.size() - 2)));
+    if (name.empty()) {
+      throw InputError(
+          fmt::format("{}:{}: header field {} is empty (a trailing comma?); the header names the "
+                      "columns, e.g. s1_um,s2_um,s3_um",
+                      source_, line_no, i + 1));
+    }
+  }
+  header_line_ = line_no;
+}
+
+CsvTable CsvTable::from_text(std::string text, const std::string& source_name) {
   CsvTable t;
   t.source_ = source_name;
-  if (text.substr(0, 3) == "\xEF\xBB\xBF")
-    text.remove_prefix(3);
+  t.text_ = std::move(text);
+  const std::string_view all = t.text_;
+  std::size_t pos = all.substr(0, 3) == "\xEF\xBB\xBF" ? 3 : 0;
   std::size_t line_no = 0;
-  std::size_t pos = 0;
-  while (pos < text.size()) {
-    const auto nl = text.find('\n', pos);
-    std::string_view line = text.substr(pos, nl == std::string_view::npos ? text.npos : nl - pos);
-    pos = (nl == std::string_view::npos) ? text.size() : nl + 1;
+  while (pos < all.size()) {
+    const std::size_t begin = pos;
+    const auto nl = all.find('\n', pos);
+    std::string_view line = all.substr(pos, nl == std::string_view::npos ? all.npos : nl - pos);
+    pos = (nl == std::string_view::npos) ? all.size() : nl + 1;
     ++line_no;
     if (!line.empty() && line.back() == '\r')
       line.remove_suffix(1);
     const std::string_view content = trim(line);
     if (content.empty() || content.front() == '#')
       continue;
-    std::vector<std::string> fields = split_fields(line);
     if (t.header_.empty()) {
-      for (std::size_t i = 0; i < fields.size(); ++i) {
-        std::string& name = fields[i];
-        if (name.size() >= 2 && name.front() == '"' && name.back() == '"')
-          name = std::string(trim(std::string_view(name).substr(1, name.size() - 2)));
-        if (name.empty()) {
-          throw InputError(fmt::format(
-              "{}:{}: header field {} is empty (a trailing comma?); the header names the "
-              "columns, e.g. s1_um,s2_um,s3_um",
-              source_name, line_no, i + 1));
-        }
-      }
-      t.header_ = std::move(fields);
-      t.header_line_ = line_no;
+      t.read_header(line, line_no);
       continue;
     }
-    if (fields.size() != t.header_.size()) {
+    // Counted, not split: the cells are found again by column().
+    const auto fields = static_cast<std::size_t>(std::count(line.begin(), line.end(), ',')) + 1;
+    if (fields != t.header_.size()) {
       throw InputError(fmt::format("{}:{}: {} fields, but the header (line {}) has {}", source_name,
-                                   line_no, fields.size(), t.header_line_, t.header_.size()));
+                                   line_no, fields, t.header_line_, t.header_.size()));
     }
-    t.cells_.push_back(std::move(fields));
-    t.lines_.push_back(line_no);
+    t.rows_.push_back(Row{begin, line_no});
   }
   if (t.header_.empty()) {
     throw InputError(
         fmt::format("{}: no header row: the file is empty or has only comments", source_name));
   }
   return t;
+}
+
+std::string_view CsvTable::cell(std::size_t row, std::size_t field) const {
+  const std::string_view all = text_;
+  std::size_t begin = rows_[row].offset;
+  for (std::size_t f = 0; f < field; ++f)
+    begin = all.find(',', begin) + 1;
+  const std::size_t end = all.find_first_of(",\n", begin);
+  std::string_view c = all.substr(begin, end == std::string_view::npos ? all.npos : end - begin);
+  // The last field of a "\r\n" line (an '\r' elsewhere stays and makes the cell no number).
+  if ((end == std::string_view::npos || all[end] == '\n') && !c.empty() && c.back() == '\r')
+    c.remove_suffix(1);
+  return trim(c);
 }
 
 bool CsvTable::has_column(std::string_view name) const {
@@ -161,16 +190,16 @@ std::size_t CsvTable::index_of(std::string_view name) const {
 
 std::vector<double> CsvTable::column(std::string_view name) const {
   const std::size_t c = index_of(name);
-  std::vector<double> values(cells_.size());
-  for (std::size_t r = 0; r < cells_.size(); ++r) {
-    const std::string& cell = cells_[r][c];
+  std::vector<double> values(rows_.size());
+  for (std::size_t r = 0; r < rows_.size(); ++r) {
+    const std::string_view cell = this->cell(r, c);
     if (parse_finite_double(cell, values[r]))
       continue;
     double any = 0.0;
     const auto [end, ec] = std::from_chars(cell.data(), cell.data() + cell.size(), any);
     const bool non_finite = ec == std::errc() && end == cell.data() + cell.size();
     throw InputError(
-        fmt::format("{}:{}: column '{}' (field {}): {}", source_, lines_[r], name, c + 1,
+        fmt::format("{}:{}: column '{}' (field {}): {}", source_, rows_[r].line, name, c + 1,
                     cell.empty() ? std::string("empty cell, expected a number")
                     : non_finite ? fmt::format("'{}' is not a finite number", shown(cell))
                                  : fmt::format("'{}' is not a number", shown(cell))));

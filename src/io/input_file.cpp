@@ -53,7 +53,9 @@ std::string read_input_file(const std::string& path, std::uintmax_t max_bytes) {
     throw InputError(fmt::format("{}: {} bytes is more than the limit of {} bytes for this file",
                                  path, size, max_bytes));
   }
-  std::string data(static_cast<std::size_t>(size), '\0');
+  // One byte more than stat() said, so that the read which finds the end needs no reallocation
+  // (growing the string would double it: 3 times the file's size at once).
+  std::string data(static_cast<std::size_t>(size) + 1, '\0');
   std::size_t got = 0;
   for (;;) {
     if (got == data.size()) {

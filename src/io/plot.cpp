@@ -15,6 +15,8 @@
 
 #include <fmt/core.h>
 
+#include "piezoshift/io/input_error.hpp"
+
 namespace piezoshift::io {
 namespace fs = std::filesystem;
 namespace {
@@ -59,6 +61,25 @@ fs::path strip_format_extension(fs::path stem) {
   if (stem.extension() == ".png" || stem.extension() == ".svg")
     stem.replace_extension();
   return stem;
+}
+
+// The file name a figure's files are named after, or empty when the path names a folder.
+bool names_a_file(const fs::path& stem) {
+  const fs::path name = stem.filename();
+  return !name.empty() && name != "." && name != "..";
+}
+
+// Whether a new file can be made in `dir` (an existing folder): tried, because permissions,
+// read-only mounts and pseudo file systems (/proc) all say no differently, and root passes
+// access(2) where open(2) fails.
+std::error_code can_create_in(const fs::path& dir) {
+  const fs::path probe = dir / fmt::format(".piezoshift-probe.{}", ::getpid());
+  const int fd = ::open(probe.c_str(), O_WRONLY | O_CREAT | O_EXCL | O_NOFOLLOW | O_CLOEXEC, 0600);
+  if (fd < 0)
+    return {errno, std::generic_category()};
+  ::close(fd);
+  ::unlink(probe.c_str());
+  return {};
 }
 
 void validate(const Figure& f) {
@@ -226,11 +247,40 @@ std::optional<fs::path> find_gnuplot(std::string_view program) {
   return std::nullopt;
 }
 
+void check_output_path(const fs::path& path, std::string_view option) {
+  const fs::path stem = strip_format_extension(path);
+  const fs::path name = path.filename();
+  if (name == ".png" || name == ".svg")  // an extension alone: it would draw ".png.png"
+    throw InputError(fmt::format("{} {}: has no name before {}; give one, e.g. {}", option,
+                                 path.string(), name.string(),
+                                 (path.parent_path() / ("figure" + name.string())).string()));
+  if (!names_a_file(stem)) {
+    const fs::path folder = path.has_filename() ? path : path.parent_path();
+    throw InputError(fmt::format("{} {}: names a folder; give a file, e.g. {}", option,
+                                 path.string(), (folder / "figure.png").string()));
+  }
+  // The folder is created when the figure is drawn: what must exist now is the nearest folder on
+  // its way, and it must take a file.
+  fs::path existing = stem.parent_path();
+  std::error_code ec;
+  while (!existing.empty() && !fs::exists(fs::symlink_status(existing, ec)) &&
+         existing != existing.parent_path())
+    existing = existing.parent_path();
+  if (existing.empty())
+    existing = ".";
+  if (!fs::is_directory(existing, ec))
+    throw InputError(
+        fmt::format("{} {}: {} is not a folder", option, path.string(), existing.string()));
+  if (const std::error_code e = can_create_in(existing))
+    throw InputError(fmt::format("{} {}: cannot create a file in {}: {}", option, path.string(),
+                                 existing.string(), e.message()));
+}
+
 PlotFiles write_plot_files(const Figure& figure, const fs::path& stem_in) {
   validate(figure);
   const fs::path stem = strip_format_extension(stem_in);
-  if (stem.filename().empty())
-    throw std::invalid_argument("plot: empty output name");
+  if (!names_a_file(stem))
+    throw InputError(fmt::format("plot output {}: names a folder, not a file", stem_in.string()));
   const fs::path dir = stem.parent_path();
   if (!dir.empty()) {
     std::error_code ec;

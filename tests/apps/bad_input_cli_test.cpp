@@ -3,6 +3,7 @@
 // finishes; the program is run as a user would.
 #include <unistd.h>
 
+#include <filesystem>
 #include <initializer_list>
 #include <string>
 
@@ -32,6 +33,31 @@ TEST_F(BadInput, APlotPathThatNamesAFolderIsRefusedNamingTheOption) {
   const std::string data = write("lin.csv", "zd_um,measured_um\n0,0\n1,1.001\n2,2\n");
   refused("analyze linearity --data '" + data + "' --plot '" + dir() + "/'",
           {"--plot " + dir() + "/", "names a folder"});
+}
+
+// Issue 27: `--plot /proc/x.png` exited 1 after the metrics, `--plot .` drew `..png`. A path
+// that names no file, or whose folder takes no file, is refused before the data is read.
+TEST_F(BadInput, APlotPathThatCannotBeWrittenIsRefusedBeforeTheData) {
+  const std::string data = write("lin.csv", "zd_um,measured_um\n0,0\n1,1.001\n2,2\n");
+  refused("analyze linearity --data '" + data + "' --plot /proc/x.png",
+          {"--plot /proc/x.png: cannot create a file in /proc"});
+  refused("analyze step --data '" + data + "' --plot /proc/self/sub/x.svg",
+          {"--plot /proc/self/sub/x.svg: cannot create a file in /proc/self"});
+  refused("analyze repeatability --data missing.csv --plot /proc/x.png", {"--plot /proc/x.png"});
+  refused("analyze linearity --data '" + data + "' --plot '" + data + "/x.png'",
+          {"--plot " + data + "/x.png: " + data + " is not a folder"});
+  refused("analyze linearity --data '" + data + "' --plot '" + dir() + "/.'",
+          {"--plot " + dir() + "/.: names a folder; give a file, e.g. " + dir() + "/./figure.png"});
+  refused("analyze linearity --data '" + data + "' --plot '" + dir() + "/..'",
+          {"--plot " + dir() + "/..: names a folder"});
+  refused("analyze linearity --data '" + data + "' --plot '" + dir() + "/.svg'",
+          {"--plot " + dir() + "/.svg: has no name before .svg; give one, e.g. " + dir() +
+           "/figure.svg"});
+  // Nothing was drawn by the refusals.
+  std::size_t files = 0;
+  for ([[maybe_unused]] const auto& e : std::filesystem::directory_iterator(dir_))
+    ++files;
+  EXPECT_EQ(files, 2u);  // lin.csv and stderr.txt
 }
 
 TEST_F(BadInput, RepeatabilityOfDataSpreadOverMicronsIsComputedAndOverflowIsRefused) {

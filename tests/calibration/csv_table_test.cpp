@@ -2,9 +2,15 @@
 
 #include <gtest/gtest.h>
 
+#include <fmt/format.h>
+
 #include <string>
+#include <vector>
 
 #include "piezoshift/io/input_error.hpp"
+
+#include "../support/temp_dir_test.hpp"
+#include "heap_peak.hpp"
 
 namespace piezoshift::io {
 namespace {
@@ -97,6 +103,77 @@ TEST(CsvTable, MissingFileNamesThePath) {
     EXPECT_EQ(std::string(e.what()),
               "/nonexistent/dir/poses.csv: cannot open: No such file or directory");
   }
+}
+
+TEST(CsvTable, AHeaderWiderThanTheLimitIsRefused) {
+  std::string wide = "c0";
+  for (std::size_t i = 1; i < CsvTable::kMaxColumns; ++i)
+    wide += fmt::format(",c{}", i);
+  const CsvTable t = CsvTable::parse(wide + "\n", "wide.csv");
+  EXPECT_EQ(t.header().size(), 1024u);
+  EXPECT_EQ(error_of(wide + ",one_more\n1\n"),
+            "data.csv:1: the header has 1025 fields, more than the limit of 1024");
+  EXPECT_EQ(error_of("# c\n" + std::string(1 << 20, ',') + "\n"),
+            "data.csv:2: the header has 1048577 fields, more than the limit of 1024");
+}
+
+// Issue 27: a 64 MiB file of commas took 3.9 GB, 32 bytes a comma, before it was refused. A row
+// is now counted, not split, when read: the reader holds the text and 16 bytes a row.
+class CsvTableMemory : public piezoshift::testing::TempDirTest {};
+
+TEST_F(CsvTableMemory, ARowOfMillionsOfEmptyCellsIsRefusedAtItsLineInTheTextsMemory) {
+  constexpr std::size_t kCommas = 4 << 20;
+  std::string text = "t_s,measured_um\n0,1\n" + std::string(kCommas, ',') + "\n1,2\n";
+  const std::size_t size = text.size();
+  const std::string file = write("commas.csv", text);
+  text = std::string();
+  std::string message;
+  const testing::HeapPeak peak;
+  try {
+    CsvTable::load(file);
+  } catch (const InputError& e) {
+    message = e.what();
+  }
+  const std::size_t bytes = peak.bytes();
+  EXPECT_EQ(message, file + ":3: 4194305 fields, but the header (line 1) has 2");
+  EXPECT_GE(bytes, size);              // the text, read once
+  EXPECT_LT(bytes, size + (1 << 20));  // and no cell: before, 32 bytes a comma (128 MiB)
+}
+
+TEST_F(CsvTableMemory, RowsOfEmptyCellsAsWideAsTheHeaderCostNoMemoryPerCell) {
+  std::string text = "c0";
+  for (std::size_t i = 1; i < CsvTable::kMaxColumns; ++i)
+    text += fmt::format(",c{}", i);
+  text += '\n';
+  constexpr std::size_t kRows = 4096;  // 4 MiB of commas
+  for (std::size_t r = 0; r < kRows; ++r)
+    text.append(CsvTable::kMaxColumns - 1, ',').push_back('\n');
+  const std::size_t size = text.size();
+  const std::string file = write("empty.csv", text);
+  text = std::string();
+  const testing::HeapPeak peak;
+  const CsvTable t = CsvTable::load(file);
+  const std::size_t bytes = peak.bytes();
+  EXPECT_EQ(t.rows(), kRows);
+  EXPECT_EQ(t.line_of_row(kRows - 1), kRows + 1);
+  EXPECT_LT(bytes, size + 16 * kRows + (1 << 20));  // before: 32 bytes a cell (128 MiB)
+  try {
+    t.column("c7");
+    ADD_FAILURE() << "no error";
+  } catch (const InputError& e) {
+    EXPECT_EQ(std::string(e.what()),
+              file + ":2: column 'c7' (field 8): empty cell, expected a number");
+  }
+}
+
+TEST(CsvTable, CellsAreFoundAgainInTheirRows) {
+  // The first and last fields, a carriage return only at the line's end, blanks trimmed.
+  const CsvTable t = CsvTable::parse("a,b,c\r\n 1 ,2,\t3\r\n4,5,6\n7,8,9", "r.csv");
+  EXPECT_EQ(t.column("a"), (std::vector<double>{1, 4, 7}));
+  EXPECT_EQ(t.column("b"), (std::vector<double>{2, 5, 8}));
+  EXPECT_EQ(t.column("c"), (std::vector<double>{3, 6, 9}));
+  EXPECT_EQ(error_of("x,y\n1\r,2\n", "x"),
+            "data.csv:2: column 'x' (field 1): '1\r' is not a number");
 }
 
 TEST(CsvTable, ParseFiniteDoubleIsStrict) {

@@ -4,6 +4,7 @@
 
 #include <cmath>
 #include <cstdlib>
+#include <limits>
 #include <map>
 #include <string>
 #include <vector>
@@ -293,6 +294,61 @@ TEST(DataRecorderTest, ReadErrors) {
   ASSERT_EQ(r.configure(1, "Z", 0), GcsError::kNone);
   ASSERT_EQ(r.configure(2, "Z", 0), GcsError::kNone);
   EXPECT_EQ(r.read(1, -1, {}, 1e-3, text), GcsError::kTableDeactivated);
+}
+
+// Issue 27: a count near the largest long long overflowed start - 1 + count and answered a header
+// of 9223372036854775807 points; a table named twice doubled the columns.
+TEST(DataRecorderTest, ReadRefusesHugeCountsAndRepeatedTables) {
+  DataRecorder r;
+  for (int k = 0; k < 10; ++k)
+    r.record(input_at(k));
+  constexpr long long kMax = std::numeric_limits<long long>::max();
+  std::string text = "stale";
+  EXPECT_EQ(r.read(2, kMax, {1}, 1e-3, text), GcsError::kNotEnoughData);
+  EXPECT_EQ(text, "");
+  EXPECT_EQ(r.read(11, kMax, {1}, 1e-3, text), GcsError::kNotEnoughData);
+  EXPECT_EQ(r.read(kMax, 1, {1}, 1e-3, text), GcsError::kNotEnoughData);
+  EXPECT_EQ(r.read(kMax, -1, {1}, 1e-3, text), GcsError::kNotEnoughData);
+  EXPECT_EQ(r.read(1, kMax, {}, 1e-3, text), GcsError::kNotEnoughData);
+  EXPECT_EQ(r.read(1, -1, {1, 2, 1}, 1e-3, text), GcsError::kParamSyntax);
+  EXPECT_EQ(r.read(1, -1, {2, 2}, 1e-3, text), GcsError::kParamSyntax);
+  EXPECT_EQ(r.read(1, -1, std::vector<int>(2000, 1), 1e-3, text), GcsError::kParamSyntax);
+  EXPECT_EQ(text, "");
+  // The last point alone, and no point after the last, still answer.
+  ASSERT_EQ(r.read(10, 1, {2, 1}, 1e-3, text), GcsError::kNone);
+  EXPECT_EQ(parse(text).rows.size(), 1u);
+  ASSERT_EQ(r.read(11, 0, {1}, 1e-3, text), GcsError::kNone);
+  EXPECT_EQ(parse(text).header.at("NDATA"), "0");
+}
+
+// The largest answer there can be (every table on, the recorder full, every value as long as
+// "{:.9g}" writes one) stays within the bound the header states and docs/gcs.md gives.
+TEST(DataRecorderTest, FullestAnswerIsWithinTheStatedBound) {
+  DataRecorder r;
+  const int options[DataRecorder::kTables] = {1, 2, 3, 90, 1, 2, 7, 17};
+  const char* sources[DataRecorder::kTables] = {"Z", "U", "V", "Z", "V", "V", "3", "2"};
+  for (int t = 0; t < DataRecorder::kTables; ++t)
+    ASSERT_EQ(r.configure(t + 1, sources[t], options[t]), GcsError::kNone) << t;
+  RecorderInput in;
+  for (std::size_t i = 0; i < 3; ++i) {
+    in.target[i] = -1.23456789e-300;
+    in.position[i] = 1.23456789e-300;  // the error, target - position, is -2.46913578e-300
+    in.interferometer[i] = -1.23456789e-300;
+    in.channel_V[i] = -1.23456789e-300;
+    in.sensor_um[i] = -1.23456789e-300;
+  }
+  for (std::size_t k = 0; k < DataRecorder::kPoints + 5; ++k)
+    r.record(in);
+  ASSERT_EQ(r.points(), DataRecorder::kPoints);
+  std::string text;
+  ASSERT_EQ(r.read(1, -1, {}, 1e-3, text), GcsError::kNone);
+  const Parsed p = parse(text);
+  EXPECT_TRUE(p.framing_ok);
+  ASSERT_EQ(p.rows.size(), DataRecorder::kPoints);
+  EXPECT_EQ(p.rows.back().size(), static_cast<std::size_t>(DataRecorder::kTables));
+  EXPECT_LE(text.size(), DataRecorder::kMaxAnswerBytes);
+  EXPECT_GT(text.size(), DataRecorder::kMaxAnswerBytes * 9 / 10);  // the bound is not loose
+  EXPECT_LT(DataRecorder::kMaxAnswerBytes, 1'200'000u);
 }
 
 TEST(DataRecorderTest, OffTableIsSkippedByDefaultRead) {

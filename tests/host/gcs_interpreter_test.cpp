@@ -2,6 +2,7 @@
 // what each command pushes to the loop, what the queries answer from the loop's samples, the
 // on-target rule, faults, the recorder, and every error number with its per-client queue.
 // No sockets, no threads, no clock.
+#include <fmt/format.h>
 #include <gtest/gtest.h>
 
 #include <cmath>
@@ -702,10 +703,25 @@ TEST_F(GcsInterpreterTest, RecorderRecordsTheLoopsSamples) {
   };
   for (const Case& k :
        {Case{"DRR? 0", 17}, Case{"DRR? 1 -1", 17}, Case{"DRR? 1 4", 77}, Case{"DRR? 5", 77},
-        Case{"DRR? 1 1 6", 78}, Case{"DRR? 1 1 9", 57}, Case{"DRR? a", 1}}) {
+        Case{"DRR? 1 1 6", 78}, Case{"DRR? 1 1 9", 57}, Case{"DRR? a", 1},
+        // Issue 27: a count that overflowed start - 1 + count, a table named twice.
+        Case{"DRR? 2 9223372036854775807", 77}, Case{"DRR? 1 9223372036854775807", 77},
+        Case{"DRR? 1 1 1 2 1", 1}, Case{"DRR? 1 1 1 2 3 4 5 1 2 3 4 5 9", 1}}) {
     EXPECT_EQ(cmd(k.line), failed_answer(k.line)) << k.line;
     EXPECT_EQ(err(), k.error) << k.line;
   }
+  // Issue 27: a line naming 100 000 tables (or 2000 different numbers) is refused, not answered
+  // with as many columns.
+  std::string many = "DRR? 1 1";
+  for (int t = 0; t < 100000; ++t)
+    many += " 2";
+  EXPECT_EQ(cmd(many), failed_answer(many));
+  EXPECT_EQ(err(), 1);
+  std::string ids = "DRR? 1 1";
+  for (int t = 1; t <= 2000; ++t)
+    ids += fmt::format(" {}", t);
+  EXPECT_EQ(cmd(ids), failed_answer(ids));
+  EXPECT_EQ(err(), 78);  // table 6 is the first named that is off
   // A motion command restarts the recording.
   EXPECT_EQ(cmd("MVR Z 0.5"), "");
   EXPECT_EQ(cmd("DRL? 1"), "1=0\n");

@@ -145,6 +145,48 @@ TEST(ConfigFile, UnknownKeyAndUnknownSection) {
   EXPECT_TRUE(contains(error_of([&] { root.reject_unknown(); }), "stray: unknown key"));
 }
 
+// Issue 27: a quoted key with dots is one key of that name. Beside the setting whose path it
+// spells, it passed as that setting (its value never read, nothing said).
+TEST(ConfigFile, AQuotedDottedKeyIsRefusedEvenBesideTheSettingItSpells) {
+  const std::string text = "\"twin.daq.sample_time_s\" = \"x\"\n[twin.daq]\nsample_time_s = 1e-4\n";
+  const ConfigFile f = ConfigFile::parse(text, "q.toml");
+  double dt_s = 0.0;
+  EXPECT_TRUE(f.section("twin.daq").read("sample_time_s", dt_s));
+  EXPECT_DOUBLE_EQ(dt_s, 1e-4);
+  std::string m = error_of([&] { f.reject_unknown(); });
+  EXPECT_TRUE(contains(m, "q.toml:1:")) << m;
+  EXPECT_TRUE(contains(m, "\"twin.daq.sample_time_s\": unknown key")) << m;
+
+  // Alone, and one level down.
+  const ConfigFile g = ConfigFile::parse("\"twin.daq.sample_time_s\" = 1e-4\n", "q2.toml");
+  g.section("twin.daq").read("sample_time_s", dt_s);
+  m = error_of([&] { g.reject_unknown(); });
+  EXPECT_TRUE(contains(m, "q2.toml:1:")) << m;
+  EXPECT_TRUE(contains(m, "\"twin.daq.sample_time_s\": unknown key")) << m;
+  const ConfigFile h = ConfigFile::parse(
+      "[twin]\nseed = 1\n\"daq.sample_time_s\" = 1e-4\n[twin.daq]\nsample_time_s = 1e-4\n",
+      "q3.toml");
+  std::int64_t seed = 0;
+  h.section("twin").read("seed", seed);
+  h.section("twin.daq").read("sample_time_s", dt_s);
+  m = error_of([&] { h.reject_unknown(); });
+  EXPECT_TRUE(contains(m, "q3.toml:3:")) << m;
+  EXPECT_TRUE(contains(m, "twin.\"daq.sample_time_s\": unknown key")) << m;
+
+  // A quoted table name with a dot, beside the real table.
+  const ConfigFile t = ConfigFile::parse(
+      "[twin.daq]\nsample_time_s = 1e-4\n[\"twin.daq\"]\nsample_time_s = 1\n", "q4.toml");
+  t.section("twin.daq").read("sample_time_s", dt_s);
+  m = error_of([&] { t.reject_unknown(); });
+  EXPECT_TRUE(contains(m, "q4.toml:3:")) << m;
+  EXPECT_TRUE(contains(m, "\"twin.daq\": unknown section")) << m;
+  // Plain dotted keys (TOML's way to name nested tables) are still read.
+  const ConfigFile d = ConfigFile::parse("twin.daq.sample_time_s = 2e-4\n", "q5.toml");
+  EXPECT_TRUE(d.section("twin.daq").read("sample_time_s", dt_s));
+  EXPECT_DOUBLE_EQ(dt_s, 2e-4);
+  EXPECT_NO_THROW(d.reject_unknown());
+}
+
 TEST(ConfigFile, EmptyUnknownSectionIsStillUnknown) {
   // A misspelt section header with nothing under it yet must not pass silently.
   const ConfigFile f = ConfigFile::parse("[actuatr]\n", "e.toml");

@@ -44,6 +44,12 @@ class DataRecorder {
   static constexpr int kTables = 8;
   static constexpr std::size_t kPoints = 8192;
   static constexpr int kMaxRate = 1000000;
+  //! The largest DRR? answer: every point of every table, each value at most kValueBytes with its
+  //! separator ("-1.23456789e-308 "), a line's " \n" counted in, and the header. About 1.1 MB.
+  static constexpr std::size_t kValueBytes = 18;
+  static constexpr std::size_t kHeaderBytes = 1024;
+  static constexpr std::size_t kMaxAnswerBytes =
+      kHeaderBytes + kPoints * static_cast<std::size_t>(kTables) * kValueBytes;
 
   DataRecorder();
 
@@ -63,7 +69,9 @@ class DataRecorder {
   std::size_t points() const noexcept { return rows_.size(); }
 
   //! DRR? answer (GCS framing applied: every line but the last ends with " \n"). start is 1-based;
-  //! count < 0: all from start; tables empty: every active table. Errors leave answer empty.
+  //! count < 0: all from start; tables empty: every active table, else each named at most once
+  //! (kParamSyntax when twice). Any start and count are safe; errors leave answer empty. The
+  //! answer is at most kMaxAnswerBytes.
   GcsError read(long long start, long long count, const std::vector<int>& tables,
                 double servo_cycle_s, std::string& answer) const;
 
@@ -73,6 +81,8 @@ class DataRecorder {
     int source = 0;  // axis 0..2 or channel 0..2
   };
   double value(const Table& t, const RecorderInput& in) const;
+  //! The tables a DRR? reads, validated (see read()).
+  GcsError choose(const std::vector<int>& tables, std::vector<int>& chosen) const;
   std::string name(const Table& t) const;
 
   std::array<Table, kTables> tables_{};

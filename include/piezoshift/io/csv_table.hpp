@@ -10,13 +10,17 @@
 //     written in double quotes ("z2_um"), which are dropped;
 //   - a line whose first non-blank character is '#' is a comment; blank lines are skipped, so
 //     blank trailing lines are fine; '\r\n' line ends and a UTF-8 byte order mark are accepted;
-//   - every data row has as many fields as the header;
+//   - every data row has as many fields as the header, and the header at most kMaxColumns;
 //   - a cell read through column() must be, as a whole, a finite number in the grammar of
 //     std::from_chars (decimal or scientific, optional leading '+' or '-'); "nan", "inf",
 //     "1.5um", "" and "1,5" are rejected rather than guessed at.
 // Every violation throws io::InputError naming the file, the line (1-based, counting every
 // physical line) and, for a cell, the column, e.g.
 //   poses.csv:7: column 'z2_um' (field 5): 'abc' is not a number
+// Memory: the text and 16 bytes a data row, however many cells a row has (a row is counted, not
+// split, when read; column() finds its cells again), so at most 9 times the text's size (a row
+// takes at least 2 bytes): 576 MiB for the 64 MiB limit of a data file, which column() adds 8
+// bytes a row to. A row with more or fewer fields than the header is refused when read.
 #include <cstddef>
 #include <initializer_list>
 #include <string>
@@ -27,6 +31,9 @@ namespace piezoshift::io {
 
 class CsvTable {
  public:
+  //! The widest header accepted (the widest file piezoshift writes has well under 100 columns).
+  static constexpr std::size_t kMaxColumns = 1024;
+
   //! Reads a file; a file that cannot be opened throws InputError naming it and the reason.
   static CsvTable load(const std::string& path);
   //! Parses text; source_name stands in for the file name in messages (tests, pipes).
@@ -35,9 +42,9 @@ class CsvTable {
   const std::string& source() const { return source_; }
   const std::vector<std::string>& header() const { return header_; }
   //! Number of data rows (comments and blank lines excluded).
-  std::size_t rows() const { return lines_.size(); }
+  std::size_t rows() const { return rows_.size(); }
   //! Physical line number (1-based) of data row `row`, for messages about a row.
-  std::size_t line_of_row(std::size_t row) const { return lines_.at(row); }
+  std::size_t line_of_row(std::size_t row) const { return rows_.at(row).line; }
 
   bool has_column(std::string_view name) const;
   //! Throws one InputError listing every name that is not in the header (and the header).
@@ -47,14 +54,22 @@ class CsvTable {
   std::vector<double> column(std::string_view name) const;
 
  private:
+  struct Row {
+    std::size_t offset;  // of the row's first byte in text_
+    std::size_t line;    // physical line, 1-based
+  };
   CsvTable() = default;
+  static CsvTable from_text(std::string text, const std::string& source_name);
+  void read_header(std::string_view line, std::size_t line_no);
   std::size_t index_of(std::string_view name) const;
+  //! Field `field` (0-based, trimmed) of data row `row`; the row has header_.size() fields.
+  std::string_view cell(std::size_t row, std::size_t field) const;
 
   std::string source_;
+  std::string text_;  // the whole input; rows_ point into it
   std::vector<std::string> header_;
   std::size_t header_line_ = 0;
-  std::vector<std::vector<std::string>> cells_;  // [row][field], trimmed
-  std::vector<std::size_t> lines_;               // physical line of each data row
+  std::vector<Row> rows_;
 };
 
 //! Parses one cell as a finite double, the whole cell (after trimming blanks) and nothing else.

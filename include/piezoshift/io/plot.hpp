@@ -93,10 +93,16 @@ struct PlotFiles {
 
 //! Writes <stem>.dat and <stem>.gp and runs gnuplot to draw the requested formats. Creates the
 //! folder of stem if needed. Throws std::invalid_argument for an inconsistent figure (series
-//! sizes, grid too small) and PlotError when gnuplot is not found, fails (its messages are in
-//! the error), or leaves an empty output file.
+//! sizes, grid too small), InputError for a stem that names no file, and PlotError when gnuplot is
+//! not found, fails (its messages are in the error), or leaves an empty output file.
 PlotFiles render(const Figure& figure, const std::filesystem::path& stem,
                  const PlotOptions& options = {});
+
+//! Refuses, with an InputError naming `option` and the path, an output path that names no file
+//! ("dir/", ".", "..") or whose folder cannot take a file: the nearest folder on
+//! its way that exists must be a folder in which a file can be created (tried, then removed).
+//! For a command to call on its option before its work; render() checks the name again.
+void check_output_path(const std::filesystem::path& path, std::string_view option);
 
 //! Writes only <stem>.dat and <stem>.gp (no gnuplot needed); returns their paths.
 PlotFiles write_plot_files(const Figure& figure, const std::filesystem::path& stem);
