@@ -27,12 +27,12 @@
 #include <chrono>
 #include <cstddef>
 #include <cstdint>
-#include <map>
 #include <memory>
 #include <string>
 #include <string_view>
 #include <vector>
 
+#include "piezoshift/host/http_request.hpp"
 #include "piezoshift/host/poll_server.hpp"
 
 namespace piezoshift::host {
@@ -47,15 +47,6 @@ struct HttpServerOptions {
   std::size_t max_body_bytes = 16384;    //!< POST bodies
   double request_timeout_s = 10.0;       //!< for a request to arrive and its answer to be taken
   std::size_t max_pending_output_bytes = std::size_t{4} << 20;  //!< per client
-};
-
-struct HttpRequest {
-  std::string method;                          //!< "GET", "POST"
-  std::string path;                            //!< "/api/stream", without the query
-  std::map<std::string, std::string> query;    //!< decoded ?key=value pairs
-  std::map<std::string, std::string> headers;  //!< names in lower case
-  std::string body;
-  std::string header(const std::string& lower_name) const;
 };
 
 struct HttpResponse {

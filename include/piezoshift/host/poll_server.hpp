@@ -71,7 +71,7 @@ class PollClient {
   ClientId id() const noexcept { return id_; }
   //! Queued bytes not yet taken by the socket.
   std::size_t pending() const noexcept { return output_.size() - output_sent_; }
-  //! Marked for closing (it gets no more protocol calls but on_disconnect()).
+  //! Marked for closing at the end of the round: no more input, serve() or output for it.
   bool closing() const noexcept { return close_ != Close::kNo; }
   //! The peer has shut down its sending side.
   bool input_ended() const noexcept { return input_ended_; }
