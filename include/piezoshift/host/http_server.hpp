@@ -17,20 +17,23 @@
 //              or this server's own (403)
 //   streams    a handler may answer with a stream (Server-Sent Events): the connection stays
 //              open and receives every broadcast() until it closes or reads too slowly
+//   poll       it runs on the shared poll server (poll_server.hpp), as the GCS LineServer does: one
+//              thread, the accept back-off, at most kReadChunkBytes read from a client per round,
+//              bounded send queues with slow-reader eviction
 // Why not a library: Debian 12's cpp-httplib (0.11) serves each connection on a pool thread with
 // an unbounded queue, so every open event stream holds a thread and the bounds above are not
-// expressible; this is ~400 lines in the same shape as LineServer. Not real-time code.
+// expressible. Not real-time code.
 #include <atomic>
 #include <chrono>
 #include <cstddef>
 #include <cstdint>
-#include <map>
 #include <memory>
 #include <string>
 #include <string_view>
 #include <vector>
 
-#include "piezoshift/host/tcp_listener.hpp"
+#include "piezoshift/host/http_request.hpp"
+#include "piezoshift/host/poll_server.hpp"
 
 namespace piezoshift::host {
 
@@ -44,15 +47,6 @@ struct HttpServerOptions {
   std::size_t max_body_bytes = 16384;    //!< POST bodies
   double request_timeout_s = 10.0;       //!< for a request to arrive and its answer to be taken
   std::size_t max_pending_output_bytes = std::size_t{4} << 20;  //!< per client
-};
-
-struct HttpRequest {
-  std::string method;                          //!< "GET", "POST"
-  std::string path;                            //!< "/api/stream", without the query
-  std::map<std::string, std::string> query;    //!< decoded ?key=value pairs
-  std::map<std::string, std::string> headers;  //!< names in lower case
-  std::string body;
-  std::string header(const std::string& lower_name) const;
 };
 
 struct HttpResponse {
@@ -82,26 +76,32 @@ class HttpHandler {
 };
 
 struct HttpServerStats {
-  std::uint64_t requests = 0;         //!< answered, any status
-  std::uint64_t refused = 0;          //!< 4xx/5xx answers, 401 included
-  std::uint64_t unauthorised = 0;     //!< 401
-  std::uint64_t streams_opened = 0;   //!< event streams started
-  std::uint64_t dropped_slow = 0;     //!< readers beyond max_pending_output_bytes
-  std::uint64_t broadcast_bytes = 0;  //!< bytes queued by broadcast(), all streams
+  std::uint64_t requests = 0;             //!< answered, any status
+  std::uint64_t refused = 0;              //!< 4xx/5xx answers, 401 included
+  std::uint64_t unauthorised = 0;         //!< 401
+  std::uint64_t streams_opened = 0;       //!< event streams started
+  std::uint64_t dropped_slow = 0;         //!< readers beyond max_pending_output_bytes
+  std::uint64_t broadcast_bytes = 0;      //!< bytes queued by broadcast(), all streams
+  std::uint64_t refused_max_clients = 0;  //!< 503 and closed: max_clients already connected
+  std::uint64_t bytes_in = 0;             //!< received from all clients
+  std::uint64_t bytes_out = 0;            //!< sent (taken by the kernel) to all clients
   //! accept() failed for lack of descriptors or memory; each pauses accepting for 100 ms
   std::uint64_t accept_failures = 0;
 };
 
-class HttpServer {
+class HttpServer : private PollProtocol {
  public:
+  //! Bytes read from one client per round at most (PollServerLimits::read_budget_bytes).
+  static constexpr std::size_t kReadChunkBytes = 16 * 1024;
+
   //! Binds and listens. Throws io::InputError naming host:port for a bad address, a non-loopback
   //! one without a token, bad limits or a failed bind.
   HttpServer(const HttpServerOptions& options, HttpHandler& handler);
-  ~HttpServer();
+  ~HttpServer() override;
   HttpServer(const HttpServer&) = delete;
   HttpServer& operator=(const HttpServer&) = delete;
 
-  std::uint16_t port() const noexcept { return listener_->port(); }
+  std::uint16_t port() const noexcept { return core_->port(); }
   //! Serves until stop() or *stop_flag != 0, then closes every connection.
   void run(const std::atomic<int>* stop_flag = nullptr, int poll_interval_ms = 5);
   //! Thread-safe and async-signal-safe.
@@ -114,37 +114,30 @@ class HttpServer {
   HttpServerStats stats() const;
 
  private:
-  using Clock = std::chrono::steady_clock;
-  struct Client {
-    int fd = -1;
-    std::string input;
-    std::string output;
-    std::size_t output_sent = 0;
-    Clock::time_point accepted;
-    bool answered = false;  // a response is queued: close once it is sent (unless a stream)
-    bool stream = false;
-    bool close = false;
-    std::size_t pending() const { return output.size() - output_sent; }
-  };
-
-  void accept_clients();
-  void read_from(Client& c);
-  //! Parses c.input when a whole request is there; answers it (or an error).
+  struct Client;
+  //! The connection as make_client() made it.
+  static Client& client(PollClient& c) noexcept;
+  static const Client& client(const PollClient& c) noexcept;
+  std::unique_ptr<PollClient> make_client() override;
+  std::string refusal() override;
+  //! Broadcasts (the handler's on_poll) and the request timeout.
+  void on_round() override;
+  bool wants_input(const PollClient& client) const override;
+  void on_input(PollClient& client, std::string_view bytes) override;
+  //! Parses the client's input when a whole request is there; answers it (or an error).
   void try_answer(Client& c);
   HttpResponse answer(const HttpRequest& request);
+  //! Counts the answer; the status line, headers and body.
+  std::string format(const HttpResponse& response);
   void respond(Client& c, const HttpResponse& response);
-  void queue(Client& c, std::string_view bytes);
-  void flush(Client& c);
 
   HttpServerOptions options_;
   HttpHandler& handler_;
   std::vector<std::string> allowed_hosts_;  // Host header values naming this server
-  std::unique_ptr<TcpListener> listener_;
-  std::vector<Client> clients_;
-  std::atomic<bool> stop_requested_{false};
+  std::unique_ptr<PollServer> core_;
   struct AtomicStats {
     std::atomic<std::uint64_t> requests{0}, refused{0}, unauthorised{0}, streams_opened{0},
-        dropped_slow{0}, broadcast_bytes{0};
+        broadcast_bytes{0};
   } stats_;
 };
 

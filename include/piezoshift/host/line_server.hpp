@@ -3,25 +3,17 @@
 // `piezoshift serve`, docs/gcs.md). It knows the framing only: a request is one line ending in
 // LF; what a line means and what to answer is the LineHandler's business.
 //
-// One turn of run():
-//   handler.on_poll()
-//   poll(wake-up fd, listening socket, every client: POLLIN only while it has no unhandled input
-//        and is not throttled, POLLOUT only while its output is pending)
-//   for each client: recv() one chunk into its input; handle its complete lines, at most
-//                    kLinesPerTurn and none once its queued output reaches
-//                    output_high_water_bytes: split at LF -> handler.on_line() -> queue the
-//                    answer (a byte for which handler.is_immediate() holds, where a line would
-//                    start: handler.on_immediate() at once, no LF needed)
-//                    send() queued output (MSG_NOSIGNAL: a vanished peer is an error, not SIGPIPE)
-//   disconnect idle clients, slow readers, failed or finished connections ->
-//   handler.on_disconnect()
-//   accept() new connections (beyond max_clients: accepted and closed at once)
+// It runs on the shared poll server (poll_server.hpp: listener, accept back-off, client table,
+// fair reads, bounded send queues, slow and idle eviction); what it adds per round and client:
+//   handle the client's complete lines in the chunk read this round, at most kLinesPerTurn and
+//   none once its queued output reaches output_high_water_bytes: split at LF ->
+//   handler.on_line() -> queue the answer (a byte for which handler.is_immediate() holds, where a
+//   line would start: handler.on_immediate() at once, no LF needed)
 // Nothing blocks on one client, and no client's work delays another's by more than one answer:
-// all sockets are non-blocking, each client has its own input and output queue, a turn handles a
-// bounded number of each client's lines, and a client that does not read its answers is
-// throttled (its further lines wait, in its own socket, until it reads) and, if it reads nothing
-// for send_timeout_s, disconnected. Not real-time code (heap, exceptions); it talks to the loop
-// through its handler.
+// a round reads at most kReadChunkBytes of each client and handles a bounded number of its
+// lines, and a client that does not read its answers is throttled (its further lines wait, in
+// its own socket, until it reads) and, if it reads nothing for send_timeout_s, disconnected.
+// Not real-time code (heap, exceptions); it talks to the loop through its handler.
 #include <atomic>
 #include <chrono>
 #include <cstddef>
@@ -31,7 +23,7 @@
 #include <string_view>
 #include <vector>
 
-#include "piezoshift/host/tcp_listener.hpp"
+#include "piezoshift/host/poll_server.hpp"
 
 namespace piezoshift::host {
 
@@ -64,9 +56,6 @@ struct LineServerLimits {
   //! A client from which no byte arrives for this long [s] is disconnected; +inf: never.
   double idle_timeout_s = 600.0;
 };
-
-//! Identifies one connection; unique and never reused during a server's life.
-using ClientId = std::uint64_t;
 
 //! What the protocol implements (the GCS interpreter). Called from the run() thread only.
 //! An exception from a handler ends run() (all connections are closed first) and propagates.
@@ -105,25 +94,27 @@ struct LineServerStats {
   std::uint64_t accept_failures = 0;
 };
 
-class LineServer {
+class LineServer : private PollProtocol {
  public:
   //! Lines (and single-character commands) of one client handled per turn at most: a client that
   //! sends many cheap commands at once delays the others' by at most this many.
   static constexpr std::size_t kLinesPerTurn = 32;
+  //! Bytes read from one client per round at most (PollServerLimits::read_budget_bytes).
+  static constexpr std::size_t kReadChunkBytes = 64 * 1024;
 
   //! Binds and listens (SO_REUSEADDR, non-blocking). Throws io::InputError naming host:port for an
   //! unparsable address, a non-loopback address without allow_remote, invalid limits, or a failed
   //! bind/listen (with the system's reason, e.g. "Address already in use").
   LineServer(const ListenAddress& address, const LineServerLimits& limits, LineHandler& handler);
   //! Closes all sockets (without handler calls: run() has already reported its disconnections).
-  ~LineServer();
+  ~LineServer() override;
   LineServer(const LineServer&) = delete;
   LineServer& operator=(const LineServer&) = delete;
 
   //! The bound port (the kernel's choice when ListenAddress::port was 0).
-  std::uint16_t port() const noexcept { return listener_->port(); }
+  std::uint16_t port() const noexcept { return core_->port(); }
   //! Connections currently served. Thread-safe.
-  std::size_t client_count() const noexcept { return client_count_.load(); }
+  std::size_t client_count() const noexcept { return core_->client_count(); }
 
   //! Serves until stop() is called or *stop_flag != 0 (checked every turn, i.e. at least every
   //! poll_interval_ms; for signal handlers), then disconnects every client and returns. stop() is
@@ -136,51 +127,28 @@ class LineServer {
   LineServerStats stats() const;
 
  private:
-  using Clock = std::chrono::steady_clock;
-
-  struct Client {
-    int fd = -1;
-    ClientId id = 0;
-    std::string unread;        // received, not handled yet (at most one read chunk)
-    std::string input;         // the partial line received so far (at most max_line_bytes + 1)
-    bool discarding = false;   // inside an overlong line: drop bytes up to the next LF
-    bool input_ended = false;  // EOF received: no more reading, close once output is sent
-    std::string output;        // queued answers; output[output_sent..] still to send
-    std::size_t output_sent = 0;
-    Clock::time_point last_input;
-    Clock::time_point last_output;  // output queued on an empty queue, or taken by the socket
-    enum class Close { kNo, kNow, kSlow, kIdle } close = Close::kNo;
-    std::size_t pending() const { return output.size() - output_sent; }
-  };
-
-  void accept_clients();
-  void read_from(Client& client);
-  //! Handles the client's complete lines in unread, within the turn's budget (see the top).
-  void serve_lines(Client& client);
-  bool throttled(const Client& client) const;
-  bool wants_input(const Client& client) const;
-  //! Marks for closing a client whose input has ended and whose lines and answers are done.
-  void close_if_done(Client& client);
-  void queue(Client& client, std::string&& answer);
-  void flush(Client& client);
-  void close_marked_clients();
-  void close_all_clients();
+  struct Client;
+  //! The connection as make_client() made it.
+  static Client& client(PollClient& c) noexcept;
+  static const Client& client(const PollClient& c) noexcept;
+  std::unique_ptr<PollClient> make_client() override;
+  void on_connect(PollClient& client) override;
+  void on_disconnect(PollClient& client) override;
+  void on_round() override { handler_.on_poll(); }
+  bool wants_input(const PollClient& client) const override;
+  bool has_work(const PollClient& client) const override;
+  void on_input(PollClient& client, std::string_view bytes) override;
+  void on_end_of_input(PollClient& client) override;
+  //! Handles the client's complete lines in unread, within the round's budget (see the top).
+  void serve(PollClient& client) override;
+  bool throttled(const PollClient& client) const;
+  //! Closes, once its answers are sent, a client whose input has ended and whose lines are done.
+  void finish_if_done(Client& client);
 
   LineServerLimits limits_;
   LineHandler& handler_;
-  std::unique_ptr<TcpListener> listener_;
-  ClientId next_id_ = 1;
-  std::vector<Client> clients_;
-  std::vector<char> read_buffer_;  // one recv() chunk, shared by all clients
-  std::atomic<std::size_t> client_count_{0};
-  std::atomic<bool> stop_requested_{false};
-  static_assert(std::atomic<bool>::is_always_lock_free, "stop() must be async-signal-safe");
-
-  // Counters, atomic so that stats() may be read from any thread while run() serves.
-  struct AtomicStats {
-    std::atomic<std::uint64_t> accepted{0}, refused_max_clients{0}, disconnected_slow{0},
-        disconnected_idle{0}, overlong_lines{0}, bytes_in{0}, bytes_out{0};
-  } stats_;
+  std::unique_ptr<PollServer> core_;
+  std::atomic<std::uint64_t> overlong_lines_{0};
 };
 
 }  // namespace piezoshift::host

@@ -1,7 +1,8 @@
 #pragma once
-// The listening end both network servers share (the GCS line server, line_server.hpp, and the
-// dashboard's HTTP server, http_server.hpp): an IPv4 TCP socket, non-blocking, bound and
-// listening, and an eventfd that wakes the server's poll() from any thread or a signal handler.
+// The listening end of the poll server (poll_server.hpp) that both network servers run on (the
+// GCS line server, line_server.hpp, and the dashboard's HTTP server, http_server.hpp): an IPv4
+// TCP socket, non-blocking, bound and listening, and an eventfd that wakes the server's poll()
+// from any thread or a signal handler.
 //
 //   parse_ipv4_host(host)   "localhost" or a numeric IPv4 address; says whether it is loopback
 //                           (127.0.0.0/8), so a server can refuse a remote bind before binding
