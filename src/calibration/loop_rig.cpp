@@ -177,7 +177,7 @@ void LoopRig::set_controller(const control::SemiClosedLoopParams& params) {
 void LoopRig::drive_actuators(const Vec3& s_um) {
   runtime::HostCommand c;
   c.kind = runtime::HostCommand::Kind::kActuators;
-  c.zd_um = s_um;
+  c.actuator_target_um = s_um;
   command(c);
   drive_ = Drive::kActuators;
 }

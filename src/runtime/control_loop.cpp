@@ -178,7 +178,7 @@ void ControlLoop::apply(const HostCommand& cmd) noexcept {
       wave_.apply(cmd.wave, host_zd_um_);
       break;
     case HostCommand::Kind::kActuators:
-      cycle_.drive(DriveMode::kActuators, cmd.zd_um);
+      cycle_.drive(DriveMode::kActuators, cmd.actuator_target_um);
       break;
     case HostCommand::Kind::kConfigure: {
       // Checked here, refused without a change and reported in the samples: never thrown.
