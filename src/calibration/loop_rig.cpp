@@ -169,8 +169,7 @@ void LoopRig::set_controller(const control::SemiClosedLoopParams& params) {
   // The sample that acknowledges the command says whether the loop took the set.
   const auto problem = static_cast<control::ParamsProblem>(last_.configure_problem);
   if (problem != control::ParamsProblem::kNone)
-    throw std::invalid_argument(std::string("loop rig: the loop refused the controller: ") +
-                                control::to_string(problem));
+    throw std::invalid_argument(runtime::refused_controller_message("loop rig", problem));
   params_ = p;
 }
 

@@ -58,8 +58,7 @@ Bench::~Bench() {
 void Bench::set_controller(const control::SemiClosedLoopParams& params) {
   const control::ParamsProblem problem = loop_->try_configure(params);
   if (problem != control::ParamsProblem::kNone)
-    throw std::invalid_argument(std::string("bench: the loop refused the controller: ") +
-                                control::to_string(problem));
+    throw std::invalid_argument(runtime::refused_controller_message("bench", problem));
 }
 
 void Bench::drive_open_loop(const Vec3& ao_V) {

@@ -17,6 +17,10 @@ const char* to_string(DriveMode mode) noexcept {
   return "unknown";
 }
 
+std::string refused_controller_message(std::string_view source, control::ParamsProblem problem) {
+  return std::string(source) + ": the loop refused the controller: " + control::to_string(problem);
+}
+
 ControlCycle::ControlCycle(const control::SemiClosedLoopParams& params,
                            const SafetyLimits& limits) {
   const control::ParamsProblem problem = control::params_problem(params, params.sample_time_s);

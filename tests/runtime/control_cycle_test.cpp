@@ -99,5 +99,10 @@ TEST(ControlCycle, EachTickCarriesTheDemandOfItsModeInItsOwnUnitAndZeroInTheOthe
   EXPECT_EQ(cycle.mode(), DriveMode::kPoints);
 }
 
+TEST(ControlCycle, ARefusedControllerIsOneSentenceForEveryCaller) {
+  EXPECT_EQ(refused_controller_message("bench", control::ParamsProblem::kOutputLimits),
+            "bench: the loop refused the controller: output_min_um is not below output_max_um");
+}
+
 }  // namespace
 }  // namespace piezoshift::runtime

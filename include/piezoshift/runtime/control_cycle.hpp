@@ -21,6 +21,8 @@
 // step() and try_configure() are real-time safe: no heap, no exceptions, no I/O. Construction is
 // set-up (it throws std::invalid_argument on parameters or limits the loop cannot run).
 #include <cstdint>
+#include <string>
+#include <string_view>
 
 #include "piezoshift/control/parameter_check.hpp"
 #include "piezoshift/control/semi_closed_loop.hpp"
@@ -31,6 +33,10 @@ namespace piezoshift::runtime {
 
 enum class DriveMode : std::uint8_t { kOpenLoop, kActuators, kPoints };
 const char* to_string(DriveMode mode) noexcept;
+
+//! The sentence for a parameter set try_configure() refused, for whoever reports it (source: who
+//! asked, e.g. "bench"): "<source>: the loop refused the controller: <problem>". Not real-time.
+std::string refused_controller_message(std::string_view source, control::ParamsProblem problem);
 
 //! What one tick saw and did.
 struct CycleSample {
