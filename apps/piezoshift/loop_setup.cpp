@@ -8,6 +8,7 @@
 
 #include "piezoshift/calibration/calibration_file.hpp"
 #include "piezoshift/calibration/calibration_procedure.hpp"
+#include "piezoshift/control/parameter_check.hpp"
 #include "piezoshift/io/input_error.hpp"
 #include "piezoshift/runtime/safety_ranges.hpp"
 
@@ -52,9 +53,13 @@ LoopCalibration resolve_calibration(const std::string& path, const std::string& 
   LoopCalibration c;
   if (!path.empty()) {
     c.params = calibration::load_calibration_file(path, &c.travel_z_max_um, &c.travel_z_min_um);
+    // The loop's own rule (control::params_problem, which the loop applies again when it takes
+    // the set), checked here so that the refusal names the file.
+    control::SemiClosedLoopParams at_loop = c.params;
+    at_loop.sample_time_s = loop_sample_time_s;
     const double t = c.params.improved.sample_time_s;
-    if (c.params.kind == control::ControllerKind::kImproved &&
-        std::fabs(t - loop_sample_time_s) > 1e-9 * loop_sample_time_s)
+    if (control::params_problem(at_loop, loop_sample_time_s) ==
+        control::ParamsProblem::kImprovedRate)
       throw io::InputError(fmt::format(
           "{}: [improved] sample_time_s = {} s, but the loop runs at {} s ({} Hz): calibrate the "
           "improved controller at the loop's rate",

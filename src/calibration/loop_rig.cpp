@@ -169,15 +169,14 @@ void LoopRig::set_controller(const control::SemiClosedLoopParams& params) {
   // The sample that acknowledges the command says whether the loop took the set.
   const auto problem = static_cast<control::ParamsProblem>(last_.configure_problem);
   if (problem != control::ParamsProblem::kNone)
-    throw std::invalid_argument(std::string("loop rig: the loop refused the controller: ") +
-                                control::to_string(problem));
+    throw std::invalid_argument(runtime::refused_controller_message("loop rig", problem));
   params_ = p;
 }
 
 void LoopRig::drive_actuators(const Vec3& s_um) {
   runtime::HostCommand c;
   c.kind = runtime::HostCommand::Kind::kActuators;
-  c.zd_um = s_um;
+  c.actuator_target_um = s_um;
   command(c);
   drive_ = Drive::kActuators;
 }

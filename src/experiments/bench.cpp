@@ -58,20 +58,19 @@ Bench::~Bench() {
 void Bench::set_controller(const control::SemiClosedLoopParams& params) {
   const control::ParamsProblem problem = loop_->try_configure(params);
   if (problem != control::ParamsProblem::kNone)
-    throw std::invalid_argument(std::string("bench: the loop refused the controller: ") +
-                                control::to_string(problem));
+    throw std::invalid_argument(runtime::refused_controller_message("bench", problem));
 }
 
 void Bench::drive_open_loop(const Vec3& ao_V) {
-  loop_->drive(DriveMode::kOpenLoop, ao_V);
+  loop_->drive_open_loop(ao_V);
 }
 
 void Bench::drive_actuators(const Vec3& target_um) {
-  loop_->drive(DriveMode::kActuators, target_um);
+  loop_->drive_actuators(target_um);
 }
 
 void Bench::drive_points(const Vec3& zd_um) {
-  loop_->drive(DriveMode::kPoints, zd_um);
+  loop_->drive_points(zd_um);
 }
 
 void Bench::tick() {

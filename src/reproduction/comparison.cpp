@@ -31,8 +31,8 @@ FigureValue not_measured() {
 
 // A figure of an experiment of the set; a failed calibration makes every figure not valid.
 template <class Get>
-std::function<FigureValue(const ControllerRun&)> from_set(Get get) {
-  return [get](const ControllerRun& r) {
+std::function<FigureValue(const VariantRun&)> from_set(Get get) {
+  return [get](const VariantRun& r) {
     if (!r.calibration.valid)
       return figure(0.0, r.calibration);
     return get(r.set);
@@ -40,9 +40,9 @@ std::function<FigureValue(const ControllerRun&)> from_set(Get get) {
 }
 
 // A figure of the phase step at 10 kHz; not measured where it was not run (the oracle).
-std::function<FigureValue(const ControllerRun&)> at_10kHz(
+std::function<FigureValue(const VariantRun&)> at_10kHz(
     double experiments::PhaseStepResult::*member) {
-  return [member](const ControllerRun& r) {
+  return [member](const VariantRun& r) {
     if (!r.calibration.valid)
       return figure(0.0, r.calibration);
     if (!r.ran_10kHz)
@@ -52,8 +52,8 @@ std::function<FigureValue(const ControllerRun&)> at_10kHz(
 }
 
 // The worst channel's margin at the i-th loop rate; the oracle has no analysis of its own.
-std::function<FigureValue(const ControllerRun&)> margin(std::size_t i, bool gain) {
-  return [i, gain](const ControllerRun& r) {
+std::function<FigureValue(const VariantRun&)> margin(std::size_t i, bool gain) {
+  return [i, gain](const VariantRun& r) {
     if (!r.calibration.valid)
       return figure(0.0, r.calibration);
     FigureValue f;
@@ -102,25 +102,25 @@ experiments::PhaseStepResult phase_step_at_10kHz(const config::ProjectConfig& co
 
 }  // namespace
 
-const char* controller_key(ControllerKind k) {
+const char* variant_key(LoopVariant k) {
   switch (k) {
-    case ControllerKind::kPaper:
+    case LoopVariant::kPaper:
       return "paper";
-    case ControllerKind::kImproved:
+    case LoopVariant::kImproved:
       return "improved";
-    case ControllerKind::kOracle:
+    case LoopVariant::kOracleFeedback:
       return "oracle";
   }
   return "";
 }
 
-const char* controller_label(ControllerKind k) {
+const char* variant_label(LoopVariant k) {
   switch (k) {
-    case ControllerKind::kPaper:
+    case LoopVariant::kPaper:
       return "paper's controller";
-    case ControllerKind::kImproved:
+    case LoopVariant::kImproved:
       return "improved controller";
-    case ControllerKind::kOracle:
+    case LoopVariant::kOracleFeedback:
       return "oracle (plate feedback: impossible on hardware)";
   }
   return "";
@@ -231,7 +231,7 @@ FigureValue median_over_seeds(const std::vector<FigureValue>& per_seed,
   return m;
 }
 
-std::vector<FigureValue> ComparisonResult::per_seed(std::size_t fig, ControllerKind k) const {
+std::vector<FigureValue> ComparisonResult::per_seed(std::size_t fig, LoopVariant k) const {
   std::vector<FigureValue> out;
   for (const SeedComparison& s : seeds)
     out.push_back(figures.at(fig).of(s[k]));
@@ -245,11 +245,10 @@ bool ComparisonResult::valid() const {
 std::vector<std::string> ComparisonResult::invalid_reasons() const {
   std::vector<std::string> out;
   for (std::size_t i = 0; i < medians.size(); ++i) {
-    for (ControllerKind k : kControllerKinds) {
+    for (LoopVariant k : kLoopVariants) {
       const FigureValue& m = medians[i][static_cast<std::size_t>(k)];
       if (m.measured && !m.validity.valid)
-        out.push_back(
-            fmt::format("{}: {}: {}", controller_key(k), figures[i].key, m.validity.reason));
+        out.push_back(fmt::format("{}: {}: {}", variant_key(k), figures[i].key, m.validity.reason));
     }
   }
   return out;
@@ -257,7 +256,7 @@ std::vector<std::string> ComparisonResult::invalid_reasons() const {
 
 namespace {
 
-// How a calibration that cannot finish is reported: that controller's seed is not valid, the
+// How a calibration that cannot finish is reported: that variant's seed is not valid, the
 // others still run.
 template <class Calibrate>
 void calibrate_or_fail(Validity& validity, const char* what, Calibrate&& calibrate) {
@@ -273,7 +272,7 @@ void calibrate_or_fail(Validity& validity, const char* what, Calibrate&& calibra
 // The 10 kHz figures of the paper's or the improved controller: its inner loop at 10 kHz and
 // the lambda/8 step with the loop at that rate.
 void run_at_10kHz(const config::ProjectConfig& config, const control::SemiClosedLoopParams& base,
-                  std::uint64_t seed, const Schedule& s, ControllerKind k, ControllerRun& run,
+                  std::uint64_t seed, const Schedule& s, LoopVariant k, VariantRun& run,
                   const experiments::Progress& progress) {
   // The paper's gains are re-expressed per sample at 10 kHz (as reproduce() does); the
   // improved controller's models are sampled at their rate, so its own procedure calibrates
@@ -285,7 +284,7 @@ void run_at_10kHz(const config::ProjectConfig& config, const control::SemiClosed
   // so the improved calibration sees the plate's mode below its Nyquist frequency.
   at.twin.interferometer.dynamic_sample_rate_Hz =
       std::max(at.twin.interferometer.dynamic_sample_rate_Hz, 1.0 / kFastSampleTime_s);
-  if (k == ControllerKind::kImproved && config.twin.daq.sample_time_s != kFastSampleTime_s) {
+  if (k == LoopVariant::kImproved && config.twin.daq.sample_time_s != kFastSampleTime_s) {
     try {
       control::SemiClosedLoopParams fast_base = base;
       fast_base.sample_time_s = kFastSampleTime_s;
@@ -306,34 +305,35 @@ void run_at_10kHz(const config::ProjectConfig& config, const control::SemiClosed
     return;
   }
   for (std::size_t i = 0; i < run.inner_loop.size(); ++i) {
-    if (run.inner_loop[i].sample_time_s == kFastSampleTime_s && k == ControllerKind::kImproved)
+    if (run.inner_loop[i].sample_time_s == kFastSampleTime_s && k == LoopVariant::kImproved)
       run.inner_loop[i] = analyze_inner_loop_at(config, fast, kFastSampleTime_s, seed + 90 + i);
   }
   run.phase_step_10kHz = phase_step_at_10kHz(config, fast, seed + 85, s.phase_step, progress);
   run.simulated_time_s += run.phase_step_10kHz.simulated_time_s;
 }
 
-// The three controllers on one seed, each calibrated by its own procedure.
+// The three variants on one seed: the paper's and the improved controller each calibrated by its
+// own procedure, the oracle feedback on the paper's calibration.
 SeedComparison compare_seed(const config::ProjectConfig& config, std::uint64_t seed,
                             const Schedule& s, const experiments::Progress& progress) {
   control::SemiClosedLoopParams base{};
   base.sample_time_s = config.twin.daq.sample_time_s;  // as reproduce(): the DAQ's rate
   SeedComparison sc;
   sc.seed = seed;
-  const auto labelled = [&](ControllerKind k) -> experiments::Progress {
+  const auto labelled = [&](LoopVariant k) -> experiments::Progress {
     if (!progress)
       return {};
     return [&progress, seed, k](double done, double total, std::string_view label) {
-      progress(done, total, fmt::format("seed {} {}: {}", seed, controller_key(k), label));
+      progress(done, total, fmt::format("seed {} {}: {}", seed, variant_key(k), label));
     };
   };
-  ControllerRun& paper = sc.runs[0];
-  ControllerRun& improved = sc.runs[1];
-  ControllerRun& oracle = sc.runs[2];
+  VariantRun& paper = sc.runs[0];
+  VariantRun& improved = sc.runs[1];
+  VariantRun& oracle = sc.runs[2];
   double paper_calibration_s = 0.0;
   calibrate_or_fail(paper.calibration, "calibration", [&] {
     const calibration::CalibrationOutcome cal =
-        calibration::calibrate(config, base, seed, s.calibration, labelled(ControllerKind::kPaper));
+        calibration::calibrate(config, base, seed, s.calibration, labelled(LoopVariant::kPaper));
     paper.controller = cal.controller;
     paper_calibration_s =
         cal.pid.simulated_time_s + cal.matrix.simulated_time_s + cal.polynomial.simulated_time_s;
@@ -342,7 +342,7 @@ SeedComparison compare_seed(const config::ProjectConfig& config, std::uint64_t s
     calibration::ImprovedCalibrationOptions io_opts;
     io_opts.paper = s.calibration;
     const calibration::ImprovedCalibrationOutcome cal = calibration::calibrate_improved(
-        config, base, seed, io_opts, labelled(ControllerKind::kImproved));
+        config, base, seed, io_opts, labelled(LoopVariant::kImproved));
     improved.controller = cal.controller;
     const auto& m = cal.static_map;
     improved.simulated_time_s =
@@ -354,11 +354,11 @@ SeedComparison compare_seed(const config::ProjectConfig& config, std::uint64_t s
   paper.simulated_time_s = paper_calibration_s;
 
   const Schedule oracle_schedule = with_feedback(s, experiments::Feedback::kOracle);
-  for (ControllerKind k : kControllerKinds) {
-    ControllerRun& run = sc.runs[static_cast<std::size_t>(k)];
+  for (LoopVariant k : kLoopVariants) {
+    VariantRun& run = sc.runs[static_cast<std::size_t>(k)];
     if (!run.calibration.valid)
       continue;
-    const bool is_oracle = k == ControllerKind::kOracle;
+    const bool is_oracle = k == LoopVariant::kOracleFeedback;
     run.set = run_experiment_set(config, run.controller, seed, is_oracle ? oracle_schedule : s,
                                  labelled(k));
     run.simulated_time_s += run.set.experiments_simulated_time_s();
@@ -404,7 +404,7 @@ std::vector<Target> comparison_targets(const config::ProjectConfig& config,
         Relative{"repeatability at 10 um, vs the oracle", "repeatability_10um_nm"}}) {
     Target x = target(rel.text, rel.key, 0.0, false, "");
     const std::size_t i = index_of(rel.key);
-    const FigureValue& o = r.medians.at(i)[static_cast<std::size_t>(ControllerKind::kOracle)];
+    const FigureValue& o = r.medians.at(i)[static_cast<std::size_t>(LoopVariant::kOracleFeedback)];
     if (o.validity.valid) {
       x.bound = 1.2 * o.value;
       x.bound_text = fmt::format("<= 1.2 x oracle ({:.4g} {})", x.bound, r.figures[i].unit);
@@ -429,7 +429,7 @@ std::vector<Target> comparison_targets(const config::ProjectConfig& config,
       continue;
     }
     x.unit = r.figures[i].unit;
-    x.improved = r.medians[i][static_cast<std::size_t>(ControllerKind::kImproved)];
+    x.improved = r.medians[i][static_cast<std::size_t>(LoopVariant::kImproved)];
     const double v = x.improved.value;
     x.met = x.improved.measured && x.improved.validity.valid && std::isfinite(x.bound) &&
             (x.at_least ? v >= x.bound : v <= x.bound);
@@ -450,11 +450,11 @@ ComparisonResult summarize_comparison(const config::ProjectConfig& config,
   r.figures = comparison_figures(config);
   r.seeds = std::move(seeds);
   for (const SeedComparison& sc : r.seeds)
-    for (const ControllerRun& run : sc.runs)
+    for (const VariantRun& run : sc.runs)
       r.simulated_time_s += run.simulated_time_s;
   for (std::size_t i = 0; i < r.figures.size(); ++i) {
     std::array<FigureValue, 3>& m = r.medians.emplace_back();
-    for (ControllerKind k : kControllerKinds)
+    for (LoopVariant k : kLoopVariants)
       m[static_cast<std::size_t>(k)] = median_over_seeds(r.per_seed(i, k), options.seeds);
   }
   r.targets = comparison_targets(config, r);

@@ -17,7 +17,7 @@ namespace {
 
 namespace fs = std::filesystem;
 
-std::size_t idx(ControllerKind k) {
+std::size_t idx(LoopVariant k) {
   return static_cast<std::size_t>(k);
 }
 
@@ -26,10 +26,10 @@ nlohmann::json number_or_null(const FigureValue& f) {
   return f.validity.valid && std::isfinite(f.value) ? nlohmann::json(f.value) : nlohmann::json();
 }
 
-// Prefixed keys of one controller's figures; values(i) is figure i's value.
+// Prefixed keys of one variant's figures; values(i) is figure i's value.
 template <class Values>
-void prefixed(nlohmann::json& j, const ComparisonResult& r, ControllerKind k, Values values) {
-  const std::string prefix = std::string(controller_key(k)) + "_";
+void prefixed(nlohmann::json& j, const ComparisonResult& r, LoopVariant k, Values values) {
+  const std::string prefix = std::string(variant_key(k)) + "_";
   nlohmann::json not_valid = nlohmann::json::object();
   for (std::size_t i = 0; i < r.figures.size(); ++i) {
     const FigureValue f = values(i);
@@ -71,8 +71,8 @@ io::Figure step_figure(const SeedComparison& sc) {
   all.key = "bottom right";
   zoom.y_range = std::pair{-50.0, 50.0};
   double t0 = 0.0, t1 = 0.0;
-  for (ControllerKind k : kControllerKinds) {
-    const ControllerRun& run = sc[k];
+  for (LoopVariant k : kLoopVariants) {
+    const VariantRun& run = sc[k];
     const auto& st = run.set.step;
     if (!run.calibration.valid || st.time_s.empty())
       continue;
@@ -82,8 +82,8 @@ io::Figure step_figure(const SeedComparison& sc) {
     for (std::size_t n = 0; n < st.measured_um.size(); ++n)
       err_nm.push_back(1e3 * (st.measured_um[n] - st.desired_um.back()));
     all.series.push_back(
-        io::line_series(controller_key(k), st.time_s, st.measured_um, kColour[idx(k)]));
-    zoom.series.push_back(io::line_series(controller_key(k), st.time_s, err_nm, kColour[idx(k)]));
+        io::line_series(variant_key(k), st.time_s, st.measured_um, kColour[idx(k)]));
+    zoom.series.push_back(io::line_series(variant_key(k), st.time_s, err_nm, kColour[idx(k)]));
   }
   zoom.series.insert(zoom.series.begin(), io::band_series("+-10 nm", t0, t1, -10.0, 10.0));
   f.panels = {std::move(all), std::move(zoom)};
@@ -100,8 +100,8 @@ io::Figure phase_step_figure(const SeedComparison& sc, double tolerance_nm) {
   p.y_label = "exposure mean - level before [nm]";
   p.key = "bottom right";
   bool band = false;
-  for (ControllerKind k : kControllerKinds) {
-    const ControllerRun& run = sc[k];
+  for (LoopVariant k : kLoopVariants) {
+    const VariantRun& run = sc[k];
     const auto& ps = run.set.phase_step;
     if (!run.calibration.valid || ps.time_s.empty())
       continue;
@@ -112,11 +112,11 @@ io::Figure phase_step_figure(const SeedComparison& sc, double tolerance_nm) {
       band = true;
     }
     p.series.push_back(
-        io::line_series(controller_key(k), ps.time_s, ps.exposure_mean_nm, kColour[idx(k)]));
+        io::line_series(variant_key(k), ps.time_s, ps.exposure_mean_nm, kColour[idx(k)]));
   }
   // The improved controller's run without the step, lifted to the target: how much of its
   // trace is the plate's own wander (the gauges' drift), not the step.
-  if (const ControllerRun& run = sc[ControllerKind::kImproved];
+  if (const VariantRun& run = sc[LoopVariant::kImproved];
       run.calibration.valid && !run.set.phase_step.still_exposure_mean_nm.empty()) {
     const auto& ps = run.set.phase_step;
     std::vector<double> lifted(ps.still_exposure_mean_nm);
@@ -141,8 +141,8 @@ io::Figure linearity_error_figure(const SeedComparison& sc) {
   b.title = "unseen 0.25 um grid";
   a.x_label = b.x_label = "desired [um]";
   a.y_label = b.y_label = "deviation from the zero-end line [nm]";
-  for (ControllerKind k : kControllerKinds) {
-    const ControllerRun& run = sc[k];
+  for (LoopVariant k : kLoopVariants) {
+    const VariantRun& run = sc[k];
     if (!run.calibration.valid)
       continue;
     for (auto [panel, lin] :
@@ -153,7 +153,7 @@ io::Figure linearity_error_figure(const SeedComparison& sc) {
       if (nm.size() != lin->desired_um.size() || nm.empty())
         continue;
       panel->series.push_back(
-          io::line_series(controller_key(k), lin->desired_um, nm, kColour[idx(k)]));
+          io::line_series(variant_key(k), lin->desired_um, nm, kColour[idx(k)]));
     }
   }
   f.panels = {std::move(a), std::move(b)};
@@ -162,16 +162,16 @@ io::Figure linearity_error_figure(const SeedComparison& sc) {
 
 io::Figure repeatability_figure(const SeedComparison& sc) {
   std::vector<experiments::RepeatabilitySet> sets;
-  for (ControllerKind k : kControllerKinds) {
-    const ControllerRun& run = sc[k];
+  for (LoopVariant k : kLoopVariants) {
+    const VariantRun& run = sc[k];
     if (!run.calibration.valid)
       continue;
-    sets.push_back({fmt::format("{}, 5 um", controller_key(k)), run.set.repeat_5um.measured_um});
-    sets.push_back({fmt::format("{}, 10 um", controller_key(k)), run.set.repeat_10um.measured_um});
+    sets.push_back({fmt::format("{}, 5 um", variant_key(k)), run.set.repeat_5um.measured_um});
+    sets.push_back({fmt::format("{}, 10 um", variant_key(k)), run.set.repeat_10um.measured_um});
   }
   io::Figure f = experiments::repeatability_figure(
       sets, 1.0, fmt::format("Repeatability, seed {} (interferometer)", sc.seed));
-  // Two rows (5 and 10 um), one column per controller.
+  // Two rows (5 and 10 um), one column per variant.
   f.cols = static_cast<int>(sets.size() + 1) / 2;
   f.rows = 2;
   std::vector<io::Panel> reordered;
@@ -190,7 +190,7 @@ std::vector<SeedComparison>::const_iterator draw_figures(const ComparisonResult&
                                                          const fs::path& dir, ReportFiles& files) {
   const auto drawn = std::find_if(r.seeds.begin(), r.seeds.end(), [](const SeedComparison& sc) {
     return std::any_of(sc.runs.begin(), sc.runs.end(),
-                       [](const ControllerRun& run) { return run.calibration.valid; });
+                       [](const VariantRun& run) { return run.calibration.valid; });
   });
   if (drawn == r.seeds.end())
     return drawn;
@@ -204,9 +204,9 @@ std::vector<SeedComparison>::const_iterator draw_figures(const ComparisonResult&
   return drawn;
 }
 
-// One CSV per controller: a row per seed, a column per figure it measures.
+// One CSV per variant: a row per seed, a column per figure it measures.
 void write_per_seed_data(const ComparisonResult& r, const fs::path& dir, ReportFiles& files) {
-  for (ControllerKind k : kControllerKinds) {
+  for (LoopVariant k : kLoopVariants) {
     std::vector<std::size_t> cols;
     std::vector<std::string> names{"seed"};
     for (std::size_t i = 0; i < r.figures.size(); ++i) {
@@ -215,7 +215,7 @@ void write_per_seed_data(const ComparisonResult& r, const fs::path& dir, ReportF
         names.push_back(r.figures[i].key);
       }
     }
-    const fs::path path = dir / fmt::format("per_seed_{}.csv", controller_key(k));
+    const fs::path path = dir / fmt::format("per_seed_{}.csv", variant_key(k));
     io::CsvWriter w(path.string(), names, 9);
     for (const SeedComparison& sc : r.seeds) {
       std::vector<double> row{static_cast<double>(sc.seed)};
@@ -250,7 +250,7 @@ void medians_section(Document& doc, const ComparisonResult& r) {
                                               "oracle (plate feedback: impossible on hardware)"}};
   for (std::size_t i = 0; i < r.figures.size(); ++i) {
     std::vector<std::string> row{r.figures[i].label};
-    for (ControllerKind k : kControllerKinds)
+    for (LoopVariant k : kLoopVariants)
       row.push_back(value_text(r.medians[i][idx(k)], r.figures[i].unit));
     rows.push_back(std::move(row));
   }
@@ -296,7 +296,7 @@ void per_seed_section(Document& doc, const ComparisonResult& r, const ReportFile
   for (const SeedComparison& sc : r.seeds) {
     for (const FigureSpec& f : r.figures) {
       std::vector<std::string> row{std::to_string(sc.seed), f.label};
-      for (ControllerKind k : kControllerKinds)
+      for (LoopVariant k : kLoopVariants)
         row.push_back(value_text(f.of(sc[k]), f.unit));
       rows.push_back(std::move(row));
     }
@@ -314,13 +314,13 @@ nlohmann::json comparison_json(const ComparisonResult& r) {
   nlohmann::json j;
   j["seeds"] = r.options.seeds;
   j["schedule"] = r.options.quick ? "quick" : "paper";
-  for (ControllerKind k : kControllerKinds)
+  for (LoopVariant k : kLoopVariants)
     prefixed(j, r, k, [&](std::size_t i) { return r.medians[i][idx(k)]; });
   nlohmann::json per = nlohmann::json::array();
   for (std::size_t s = 0; s < r.seeds.size(); ++s) {
     nlohmann::json o;
     o["seed"] = r.seeds[s].seed;
-    for (ControllerKind k : kControllerKinds)
+    for (LoopVariant k : kLoopVariants)
       prefixed(o, r, k, [&](std::size_t i) { return r.figures[i].of(r.seeds[s][k]); });
     per.push_back(std::move(o));
   }

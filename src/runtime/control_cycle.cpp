@@ -17,6 +17,10 @@ const char* to_string(DriveMode mode) noexcept {
   return "unknown";
 }
 
+std::string refused_controller_message(std::string_view source, control::ParamsProblem problem) {
+  return std::string(source) + ": the loop refused the controller: " + control::to_string(problem);
+}
+
 ControlCycle::ControlCycle(const control::SemiClosedLoopParams& params,
                            const SafetyLimits& limits) {
   const control::ParamsProblem problem = control::params_problem(params, params.sample_time_s);
@@ -57,11 +61,26 @@ void ControlCycle::restart_from_outputs() noexcept {
   controller_.hold_integrators(false);
 }
 
-void ControlCycle::drive(DriveMode mode, const Vec3& setpoint) noexcept {
+void ControlCycle::enter(DriveMode mode) noexcept {
   if (mode_ == DriveMode::kOpenLoop && mode != DriveMode::kOpenLoop)
     restart_from_outputs();
   mode_ = mode;
-  setpoint_ = setpoint;
+  zd_um_ = actuator_target_um_ = open_loop_V_ = Vec3{};
+}
+
+void ControlCycle::drive_open_loop(const Vec3& ao_V) noexcept {
+  enter(DriveMode::kOpenLoop);
+  open_loop_V_ = ao_V;
+}
+
+void ControlCycle::drive_actuators(const Vec3& target_um) noexcept {
+  enter(DriveMode::kActuators);
+  actuator_target_um_ = target_um;
+}
+
+void ControlCycle::drive_points(const Vec3& zd_um) noexcept {
+  enter(DriveMode::kPoints);
+  zd_um_ = zd_um;
 }
 
 bool ControlCycle::clear_fault() noexcept {
@@ -76,7 +95,7 @@ void ControlCycle::reset() noexcept {
   supervisor_.reset();
   controller_.configure(controller_.params());
   mode_ = DriveMode::kOpenLoop;
-  setpoint_ = Vec3{};
+  zd_um_ = actuator_target_um_ = open_loop_V_ = Vec3{};
   previous_write_ = DaqStatus::kOk;
   last_ = CycleSample{};
 }
@@ -86,18 +105,20 @@ const CycleSample& ControlCycle::step(DaqBackend& daq, const CycleTime& t,
   CycleSample& c = last_;
   c.tick = t.tick;
   c.mode = mode_;
-  c.setpoint = setpoint_;
+  c.zd_um = zd_um_;
+  c.actuator_target_um = actuator_target_um_;
+  c.open_loop_V = open_loop_V_;
   c.read_status = daq.read(t, c.ai_V);
   switch (mode_) {
     case DriveMode::kPoints:
-      c.controller = controller_.update(setpoint_, c.ai_V);
+      c.controller = controller_.update(zd_um_, c.ai_V);
       break;
     case DriveMode::kActuators:
-      c.controller = controller_.update_actuators(setpoint_, c.ai_V);
+      c.controller = controller_.update_actuators(actuator_target_um_, c.ai_V);
       break;
     case DriveMode::kOpenLoop:
       c.controller = control::ControllerOutput{};
-      c.controller.dac_V = setpoint_;
+      c.controller.dac_V = open_loop_V_;
       for (std::size_t i = 0; i < c.ai_V.size(); ++i)
         c.controller.feedback_um[i] = controller_.params().scaling[i].sgs_to_um(c.ai_V[i]);
       c.controller.target_um = c.controller.feedback_um;

@@ -86,7 +86,7 @@ void ControlLoop::start() noexcept {
   applied_sequence_ = 0;
   configure_problem_ = control::ParamsProblem::kNone;
   if (config_.host == nullptr && !config_.owner_drives)
-    cycle_.drive(DriveMode::kPoints, profile_.at(0.0));
+    cycle_.drive_points(profile_.at(0.0));
 }
 
 bool ControlLoop::tick() noexcept {
@@ -103,7 +103,7 @@ bool ControlLoop::tick() noexcept {
   choose_setpoint(ct);
 
   const CycleSample& cs = cycle_.step(daq_, ct, previous_overran_);
-  const Vec3 zd = cs.mode == DriveMode::kPoints ? cs.setpoint : Vec3{};  // S is no Z_d
+  const Vec3& zd = cs.zd_um;  // zero unless on Z_d: S is no Z_d
   record_outputs(cs, zd);
   publish_status(cs, zd, ct);
 
@@ -163,22 +163,22 @@ void ControlLoop::apply(const HostCommand& cmd) noexcept {
       clear_latched_fault();
       // Bumpless: each PID resumes from the command the output already holds.
       host_zd_um_ = cmd.zd_um;
-      cycle_.drive(DriveMode::kPoints, host_zd_um_);
+      cycle_.drive_points(host_zd_um_);
       cycle_.restart_from_outputs();
       break;
     case HostCommand::Kind::kServoOff:
       clear_latched_fault();
-      cycle_.drive(DriveMode::kOpenLoop, cycle_.supervisor().last_output_V());
+      cycle_.drive_open_loop(cycle_.supervisor().last_output_V());
       break;
     case HostCommand::Kind::kOpenLoop:
       if (!closed_loop)
-        cycle_.drive(DriveMode::kOpenLoop, cmd.ao_V);
+        cycle_.drive_open_loop(cmd.ao_V);
       break;
     case HostCommand::Kind::kWave:
       wave_.apply(cmd.wave, host_zd_um_);
       break;
     case HostCommand::Kind::kActuators:
-      cycle_.drive(DriveMode::kActuators, cmd.zd_um);
+      cycle_.drive_actuators(cmd.actuator_target_um);
       break;
     case HostCommand::Kind::kConfigure: {
       // Checked here, refused without a change and reported in the samples: never thrown.
@@ -197,9 +197,9 @@ void ControlLoop::choose_setpoint(const CycleTime& t) noexcept {
     const bool points = cycle_.mode() == DriveMode::kPoints;
     const Vec3 zd = wave_.next(host_zd_um_, points && !cycle_.supervisor().faulted());
     if (points)
-      cycle_.drive(DriveMode::kPoints, zd);
+      cycle_.drive_points(zd);
   } else if (!config_.owner_drives) {
-    cycle_.drive(DriveMode::kPoints, profile_.at(static_cast<double>(t.since_start_ns) * 1e-9));
+    cycle_.drive_points(profile_.at(static_cast<double>(t.since_start_ns) * 1e-9));
   }
 }
 

@@ -49,7 +49,7 @@ ComparisonResult nothing_calibrated() {
   std::vector<SeedComparison> seeds(2);
   for (std::size_t s = 0; s < seeds.size(); ++s) {
     seeds[s].seed = o.seeds[s];
-    for (ControllerRun& run : seeds[s].runs)
+    for (VariantRun& run : seeds[s].runs)
       run.calibration.fail("calibration: made up for the test");
   }
   return summarize_comparison(config::ProjectConfig{}, o, std::move(seeds));

@@ -34,34 +34,34 @@ std::size_t figure_index(const ComparisonResult& r, const std::string& key) {
 TEST(Comparison, RunsTheThreeControllersThroughEveryExperiment) {
   const auto& r = quick_comparison();
   ASSERT_EQ(r.seeds.size(), 1U);
-  for (const ControllerRun& run : r.seeds[0].runs) {
+  for (const VariantRun& run : r.seeds[0].runs) {
     EXPECT_TRUE(run.calibration.valid) << run.calibration.reason;
     EXPECT_EQ(run.set.repeat_5um.measured_um.size(), 230U);  // the paper's 230 moves
     EXPECT_GT(run.simulated_time_s, 100.0);
   }
   // The paper's controller and the oracle are valid on the default twin (reproduce's tests);
   // the improved controller's validity is its own tests' business, here it is only reported.
-  EXPECT_TRUE(r.seeds[0][ControllerKind::kPaper].set.table4_valid());
-  EXPECT_TRUE(r.seeds[0][ControllerKind::kOracle].set.table4_valid());
+  EXPECT_TRUE(r.seeds[0][LoopVariant::kPaper].set.table4_valid());
+  EXPECT_TRUE(r.seeds[0][LoopVariant::kOracleFeedback].set.table4_valid());
   EXPECT_EQ(r.valid(), r.invalid_reasons().empty());
   for (const std::string& why : r.invalid_reasons())
     EXPECT_EQ(why.rfind("improved: ", 0), 0U) << why;
   // The paper's and the improved controller are analysed at 1 and 10 kHz, the oracle not.
-  EXPECT_EQ(r.seeds[0][ControllerKind::kPaper].inner_loop.size(), 2U);
-  EXPECT_EQ(r.seeds[0][ControllerKind::kImproved].inner_loop.size(), 2U);
-  EXPECT_TRUE(r.seeds[0][ControllerKind::kOracle].inner_loop.empty());
+  EXPECT_EQ(r.seeds[0][LoopVariant::kPaper].inner_loop.size(), 2U);
+  EXPECT_EQ(r.seeds[0][LoopVariant::kImproved].inner_loop.size(), 2U);
+  EXPECT_TRUE(r.seeds[0][LoopVariant::kOracleFeedback].inner_loop.empty());
   // The phase step at 10 kHz: ten ticks per 1 ms exposure, the same step asked for.
-  const auto& fast = r.seeds[0][ControllerKind::kPaper].phase_step_10kHz;
+  const auto& fast = r.seeds[0][LoopVariant::kPaper].phase_step_10kHz;
   EXPECT_TRUE(fast.validity.valid) << fast.validity.reason;
   EXPECT_NEAR(fast.step_nm, 632.8 / 8.0, 1e-9);
-  EXPECT_FALSE(r.seeds[0][ControllerKind::kOracle].ran_10kHz);
+  EXPECT_FALSE(r.seeds[0][LoopVariant::kOracleFeedback].ran_10kHz);
 }
 
 // The oracle is the paper's calibration with p = identity, fed the plate's truth.
 TEST(Comparison, TheOracleIsThePapersGainsAndMatrixWithoutTheCubic) {
   const auto& s = quick_comparison().seeds[0];
-  const auto& paper = s[ControllerKind::kPaper].controller;
-  const auto& oracle = s[ControllerKind::kOracle].controller;
+  const auto& paper = s[LoopVariant::kPaper].controller;
+  const auto& oracle = s[LoopVariant::kOracleFeedback].controller;
   EXPECT_EQ(oracle.gains.kp, paper.gains.kp);
   EXPECT_EQ(oracle.matrix.a, paper.matrix.a);
   EXPECT_EQ(oracle.polynomial.p1, 1.0);
@@ -76,15 +76,15 @@ TEST(Comparison, ThePapersColumnIsReproduceOnTheSameSeed) {
   o.seed = 1;
   const ReproductionResult rep = reproduce(config::ProjectConfig{}, o);
   const auto& c = quick_comparison().seeds[0];
-  const auto& paper = c[ControllerKind::kPaper].set;
+  const auto& paper = c[LoopVariant::kPaper].set;
   EXPECT_EQ(paper.repeat_10um.metrics.repeatability_nm, rep.repeat_10um.metrics.repeatability_nm);
   EXPECT_EQ(paper.linearity.metrics.linearity_zero_end_pct,
             rep.linearity.metrics.linearity_zero_end_pct);
   EXPECT_EQ(paper.phase_step.hold_jitter_nm_rms, rep.phase_step.hold_jitter_nm_rms);
-  EXPECT_EQ(c[ControllerKind::kOracle].set.step.metrics.settling_time_abs_s,
+  EXPECT_EQ(c[LoopVariant::kOracleFeedback].set.step.metrics.settling_time_abs_s,
             rep.oracle.step.metrics.settling_time_abs_s);
   ASSERT_EQ(rep.inner_loop.size(), 2U);
-  EXPECT_EQ(c[ControllerKind::kPaper].inner_loop[0].worst().gain_margin_dB,
+  EXPECT_EQ(c[LoopVariant::kPaper].inner_loop[0].worst().gain_margin_dB,
             rep.inner_loop[0].worst().gain_margin_dB);
 }
 
@@ -93,8 +93,8 @@ TEST(Comparison, ThePapersColumnIsReproduceOnTheSameSeed) {
 TEST(Comparison, TheOraclesPhaseStepJittersLessThanThePapers) {
   const auto& r = quick_comparison();
   const std::size_t i = figure_index(r, "phase_step_hold_jitter_nm_rms");
-  const FigureValue& paper = r.medians[i][static_cast<std::size_t>(ControllerKind::kPaper)];
-  const FigureValue& oracle = r.medians[i][static_cast<std::size_t>(ControllerKind::kOracle)];
+  const FigureValue& paper = r.medians[i][static_cast<std::size_t>(LoopVariant::kPaper)];
+  const FigureValue& oracle = r.medians[i][static_cast<std::size_t>(LoopVariant::kOracleFeedback)];
   ASSERT_TRUE(paper.validity.valid && oracle.validity.valid);
   EXPECT_LT(oracle.value, 0.5 * paper.value);
   EXPECT_GT(oracle.value, 0.0);
@@ -103,7 +103,7 @@ TEST(Comparison, TheOraclesPhaseStepJittersLessThanThePapers) {
 TEST(Comparison, TargetsRelativeToTheOracleUseItsMedian) {
   const auto& r = quick_comparison();
   const std::size_t i = figure_index(r, "repeatability_5um_nm");
-  const double oracle = r.medians[i][static_cast<std::size_t>(ControllerKind::kOracle)].value;
+  const double oracle = r.medians[i][static_cast<std::size_t>(LoopVariant::kOracleFeedback)].value;
   bool found = false;
   for (const Target& t : r.targets) {
     if (t.key == "repeatability_5um_nm") {

@@ -69,6 +69,12 @@ HostCommand command(HostCommand::Kind kind, std::uint64_t sequence, Vec3 zd = {}
   return c;
 }
 
+HostCommand actuators_command(std::uint64_t sequence, Vec3 s_um) {
+  HostCommand c = command(HostCommand::Kind::kActuators, sequence);
+  c.actuator_target_um = s_um;
+  return c;
+}
+
 TEST(HostMode, StartsWithTheServoOffAtZeroVoltsAndSendsOneSamplePerTick) {
   const HostRun r = run_host({}, 0.1);
   EXPECT_FALSE(r.result.fault_detected);
@@ -132,7 +138,7 @@ TEST(HostMode, ServoOffHoldsTheAppliedVolts) {
 TEST(HostMode, ActuatorTargetsHoldTheSgsOnSAndAreNoZd) {
   // The guided calibration's stage 2 (calibration/loop_rig.hpp): the PIDs alone on S.
   const Vec3 s_um{2.0, 9.0, 2.0};
-  const HostRun r = run_host({command(HostCommand::Kind::kActuators, 1, s_um)}, 0.3);
+  const HostRun r = run_host({actuators_command(1, s_um)}, 0.3);
   EXPECT_FALSE(r.result.fault_detected) << to_string(r.result.fault.reason);
   const HostSample& h = r.samples.at(299);
   EXPECT_EQ(h.closed_loop, 1);
@@ -158,8 +164,7 @@ SwitchRun run_switch(const control::SemiClosedLoopParams* params) {
   daq.activate();
   SimulatedClock clock;
   HostLink link;
-  EXPECT_TRUE(
-      link.commands.try_push(command(HostCommand::Kind::kActuators, 1, control::filled(5.0))));
+  EXPECT_TRUE(link.commands.try_push(actuators_command(1, control::filled(5.0))));
   LoopConfig cfg;
   cfg.rate_Hz = 1000.0;
   cfg.duration_s = 0.6;
@@ -345,7 +350,7 @@ TEST(HostMode, CommandsAndSamplesMakeNoHeapAllocation) {
       command(HostCommand::Kind::kMoveTo, 2, Vec3{3, 4, 5}),
       command(HostCommand::Kind::kServoOff, 3),
       command(HostCommand::Kind::kOpenLoop, 4, {}, Vec3{2, 2, 2}),
-      command(HostCommand::Kind::kActuators, 5, Vec3{1, 1, 1}),
+      actuators_command(5, Vec3{1, 1, 1}),
       command(HostCommand::Kind::kConfigure, 6)};
   for (const HostCommand& c : commands)
     ASSERT_TRUE(link.commands.try_push(c));

@@ -1,7 +1,8 @@
 #pragma once
-// `piezoshift compare` (issue 12): the paper's controller, the improved one and the oracle side by
-// side, each calibrated by its own procedure, through the same experiments and the same seeds.
-// For each seed s:
+// `piezoshift compare` (issue 12): three variants of the loop side by side, through the same
+// experiments and the same seeds: the paper's controller and the improved one, each calibrated by
+// its own procedure and fed by the strain gauges, and the paper's controller fed by the oracle (a
+// feedback, not a controller). For each seed s:
 //   paper     calibration::calibrate(s) (reproduce()'s), then run_experiment_set(s) and
 //             analyze_inner_loop(s)
 //   improved  calibration::calibrate_improved(s), then the same set and analysis
@@ -15,8 +16,8 @@
 //
 // Every figure (travel, the 11 um step, the three linearity sweeps, repeatability at 5 and 10 um,
 // the lambda/8 phase step at the DAQ's rate and at 10 kHz, the PID's margins at each loop rate) is
-// a number per controller and seed, or not valid with its reason (a calibration that failed makes
-// every figure of that controller on that seed not valid). The median over seeds of a figure is not
+// a number per variant and seed, or not valid with its reason (a calibration that failed makes
+// every figure of that variant on that seed not valid). The median over seeds of a figure is not
 // valid when any seed's value is not: a failure is never averaged away.
 //
 // The targets are issue 12's done-when criteria, judged on the improved controller's medians.
@@ -36,16 +37,21 @@ struct CompareOptions {
   bool quick = false;  //!< Schedule::quick() instead of Schedule::paper()
 };
 
-enum class ControllerKind { kPaper = 0, kImproved = 1, kOracle = 2 };
-inline constexpr std::array<ControllerKind, 3> kControllerKinds{
-    ControllerKind::kPaper, ControllerKind::kImproved, ControllerKind::kOracle};
-//! "paper", "improved", "oracle": the JSON prefixes (without the underscore).
-const char* controller_key(ControllerKind k);
+//! What closes the loop in one column of the comparison: a controller and its feedback.
+enum class LoopVariant {
+  kPaper = 0,           //!< the paper's controller on the strain gauges
+  kImproved = 1,        //!< the improved controller on the strain gauges
+  kOracleFeedback = 2,  //!< the paper's gains and A, p = identity, on the plate's true position
+};
+inline constexpr std::array<LoopVariant, 3> kLoopVariants{
+    LoopVariant::kPaper, LoopVariant::kImproved, LoopVariant::kOracleFeedback};
+//! "paper", "improved", "oracle": the JSON prefixes (without the underscore) and file names.
+const char* variant_key(LoopVariant k);
 //! How the report names it.
-const char* controller_label(ControllerKind k);
+const char* variant_label(LoopVariant k);
 
-//! One controller on one seed.
-struct ControllerRun {
+//! One variant of the loop on one seed.
+struct VariantRun {
   control::SemiClosedLoopParams controller;
   //! Not valid when its calibration failed (experiments::ProcedureFailed, or calibration::FitError
   //! on the twin's records); nothing ran then.
@@ -65,14 +71,12 @@ struct ControllerRun {
 
 struct SeedComparison {
   std::uint64_t seed = 0;
-  std::array<ControllerRun, 3> runs;  //!< indexed by ControllerKind
-  const ControllerRun& operator[](ControllerKind k) const {
-    return runs[static_cast<std::size_t>(k)];
-  }
+  std::array<VariantRun, 3> runs;  //!< indexed by LoopVariant
+  const VariantRun& operator[](LoopVariant k) const { return runs[static_cast<std::size_t>(k)]; }
 };
 
 //! One figure of one run: a number (infinite for a time that never came: not settled), or not
-//! valid with its reason, or not measured for that controller (the oracle's margins).
+//! valid with its reason, or not measured for that variant (the oracle's margins).
 struct FigureValue {
   double value = std::numeric_limits<double>::quiet_NaN();
   experiments::Validity validity;
@@ -83,13 +87,13 @@ struct FigureSpec {
   std::string key;    //!< JSON key after the prefix, unit last: "step_settling_time_10nm_s"
   std::string label;  //!< the report's row
   std::string unit;   //!< shown after the number: "s", "nm", "%", "um", "dB", "deg"
-  std::function<FigureValue(const ControllerRun&)> of;
+  std::function<FigureValue(const VariantRun&)> of;
 };
 
 //! The figures compare reports, in the report's order (the margins at the config's loop rates).
 std::vector<FigureSpec> comparison_figures(const config::ProjectConfig& config);
 
-//! The median over seeds of one figure for one controller (the mean of the middle two for an even
+//! The median over seeds of one figure for one variant (the mean of the middle two for an even
 //! count). Not valid when a seed's value is not: the reason names the first such seed.
 FigureValue median_over_seeds(const std::vector<FigureValue>& per_seed,
                               const std::vector<std::uint64_t>& seeds);
@@ -111,17 +115,17 @@ struct ComparisonResult {
   Schedule schedule;
   std::vector<FigureSpec> figures;
   std::vector<SeedComparison> seeds;
-  //! [figure][controller]: the median over seeds.
+  //! [figure][variant]: the median over seeds.
   std::vector<std::array<FigureValue, 3>> medians;
   std::vector<Target> targets;
   double simulated_time_s = 0.0;
   double wall_time_s = 0.0;
 
-  //! The per-seed values of one figure of one controller.
-  std::vector<FigureValue> per_seed(std::size_t figure, ControllerKind k) const;
-  //! Every measured median of every controller valid.
+  //! The per-seed values of one figure of one variant.
+  std::vector<FigureValue> per_seed(std::size_t figure, LoopVariant k) const;
+  //! Every measured median of every variant valid.
   bool valid() const;
-  //! "controller: figure: reason" for every median that is not valid.
+  //! "variant: figure: reason" (variant_key) for every median that is not valid.
   std::vector<std::string> invalid_reasons() const;
 };
 

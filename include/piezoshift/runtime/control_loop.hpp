@@ -15,7 +15,7 @@
 //                last move plus its running wave           servo off the host's open-loop
 //                generators (wave_generator.hpp)           volts; the generators stop when the
 //                                                          servo is off or a fault is latched)
-//       owner    whatever drive() set between ticks      (the simulated bench)
+//       owner    whatever drive_*() set between ticks    (the simulated bench)
 //     cycle.step(daq, k, overrun(k-1))                   the one control tick (control_cycle.hpp):
 //                                                        read, controller, supervisor, write
 //                                                        E_k = end of work
@@ -30,8 +30,9 @@
 // Host mode (LoopConfig::host set): the loop starts with the servo off and the outputs at 0 V,
 // and takes its set-points (Z_d, actuator targets S or open-loop volts) and parameter changes
 // from the host's commands instead of the profile. Owner mode (LoopConfig::owner_drives): the
-// same start, and the set-points and parameter changes come from drive() and try_configure(),
-// called by the thread that calls tick().
+// same start, and the set-points and parameter changes come from drive_points(),
+// drive_actuators(), drive_open_loop() and try_configure(), called by the thread that calls
+// tick().
 //
 // start(), tick() and run() are real-time safe: everything they touch is allocated by the
 // constructor; the telemetry and host pushes are lock-free ring writes that drop (and count) on a
@@ -65,7 +66,8 @@ struct LoopConfig {
   HostLink* host = nullptr;
   //! When set, the latest tick is published here for a display (loop_status.hpp).
   LoopStatus* status = nullptr;
-  //! Owner mode (no host): the set-points come from drive() between ticks, not from the profile.
+  //! Owner mode (no host): the set-points come from drive_*() between ticks, not from the
+  //! profile.
   bool owner_drives = false;
 };
 
@@ -113,8 +115,11 @@ class ControlLoop {
   //! The run so far (final once tick() returned false).
   const LoopResult& result() const noexcept { return result_; }
 
-  //! Owner mode, between ticks: what the next ticks follow (control_cycle.hpp's drive()).
-  void drive(DriveMode mode, const Vec3& setpoint) noexcept { cycle_.drive(mode, setpoint); }
+  //! Owner mode, between ticks: what the next ticks follow (control_cycle.hpp's): DAQ volts,
+  //! the actuator targets S, or Z_d of P1..P3.
+  void drive_open_loop(const Vec3& ao_V) noexcept { cycle_.drive_open_loop(ao_V); }
+  void drive_actuators(const Vec3& target_um) noexcept { cycle_.drive_actuators(target_um); }
+  void drive_points(const Vec3& zd_um) noexcept { cycle_.drive_points(zd_um); }
   //! Owner mode, between ticks: a new controller, or the problem that refused it (nothing
   //! changes then). params.sample_time_s must be the loop's period.
   control::ParamsProblem try_configure(const control::SemiClosedLoopParams& params) noexcept {

@@ -16,8 +16,9 @@
 //   kOpenLoop    servo off: the DAQ outputs := ao_V (through the safety supervisor's limits)
 //   kWave        starts or stops one wave generator (wave_generator.hpp); it plays into Z_d while
 //                the servo is on and no fault is latched, and stops otherwise
-//   kActuators   the PIDs alone on the SGS targets S := zd_um (calibration stage 2, the guided
-//                calibration's LoopRig); bumpless from open loop; kServoOn returns to Z_d
+//   kActuators   the PIDs alone on the SGS targets S := actuator_target_um (calibration stage 2,
+//                the guided calibration's LoopRig); bumpless from open loop; kServoOn returns to
+//                Z_d
 //   kConfigure   pops the next parameter set from `params` and makes it the controller's,
 //                bumplessly, when the loop can run it (ControlCycle::try_configure, at the loop's
 //                sample time); otherwise nothing changes and every later sample's
@@ -48,7 +49,8 @@ struct HostCommand {
   };
   Kind kind = Kind::kMoveTo;
   std::uint64_t sequence = 0;  //!< set by the host, increasing
-  Vec3 zd_um{};                //!< kMoveTo, kServoOn: Z_d of P1..P3; kActuators: S
+  Vec3 zd_um{};                //!< kMoveTo, kServoOn: Z_d of P1..P3
+  Vec3 actuator_target_um{};   //!< kActuators: S, the SGS targets of actuators 1..3
   Vec3 ao_V{};                 //!< kOpenLoop: DAQ volts per channel
   WaveCommand wave{};          //!< kWave
 };
