@@ -8,6 +8,7 @@
 
 #include "piezoshift/calibration/calibration_file.hpp"
 #include "piezoshift/calibration/calibration_procedure.hpp"
+#include "piezoshift/calibration/controller_ranges.hpp"
 #include "piezoshift/control/parameter_check.hpp"
 #include "piezoshift/io/input_error.hpp"
 #include "piezoshift/runtime/safety_ranges.hpp"
@@ -64,6 +65,12 @@ LoopCalibration resolve_calibration(const std::string& path, const std::string& 
           "{}: [improved] sample_time_s = {} s, but the loop runs at {} s ({} Hz): calibrate the "
           "improved controller at the loop's rate",
           path, t, loop_sample_time_s, 1.0 / loop_sample_time_s));
+    // The file was checked at its own rate; the gains are rescaled to the loop's, where they
+    // must be stable too (calibration/controller_ranges.hpp).
+    if (const std::string why = calibration::controller_problem(c.params, loop_sample_time_s);
+        !why.empty())
+      throw io::InputError(fmt::format("{} at the loop's {} Hz: {}", path,
+                                       1.0 / loop_sample_time_s, why));
     c.source = path;
     return c;
   }
