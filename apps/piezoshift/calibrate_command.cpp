@@ -205,7 +205,9 @@ FitDataFiles write_fit_data(const std::string& out, const calibration::GuidedOut
   const std::filesystem::path folder = std::filesystem::path(out).parent_path();
   const FitDataFiles files{(folder / "matrix_poses.csv").string(),
                            (folder / "polynomial_points.csv").string()};
-  io::CsvWriter poses(files.poses, {"s1_um", "s2_um", "s3_um", "z1_um", "z2_um", "z3_um"}, 9);
+  constexpr auto kAtomic = io::CsvWriter::Mode::kReplaceAtomically;
+  io::CsvWriter poses(files.poses, {"s1_um", "s2_um", "s3_um", "z1_um", "z2_um", "z3_um"}, 9,
+                      kAtomic);
   poses.comment(
       fmt::format("guided calibration stage 2: poses (dS, dZ), session {}", session_file));
   for (std::size_t k = 0; k < r.matrix.ds_um.size(); ++k) {
@@ -214,7 +216,7 @@ FitDataFiles write_fit_data(const std::string& out, const calibration::GuidedOut
     poses.row({ds[0], ds[1], ds[2], dz[0], dz[1], dz[2]});
   }
   poses.close();
-  io::CsvWriter points(files.points, {"command_um", "measured_um"}, 9);
+  io::CsvWriter points(files.points, {"command_um", "measured_um"}, 9, kAtomic);
   points.comment(
       fmt::format("guided calibration stage 3: commands and readings, session {}", session_file));
   for (std::size_t k = 0; k < r.polynomial.command_um.size(); ++k)
@@ -289,13 +291,13 @@ int run_guided(const Options& o) {
         "{} ended: {} of {} steps are recorded in {}; run the same command again to resume",
         source->name(), session.readings.size(), plan.size(), session_file));
 
+  const FitDataFiles files = write_fit_data(o.out, r, session_file);  // before: see run_improved
   calibration::write_calibration_file(
       o.out, r.controller,
       fmt::format("piezoshift calibration, identified by the guided `piezoshift calibrate` on {} "
                   "with the interferometer from {}\nseed {}, configuration: {}, session: {}",
                   o.daq, o.interferometer, o.seed,
                   o.config.empty() ? "built-in defaults" : o.config, session_file));
-  const FitDataFiles files = write_fit_data(o.out, r, session_file);
   const calibration::LoopRig* loop_rig = rigs.loop_rig();
   if (o.json) {
     nlohmann::json j = guided_json(o, r, files, session_file, plan.size());
@@ -336,6 +338,12 @@ int run_improved(const Options& o, const config::ProjectConfig& config) {
     throw experiments::ProcedureFailed(
         fmt::format("calibration: the improved loop has no semi-closed-loop travel: {}",
                     travel.validity.reason));
+  // The records stages 4 and 5 fitted, in the formats `fit improved` reads (docs/files.md),
+  // each replaced atomically and before the calibration file: its presence implies them whole.
+  const std::filesystem::path folder = std::filesystem::path(o.out).parent_path();
+  const std::string excitation_file = (folder / "excitation.csv").string();
+  const std::string mode_file = (folder / "mode_step.csv").string();
+  write_improved_records(ic, excitation_file, mode_file);
   calibration::write_calibration_file(
       o.out, ic.controller,
       fmt::format("piezoshift calibration of the improved controller, identified on the digital "
@@ -343,11 +351,6 @@ int run_improved(const Options& o, const config::ProjectConfig& config) {
                   "{}",
                   o.seed, o.config.empty() ? "built-in defaults" : o.config),
       travel.single_move_um, travel.single_move_min_um);
-  // The records stages 4 and 5 fitted, in the formats `fit improved` reads (docs/files.md).
-  const std::filesystem::path folder = std::filesystem::path(o.out).parent_path();
-  const std::string excitation_file = (folder / "excitation.csv").string();
-  const std::string mode_file = (folder / "mode_step.csv").string();
-  write_improved_records(ic, excitation_file, mode_file);
   const ImprovedSummary summary{ic.controller.improved, ic.model, ic.mode, ic.shaped};
   if (o.json) {
     nlohmann::json j = improved_json(summary);

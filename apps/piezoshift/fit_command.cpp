@@ -193,7 +193,7 @@ int run_improved(const FitOptions& o) {
   const config::ProjectConfig config = o.config.empty()
                                            ? config::ProjectConfig{}
                                            : runtime::load_installation_config(o.config).project;
-  const io::CsvTable t = io::CsvTable::load(o.data_path);
+  const io::CsvTable t = load_record(o.data_path);
   t.require_columns({"t_s", "u1_um", "u2_um", "u3_um", "sgs1_um", "sgs2_um", "sgs3_um"});
   const double sample_time_s = record_step_s(t, t.column("t_s"));
   std::array<calibration::HysteresisFit, 3> model;
@@ -205,7 +205,7 @@ int run_improved(const FitOptions& o) {
   }
   calibration::PlateModeEstimate mode;
   if (!o.mode_path.empty()) {
-    const io::CsvTable m = io::CsvTable::load(o.mode_path);
+    const io::CsvTable m = load_record(o.mode_path);
     m.require_columns({"t_s", "measured_um"});
     const double step_s = record_step_s(m, m.column("t_s"));
     mode = calibration::identify_plate_mode(m.column("measured_um"), 1.0 / step_s);

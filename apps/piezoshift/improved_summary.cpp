@@ -1,10 +1,16 @@
 #include "improved_summary.hpp"
 
+#include <algorithm>
+#include <charconv>
+#include <optional>
+#include <string_view>
 #include <vector>
 
 #include <fmt/core.h>
 
 #include "piezoshift/io/csv_writer.hpp"
+#include "piezoshift/io/input_error.hpp"
+#include "piezoshift/io/input_file.hpp"
 
 namespace piezoshift::app {
 
@@ -48,26 +54,70 @@ void print_improved(const ImprovedSummary& s) {
                sh.rate_um_per_s);
 }
 
+namespace {
+
+constexpr std::string_view kRowsKey = "rows = ";
+
+// N of the first comment line "# rows = N", nullopt without one (a file another tool wrote).
+std::optional<std::size_t> promised_rows(std::string_view text) {
+  std::size_t pos = 0;
+  while (pos < text.size()) {
+    const std::size_t nl = std::min(text.find('\n', pos), text.size());
+    std::string_view line = text.substr(pos, nl - pos);
+    pos = nl + 1;
+    while (!line.empty() && (line.back() == '\r' || line.back() == ' '))
+      line.remove_suffix(1);
+    if (line.size() < 2 || line.substr(0, 2) != "# " || line.substr(2, kRowsKey.size()) != kRowsKey)
+      continue;
+    const std::string_view digits = line.substr(2 + kRowsKey.size());
+    std::size_t n = 0;
+    const auto [end, ec] = std::from_chars(digits.data(), digits.data() + digits.size(), n);
+    if (ec == std::errc() && end == digits.data() + digits.size())
+      return n;
+  }
+  return std::nullopt;
+}
+
+}  // namespace
+
 void write_improved_records(const calibration::ImprovedCalibrationOutcome& ic,
                             const std::string& excitation_file, const std::string& mode_file) {
+  constexpr auto kAtomic = io::CsvWriter::Mode::kReplaceAtomically;
   {
     io::CsvWriter w(excitation_file,
-                    {"t_s", "u1_um", "u2_um", "u3_um", "sgs1_um", "sgs2_um", "sgs3_um"}, 12);
+                    {"t_s", "u1_um", "u2_um", "u3_um", "sgs1_um", "sgs2_um", "sgs3_um"}, 12,
+                    kAtomic);
     w.comment("improved calibration stage 4: the open-loop excitation, one row per tick");
+    w.comment(fmt::format("{}{}", kRowsKey, ic.record_t_s.size()));
     for (std::size_t k = 0; k < ic.record_t_s.size(); ++k)
       w.row({ic.record_t_s[k], ic.record_command_um[0][k], ic.record_command_um[1][k],
              ic.record_command_um[2][k], ic.record_gauge_um[0][k], ic.record_gauge_um[1][k],
              ic.record_gauge_um[2][k]});
     w.close();
   }
-  io::CsvWriter w(mode_file, {"t_s", "measured_um"}, 9);
+  io::CsvWriter w(mode_file, {"t_s", "measured_um"}, 9, kAtomic);
   w.comment(fmt::format(
       "improved calibration stage 5: the interferometer (mean of P1..P3) after a small open-loop "
       "step, at {} Hz, t_s from the step",
       ic.mode.sample_rate_Hz));
+  w.comment(fmt::format("{}{}", kRowsKey, ic.mode_record_t_s.size()));
   for (std::size_t k = 0; k < ic.mode_record_t_s.size(); ++k)
     w.row({ic.mode_record_t_s[k], ic.mode_record_um[k]});
   w.close();
+}
+
+io::CsvTable load_record(const std::string& path) {
+  const std::string text = io::read_input_file(path, io::kMaxDataFileBytes);
+  if (!text.empty() && text.back() != '\n')
+    throw io::InputError(
+        fmt::format("{}:{}: the last line has no line end: the file is cut short (truncated)", path,
+                    std::count(text.begin(), text.end(), '\n') + 1));
+  io::CsvTable t = io::CsvTable::parse(text, path);
+  if (const std::optional<std::size_t> n = promised_rows(text); n && *n != t.rows())
+    throw io::InputError(fmt::format(
+        "{}: {} data rows where the file promises {} (# {}{}): the file is cut short (truncated)",
+        path, t.rows(), *n, kRowsKey, *n));
+  return t;
 }
 
 }  // namespace piezoshift::app

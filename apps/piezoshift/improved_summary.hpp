@@ -11,6 +11,7 @@
 #include "piezoshift/calibration/hysteresis_identification.hpp"
 #include "piezoshift/calibration/improved_calibration.hpp"
 #include "piezoshift/calibration/mode_identification.hpp"
+#include "piezoshift/io/csv_table.hpp"
 
 namespace piezoshift::app {
 
@@ -25,8 +26,13 @@ nlohmann::json improved_json(const ImprovedSummary& s);
 void print_improved(const ImprovedSummary& s);
 
 //! The excitation (t_s, u1_um..u3_um, sgs1_um..sgs3_um) and the ring-down (t_s, measured_um)
-//! of a calibration outcome, written to these paths.
+//! of a calibration outcome, each file replaced atomically and promising its rows ("# rows = N"
+//! before the data) so that `fit improved` can tell a copy cut short.
 void write_improved_records(const calibration::ImprovedCalibrationOutcome& ic,
                             const std::string& excitation_file, const std::string& mode_file);
+
+//! A record as `fit improved` reads it: a last line without its newline, or fewer (or more) data
+//! rows than a "# rows = N" comment promises, is a file cut short: InputError naming it.
+io::CsvTable load_record(const std::string& path);
 
 }  // namespace piezoshift::app

@@ -9,6 +9,7 @@
 #include <filesystem>
 #include <memory>
 #include <numbers>
+#include <span>
 #include <sstream>
 #include <string>
 #include <vector>
@@ -18,10 +19,12 @@
 
 #include "command.hpp"
 #include "piezoshift/config/project_config.hpp"
+#include "piezoshift/experiments/validity.hpp"
 #include "piezoshift/io/atomic_file.hpp"
 #include "piezoshift/io/input_error.hpp"
 #include "piezoshift/psi/analysis.hpp"
 #include "piezoshift/psi/error_budget.hpp"
+#include "piezoshift/psi/frame_set.hpp"
 #include "piezoshift/psi/npy.hpp"
 #include "piezoshift/psi/png_image.hpp"
 #include "piezoshift/psi/simulation.hpp"
@@ -73,23 +76,6 @@ std::vector<double> parse_list(const std::string& text, const std::string& optio
     }
   }
   return v;
-}
-
-std::vector<psi::Map> load_frames(const std::vector<std::string>& paths) {
-  if (paths.size() < 3)
-    throw io::InputError(
-        fmt::format("psi: {} frame(s) given, at least 3 are needed", paths.size()));
-  std::vector<psi::Map> frames;
-  for (const std::string& p : paths) {
-    psi::GrayImage g = psi::read_png_gray(p);
-    if (!frames.empty() &&
-        (g.counts.width != frames[0].width || g.counts.height != frames[0].height))
-      throw io::InputError(fmt::format("{}: {} x {} pixels, but {} is {} x {}", p, g.counts.width,
-                                       g.counts.height, paths[0], frames[0].width,
-                                       frames[0].height));
-    frames.push_back(std::move(g.counts));
-  }
-  return frames;
 }
 
 psi::Mask load_mask(const std::string& path, const psi::Map& frame) {
@@ -190,7 +176,7 @@ void print_analysis(const psi::Analysis& a, psi::Algorithm alg, const std::strin
 
 int run_analyze(const PsiOptions& o) {
   check_wavelength(o.wavelength_nm);
-  const std::vector<psi::Map> frames = load_frames(o.frames);
+  const std::vector<psi::Map> frames = psi::read_frame_set(o.frames);
   const psi::Mask mask = load_mask(o.mask, frames[0]);
   const psi::Algorithm alg = choose_algorithm(o.algorithm, frames.size());
   check_count(alg, frames.size());
@@ -213,12 +199,10 @@ int run_analyze(const PsiOptions& o) {
   return 0;
 }
 
-int run_calibrate(const PsiOptions& o) {
-  check_wavelength(o.wavelength_nm);
-  if (!(o.nominal_step_rad > 0.0 && o.nominal_step_rad < std::numbers::pi))
-    throw io::InputError(
-        fmt::format("--nominal-step-rad {}: must be in (0, pi)", o.nominal_step_rad));
-  const std::vector<psi::Map> frames = load_frames(o.frames);
+// The steps a frame set made, recovered by AIA, tilt-aia or Carre. Frames without fringes are
+// refused as `psi analyze` refuses them (exit 2); a recovery that did not converge, or a gain
+// that is not finite and positive, is not a calibration (exit 4, no file written).
+psi::StepCalibration recover_steps(const PsiOptions& o, std::span<const psi::Map> frames) {
   const psi::Mask mask = load_mask(o.mask, frames[0]);
   const psi::Algorithm alg =
       o.algorithm.empty() ? psi::Algorithm::kAia : psi::parse_algorithm(o.algorithm);
@@ -234,6 +218,7 @@ int run_calibrate(const PsiOptions& o) {
   psi::PhaseResult r;
   try {
     r = psi::wrapped_phase(frames, mask, po);
+    psi::modulated_pixels(r, mask, psi::AnalysisOptions{});
   } catch (const std::invalid_argument& e) {
     throw io::InputError(fmt::format("psi calibrate: {}", e.what()));
   }
@@ -241,6 +226,28 @@ int run_calibrate(const PsiOptions& o) {
   c.algorithm = std::string(psi::algorithm_name(alg));
   c.iterations = r.iterations;
   c.converged = r.converged;
+  if (const std::string problem = psi::step_calibration_problem(c); !problem.empty()) {
+    if (o.json)
+      fmt::print("{}\n", Json{{"algorithm", c.algorithm},
+                              {"iterations", c.iterations},
+                              {"converged", false},
+                              {"reason", problem}}
+                             .dump(2));
+    throw experiments::ProcedureFailed(fmt::format("psi calibrate: {}", problem));
+  }
+  return c;
+}
+
+int run_calibrate(const PsiOptions& o) {
+  check_wavelength(o.wavelength_nm);
+  if (!(o.nominal_step_rad >= psi::kMinNominalStepRad &&
+        o.nominal_step_rad <= psi::kMaxNominalStepRad))
+    throw io::InputError(fmt::format(
+        "--nominal-step-rad {}: must be in [{:g}, pi - {:g}] = [{:g}, {:.4f}] rad",
+        o.nominal_step_rad, psi::kMinNominalStepRad, std::numbers::pi - psi::kMaxNominalStepRad,
+        psi::kMinNominalStepRad, psi::kMaxNominalStepRad));
+  const std::vector<psi::Map> frames = psi::read_frame_set(o.frames);
+  const psi::StepCalibration c = recover_steps(o, frames);
   if (const fs::path parent = fs::path(o.out).parent_path(); !parent.empty())
     fs::create_directories(parent);
   io::write_file_atomically(o.out, psi::format_step_calibration_toml(c));

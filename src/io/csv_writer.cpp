@@ -7,19 +7,21 @@
 
 #include <fmt/core.h>
 
+#include "piezoshift/io/atomic_file.hpp"
 #include "piezoshift/io/input_error.hpp"
 
 namespace piezoshift::io {
 
-CsvWriter::CsvWriter(const std::string& path, std::vector<std::string> columns, int decimals)
-    : path_(path), columns_(columns.size()), decimals_(decimals) {
+CsvWriter::CsvWriter(const std::string& path, std::vector<std::string> columns, int decimals,
+                     Mode mode)
+    : path_(path),
+      columns_(columns.size()),
+      decimals_(decimals),
+      atomic_(mode == Mode::kReplaceAtomically) {
   if (columns.empty())
     throw std::invalid_argument("CsvWriter: no columns");
   if (decimals < 0 || decimals > 17)
     throw std::invalid_argument("CsvWriter: decimals must be in [0, 17]");
-  file_ = std::fopen(path.c_str(), "w");
-  if (file_ == nullptr)
-    throw InputError(fmt::format("{}: cannot create: {}", path, std::strerror(errno)));
   std::string header;
   for (const auto& c : columns) {
     if (c.empty() || c.find_first_of(",\n\r#") != std::string::npos)
@@ -27,7 +29,12 @@ CsvWriter::CsvWriter(const std::string& path, std::vector<std::string> columns, 
     header += header.empty() ? c : "," + c;
   }
   header += '\n';
-  check_write(std::fputs(header.c_str(), file_) >= 0);
+  if (!atomic_) {
+    file_ = std::fopen(path.c_str(), "w");
+    if (file_ == nullptr)
+      throw InputError(fmt::format("{}: cannot create: {}", path, std::strerror(errno)));
+  }
+  put(header);
 }
 
 CsvWriter::~CsvWriter() {
@@ -40,12 +47,19 @@ void CsvWriter::check_write(bool ok) {
     throw InputError(fmt::format("{}: write failed: {}", path_, std::strerror(errno)));
 }
 
+void CsvWriter::put(const std::string& text) {
+  if (atomic_)
+    contents_ += text;
+  else
+    check_write(std::fwrite(text.data(), 1, text.size(), file_) == text.size());
+}
+
 void CsvWriter::row(std::span<const double> values) {
   if (values.size() != columns_) {
     throw std::invalid_argument(fmt::format("CsvWriter({}): row of {} values for {} columns", path_,
                                             values.size(), columns_));
   }
-  if (file_ == nullptr)
+  if (!open_)
     throw std::logic_error("CsvWriter: row() after close()");
   buffer_.clear();
   for (std::size_t i = 0; i < values.size(); ++i) {
@@ -59,12 +73,12 @@ void CsvWriter::row(std::span<const double> values) {
     }
   }
   buffer_ += '\n';
-  check_write(std::fwrite(buffer_.data(), 1, buffer_.size(), file_) == buffer_.size());
+  put(buffer_);
   ++rows_;
 }
 
 void CsvWriter::comment(const std::string& text) {
-  if (file_ == nullptr)
+  if (!open_)
     throw std::logic_error("CsvWriter: comment() after close()");
   std::string line = "# " + text;
   for (char& ch : line) {
@@ -72,7 +86,7 @@ void CsvWriter::comment(const std::string& text) {
       ch = ' ';
   }
   line += '\n';
-  check_write(std::fputs(line.c_str(), file_) >= 0);
+  put(line);
 }
 
 void CsvWriter::flush() {
@@ -81,8 +95,14 @@ void CsvWriter::flush() {
 }
 
 void CsvWriter::close() {
-  if (file_ == nullptr)
+  if (!open_)
     return;
+  open_ = false;
+  if (atomic_) {
+    write_file_atomically(path_, contents_);
+    contents_ = std::string();
+    return;
+  }
   const bool flushed = std::fflush(file_) == 0;
   const bool closed = std::fclose(file_) == 0;
   file_ = nullptr;

@@ -5,31 +5,43 @@
 #include <numbers>
 #include <stdexcept>
 
+#include <fmt/core.h>
+
 #include "piezoshift/psi/unwrap.hpp"
 #include "piezoshift/psi/zernike.hpp"
 
 namespace piezoshift::psi {
 
-Analysis analyze_frames(std::span<const Map> frames, const Mask& mask, const AnalysisOptions& o) {
-  Analysis a;
-  a.phase = wrapped_phase(frames, mask, o.phase);
-  // drop pixels without modulation
+Mask modulated_pixels(const PhaseResult& phase, const Mask& mask, const AnalysisOptions& o) {
+  const std::size_t need = static_cast<std::size_t>(std::max(o.zernike_terms, 36));
+  const auto refuse = [need](std::size_t have) {
+    return std::invalid_argument(fmt::format(
+        "too few pixels with fringe modulation ({} of the {} needed): identical, blank or too "
+        "small frames?",
+        have, need));
+  };
   std::vector<double> mod;
   for (std::size_t p = 0; p < mask.size(); ++p)
-    if (mask.v[p] && std::isfinite(a.phase.modulation.v[p]))
-      mod.push_back(a.phase.modulation.v[p]);
-  if (mod.size() < static_cast<std::size_t>(std::max(o.zernike_terms, 36)))
-    throw std::invalid_argument("analysis: too few pixels with fringe modulation");
+    if (mask.v[p] && std::isfinite(phase.modulation.v[p]))
+      mod.push_back(phase.modulation.v[p]);
+  if (mod.size() < need)
+    throw refuse(mod.size());
   const auto mid = mod.begin() + static_cast<std::ptrdiff_t>(mod.size() / 2);
   std::nth_element(mod.begin(), mid, mod.end());
   const double floor = o.min_modulation_fraction * *mid;
-  a.valid = Mask(mask.width, mask.height, 0);
+  Mask valid(mask.width, mask.height, 0);
   for (std::size_t p = 0; p < mask.size(); ++p)
-    a.valid.v[p] =
-        mask.v[p] && std::isfinite(a.phase.phase_rad.v[p]) && a.phase.modulation.v[p] >= floor ? 1
-                                                                                               : 0;
-  if (a.valid.count() < static_cast<std::size_t>(std::max(o.zernike_terms, 36)))
-    throw std::invalid_argument("analysis: too few pixels with fringe modulation");
+    valid.v[p] =
+        mask.v[p] && std::isfinite(phase.phase_rad.v[p]) && phase.modulation.v[p] >= floor ? 1 : 0;
+  if (valid.count() < need)
+    throw refuse(valid.count());
+  return valid;
+}
+
+Analysis analyze_frames(std::span<const Map> frames, const Mask& mask, const AnalysisOptions& o) {
+  Analysis a;
+  a.phase = wrapped_phase(frames, mask, o.phase);
+  a.valid = modulated_pixels(a.phase, mask, o);
   Map phi = unwrap_phase(a.phase.phase_rad, a.valid);
   const double nm_per_rad = o.wavelength_nm / (4.0 * std::numbers::pi);
   for (double& v : phi.v)

@@ -21,8 +21,10 @@ std::string toml_array(const std::vector<double>& v) {
 
 StepCalibration calibrate_steps(std::span<const double> steps, double s, double wavelength_nm) {
   const auto n = static_cast<Eigen::Index>(steps.size());
-  if (n < 3 || !(s > 0.0))
-    throw std::invalid_argument("step calibration: at least 3 steps and a positive nominal step");
+  if (n < 3 || !(s >= kMinNominalStepRad && s <= kMaxNominalStepRad))
+    throw std::invalid_argument(
+        fmt::format("step calibration: at least 3 steps and a nominal step in [{:g}, {:.4f}] rad",
+                    kMinNominalStepRad, kMaxNominalStepRad));
   StepCalibration c;
   c.wavelength_nm = wavelength_nm;
   c.nominal_step_rad = s;
@@ -53,6 +55,17 @@ StepCalibration calibrate_steps(std::span<const double> steps, double s, double 
   c.nonlinearity_pct = span > 0.0 ? 100.0 * worst / span : 0.0;
   c.rms_step_error_rad = std::sqrt(sq / static_cast<double>(n));
   return c;
+}
+
+std::string step_calibration_problem(const StepCalibration& c) {
+  if (!c.converged)
+    return fmt::format("{} did not converge in {} iterations", c.algorithm, c.iterations);
+  for (std::size_t k = 0; k < c.steps_rad.size(); ++k)
+    if (!std::isfinite(c.steps_rad[k]))
+      return fmt::format("step {} is not a number ({})", k, c.steps_rad[k]);
+  if (!std::isfinite(c.step_gain) || !(c.step_gain > 0.0))
+    return fmt::format("step gain {}: the steps did not advance", c.step_gain);
+  return {};
 }
 
 std::string format_step_calibration_toml(const StepCalibration& c) {

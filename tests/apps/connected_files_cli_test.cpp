@@ -3,6 +3,7 @@
 // profile for `run` and `simulate`, `run --config`, and `run`'s final position in its summary.
 #include <cmath>
 #include <filesystem>
+#include <fstream>
 #include <string>
 #include <vector>
 
@@ -203,6 +204,44 @@ TEST_F(ConnectedFilesCli, ImprovedCalibrationRunsFitsAgainFromItsRecordsAndIsRef
   const CliResult gap = run("fit improved --data '" + path("gap.csv") + "'");
   EXPECT_EQ(gap.status, 2);
   EXPECT_NE(gap.err.find("gap.csv:502: t_s steps by 0.002 s"), std::string::npos) << gap.err;
+  // Issue 27: the records are written (atomically) before the calibration file, so the file's
+  // presence implies them whole; each promises its rows, and `fit improved` refuses a copy cut
+  // short, at a line end or within a line, naming the file.
+  namespace fs = std::filesystem;
+  EXPECT_LE(fs::last_write_time(excitation), fs::last_write_time(cal));
+  EXPECT_LE(fs::last_write_time(mode), fs::last_write_time(cal));
+  const std::string text = piezoshift::testing::slurp(excitation);
+  const std::size_t rows = piezoshift::io::CsvTable::load(excitation).rows();
+  EXPECT_NE(text.find(fmt::format("\n# rows = {}\n", rows)), std::string::npos);
+  EXPECT_NE(piezoshift::testing::slurp(mode).find(
+                fmt::format("\n# rows = {}\n", piezoshift::io::CsvTable::load(mode).rows())),
+            std::string::npos);
+  const auto cut = [&](const std::string& name, std::size_t bytes) {
+    std::ofstream(path(name), std::ios::binary) << text.substr(0, bytes);
+    return run("fit improved --data '" + path(name) + "'");
+  };
+  const std::size_t half = text.size() / 2;
+  const CliResult at_line = cut("at_line.csv", text.find('\n', half) + 1);
+  EXPECT_EQ(at_line.status, 2);
+  EXPECT_NE(at_line.err.find("at_line.csv: "), std::string::npos) << at_line.err;
+  EXPECT_NE(at_line.err.find(fmt::format(" data rows where the file promises {} (# rows = {}): "
+                                         "the file is cut short",
+                                         rows, rows)),
+            std::string::npos)
+      << at_line.err;
+  const CliResult in_line = cut("in_line.csv", text.find('\n', half) - 3);
+  EXPECT_EQ(in_line.status, 2);
+  EXPECT_NE(in_line.err.find("in_line.csv:"), std::string::npos) << in_line.err;
+  EXPECT_NE(in_line.err.find(": the last line has no line end: the file is cut short"),
+            std::string::npos)
+      << in_line.err;
+  std::ofstream(path("mode_cut.csv"), std::ios::binary)
+      << piezoshift::testing::slurp(mode).substr(0, piezoshift::testing::slurp(mode).size() - 40);
+  const CliResult mode_cut =
+      run("fit improved --data '" + excitation + "' --mode-data '" + path("mode_cut.csv") + "'");
+  EXPECT_EQ(mode_cut.status, 2);
+  EXPECT_NE(mode_cut.err.find("mode_cut.csv"), std::string::npos) << mode_cut.err;
+  EXPECT_NE(mode_cut.err.find("cut short"), std::string::npos) << mode_cut.err;
   const CliResult guided =
       run("calibrate --controller improved --daq sim --interferometer sim "
           "--out '" +

@@ -9,6 +9,7 @@
 
 #include "../support/cli_test.hpp"
 #include "piezoshift/psi/npy.hpp"
+#include "piezoshift/psi/png_image.hpp"
 
 namespace piezoshift {
 namespace {
@@ -89,6 +90,48 @@ TEST_F(PsiCliTest, BadInputExitsTwoNamingTheFile) {
   expect_bad("psi analyze" + frames(sim, 5) + " --algorithm nope --out '" + path("a") + "'",
              "nope");
   expect_bad("psi simulate --out '" + path("s") + "' --surface Z4=oops --no-budget", "Z4=oops");
+}
+
+// Issue 27. The frames are bounded before they are decoded (64 files; 150 copies of one PNG ended
+// in std::bad_alloc); `psi calibrate` refuses the frames without fringes that `psi analyze`
+// refuses (it wrote step_gain = 0 with converged = true) and a nominal step outside
+// [0.05, pi - 0.05] rad (1e-300 gave a NaN gain), each with exit 2 and no file written.
+TEST_F(PsiCliTest, FrameCountDegenerateFramesAndNominalStepAreRefused) {
+  const std::string sim = simulate();
+  auto expect_bad = [&](const std::string& args, const std::string& needle) {
+    const testing::CliResult r = run(args);
+    EXPECT_EQ(r.status, 2) << args;
+    EXPECT_NE(r.err.find(needle), std::string::npos) << r.err;
+    EXPECT_EQ(r.err.find("internal error"), std::string::npos) << r.err;
+  };
+  std::string many;
+  for (int k = 0; k < 65; ++k)
+    many += " '" + sim + "/frame_0" + std::to_string(k % 5) + ".png'";
+  expect_bad("psi analyze" + many + " --out '" + path("a") + "'",
+             "psi: 65 frames given, at most 64 are read");
+  expect_bad("psi calibrate" + many + " --out '" + path("c.toml") + "'",
+             "psi: 65 frames given, at most 64 are read");
+
+  const std::string f0 = " '" + sim + "/frame_00.png'";
+  const std::string identical = f0 + f0 + f0 + f0 + f0;
+  psi::write_png_gray16(path("blank.png"), psi::Map(64, 64, 0.0));
+  psi::write_png_gray16(path("one.png"), psi::Map(1, 1, 100.0));
+  const std::string blank = " '" + path("blank.png") + "'", one = " '" + path("one.png") + "'";
+  for (const std::string& frames :
+       {identical, blank + blank + blank + blank + blank, one + one + one + one + one}) {
+    expect_bad("psi analyze" + frames + " --out '" + path("a") + "'",
+               "too few pixels with fringe modulation");
+    expect_bad("psi calibrate" + frames + " --out '" + path("c.toml") + "' --json",
+               "psi calibrate: too few pixels with fringe modulation");
+  }
+  expect_bad("psi calibrate" + frames(sim, 5) + " --nominal-step-rad 1e-300 --out '" +
+                 path("c.toml") + "'",
+             "--nominal-step-rad 1e-300: must be in [0.05, pi - 0.05] = [0.05, 3.0916] rad");
+  expect_bad(
+      "psi calibrate" + frames(sim, 5) + " --nominal-step-rad 3.1 --out '" + path("c.toml") + "'",
+      "--nominal-step-rad 3.1: must be in");
+  EXPECT_FALSE(std::filesystem::exists(path("c.toml")));
+  EXPECT_FALSE(std::filesystem::exists(path("a")));
 }
 
 }  // namespace

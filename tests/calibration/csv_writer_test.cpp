@@ -59,5 +59,45 @@ TEST(CsvWriter, UncreatableFileIsAnInputErrorNamingIt) {
   EXPECT_THROW(CsvWriter("/nonexistent/dir/log.csv", {"z_um"}), InputError);
 }
 
+// A record replaced atomically: the old file stays whole until close() writes every row at once
+// (issue 27: `calibrate --controller improved` left excitation.csv half written when stopped);
+// a writer dropped without close() leaves the old file and no temporary.
+TEST(CsvWriter, ReplaceAtomicallyKeepsTheOldFileUntilClose) {
+  const auto path = temp_file("record.csv");
+  std::filesystem::remove(path);
+  std::ofstream(path) << "old\n";
+  const auto slurp = [&path] {
+    std::ifstream in(path);
+    std::stringstream ss;
+    ss << in.rdbuf();
+    return ss.str();
+  };
+  {
+    CsvWriter w(path.string(), {"t_s", "z_um"}, 2, CsvWriter::Mode::kReplaceAtomically);
+    w.comment("rows = 2");
+    w.row({0.0, 1.0});
+    w.flush();
+    EXPECT_EQ(slurp(), "old\n");
+    w.row({0.5, -1.0});
+    EXPECT_EQ(w.rows_written(), 2u);
+  }  // no close(): nothing replaced
+  EXPECT_EQ(slurp(), "old\n");
+  CsvWriter w(path.string(), {"t_s", "z_um"}, 2, CsvWriter::Mode::kReplaceAtomically);
+  w.row({0.0, 1.0});
+  EXPECT_EQ(slurp(), "old\n");
+  w.row({0.5, -1.0});
+  w.close();
+  EXPECT_EQ(slurp(), "t_s,z_um\n0.00,1.00\n0.50,-1.00\n");
+  EXPECT_THROW(w.row({1.0, 2.0}), std::logic_error);
+  for (const auto& e : std::filesystem::directory_iterator(path.parent_path()))
+    EXPECT_EQ(e.path().filename().string().find(".record.csv.tmp"), std::string::npos) << e.path();
+  EXPECT_THROW(
+      {
+        CsvWriter bad("/nonexistent/dir/r.csv", {"z_um"}, 6, CsvWriter::Mode::kReplaceAtomically);
+        bad.close();
+      },
+      InputError);
+}
+
 }  // namespace
 }  // namespace piezoshift::io

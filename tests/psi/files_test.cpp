@@ -3,8 +3,13 @@
 #include <cmath>
 #include <filesystem>
 #include <fstream>
+#include <numbers>
+#include <string>
+#include <vector>
 
 #include "piezoshift/io/input_error.hpp"
+#include "piezoshift/psi/analysis.hpp"
+#include "piezoshift/psi/frame_set.hpp"
 #include "piezoshift/psi/npy.hpp"
 #include "piezoshift/psi/png_image.hpp"
 #include "piezoshift/psi/step_calibration.hpp"
@@ -80,6 +85,112 @@ TEST(StepCalibrationTest, GainAndNonlinearityOfKnownSteps) {
   const std::string toml = format_step_calibration_toml(c);
   EXPECT_NE(toml.find("[psi_calibration]"), std::string::npos);
   EXPECT_NE(toml.find("step_gain = 1.02"), std::string::npos);
+}
+
+// The message of the InputError f throws ("" when it throws none).
+template <class F>
+std::string input_error(F&& f) {
+  try {
+    f();
+  } catch (const io::InputError& e) {
+    return e.what();
+  }
+  return "";
+}
+
+// Issue 27: 150 copies of one PNG ended `psi analyze` in std::bad_alloc. The count is refused
+// before any file is read (the paths here do not exist), the pixels after the first frame only.
+TEST(FrameSetTest, CountIsRefusedBeforeAnyFileIsRead) {
+  const std::vector<std::string> many(kMaxFrames + 1, "/nonexistent/f.png");
+  EXPECT_EQ(input_error([&] { read_frame_set(many); }),
+            "psi: 65 frames given, at most 64 are read (docs/psi.md)");
+  const std::vector<std::string> two(2, "/nonexistent/f.png");
+  EXPECT_EQ(input_error([&] { read_frame_set(two); }),
+            "psi: 2 frame(s) given, at least 3 are needed");
+}
+
+TEST(FrameSetTest, PixelsAreBoundedOnceTheFirstFrameGivesTheSize) {
+  const fs::path d = temp_dir();
+  const std::string f = (d / "f.png").string();
+  write_png_gray16(f, Map(10, 10, 7.0));
+  // exactly at the limit: read; one pixel more: refused naming the first file, the rest unread
+  std::vector<std::string> paths(10, f);
+  EXPECT_EQ(read_frame_set(paths, {64, 1000}).size(), 10u);
+  paths.push_back(f);
+  for (std::size_t k = 1; k < paths.size(); ++k)
+    paths[k] = (d / "missing.png").string();
+  EXPECT_EQ(input_error([&] {
+              read_frame_set(paths, {64, 1099});
+            }),
+            f + ": 11 frames of 10 x 10 pixels are 1100 pixels, at most 1099 are read "
+                "(docs/psi.md)");
+  // the default: 16 frames of 2048 x 2048 (512 MiB of doubles), not 17
+  const std::string big = (d / "big.png").string();
+  write_png_gray16(big, Map(kMaxPngSide, kMaxPngSide, 0.0));
+  std::vector<std::string> seventeen(17, (d / "missing.png").string());
+  seventeen[0] = big;
+  EXPECT_EQ(input_error([&] { read_frame_set(seventeen); }),
+            big +
+                ": 17 frames of 2048 x 2048 pixels are 71303168 pixels, at most 67108864 are "
+                "read (docs/psi.md)");
+  fs::remove_all(d);
+}
+
+// Identical, blank and 1 x 1 frames carry no phase: the one check `psi analyze` and `psi
+// calibrate` share refuses them (calibrate used to write step_gain = 0, converged = true).
+TEST(FrameSetTest, FramesWithoutFringesAreRefusedByTheSharedCheck) {
+  const auto fringes = [](int n, int size) {
+    std::vector<Map> frames;
+    for (int k = 0; k < n; ++k) {
+      Map f(size, size);
+      for (int j = 0; j < size; ++j)
+        for (int i = 0; i < size; ++i)
+          f.v[static_cast<std::size_t>(j * size + i)] =
+              100.0 + 50.0 * std::cos(0.3 * i + 0.1 * j + k * std::numbers::pi / 2.0);
+      frames.push_back(f);
+    }
+    return frames;
+  };
+  const auto check = [](const std::vector<Map>& frames) {
+    const Mask mask(frames[0].width, frames[0].height, 1);
+    PhaseOptions po;
+    po.algorithm = Algorithm::kAia;
+    return modulated_pixels(wrapped_phase(frames, mask, po), mask, AnalysisOptions{}).count();
+  };
+  EXPECT_EQ(check(fringes(5, 32)), 32u * 32u);
+  const std::vector<Map> identical(5, fringes(1, 32)[0]);
+  const std::vector<Map> blank(5, Map(32, 32, 0.0));
+  const std::vector<Map> one_pixel = fringes(5, 1);
+  for (const auto* frames : {&identical, &blank, &one_pixel}) {
+    try {
+      check(*frames);
+      ADD_FAILURE() << frames->front().width << " px frames accepted";
+    } catch (const std::invalid_argument& e) {
+      EXPECT_NE(std::string(e.what()).find("too few pixels with fringe modulation"),
+                std::string::npos)
+          << e.what();
+    }
+  }
+}
+
+// A nominal step of 1e-300 rad gave a NaN gain; outside [0.05, pi - 0.05] rad it is refused, and
+// a recovery that did not converge or steps that did not advance are not a calibration.
+TEST(StepCalibrationTest, NominalStepRangeAndProblemsOfARecovery) {
+  const std::vector<double> d{0.0, 1.6, 3.1, 4.7};
+  EXPECT_THROW(calibrate_steps(d, 1e-300, 632.8), std::invalid_argument);
+  EXPECT_THROW(calibrate_steps(d, 0.049, 632.8), std::invalid_argument);
+  EXPECT_THROW(calibrate_steps(d, std::numbers::pi - 0.049, 632.8), std::invalid_argument);
+  EXPECT_NO_THROW(calibrate_steps(d, kMinNominalStepRad, 632.8));
+  StepCalibration c = calibrate_steps(d, std::numbers::pi / 2.0, 632.8);
+  EXPECT_EQ(step_calibration_problem(c), "");
+  c.converged = false;
+  c.iterations = 200;
+  EXPECT_EQ(step_calibration_problem(c), "aia did not converge in 200 iterations");
+  const StepCalibration still = calibrate_steps(std::vector<double>(4, 0.0), 1.5, 632.8);
+  EXPECT_EQ(step_calibration_problem(still), "step gain 0: the steps did not advance");
+  const StepCalibration nan =
+      calibrate_steps(std::vector<double>{0.0, 1.5, std::nan(""), 4.5}, 1.5, 632.8);
+  EXPECT_EQ(step_calibration_problem(nan), "step 2 is not a number (nan)");
 }
 
 }  // namespace

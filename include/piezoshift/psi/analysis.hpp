@@ -30,6 +30,12 @@ struct Analysis {
   std::vector<double> zernike_nm;  //!< Noll j = 1..zernike_terms, of surface_nm
 };
 
+//! The mask's pixels with a finite phase and a modulation of at least min_modulation_fraction of
+//! the pupil's median: the pixels that carry a phase. std::invalid_argument when fewer than
+//! max(zernike_terms, 36) do (identical, blank or too small frames): the one check of a frame
+//! set's fringes, that `psi analyze` and `psi calibrate` share.
+Mask modulated_pixels(const PhaseResult& phase, const Mask& mask, const AnalysisOptions& options);
+
 //! std::invalid_argument for wrong frame counts or sizes, or too few valid pixels.
 Analysis analyze_frames(std::span<const Map> frames, const Mask& mask,
                         const AnalysisOptions& options);

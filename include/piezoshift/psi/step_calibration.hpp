@@ -9,11 +9,18 @@
 //                      through the origin, as a percentage of the span)
 //   steps_nm = delta_k lambda / (4 pi): the mirror motion (Fizeau in reflection)
 // Written as a TOML table [psi_calibration] (format_step_calibration_toml; docs/psi.md).
+#include <numbers>
 #include <span>
 #include <string>
 #include <vector>
 
 namespace piezoshift::psi {
+
+// The nominal steps calibrated: below 0.05 rad (2.5 nm of mirror motion at 632.8 nm) the frames
+// of a set differ by a few % of their modulation, within a camera's noise; at pi they repeat in
+// pairs (sin delta = 0) and the phase's sign is lost. 1e-300 rad used to give a NaN gain.
+inline constexpr double kMinNominalStepRad = 0.05;
+inline constexpr double kMaxNominalStepRad = std::numbers::pi - 0.05;
 
 struct StepCalibration {
   std::string algorithm = "aia";
@@ -30,9 +37,15 @@ struct StepCalibration {
   bool converged = true;
 };
 
-//! std::invalid_argument for fewer than 3 steps or a non-positive nominal step.
+//! std::invalid_argument for fewer than 3 steps or a nominal step outside
+//! [kMinNominalStepRad, kMaxNominalStepRad].
 StepCalibration calibrate_steps(std::span<const double> steps_rad, double nominal_step_rad,
                                 double wavelength_nm);
+
+//! Why c is not a calibration, "" when it is: the iteration that recovered the steps did not
+//! converge, or a step or the step gain is not finite, or the gain is not positive (the steps
+//! did not advance). A failure is a failure, never a number: such a c is not written.
+std::string step_calibration_problem(const StepCalibration& c);
 
 std::string format_step_calibration_toml(const StepCalibration& c);
 
