@@ -48,7 +48,7 @@ auto with_file(const std::string& path, F&& metric) {
   try {
     return metric();
   } catch (const experiments::MetricsError& e) {
-    throw io::InputError(fmt::format("{}: {}", path, e.what()));
+    throw core::InputError(fmt::format("{}: {}", path, e.what()));
   }
 }
 
@@ -59,8 +59,8 @@ int draw(const AnalyzeOptions& o, const io::Figure& figure) {
     return 0;
   // A folder is not a figure's name: it was `internal error: plot: empty output name` (issue 27).
   if (!std::filesystem::path(o.plot_path).has_filename())
-    throw io::InputError(fmt::format("--plot {}: names a folder; give a file, e.g. {}figure.png",
-                                     o.plot_path, o.plot_path));
+    throw core::InputError(fmt::format("--plot {}: names a folder; give a file, e.g. {}figure.png",
+                                       o.plot_path, o.plot_path));
   io::Figure f = figure;
   const bool svg = o.plot_path.size() > 4 && o.plot_path.ends_with(".svg");
   f.png = !svg;
@@ -136,9 +136,9 @@ int run_repeatability(const AnalyzeOptions& o) {
 int run_step(const AnalyzeOptions& o_in) {
   AnalyzeOptions o = o_in;
   if (o.median_window % 2 == 0)  // the option's check has its range
-    throw io::InputError(fmt::format("--median-window {}: must be odd", o.median_window));
+    throw core::InputError(fmt::format("--median-window {}: must be odd", o.median_window));
   if (!std::isfinite(o.step.step_time_s))
-    throw io::InputError(
+    throw core::InputError(
         fmt::format("--step-time-s {}: must be a finite number", o.step.step_time_s));
   o.step.median_window = static_cast<std::size_t>(o.median_window);
   const io::CsvTable t = io::CsvTable::load(o.data_path);

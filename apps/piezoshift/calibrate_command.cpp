@@ -19,11 +19,11 @@
 #include "piezoshift/calibration/calibration_procedure.hpp"
 #include "piezoshift/calibration/guided_calibration.hpp"
 #include "piezoshift/calibration/improved_calibration.hpp"
-#include "piezoshift/calibration/loop_rig.hpp"
 #include "piezoshift/config/project_config.hpp"
+#include "piezoshift/core/input_error.hpp"
 #include "piezoshift/experiments/paper_experiments.hpp"
 #include "piezoshift/io/csv_writer.hpp"
-#include "piezoshift/io/input_error.hpp"
+#include "piezoshift/rig/loop_rig.hpp"
 #include "piezoshift/runtime/loop_clock.hpp"
 #include "piezoshift/runtime/paced_clock.hpp"
 #include "piezoshift/runtime/safety_ranges.hpp"
@@ -75,32 +75,32 @@ void print_fits(const control::SemiClosedLoopParams& controller,
 // operator, a log file or the twin's interferometer, the session recorded beside --out.
 int run_guided(const Options& o) {
   if (o.pid != "paper")
-    throw io::InputError(
+    throw core::InputError(
         "--pid search: the guided calibration keeps the paper's gains (the search scores the "
         "plate's motion between the ticks, which a bench does not see)");
   const bool sim = o.daq == "sim";
   const bool sim_rt = o.daq == "sim-rt";
   const bool comedi = o.daq == "comedi" || o.daq.rfind("comedi:", 0) == 0;
   if (!sim && !sim_rt && !comedi)
-    throw io::InputError(
+    throw core::InputError(
         fmt::format("--daq {}: expected sim, sim-rt or comedi:/dev/comediN", o.daq));
   if (o.free_run && !sim_rt)
-    throw io::InputError(fmt::format(
+    throw core::InputError(fmt::format(
         "--free-run needs --daq sim-rt (--daq {} {})", o.daq,
         sim ? "runs on a simulated clock already" : "runs in real time: it is hardware"));
   const std::string& ifm = o.interferometer;
   if (ifm.empty())
-    throw io::InputError("--daq needs --interferometer prompt, file:PATH or sim");
+    throw core::InputError("--daq needs --interferometer prompt, file:PATH or sim");
   if (ifm != "prompt" && ifm != "sim" && !(ifm.rfind("file:", 0) == 0 && ifm.size() > 5))
-    throw io::InputError(
+    throw core::InputError(
         fmt::format("--interferometer {}: expected prompt, file:PATH or sim", ifm));
   if (comedi && ifm == "sim")
-    throw io::InputError(
+    throw core::InputError(
         fmt::format("--interferometer sim: the twin's interferometer does not see the stage on "
                     "--daq {}; give prompt or file:PATH",
                     o.daq));
   if (!(o.max_zero_drift_um > 0.0))
-    throw io::InputError(
+    throw core::InputError(
         fmt::format("--max-zero-drift-um {}: must be a positive length", o.max_zero_drift_um));
 
   const runtime::InstallationConfig installation =
@@ -120,7 +120,7 @@ int run_guided(const Options& o) {
   if (!o.restart) {
     if (auto loaded = calibration::load_guided_session(session_file)) {
       if (loaded->plan != plan_text || loaded->steps != plan.size())
-        throw io::InputError(fmt::format(
+        throw core::InputError(fmt::format(
             "{}: this session was recorded for \"{}\", not \"{}\": give --restart to discard it",
             session_file, loaded->plan, plan_text));
       session = std::move(*loaded);
@@ -154,19 +154,19 @@ int run_guided(const Options& o) {
   // seed + 2, as `calibrate` on the twin); otherwise one rig on the real-time loop in a thread of
   // its own, for both stages.
   std::optional<StopSignals> signals;  // outlives the loop: Ctrl-C during its ramp is harmless
-  std::unique_ptr<experiments::Bench> bench2, bench3;
-  std::unique_ptr<calibration::BenchRig> bench_rig2, bench_rig3;
+  std::unique_ptr<rig::Bench> bench2, bench3;
+  std::unique_ptr<rig::BenchRig> bench_rig2, bench_rig3;
   std::unique_ptr<runtime::DaqBackend> daq;
   std::unique_ptr<runtime::LoopClock> clock;
-  std::unique_ptr<calibration::LoopRig> loop_rig;
-  calibration::GuidedRig* rig2 = nullptr;
-  calibration::GuidedRig* rig3 = nullptr;
+  std::unique_ptr<rig::LoopRig> loop_rig;
+  rig::GuidedRig* rig2 = nullptr;
+  rig::GuidedRig* rig3 = nullptr;
   const double window_s = config.twin.interferometer.static_average_s;
   if (sim) {
-    bench2 = std::make_unique<experiments::Bench>(config, base, o.seed + 1);
-    bench3 = std::make_unique<experiments::Bench>(config, base, o.seed + 2);
-    bench_rig2 = std::make_unique<calibration::BenchRig>(*bench2, window_s);
-    bench_rig3 = std::make_unique<calibration::BenchRig>(*bench3, window_s, bench_rig2.get());
+    bench2 = std::make_unique<rig::Bench>(config, base, o.seed + 1);
+    bench3 = std::make_unique<rig::Bench>(config, base, o.seed + 2);
+    bench_rig2 = std::make_unique<rig::BenchRig>(*bench2, window_s);
+    bench_rig3 = std::make_unique<rig::BenchRig>(*bench3, window_s, bench_rig2.get());
     rig2 = bench_rig2.get();
     rig3 = bench_rig3.get();
   } else {
@@ -184,14 +184,14 @@ int run_guided(const Options& o) {
     } else {
       clock = std::make_unique<runtime::MonotonicClock>();
     }
-    calibration::LoopRigOptions lo;
+    rig::LoopRigOptions lo;
     lo.rate_Hz = rate_Hz;
     lo.window_s = window_s;
     // An interferometer log is stamped by the wall clock: real-time windows are in Unix time.
     lo.unix_time = clock->real_time();
     signals.emplace();  // Ctrl-C ramps the stage to 0 V instead of leaving it driven
     lo.stop_signal = &g_stop_signal;
-    loop_rig = std::make_unique<calibration::LoopRig>(
+    loop_rig = std::make_unique<rig::LoopRig>(
         *daq, *clock, paced, base, loop_safety_limits(installation.safety, std::nullopt), lo);
     for (const std::string& refusal : loop_rig->realtime().refusals)
       fmt::print(stderr, "piezoshift: warning: the loop runs without real-time treatment: {}\n",
@@ -206,7 +206,7 @@ int run_guided(const Options& o) {
   if (loop_rig)
     loop_result = loop_rig->stop();  // the stage at rest at 0 V before anything is written
   if (!r.complete)
-    throw io::InputError(fmt::format(
+    throw core::InputError(fmt::format(
         "{} ended: {} of {} steps are recorded in {}; run the same command again to resume",
         source->name(), session.readings.size(), plan.size(), session_file));
 
@@ -278,7 +278,7 @@ int run_guided(const Options& o) {
 // The improved controller (issue 12): the paper's stages for A and p, then its own models.
 int run_improved(const Options& o, const config::ProjectConfig& config) {
   if (o.pid != "paper")
-    throw io::InputError("--pid search: the improved controller has no PID to search");
+    throw core::InputError("--pid search: the improved controller has no PID to search");
   control::SemiClosedLoopParams base;
   base.sample_time_s = config.twin.daq.sample_time_s;
   calibration::ImprovedCalibrationOutcome ic;
@@ -290,7 +290,7 @@ int run_improved(const Options& o, const config::ProjectConfig& config) {
                                            calibration::CalibrationOptions{}.travel);
   }
   if (!(travel.single_move_um > 0.0))
-    throw experiments::ProcedureFailed(
+    throw rig::ProcedureFailed(
         fmt::format("calibration: the improved loop has no semi-closed-loop travel: {}",
                     travel.validity.reason));
   calibration::write_calibration_file(
@@ -332,13 +332,13 @@ int run_improved(const Options& o, const config::ProjectConfig& config) {
 int run(const Options& o) {
   if (!o.daq.empty()) {
     if (o.controller != "paper")
-      throw io::InputError(
+      throw core::InputError(
           "--controller improved: the guided calibration calibrates the paper's "
           "controller only");
     return run_guided(o);
   }
   if (!o.interferometer.empty())
-    throw io::InputError("--interferometer needs --daq (the guided calibration)");
+    throw core::InputError("--interferometer needs --daq (the guided calibration)");
   const config::ProjectConfig config = o.config.empty()
                                            ? config::ProjectConfig{}
                                            : runtime::load_installation_config(o.config).project;

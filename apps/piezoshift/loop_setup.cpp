@@ -8,7 +8,7 @@
 
 #include "piezoshift/calibration/calibration_file.hpp"
 #include "piezoshift/calibration/calibration_procedure.hpp"
-#include "piezoshift/io/input_error.hpp"
+#include "piezoshift/core/input_error.hpp"
 #include "piezoshift/runtime/comedi_backend.hpp"
 #include "piezoshift/runtime/safety_ranges.hpp"
 
@@ -24,7 +24,7 @@ extern "C" void on_stop_signal(int signo) {
 
 void check_loop_rate(double rate_Hz) {
   if (!(rate_Hz >= 1000.0 && rate_Hz <= 10000.0))
-    throw io::InputError(
+    throw core::InputError(
         fmt::format("--rate-hz {}: supported rates are 1000 to 10000 Hz", rate_Hz));
 }
 
@@ -34,8 +34,8 @@ runtime::SafetyLimits loop_safety_limits(const runtime::SafetyLimits& installati
   if (!max_overruns)
     return limits;
   if (*max_overruns < 1 || *max_overruns > runtime::kMaxConsecutiveOverruns)
-    throw io::InputError(fmt::format("--max-overruns {}: must be in [1, {}]", *max_overruns,
-                                     runtime::kMaxConsecutiveOverruns));
+    throw core::InputError(fmt::format("--max-overruns {}: must be in [1, {}]", *max_overruns,
+                                       runtime::kMaxConsecutiveOverruns));
   limits.max_consecutive_overruns = static_cast<std::uint32_t>(*max_overruns);
   return limits;
 }
@@ -43,7 +43,7 @@ runtime::SafetyLimits loop_safety_limits(const runtime::SafetyLimits& installati
 nlohmann::json safety_json(const runtime::SafetyLimits& limits) {
   nlohmann::json j = nlohmann::json::object();
   runtime::visit_safety_limits(limits, [&](const char*, const char* key, const auto& value,
-                                           design::Bounds) { j[key] = value; });
+                                           core::Bounds) { j[key] = value; });
   return j;
 }
 
@@ -67,7 +67,7 @@ ChosenBackend make_backend(const std::string& daq, const config::ProjectConfig& 
       co.device = daq.substr(7);
     chosen.backend = std::make_unique<runtime::ComediBackend>(co);
   } else {
-    throw io::InputError(fmt::format("--daq '{}': expected sim or comedi:/dev/comediN", daq));
+    throw core::InputError(fmt::format("--daq '{}': expected sim or comedi:/dev/comediN", daq));
   }
   return chosen;
 }
@@ -81,7 +81,7 @@ LoopCalibration resolve_calibration(const std::string& path, const std::string& 
     const double t = c.params.improved.sample_time_s;
     if (c.params.kind == control::ControllerKind::kImproved &&
         std::fabs(t - loop_sample_time_s) > 1e-9 * loop_sample_time_s)
-      throw io::InputError(fmt::format(
+      throw core::InputError(fmt::format(
           "{}: [improved] sample_time_s = {} s, but the loop runs at {} s ({} Hz): calibrate the "
           "improved controller at the loop's rate",
           path, t, loop_sample_time_s, 1.0 / loop_sample_time_s));

@@ -25,12 +25,12 @@ struct ChosenBackend {
   runtime::SimBackend* sim = nullptr;  //!< the same object when it is the twin, else null
 };
 
-//! Throws io::InputError naming --rate-hz unless 1000 <= rate_Hz <= 10000 (the paper's 1 kHz to
+//! Throws core::InputError naming --rate-hz unless 1000 <= rate_Hz <= 10000 (the paper's 1 kHz to
 //! the DAQ's practical limit, docs/runtime.md).
 void check_loop_rate(double rate_Hz);
 
 //! The installation's limits (a config's [safety], or the built-in ones), with --max-overruns
-//! consecutive overruns instead when given; throws io::InputError when that is not in
+//! consecutive overruns instead when given; throws core::InputError when that is not in
 //! [1, runtime::kMaxConsecutiveOverruns].
 runtime::SafetyLimits loop_safety_limits(const runtime::SafetyLimits& installation,
                                          std::optional<std::int64_t> max_overruns);
@@ -38,7 +38,7 @@ runtime::SafetyLimits loop_safety_limits(const runtime::SafetyLimits& installati
 //! The limits as a JSON object, one member per [safety] key.
 nlohmann::json safety_json(const runtime::SafetyLimits& limits);
 
-//! "sim" (the twin of config, at rate_Hz, with seed) or "comedi[:DEVICE]". Throws io::InputError
+//! "sim" (the twin of config, at rate_Hz, with seed) or "comedi[:DEVICE]". Throws core::InputError
 //! for anything else. Not configured yet. config_path: where config came from ("" built in), named
 //! in the sim backend's messages.
 ChosenBackend make_backend(const std::string& daq, const config::ProjectConfig& config,

@@ -18,8 +18,8 @@
 
 #include "command.hpp"
 #include "piezoshift/config/project_config.hpp"
+#include "piezoshift/core/input_error.hpp"
 #include "piezoshift/io/atomic_file.hpp"
-#include "piezoshift/io/input_error.hpp"
 #include "piezoshift/psi/analysis.hpp"
 #include "piezoshift/psi/error_budget.hpp"
 #include "piezoshift/psi/npy.hpp"
@@ -69,7 +69,7 @@ std::vector<double> parse_list(const std::string& text, const std::string& optio
         throw std::invalid_argument(item);
       v.push_back(x);
     } catch (const std::exception&) {
-      throw io::InputError(fmt::format("{} '{}': '{}' is not a number", option, text, item));
+      throw core::InputError(fmt::format("{} '{}': '{}' is not a number", option, text, item));
     }
   }
   return v;
@@ -77,16 +77,16 @@ std::vector<double> parse_list(const std::string& text, const std::string& optio
 
 std::vector<psi::Map> load_frames(const std::vector<std::string>& paths) {
   if (paths.size() < 3)
-    throw io::InputError(
+    throw core::InputError(
         fmt::format("psi: {} frame(s) given, at least 3 are needed", paths.size()));
   std::vector<psi::Map> frames;
   for (const std::string& p : paths) {
     psi::GrayImage g = psi::read_png_gray(p);
     if (!frames.empty() &&
         (g.counts.width != frames[0].width || g.counts.height != frames[0].height))
-      throw io::InputError(fmt::format("{}: {} x {} pixels, but {} is {} x {}", p, g.counts.width,
-                                       g.counts.height, paths[0], frames[0].width,
-                                       frames[0].height));
+      throw core::InputError(fmt::format("{}: {} x {} pixels, but {} is {} x {}", p, g.counts.width,
+                                         g.counts.height, paths[0], frames[0].width,
+                                         frames[0].height));
     frames.push_back(std::move(g.counts));
   }
   return frames;
@@ -97,8 +97,8 @@ psi::Mask load_mask(const std::string& path, const psi::Map& frame) {
     return psi::Mask(frame.width, frame.height, 1);
   psi::Mask m = psi::read_mask_png(path);
   if (m.width != frame.width || m.height != frame.height)
-    throw io::InputError(fmt::format("{}: mask is {} x {} pixels, the frames {} x {}", path,
-                                     m.width, m.height, frame.width, frame.height));
+    throw core::InputError(fmt::format("{}: mask is {} x {} pixels, the frames {} x {}", path,
+                                       m.width, m.height, frame.width, frame.height));
   return m;
 }
 
@@ -122,13 +122,13 @@ psi::Algorithm choose_algorithm(const std::string& name, std::size_t frames) {
 void check_count(psi::Algorithm a, std::size_t frames) {
   const int need = psi::required_frames(a);
   if (need > 0 && static_cast<std::size_t>(need) != frames)
-    throw io::InputError(fmt::format("--algorithm {} needs {} frames, {} given",
-                                     psi::algorithm_name(a), need, frames));
+    throw core::InputError(fmt::format("--algorithm {} needs {} frames, {} given",
+                                       psi::algorithm_name(a), need, frames));
 }
 
 void check_wavelength(double nm) {
   if (!(nm >= 100.0 && nm <= 20000.0))
-    throw io::InputError(fmt::format("--wavelength-nm {}: must be in 100..20000", nm));
+    throw core::InputError(fmt::format("--wavelength-nm {}: must be in 100..20000", nm));
 }
 
 psi::Analysis run_analysis(const std::vector<psi::Map>& frames, const psi::Mask& mask,
@@ -136,7 +136,7 @@ psi::Analysis run_analysis(const std::vector<psi::Map>& frames, const psi::Mask&
   try {
     return psi::analyze_frames(frames, mask, ao);
   } catch (const std::invalid_argument& e) {
-    throw io::InputError(fmt::format("psi: {}", e.what()));
+    throw core::InputError(fmt::format("psi: {}", e.what()));
   }
 }
 
@@ -201,8 +201,8 @@ int run_analyze(const PsiOptions& o) {
   if (!o.steps_rad.empty()) {
     ao.phase.steps_rad = parse_list(o.steps_rad, "--steps-rad");
     if (ao.phase.steps_rad.size() != frames.size())
-      throw io::InputError(fmt::format("--steps-rad: {} values for {} frames",
-                                       ao.phase.steps_rad.size(), frames.size()));
+      throw core::InputError(fmt::format("--steps-rad: {} values for {} frames",
+                                         ao.phase.steps_rad.size(), frames.size()));
   }
   const psi::Analysis a = run_analysis(frames, mask, ao);
   const Json j = write_analysis(a, alg, o.wavelength_nm, o.out);
@@ -216,7 +216,7 @@ int run_analyze(const PsiOptions& o) {
 int run_calibrate(const PsiOptions& o) {
   check_wavelength(o.wavelength_nm);
   if (!(o.nominal_step_rad > 0.0 && o.nominal_step_rad < std::numbers::pi))
-    throw io::InputError(
+    throw core::InputError(
         fmt::format("--nominal-step-rad {}: must be in (0, pi)", o.nominal_step_rad));
   const std::vector<psi::Map> frames = load_frames(o.frames);
   const psi::Mask mask = load_mask(o.mask, frames[0]);
@@ -224,7 +224,7 @@ int run_calibrate(const PsiOptions& o) {
       o.algorithm.empty() ? psi::Algorithm::kAia : psi::parse_algorithm(o.algorithm);
   if (alg != psi::Algorithm::kAia && alg != psi::Algorithm::kTiltAia &&
       alg != psi::Algorithm::kCarre)
-    throw io::InputError(
+    throw core::InputError(
         fmt::format("--algorithm {}: calibration needs aia, tilt-aia or carre", o.algorithm));
   check_count(alg, frames.size());
   psi::PhaseOptions po;
@@ -235,7 +235,7 @@ int run_calibrate(const PsiOptions& o) {
   try {
     r = psi::wrapped_phase(frames, mask, po);
   } catch (const std::invalid_argument& e) {
-    throw io::InputError(fmt::format("psi calibrate: {}", e.what()));
+    throw core::InputError(fmt::format("psi calibrate: {}", e.what()));
   }
   psi::StepCalibration c = psi::calibrate_steps(r.steps_rad, o.nominal_step_rad, o.wavelength_nm);
   c.algorithm = std::string(psi::algorithm_name(alg));
@@ -284,7 +284,7 @@ int run_simulate(const PsiOptions& o) {
   if (!o.surface.empty())
     p.surface = psi::parse_surface_spec(o.surface);
   if (o.size_px < 32 || o.size_px > 2048)
-    throw io::InputError(fmt::format("--size {}: must be in 32..2048", o.size_px));
+    throw core::InputError(fmt::format("--size {}: must be in 32..2048", o.size_px));
   p.fizeau.width_px = p.fizeau.height_px = o.size_px;
   p.fizeau.pupil_radius_px = 0.47 * o.size_px;
   p.fizeau.wavelength_nm = o.wavelength_nm;

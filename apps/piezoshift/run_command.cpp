@@ -26,7 +26,7 @@
 #include "loop_setup.hpp"
 #include "piezoshift/calibration/calibration_file.hpp"
 #include "piezoshift/config/project_config.hpp"
-#include "piezoshift/io/input_error.hpp"
+#include "piezoshift/core/input_error.hpp"
 #include "piezoshift/runtime/control_loop.hpp"
 #include "piezoshift/runtime/csv_logger.hpp"
 #include "piezoshift/runtime/fault_injection.hpp"
@@ -122,7 +122,7 @@ nlohmann::json vec_json(const Vec3& v) {
 int run(const RunOptions& o) {
   check_loop_rate(o.rate_Hz);
   if (!(o.duration_s > 0.0) || o.duration_s > kMaxRunDurationS)
-    throw io::InputError(
+    throw core::InputError(
         fmt::format("--duration-s {}: must be in (0, {}] s", o.duration_s, kMaxRunDurationS));
 
   SetpointProfile profile = !o.profile.empty() ? SetpointProfile::load_csv(o.profile)
@@ -139,7 +139,7 @@ int run(const RunOptions& o) {
       resolve_calibration(o.calibration, o.daq, project, o.seed, 1.0 / o.rate_Hz);
   const control::SemiClosedLoopParams& params = cal.params;
   if (o.step_um && cal.travel_z_max_um && *o.step_um > *cal.travel_z_max_um)
-    throw io::InputError(
+    throw core::InputError(
         fmt::format("--step-um {}: beyond the calibrated semi-closed-loop "
                     "travel, {} um ({})",
                     *o.step_um, *cal.travel_z_max_um, cal.source));
@@ -147,9 +147,9 @@ int run(const RunOptions& o) {
   // The backend.
   const bool comedi = o.daq.rfind("comedi", 0) == 0;
   if (comedi && !faults.empty())
-    throw io::InputError("--fault needs --daq sim (faults are injected into the twin)");
+    throw core::InputError("--fault needs --daq sim (faults are injected into the twin)");
   if (comedi && o.free_run)
-    throw io::InputError("--free-run needs --daq sim (hardware runs in real time)");
+    throw core::InputError("--free-run needs --daq sim (hardware runs in real time)");
   ChosenBackend chosen = make_backend(o.daq, project, o.seed, o.rate_Hz, o.config);
   std::unique_ptr<DaqBackend> hardware = std::move(chosen.backend);
   SimBackend* sim = chosen.sim;

@@ -8,9 +8,9 @@
 
 #include <fmt/core.h>
 
+#include "piezoshift/core/input_error.hpp"
 #include "piezoshift/io/atomic_file.hpp"
 #include "piezoshift/io/config_file.hpp"
-#include "piezoshift/io/input_error.hpp"
 
 namespace piezoshift::calibration {
 
@@ -18,23 +18,23 @@ namespace {
 
 [[noreturn]] void fail(const io::ConfigFile& file, std::string_view section, std::string_view key,
                        const std::string& why) {
-  throw io::InputError(fmt::format("{}: [{}] {}: {}", file.source(), section, key, why));
+  throw core::InputError(fmt::format("{}: [{}] {}: {}", file.source(), section, key, why));
 }
 
 void read_improved(const io::ConfigFile& file, control::ImprovedParams& im) {
   const io::ConfigSection s = file.section("improved");
-  if (!s.read("sample_time_s", im.sample_time_s, io::Bounds::positive()))
+  if (!s.read("sample_time_s", im.sample_time_s, core::Bounds::positive()))
     fail(file, "improved", "sample_time_s", "missing (kind = \"improved\" needs [improved])");
   std::int64_t delay = static_cast<std::int64_t>(im.reference_delay_ticks);
   s.read("reference_delay_ticks", delay,
-         io::Bounds::closed(0.0, static_cast<double>(control::kMaxReferenceDelayTicks)));
+         core::Bounds::closed(0.0, static_cast<double>(control::kMaxReferenceDelayTicks)));
   im.reference_delay_ticks = static_cast<std::size_t>(delay);
-  s.read("correction_ki", im.correction_ki, io::Bounds::closed(0.0, 1.0));
-  s.read("correction_ki_max", im.correction_ki_max, io::Bounds::closed(0.0, 1.0));
-  s.read("correction_boost_error_um", im.correction_boost_error_um, io::Bounds::non_negative());
-  s.read("correction_limit_um", im.correction_limit_um, io::Bounds::positive());
+  s.read("correction_ki", im.correction_ki, core::Bounds::closed(0.0, 1.0));
+  s.read("correction_ki_max", im.correction_ki_max, core::Bounds::closed(0.0, 1.0));
+  s.read("correction_boost_error_um", im.correction_boost_error_um, core::Bounds::non_negative());
+  s.read("correction_limit_um", im.correction_limit_um, core::Bounds::positive());
   std::vector<double> taps;
-  if (s.read("shaper_taps", taps, control::kMaxShaperTaps, io::Bounds::closed(0.0, 1.0))) {
+  if (s.read("shaper_taps", taps, control::kMaxShaperTaps, core::Bounds::closed(0.0, 1.0))) {
     im.shaper.taps = taps.size();
     im.shaper.weight = {};
     double sum = 0.0;
@@ -43,17 +43,17 @@ void read_improved(const io::ConfigFile& file, control::ImprovedParams& im) {
     if (std::fabs(sum - 1.0) > 1e-9)
       fail(file, "improved", "shaper_taps", fmt::format("must sum to 1 (they sum to {})", sum));
   }
-  s.read("shaper_rate_um_per_s", im.shaper.rate_um_per_s, io::Bounds::positive());
+  s.read("shaper_rate_um_per_s", im.shaper.rate_um_per_s, core::Bounds::positive());
   for (std::size_t i = 0; i < control::kChannels; ++i) {
     const std::string name = fmt::format("improved.channel{}", i + 1);
     const io::ConfigSection c = file.section(name);
     control::HysteresisCreepParams& m = im.model[i];
-    c.read("offset_um", m.offset_um, io::Bounds::closed(-100.0, 100.0));
-    if (!c.read("linear_weight", m.linear_weight, io::Bounds::closed(1e-3, 100.0)))
+    c.read("offset_um", m.offset_um, core::Bounds::closed(-100.0, 100.0));
+    if (!c.read("linear_weight", m.linear_weight, core::Bounds::closed(1e-3, 100.0)))
       fail(file, name, "linear_weight", "missing");
     std::vector<double> r, w, tau;
-    c.read("thresholds_um", r, control::kMaxModelOperators, io::Bounds::positive());
-    c.read("weights", w, control::kMaxModelOperators, io::Bounds::closed(0.0, 100.0));
+    c.read("thresholds_um", r, control::kMaxModelOperators, core::Bounds::positive());
+    c.read("weights", w, control::kMaxModelOperators, core::Bounds::closed(0.0, 100.0));
     if (r.size() != w.size())
       fail(file, name, "weights", fmt::format("{} weights for {} thresholds", w.size(), r.size()));
     m.operators = r.size();
@@ -61,11 +61,11 @@ void read_improved(const io::ConfigFile& file, control::ImprovedParams& im) {
       m.threshold_um[j] = r[j];
       m.weight[j] = w[j];
     }
-    c.read("creep_time_constants_s", tau, control::kMaxCreepTerms, io::Bounds::positive());
+    c.read("creep_time_constants_s", tau, control::kMaxCreepTerms, core::Bounds::positive());
     m.creep_terms = tau.size();
     for (std::size_t k = 0; k < tau.size(); ++k)
       m.creep_time_constant_s[k] = tau[k];
-    c.read("creep_gain", m.creep_gain, io::Bounds::closed(-0.05, 0.05));
+    c.read("creep_gain", m.creep_gain, core::Bounds::closed(-0.05, 0.05));
   }
 }
 
@@ -106,10 +106,10 @@ std::string format_improved(const control::ImprovedParams& im) {
 
 void read_controller_section(const io::ConfigFile& file, control::SemiClosedLoopParams& params) {
   const io::ConfigSection c = file.section("controller");
-  c.read("kp", params.gains.kp, io::Bounds::non_negative());
-  c.read("ki", params.gains.ki, io::Bounds::non_negative());
-  c.read("kd", params.gains.kd, io::Bounds::non_negative());
-  c.read("gains_sample_time_s", params.gains_sample_time_s, io::Bounds::positive());
+  c.read("kp", params.gains.kp, core::Bounds::non_negative());
+  c.read("ki", params.gains.ki, core::Bounds::non_negative());
+  c.read("kd", params.gains.kd, core::Bounds::non_negative());
+  c.read("gains_sample_time_s", params.gains_sample_time_s, core::Bounds::positive());
   std::array<double, 4> p{params.polynomial.p3, params.polynomial.p2, params.polynomial.p1,
                           params.polynomial.p0};
   if (c.read("p", p))
@@ -135,13 +135,13 @@ control::SemiClosedLoopParams load_calibration_file(const std::string& path,
   control::SemiClosedLoopParams params;
   read_controller_section(file, params);
   double z_max_um = 0.0, z_min_um = 0.0;
-  const bool has_max = file.section("travel").read("z_max_um", z_max_um, io::Bounds::positive());
+  const bool has_max = file.section("travel").read("z_max_um", z_max_um, core::Bounds::positive());
   const bool has_min =
-      file.section("travel").read("z_min_um", z_min_um, io::Bounds::non_negative());
+      file.section("travel").read("z_min_um", z_min_um, core::Bounds::non_negative());
   file.reject_unknown();
   if (has_min && has_max && !(z_min_um < z_max_um))
-    throw io::InputError(fmt::format("{}: [travel] z_min_um = {} must be below z_max_um = {}", path,
-                                     z_min_um, z_max_um));
+    throw core::InputError(fmt::format("{}: [travel] z_min_um = {} must be below z_max_um = {}",
+                                       path, z_min_um, z_max_um));
   if (travel_z_max_um != nullptr)
     *travel_z_max_um = has_max ? std::optional<double>(z_max_um) : std::nullopt;
   if (travel_z_min_um != nullptr)

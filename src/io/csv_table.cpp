@@ -5,7 +5,7 @@
 
 #include <fmt/core.h>
 
-#include "piezoshift/io/input_error.hpp"
+#include "piezoshift/core/input_error.hpp"
 #include "piezoshift/io/input_file.hpp"
 
 namespace piezoshift::io {
@@ -94,7 +94,7 @@ CsvTable CsvTable::parse(std::string_view text, const std::string& source_name) 
         if (name.size() >= 2 && name.front() == '"' && name.back() == '"')
           name = std::string(trim(std::string_view(name).substr(1, name.size() - 2)));
         if (name.empty()) {
-          throw InputError(fmt::format(
+          throw core::InputError(fmt::format(
               "{}:{}: header field {} is empty (a trailing comma?); the header names the "
               "columns, e.g. s1_um,s2_um,s3_um",
               source_name, line_no, i + 1));
@@ -105,14 +105,15 @@ CsvTable CsvTable::parse(std::string_view text, const std::string& source_name) 
       continue;
     }
     if (fields.size() != t.header_.size()) {
-      throw InputError(fmt::format("{}:{}: {} fields, but the header (line {}) has {}", source_name,
-                                   line_no, fields.size(), t.header_line_, t.header_.size()));
+      throw core::InputError(fmt::format("{}:{}: {} fields, but the header (line {}) has {}",
+                                         source_name, line_no, fields.size(), t.header_line_,
+                                         t.header_.size()));
     }
     t.cells_.push_back(std::move(fields));
     t.lines_.push_back(line_no);
   }
   if (t.header_.empty()) {
-    throw InputError(
+    throw core::InputError(
         fmt::format("{}: no header row: the file is empty or has only comments", source_name));
   }
   return t;
@@ -136,8 +137,8 @@ void CsvTable::require_columns(std::initializer_list<std::string_view> names) co
     }
   }
   if (count > 0) {
-    throw InputError(fmt::format("{}:{}: missing column{} {} (the header has: {})", source_,
-                                 header_line_, count > 1 ? "s" : "", missing, join(header_)));
+    throw core::InputError(fmt::format("{}:{}: missing column{} {} (the header has: {})", source_,
+                                       header_line_, count > 1 ? "s" : "", missing, join(header_)));
   }
 }
 
@@ -147,14 +148,14 @@ std::size_t CsvTable::index_of(std::string_view name) const {
     if (header_[i] != name)
       continue;
     if (found != header_.size()) {
-      throw InputError(fmt::format("{}:{}: column '{}' appears twice (fields {} and {})", source_,
-                                   header_line_, name, found + 1, i + 1));
+      throw core::InputError(fmt::format("{}:{}: column '{}' appears twice (fields {} and {})",
+                                         source_, header_line_, name, found + 1, i + 1));
     }
     found = i;
   }
   if (found == header_.size()) {
-    throw InputError(fmt::format("{}:{}: missing column '{}' (the header has: {})", source_,
-                                 header_line_, name, join(header_)));
+    throw core::InputError(fmt::format("{}:{}: missing column '{}' (the header has: {})", source_,
+                                       header_line_, name, join(header_)));
   }
   return found;
 }
@@ -169,7 +170,7 @@ std::vector<double> CsvTable::column(std::string_view name) const {
     double any = 0.0;
     const auto [end, ec] = std::from_chars(cell.data(), cell.data() + cell.size(), any);
     const bool non_finite = ec == std::errc() && end == cell.data() + cell.size();
-    throw InputError(
+    throw core::InputError(
         fmt::format("{}:{}: column '{}' (field {}): {}", source_, lines_[r], name, c + 1,
                     cell.empty() ? std::string("empty cell, expected a number")
                     : non_finite ? fmt::format("'{}' is not a finite number", shown(cell))

@@ -7,7 +7,7 @@
 
 #include <fmt/core.h>
 
-#include "piezoshift/io/input_error.hpp"
+#include "piezoshift/core/input_error.hpp"
 
 namespace piezoshift::io {
 
@@ -19,7 +19,7 @@ CsvWriter::CsvWriter(const std::string& path, std::vector<std::string> columns, 
     throw std::invalid_argument("CsvWriter: decimals must be in [0, 17]");
   file_ = std::fopen(path.c_str(), "w");
   if (file_ == nullptr)
-    throw InputError(fmt::format("{}: cannot create: {}", path, std::strerror(errno)));
+    throw core::InputError(fmt::format("{}: cannot create: {}", path, std::strerror(errno)));
   std::string header;
   for (const auto& c : columns) {
     if (c.empty() || c.find_first_of(",\n\r#") != std::string::npos)
@@ -37,7 +37,7 @@ CsvWriter::~CsvWriter() {
 
 void CsvWriter::check_write(bool ok) {
   if (!ok)
-    throw InputError(fmt::format("{}: write failed: {}", path_, std::strerror(errno)));
+    throw core::InputError(fmt::format("{}: write failed: {}", path_, std::strerror(errno)));
 }
 
 void CsvWriter::row(std::span<const double> values) {

@@ -4,7 +4,7 @@
 
 #include <string>
 
-#include "piezoshift/io/input_error.hpp"
+#include "piezoshift/core/input_error.hpp"
 
 namespace piezoshift::io {
 namespace {
@@ -14,7 +14,7 @@ std::string error_of(std::string_view text, std::string_view column = {}) {
     const CsvTable t = CsvTable::parse(text, "data.csv");
     if (!column.empty())
       t.column(column);
-  } catch (const InputError& e) {
+  } catch (const core::InputError& e) {
     return e.what();
   }
   return "no error";
@@ -83,7 +83,7 @@ TEST(CsvTable, RequireColumnsListsEveryMissingName) {
   try {
     t.require_columns({"s1_um", "s2_um", "z1_um", "z3_um"});
     FAIL() << "no error";
-  } catch (const InputError& e) {
+  } catch (const core::InputError& e) {
     EXPECT_STREQ(e.what(),
                  "poses.csv:1: missing columns 's2_um', 'z3_um' (the header has: s1_um,z1_um)");
   }
@@ -93,7 +93,7 @@ TEST(CsvTable, MissingFileNamesThePath) {
   try {
     CsvTable::load("/nonexistent/dir/poses.csv");
     FAIL() << "no error";
-  } catch (const InputError& e) {
+  } catch (const core::InputError& e) {
     EXPECT_EQ(std::string(e.what()),
               "/nonexistent/dir/poses.csv: cannot open: No such file or directory");
   }

@@ -129,7 +129,7 @@ TEST(ImprovedController, CalibrationFileRoundTripsAndRefusesAnotherRate) {
     const io::ConfigFile f = io::ConfigFile::parse(bad, "bad.toml");
     read_controller_section(f, back);
     FAIL() << "accepted";
-  } catch (const io::InputError& e) {
+  } catch (const core::InputError& e) {
     EXPECT_NE(std::string(e.what()).find("shaper_taps"), std::string::npos) << e.what();
   }
 }

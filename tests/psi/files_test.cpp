@@ -4,7 +4,7 @@
 #include <filesystem>
 #include <fstream>
 
-#include "piezoshift/io/input_error.hpp"
+#include "piezoshift/core/input_error.hpp"
 #include "piezoshift/psi/npy.hpp"
 #include "piezoshift/psi/png_image.hpp"
 #include "piezoshift/psi/step_calibration.hpp"
@@ -56,10 +56,10 @@ TEST(PsiFilesTest, Png16RoundTripAndBadFilesNameThemselves) {
   try {
     read_png_gray((d / "bad.png").string());
     FAIL();
-  } catch (const io::InputError& e) {
+  } catch (const core::InputError& e) {
     EXPECT_NE(std::string(e.what()).find("bad.png"), std::string::npos);
   }
-  EXPECT_THROW(read_png_gray((d / "missing.png").string()), io::InputError);
+  EXPECT_THROW(read_png_gray((d / "missing.png").string()), core::InputError);
   fs::remove_all(d);
 }
 

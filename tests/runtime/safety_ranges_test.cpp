@@ -7,7 +7,7 @@
 
 #include <gtest/gtest.h>
 
-#include "piezoshift/io/input_error.hpp"
+#include "piezoshift/core/input_error.hpp"
 
 namespace piezoshift::runtime {
 namespace {
@@ -16,7 +16,7 @@ std::string error_of(const std::string& toml) {
   try {
     SafetyLimits l;
     read_safety_section(io::ConfigFile::parse(toml, "site.toml"), l);
-  } catch (const io::InputError& e) {
+  } catch (const core::InputError& e) {
     return e.what();
   }
   return {};
@@ -26,7 +26,7 @@ TEST(SafetyRanges, DefaultsAreInRangeAndEveryLimitIsListed) {
   EXPECT_EQ(safety_limits_problem(SafetyLimits{}), "");
   int n = 0;
   SafetyLimits l;
-  visit_safety_limits(l, [&](const char*, const char*, auto&, design::Bounds) { ++n; });
+  visit_safety_limits(l, [&](const char*, const char*, auto&, core::Bounds) { ++n; });
   EXPECT_EQ(n, 19);  // every field of SafetyLimits
 }
 

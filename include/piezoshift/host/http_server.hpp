@@ -94,7 +94,7 @@ struct HttpServerStats {
 
 class HttpServer {
  public:
-  //! Binds and listens. Throws io::InputError naming host:port for a bad address, a non-loopback
+  //! Binds and listens. Throws core::InputError naming host:port for a bad address, a non-loopback
   //! one without a token, bad limits or a failed bind.
   HttpServer(const HttpServerOptions& options, HttpHandler& handler);
   ~HttpServer();

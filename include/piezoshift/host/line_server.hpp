@@ -111,9 +111,9 @@ class LineServer {
   //! sends many cheap commands at once delays the others' by at most this many.
   static constexpr std::size_t kLinesPerTurn = 32;
 
-  //! Binds and listens (SO_REUSEADDR, non-blocking). Throws io::InputError naming host:port for an
-  //! unparsable address, a non-loopback address without allow_remote, invalid limits, or a failed
-  //! bind/listen (with the system's reason, e.g. "Address already in use").
+  //! Binds and listens (SO_REUSEADDR, non-blocking). Throws core::InputError naming host:port for
+  //! an unparsable address, a non-loopback address without allow_remote, invalid limits, or a
+  //! failed bind/listen (with the system's reason, e.g. "Address already in use").
   LineServer(const ListenAddress& address, const LineServerLimits& limits, LineHandler& handler);
   //! Closes all sockets (without handler calls: run() has already reported its disconnections).
   ~LineServer();

@@ -47,9 +47,9 @@ const char* controller_label(ControllerKind k);
 //! One controller on one seed.
 struct ControllerRun {
   control::SemiClosedLoopParams controller;
-  //! Not valid when its calibration failed (experiments::ProcedureFailed, or calibration::FitError
+  //! Not valid when its calibration failed (rig::ProcedureFailed, or calibration::FitError
   //! on the twin's records); nothing ran then.
-  experiments::Validity calibration;
+  rig::Validity calibration;
   ExperimentSet set;
   std::vector<InnerLoopAnalysis> inner_loop;  //!< empty for the oracle
   //! The lambda/8 step again with the loop at 10 kHz (seed + 85): the twin's DAQ at 0.1 ms; the
@@ -75,7 +75,7 @@ struct SeedComparison {
 //! valid with its reason, or not measured for that controller (the oracle's margins).
 struct FigureValue {
   double value = std::numeric_limits<double>::quiet_NaN();
-  experiments::Validity validity;
+  rig::Validity validity;
   bool measured = true;
 };
 
@@ -134,6 +134,6 @@ ComparisonResult summarize_comparison(const config::ProjectConfig& config,
 
 //! Throws std::invalid_argument on an empty seed list.
 ComparisonResult compare(const config::ProjectConfig& config, const CompareOptions& options,
-                         const experiments::Progress& progress = {});
+                         const rig::Progress& progress = {});
 
 }  // namespace piezoshift::reproduction
