@@ -4,8 +4,8 @@
 // simulated seconds per wall-clock second (docs/performance.md).
 #include <benchmark/benchmark.h>
 
-#include "piezoshift/experiments/bench.hpp"
 #include "piezoshift/plant/twin.hpp"
+#include "piezoshift/rig/bench.hpp"
 
 namespace {
 
@@ -38,7 +38,7 @@ BENCHMARK(BM_TwinTickOpenLoop)->Arg(20000)->Arg(40000)->Arg(100000);
 // Closed loop: the paper's controller and the twin, one tick each, with Z_d stepping between
 // 1 um and 10 um every 0.5 s (steps, settling and holding, as the experiments do).
 void BM_TwinTickWithController(benchmark::State& state) {
-  piezoshift::experiments::Bench bench({}, {}, 1);
+  piezoshift::rig::Bench bench({}, {}, 1);
   long k = 0;
   for (auto _ : state) {
     const double zd = (k++ / 500) % 2 == 0 ? 1.0 : 10.0;

@@ -7,7 +7,7 @@
 
 #include "piezoshift/calibration/calibration_file.hpp"
 #include "piezoshift/config/project_config.hpp"
-#include "piezoshift/io/input_error.hpp"
+#include "piezoshift/core/input_error.hpp"
 #include "program.hpp"
 #include "scratch_file.hpp"
 
@@ -32,7 +32,7 @@ bool quick_design(const CLI::App& app) {
 void config_input(std::string_view data) {
   try {
     config::load_project_config(scratch_file("config.toml", data));
-  } catch (const io::InputError&) {
+  } catch (const core::InputError&) {
   }
 }
 
@@ -40,7 +40,7 @@ void calibration_input(std::string_view data) {
   try {
     std::optional<double> z_max, z_min;
     calibration::load_calibration_file(scratch_file("calibration.toml", data), &z_max, &z_min);
-  } catch (const io::InputError&) {
+  } catch (const core::InputError&) {
   }
 }
 

@@ -1,7 +1,7 @@
 #pragma once
 // The fuzz targets' entry points (docs/fuzzing.md): each takes one input as bytes and feeds it to
 // piezoshift the way a user's file, command line or socket would. An entry returns normally
-// when the input was handled, accepted or refused as bad input (io::InputError, a GCS error, a
+// when the input was handled, accepted or refused as bad input (core::InputError, a GCS error, a
 // CLI11 parse error); anything else is a finding: an exception escapes (libFuzzer reports the
 // std::terminate as a crash, the replay test as a failure), a sanitizer fires, the input takes
 // longer than a second or more than 512 MB.

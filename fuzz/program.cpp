@@ -1,7 +1,7 @@
 #include "program.hpp"
 
-#include "piezoshift/experiments/validity.hpp"
-#include "piezoshift/io/input_error.hpp"
+#include "piezoshift/core/input_error.hpp"
+#include "piezoshift/rig/validity.hpp"
 
 namespace piezoshift::fuzz {
 
@@ -25,8 +25,8 @@ void Program::run(const std::vector<std::string>& args, MayRun may_run) {
     return;
   try {
     action_();
-  } catch (const io::InputError&) {
-  } catch (const experiments::ProcedureFailed&) {
+  } catch (const core::InputError&) {
+  } catch (const rig::ProcedureFailed&) {
   }
 }
 

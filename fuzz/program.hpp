@@ -22,7 +22,7 @@ class Program {
   Program& operator=(const Program&) = delete;
 
   //! Parses args (args[0] is the program name); runs the action when may_run says so. Bad input
-  //! (a CLI11 parse error, io::InputError, ProcedureFailed) returns; any other exception
+  //! (a CLI11 parse error, core::InputError, ProcedureFailed) returns; any other exception
   //! propagates. Options keep what an earlier
   //! run() set when args do not set them again: run one Program more than once only with the
   //! same options.

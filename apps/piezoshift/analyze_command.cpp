@@ -19,6 +19,7 @@
 #include <nlohmann/json.hpp>
 
 #include "command.hpp"
+#include "piezoshift/core/input_error.hpp"
 #include "piezoshift/experiments/metrics_figures.hpp"
 #include "piezoshift/experiments/metrics_linearity.hpp"
 #include "piezoshift/experiments/metrics_repeatability.hpp"
@@ -47,7 +48,7 @@ auto with_file(const std::string& path, F&& metric) {
   try {
     return metric();
   } catch (const experiments::MetricsError& e) {
-    throw io::InputError(fmt::format("{}: {}", path, e.what()));
+    throw core::InputError(fmt::format("{}: {}", path, e.what()));
   }
 }
 
@@ -131,9 +132,9 @@ int run_repeatability(const AnalyzeOptions& o) {
 int run_step(const AnalyzeOptions& o_in) {
   AnalyzeOptions o = o_in;
   if (o.median_window % 2 == 0)  // the option's check has its range
-    throw io::InputError(fmt::format("--median-window {}: must be odd", o.median_window));
+    throw core::InputError(fmt::format("--median-window {}: must be odd", o.median_window));
   if (!std::isfinite(o.step.step_time_s))
-    throw io::InputError(
+    throw core::InputError(
         fmt::format("--step-time-s {}: must be a finite number", o.step.step_time_s));
   o.step.median_window = static_cast<std::size_t>(o.median_window);
   const io::CsvTable t = io::CsvTable::load(o.data_path);

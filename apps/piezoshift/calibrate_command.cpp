@@ -20,16 +20,16 @@
 #include "piezoshift/calibration/calibration_file.hpp"
 #include "piezoshift/calibration/calibration_procedure.hpp"
 #include "piezoshift/calibration/guided_calibration.hpp"
-#include "piezoshift/calibration/guided_rig.hpp"
+#include "piezoshift/rig/guided_rig.hpp"
 #include "piezoshift/calibration/guided_session.hpp"
 #include "piezoshift/calibration/improved_calibration.hpp"
 #include "piezoshift/calibration/interferometer_source.hpp"
-#include "piezoshift/calibration/loop_rig.hpp"
+#include "piezoshift/rig/loop_rig.hpp"
 #include "piezoshift/config/project_config.hpp"
-#include "piezoshift/experiments/bench.hpp"
+#include "piezoshift/rig/bench.hpp"
 #include "piezoshift/experiments/paper_experiments.hpp"
 #include "piezoshift/io/csv_writer.hpp"
-#include "piezoshift/io/input_error.hpp"
+#include "piezoshift/core/input_error.hpp"
 #include "piezoshift/runtime/safety_ranges.hpp"
 #include "progress_bar.hpp"
 #include "whole_number.hpp"
@@ -79,32 +79,32 @@ void print_fits(const control::SemiClosedLoopParams& controller,
 // operator, a log file or the twin's interferometer, the session recorded beside --out.
 void check_guided_options(const Options& o) {
   if (o.pid != "paper")
-    throw io::InputError(
+    throw core::InputError(
         "--pid search: the guided calibration keeps the paper's gains (the search scores the "
         "plate's motion between the ticks, which a bench does not see)");
   const bool sim = o.daq == "sim";
   const bool sim_rt = o.daq == "sim-rt";
   const bool comedi = o.daq == "comedi" || o.daq.rfind("comedi:", 0) == 0;
   if (!sim && !sim_rt && !comedi)
-    throw io::InputError(
+    throw core::InputError(
         fmt::format("--daq {}: expected sim, sim-rt or comedi:/dev/comediN", o.daq));
   if (o.free_run && !sim_rt)
-    throw io::InputError(fmt::format(
+    throw core::InputError(fmt::format(
         "--free-run needs --daq sim-rt (--daq {} {})", o.daq,
         sim ? "runs on a simulated clock already" : "runs in real time: it is hardware"));
   const std::string& ifm = o.interferometer;
   if (ifm.empty())
-    throw io::InputError("--daq needs --interferometer prompt, file:PATH or sim");
+    throw core::InputError("--daq needs --interferometer prompt, file:PATH or sim");
   if (ifm != "prompt" && ifm != "sim" && !(ifm.rfind("file:", 0) == 0 && ifm.size() > 5))
-    throw io::InputError(
+    throw core::InputError(
         fmt::format("--interferometer {}: expected prompt, file:PATH or sim", ifm));
   if (comedi && ifm == "sim")
-    throw io::InputError(
+    throw core::InputError(
         fmt::format("--interferometer sim: the twin's interferometer does not see the stage on "
                     "--daq {}; give prompt or file:PATH",
                     o.daq));
   if (!(o.max_zero_drift_um > 0.0))
-    throw io::InputError(
+    throw core::InputError(
         fmt::format("--max-zero-drift-um {}: must be a positive length", o.max_zero_drift_um));
 }
 
@@ -117,7 +117,7 @@ calibration::GuidedSession open_session(const Options& o, const std::string& ses
     return session;
   if (auto loaded = calibration::load_guided_session(session_file)) {
     if (loaded->plan != plan_text || loaded->steps != steps)
-      throw io::InputError(fmt::format(
+      throw core::InputError(fmt::format(
           "{}: this session was recorded for \"{}\", not \"{}\": give --restart to discard it",
           session_file, loaded->plan, plan_text));
     session = std::move(*loaded);
@@ -146,10 +146,10 @@ class GuidedRigs {
     const config::ProjectConfig& config = installation.project;
     const double window_s = config.twin.interferometer.static_average_s;
     if (o.daq == "sim") {
-      bench2_ = std::make_unique<experiments::Bench>(config, base, o.seed + 1);
-      bench3_ = std::make_unique<experiments::Bench>(config, base, o.seed + 2);
-      bench_rig2_ = std::make_unique<calibration::BenchRig>(*bench2_, window_s);
-      bench_rig3_ = std::make_unique<calibration::BenchRig>(*bench3_, window_s, bench_rig2_.get());
+      bench2_ = std::make_unique<rig::Bench>(config, base, o.seed + 1);
+      bench3_ = std::make_unique<rig::Bench>(config, base, o.seed + 2);
+      bench_rig2_ = std::make_unique<rig::BenchRig>(*bench2_, window_s);
+      bench_rig3_ = std::make_unique<rig::BenchRig>(*bench3_, window_s, bench_rig2_.get());
       rig2_ = bench_rig2_.get();
       rig3_ = bench_rig3_.get();
       return;
@@ -161,14 +161,14 @@ class GuidedRigs {
     so.config_path = o.config;
     so.clock = o.free_run ? StackClock::kPaced : StackClock::kRealTime;
     stack_ = std::make_unique<LoopStack>(so, config);  // names a device it cannot open
-    calibration::LoopRigOptions lo;
+    rig::LoopRigOptions lo;
     lo.rate_Hz = so.rate_Hz;
     lo.window_s = window_s;
     // An interferometer log is stamped by the wall clock: real-time windows are in Unix time.
     lo.unix_time = stack_->clock().real_time();
     signals_.emplace();  // Ctrl-C ramps the stage to 0 V instead of leaving it driven
     lo.stop_signal = &g_stop_signal;
-    loop_rig_ = std::make_unique<calibration::LoopRig>(
+    loop_rig_ = std::make_unique<rig::LoopRig>(
         stack_->daq(), stack_->clock(), stack_->paced(), base,
         loop_safety_limits(installation.safety, std::nullopt), lo);
     for (const std::string& refusal : loop_rig_->realtime().refusals)
@@ -178,19 +178,19 @@ class GuidedRigs {
     rig3_ = loop_rig_.get();
   }
 
-  calibration::GuidedRig& stage2() { return *rig2_; }
-  calibration::GuidedRig& stage3() { return *rig3_; }
+  rig::GuidedRig& stage2() { return *rig2_; }
+  rig::GuidedRig& stage3() { return *rig3_; }
   //! The real-time loop's rig, or null on the simulated bench.
-  calibration::LoopRig* loop_rig() { return loop_rig_.get(); }
+  rig::LoopRig* loop_rig() { return loop_rig_.get(); }
 
  private:
   std::optional<StopSignals> signals_;  // outlives the loop: Ctrl-C during its ramp is harmless
-  std::unique_ptr<experiments::Bench> bench2_, bench3_;
-  std::unique_ptr<calibration::BenchRig> bench_rig2_, bench_rig3_;
+  std::unique_ptr<rig::Bench> bench2_, bench3_;
+  std::unique_ptr<rig::BenchRig> bench_rig2_, bench_rig3_;
   std::unique_ptr<LoopStack> stack_;
-  std::unique_ptr<calibration::LoopRig> loop_rig_;
-  calibration::GuidedRig* rig2_ = nullptr;
-  calibration::GuidedRig* rig3_ = nullptr;
+  std::unique_ptr<rig::LoopRig> loop_rig_;
+  rig::GuidedRig* rig2_ = nullptr;
+  rig::GuidedRig* rig3_ = nullptr;
 };
 
 struct FitDataFiles {
@@ -287,7 +287,7 @@ int run_guided(const Options& o) {
   if (rigs.loop_rig())
     loop_result = rigs.loop_rig()->stop();  // the stage at rest at 0 V before anything is written
   if (!r.complete)
-    throw io::InputError(fmt::format(
+    throw core::InputError(fmt::format(
         "{} ended: {} of {} steps are recorded in {}; run the same command again to resume",
         source->name(), session.readings.size(), plan.size(), session_file));
 
@@ -298,7 +298,7 @@ int run_guided(const Options& o) {
                   "with the interferometer from {}\nseed {}, configuration: {}, session: {}",
                   o.daq, o.interferometer, o.seed,
                   o.config.empty() ? "built-in defaults" : o.config, session_file));
-  const calibration::LoopRig* loop_rig = rigs.loop_rig();
+  const rig::LoopRig* loop_rig = rigs.loop_rig();
   if (o.json) {
     nlohmann::json j = guided_json(o, r, files, session_file, plan.size());
     if (loop_rig) {
@@ -323,7 +323,7 @@ int run_guided(const Options& o) {
 // The improved controller (issue 12): the paper's stages for A and p, then its own models.
 int run_improved(const Options& o, const config::ProjectConfig& config) {
   if (o.pid != "paper")
-    throw io::InputError("--pid search: the improved controller has no PID to search");
+    throw core::InputError("--pid search: the improved controller has no PID to search");
   control::SemiClosedLoopParams base;
   base.sample_time_s = config.twin.daq.sample_time_s;
   calibration::ImprovedCalibrationOutcome ic;
@@ -335,7 +335,7 @@ int run_improved(const Options& o, const config::ProjectConfig& config) {
                                            calibration::CalibrationOptions{}.travel);
   }
   if (!(travel.single_move_um > 0.0))
-    throw experiments::ProcedureFailed(
+    throw rig::ProcedureFailed(
         fmt::format("calibration: the improved loop has no semi-closed-loop travel: {}",
                     travel.validity.reason));
   // The records stages 4 and 5 fitted, in the formats `fit improved` reads (docs/files.md),
@@ -378,13 +378,13 @@ int run_improved(const Options& o, const config::ProjectConfig& config) {
 int run(const Options& o) {
   if (!o.daq.empty()) {
     if (o.controller != "paper")
-      throw io::InputError(
+      throw core::InputError(
           "--controller improved: the guided calibration calibrates the paper's "
           "controller only");
     return run_guided(o);
   }
   if (!o.interferometer.empty())
-    throw io::InputError("--interferometer needs --daq (the guided calibration)");
+    throw core::InputError("--interferometer needs --daq (the guided calibration)");
   const config::ProjectConfig config = o.config.empty()
                                            ? config::ProjectConfig{}
                                            : runtime::load_installation_config(o.config).project;

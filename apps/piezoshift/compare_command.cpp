@@ -97,7 +97,7 @@ int run(const Options& o) {
     ProgressBar bar(static_cast<int>(co.seeds.size()) * (2 * 3 + 3 * 7 + 3 + 1));
     result = reproduction::compare(config, co, bar.callback());
   }
-  const int status = result.valid() ? 0 : experiments::kExitNotValid;
+  const int status = result.valid() ? 0 : rig::kExitNotValid;
   std::string report;
   if (!o.out.empty()) {
     const std::string label =

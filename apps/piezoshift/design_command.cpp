@@ -12,9 +12,9 @@
 
 #include "command.hpp"
 #include "piezoshift/config/project_config.hpp"
+#include "piezoshift/core/input_error.hpp"
 #include "piezoshift/design/design_evaluation.hpp"
 #include "piezoshift/design/hinge_search.hpp"
-#include "piezoshift/io/input_error.hpp"
 #include "piezoshift/runtime/safety_ranges.hpp"
 
 namespace piezoshift::app {
@@ -149,7 +149,8 @@ design::SearchRange range_option(const char* option, const std::vector<double>& 
   if (mm.empty())
     return fallback;
   auto bad = [option, &mm](const std::string& why) {
-    return io::InputError(fmt::format("option {} {} {} {}: {}", option, mm[0], mm[1], mm[2], why));
+    return core::InputError(
+        fmt::format("option {} {} {} {}: {}", option, mm[0], mm[1], mm[2], why));
   };
   for (const double v : mm) {
     if (!std::isfinite(v))
@@ -171,7 +172,7 @@ design::SearchRange range_option(const char* option, const std::vector<double>& 
 
 double positive_option(const char* option, double value) {
   if (!(std::isfinite(value) && value > 0.0))
-    throw io::InputError(fmt::format("option {} {}: must be a positive number", option, value));
+    throw core::InputError(fmt::format("option {} {}: must be a positive number", option, value));
   return value;
 }
 
@@ -192,7 +193,7 @@ int run_search(const DesignOptions& opt, const design::DesignInputs& in,
                         static_cast<double>(design::search_range_size(space.width)) *
                         static_cast<double>(design::search_range_size(space.link_length));
   if (points > static_cast<double>(design::max_search_evaluations)) {
-    throw io::InputError(
+    throw core::InputError(
         fmt::format("--search: the grid has {:g} points, more than {}; use larger "
                     "steps or narrower ranges",
                     points, design::max_search_evaluations));
@@ -202,7 +203,7 @@ int run_search(const DesignOptions& opt, const design::DesignInputs& in,
   c.min_stress_margin = positive_option("--min-stress-margin", opt.min_stress_margin);
   c.max_thickness_to_radius = positive_option("--max-t-over-r", opt.max_t_over_r);
   if (!(std::isfinite(opt.min_frequency_Hz) && opt.min_frequency_Hz >= 0.0)) {
-    throw io::InputError(
+    throw core::InputError(
         fmt::format("option --min-frequency-hz {}: must be a number >= 0", opt.min_frequency_Hz));
   }
   c.min_natural_frequency_Hz = opt.min_frequency_Hz;

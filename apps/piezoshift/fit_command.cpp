@@ -28,8 +28,8 @@
 #include "piezoshift/calibration/matrix_fit.hpp"
 #include "piezoshift/calibration/poly_fit.hpp"
 #include "piezoshift/config/project_config.hpp"
+#include "piezoshift/core/input_error.hpp"
 #include "piezoshift/io/csv_table.hpp"
-#include "piezoshift/io/input_error.hpp"
 #include "piezoshift/runtime/safety_ranges.hpp"
 
 namespace piezoshift::app {
@@ -71,7 +71,7 @@ auto with_file(const std::string& path, F&& fit) {
   try {
     return fit();
   } catch (const calibration::FitError& e) {
-    throw io::InputError(fmt::format("{}: {}", path, e.what()));
+    throw core::InputError(fmt::format("{}: {}", path, e.what()));
   }
 }
 
@@ -172,15 +172,15 @@ int run_poly(const FitOptions& o) {
 // differ from the loop's, which `run` checks to 1e-9).
 double record_step_s(const io::CsvTable& t, const std::vector<double>& ts) {
   if (ts.size() < 2)
-    throw io::InputError(
+    throw core::InputError(
         fmt::format("{}: {} data rows; a record needs many", t.source(), ts.size()));
   const double mean = (ts.back() - ts.front()) / static_cast<double>(ts.size() - 1);
   if (!(mean > 0.0))
-    throw io::InputError(fmt::format("{}: t_s does not increase", t.source()));
+    throw core::InputError(fmt::format("{}: t_s does not increase", t.source()));
   for (std::size_t k = 1; k < ts.size(); ++k) {
     const double dt = ts[k] - ts[k - 1];
     if (std::fabs(dt - mean) > 0.01 * mean)
-      throw io::InputError(fmt::format(
+      throw core::InputError(fmt::format(
           "{}:{}: t_s steps by {:.6g} s where the record's mean step is {:.6g} s: the fit needs "
           "one row per sample, evenly spaced",
           t.source(), t.line_of_row(k), dt, mean));

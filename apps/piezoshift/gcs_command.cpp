@@ -16,9 +16,9 @@
 #include <fmt/core.h>
 
 #include "command.hpp"
+#include "piezoshift/core/input_error.hpp"
 #include "piezoshift/host/gcs_client.hpp"
 #include "piezoshift/host/gcs_error.hpp"
-#include "piezoshift/io/input_error.hpp"
 
 namespace piezoshift::app {
 
@@ -61,9 +61,9 @@ int error_number(const std::string& answer) {
 
 int gcs(const GcsClientOptions& o) {
   if (o.port < 1 || o.port > 65535)
-    throw io::InputError(fmt::format("--port {}: must be 1 to 65535", o.port));
+    throw core::InputError(fmt::format("--port {}: must be 1 to 65535", o.port));
   if (!(o.timeout_s > 0.0))
-    throw io::InputError(fmt::format("--timeout-s {}: must be > 0 s", o.timeout_s));
+    throw core::InputError(fmt::format("--timeout-s {}: must be > 0 s", o.timeout_s));
   try {
     host::GcsClient client(o.host, static_cast<std::uint16_t>(o.port), o.timeout_s);
     for (const std::string& command : o.commands) {
@@ -95,7 +95,7 @@ int gcs(const GcsClientOptions& o) {
         fmt::print(stderr, "piezoshift gcs: {}: done (ERR? 0)\n", printable(command));
     }
   } catch (const std::runtime_error& e) {
-    throw io::InputError(e.what());
+    throw core::InputError(e.what());
   }
   return 0;
 }

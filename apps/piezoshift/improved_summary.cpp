@@ -9,7 +9,7 @@
 #include <fmt/core.h>
 
 #include "piezoshift/io/csv_writer.hpp"
-#include "piezoshift/io/input_error.hpp"
+#include "piezoshift/core/input_error.hpp"
 #include "piezoshift/io/input_file.hpp"
 
 namespace piezoshift::app {
@@ -109,12 +109,12 @@ void write_improved_records(const calibration::ImprovedCalibrationOutcome& ic,
 io::CsvTable load_record(const std::string& path) {
   const std::string text = io::read_input_file(path, io::kMaxDataFileBytes);
   if (!text.empty() && text.back() != '\n')
-    throw io::InputError(
+    throw core::InputError(
         fmt::format("{}:{}: the last line has no line end: the file is cut short (truncated)", path,
                     std::count(text.begin(), text.end(), '\n') + 1));
   io::CsvTable t = io::CsvTable::parse(text, path);
   if (const std::optional<std::size_t> n = promised_rows(text); n && *n != t.rows())
-    throw io::InputError(fmt::format(
+    throw core::InputError(fmt::format(
         "{}: {} data rows where the file promises {} (# {}{}): the file is cut short (truncated)",
         path, t.rows(), *n, kRowsKey, *n));
   return t;

@@ -10,7 +10,8 @@
 #include "piezoshift/calibration/calibration_procedure.hpp"
 #include "piezoshift/calibration/controller_ranges.hpp"
 #include "piezoshift/control/parameter_check.hpp"
-#include "piezoshift/io/input_error.hpp"
+#include "piezoshift/core/bounds.hpp"
+#include "piezoshift/core/input_error.hpp"
 #include "piezoshift/runtime/safety_ranges.hpp"
 
 namespace piezoshift::app {
@@ -25,7 +26,7 @@ extern "C" void on_stop_signal(int signo) {
 
 void check_loop_rate(double rate_Hz) {
   if (!(rate_Hz >= 1000.0 && rate_Hz <= 10000.0))
-    throw io::InputError(
+    throw core::InputError(
         fmt::format("--rate-hz {}: supported rates are 1000 to 10000 Hz", rate_Hz));
 }
 
@@ -35,8 +36,8 @@ runtime::SafetyLimits loop_safety_limits(const runtime::SafetyLimits& installati
   if (!max_overruns)
     return limits;
   if (*max_overruns < 1 || *max_overruns > runtime::kMaxConsecutiveOverruns)
-    throw io::InputError(fmt::format("--max-overruns {}: must be in [1, {}]", *max_overruns,
-                                     runtime::kMaxConsecutiveOverruns));
+    throw core::InputError(fmt::format("--max-overruns {}: must be in [1, {}]", *max_overruns,
+                                       runtime::kMaxConsecutiveOverruns));
   limits.max_consecutive_overruns = static_cast<std::uint32_t>(*max_overruns);
   return limits;
 }
@@ -44,7 +45,7 @@ runtime::SafetyLimits loop_safety_limits(const runtime::SafetyLimits& installati
 nlohmann::json safety_json(const runtime::SafetyLimits& limits) {
   nlohmann::json j = nlohmann::json::object();
   runtime::visit_safety_limits(limits, [&](const char*, const char* key, const auto& value,
-                                           design::Bounds) { j[key] = value; });
+                                           core::Bounds) { j[key] = value; });
   return j;
 }
 
@@ -61,7 +62,7 @@ LoopCalibration resolve_calibration(const std::string& path, const std::string& 
     const double t = c.params.improved.sample_time_s;
     if (control::params_problem(at_loop, loop_sample_time_s) ==
         control::ParamsProblem::kImprovedRate)
-      throw io::InputError(fmt::format(
+      throw core::InputError(fmt::format(
           "{}: [improved] sample_time_s = {} s, but the loop runs at {} s ({} Hz): calibrate the "
           "improved controller at the loop's rate",
           path, t, loop_sample_time_s, 1.0 / loop_sample_time_s));
@@ -69,8 +70,8 @@ LoopCalibration resolve_calibration(const std::string& path, const std::string& 
     // must be stable too (calibration/controller_ranges.hpp).
     if (const std::string why = calibration::controller_problem(c.params, loop_sample_time_s);
         !why.empty())
-      throw io::InputError(fmt::format("{} at the loop's {} Hz: {}", path,
-                                       1.0 / loop_sample_time_s, why));
+      throw core::InputError(
+          fmt::format("{} at the loop's {} Hz: {}", path, 1.0 / loop_sample_time_s, why));
     c.source = path;
     return c;
   }

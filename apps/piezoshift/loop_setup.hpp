@@ -19,12 +19,12 @@
 
 namespace piezoshift::app {
 
-//! Throws io::InputError naming --rate-hz unless 1000 <= rate_Hz <= 10000 (the paper's 1 kHz to
+//! Throws core::InputError naming --rate-hz unless 1000 <= rate_Hz <= 10000 (the paper's 1 kHz to
 //! the DAQ's practical limit, docs/runtime.md).
 void check_loop_rate(double rate_Hz);
 
 //! The installation's limits (a config's [safety], or the built-in ones), with --max-overruns
-//! consecutive overruns instead when given; throws io::InputError when that is not in
+//! consecutive overruns instead when given; throws core::InputError when that is not in
 //! [1, runtime::kMaxConsecutiveOverruns].
 runtime::SafetyLimits loop_safety_limits(const runtime::SafetyLimits& installation,
                                          std::optional<std::int64_t> max_overruns);

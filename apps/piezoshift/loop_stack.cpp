@@ -5,7 +5,7 @@
 #include <fmt/core.h>
 
 #include "loop_setup.hpp"
-#include "piezoshift/io/input_error.hpp"
+#include "piezoshift/core/input_error.hpp"
 #include "piezoshift/runtime/comedi_backend.hpp"
 
 namespace piezoshift::app {
@@ -42,13 +42,13 @@ LoopStack::LoopStack(const LoopStackOptions& o, const config::ProjectConfig& con
     faults.push_back(runtime::parse_fault_spec(f));
   const bool comedi = is_comedi(o.daq);
   if (!comedi && o.daq != "sim")
-    throw io::InputError(fmt::format("--daq '{}': expected sim or comedi:/dev/comediN", o.daq));
+    throw core::InputError(fmt::format("--daq '{}': expected sim or comedi:/dev/comediN", o.daq));
   if (comedi && !faults.empty())
-    throw io::InputError("--fault needs --daq sim (faults are injected into the twin)");
+    throw core::InputError("--fault needs --daq sim (faults are injected into the twin)");
   if (comedi && o.clock == StackClock::kFreeRun)
-    throw io::InputError("--free-run needs --daq sim (hardware runs in real time)");
+    throw core::InputError("--free-run needs --daq sim (hardware runs in real time)");
   if (comedi && o.clock == StackClock::kPaced)
-    throw io::InputError("a paced clock needs the twin (hardware runs in real time)");
+    throw core::InputError("a paced clock needs the twin (hardware runs in real time)");
 
   if (comedi) {
     runtime::ComediOptions co;

@@ -40,7 +40,7 @@ struct LoopStackOptions {
 
 class LoopStack {
  public:
-  //! Builds and configures the stack. Throws io::InputError naming the option or device at fault.
+  //! Builds and configures the stack. Throws core::InputError naming the option or device at fault.
   LoopStack(const LoopStackOptions& options, const config::ProjectConfig& config);
   ~LoopStack();
   LoopStack(const LoopStack&) = delete;

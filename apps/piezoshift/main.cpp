@@ -8,8 +8,8 @@
 
 #include "command.hpp"
 #include "option_suggestion.hpp"
-#include "piezoshift/experiments/validity.hpp"
-#include "piezoshift/io/input_error.hpp"
+#include "piezoshift/core/input_error.hpp"
+#include "piezoshift/rig/validity.hpp"
 
 int main(int argc, char** argv) {
   CLI::App app;
@@ -30,21 +30,21 @@ int main(int argc, char** argv) {
     if (!hint.empty())
       fmt::print(stderr, "piezoshift: {}\n", hint);
     fmt::print(stderr, "Run with --help for more information.\n");
-    return piezoshift::io::kExitBadInput;
+    return piezoshift::core::kExitBadInput;
   }
 
   try {
     return action ? action() : 0;
-  } catch (const piezoshift::io::InputError& e) {
+  } catch (const piezoshift::core::InputError& e) {
     fmt::print(stderr, "piezoshift: error: {}\n", e.what());
-    return piezoshift::io::kExitBadInput;
+    return piezoshift::core::kExitBadInput;
   } catch (const std::filesystem::filesystem_error& e) {
     // Raised on a path the user named (an output folder under a file, no permission): bad input.
     fmt::print(stderr, "piezoshift: error: {}: {}\n", e.path1().string(), e.code().message());
-    return piezoshift::io::kExitBadInput;
-  } catch (const piezoshift::experiments::ProcedureFailed& e) {
+    return piezoshift::core::kExitBadInput;
+  } catch (const piezoshift::rig::ProcedureFailed& e) {
     fmt::print(stderr, "piezoshift: not valid: {}\n", e.what());
-    return piezoshift::experiments::kExitNotValid;
+    return piezoshift::rig::kExitNotValid;
   } catch (const std::exception& e) {
     fmt::print(stderr, "piezoshift: internal error: {}\n", e.what());
     return 1;

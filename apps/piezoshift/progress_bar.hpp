@@ -4,7 +4,7 @@
 #include <string>
 #include <string_view>
 
-#include "piezoshift/experiments/progress.hpp"
+#include "piezoshift/rig/progress.hpp"
 
 namespace piezoshift::app {
 
@@ -15,7 +15,7 @@ class ProgressBar {
   //! done/total of the stage called label; a new label starts the next stage.
   void update(double done, double total, std::string_view label);
   //! update() as the Progress callback that long jobs take.
-  experiments::Progress callback() {
+  rig::Progress callback() {
     return
         [this](double done, double total, std::string_view label) { update(done, total, label); };
   }

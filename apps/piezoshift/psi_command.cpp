@@ -19,9 +19,8 @@
 
 #include "command.hpp"
 #include "piezoshift/config/project_config.hpp"
-#include "piezoshift/experiments/validity.hpp"
+#include "piezoshift/core/input_error.hpp"
 #include "piezoshift/io/atomic_file.hpp"
-#include "piezoshift/io/input_error.hpp"
 #include "piezoshift/psi/analysis.hpp"
 #include "piezoshift/psi/error_budget.hpp"
 #include "piezoshift/psi/frame_set.hpp"
@@ -30,6 +29,7 @@
 #include "piezoshift/psi/simulation.hpp"
 #include "piezoshift/psi/step_calibration.hpp"
 #include "piezoshift/psi/zernike.hpp"
+#include "piezoshift/rig/validity.hpp"
 #include "piezoshift/runtime/safety_ranges.hpp"
 #include "whole_number.hpp"
 
@@ -72,7 +72,7 @@ std::vector<double> parse_list(const std::string& text, const std::string& optio
         throw std::invalid_argument(item);
       v.push_back(x);
     } catch (const std::exception&) {
-      throw io::InputError(fmt::format("{} '{}': '{}' is not a number", option, text, item));
+      throw core::InputError(fmt::format("{} '{}': '{}' is not a number", option, text, item));
     }
   }
   return v;
@@ -83,8 +83,8 @@ psi::Mask load_mask(const std::string& path, const psi::Map& frame) {
     return psi::Mask(frame.width, frame.height, 1);
   psi::Mask m = psi::read_mask_png(path);
   if (m.width != frame.width || m.height != frame.height)
-    throw io::InputError(fmt::format("{}: mask is {} x {} pixels, the frames {} x {}", path,
-                                     m.width, m.height, frame.width, frame.height));
+    throw core::InputError(fmt::format("{}: mask is {} x {} pixels, the frames {} x {}", path,
+                                       m.width, m.height, frame.width, frame.height));
   return m;
 }
 
@@ -108,13 +108,13 @@ psi::Algorithm choose_algorithm(const std::string& name, std::size_t frames) {
 void check_count(psi::Algorithm a, std::size_t frames) {
   const int need = psi::required_frames(a);
   if (need > 0 && static_cast<std::size_t>(need) != frames)
-    throw io::InputError(fmt::format("--algorithm {} needs {} frames, {} given",
-                                     psi::algorithm_name(a), need, frames));
+    throw core::InputError(fmt::format("--algorithm {} needs {} frames, {} given",
+                                       psi::algorithm_name(a), need, frames));
 }
 
 void check_wavelength(double nm) {
   if (!(nm >= 100.0 && nm <= 20000.0))
-    throw io::InputError(fmt::format("--wavelength-nm {}: must be in 100..20000", nm));
+    throw core::InputError(fmt::format("--wavelength-nm {}: must be in 100..20000", nm));
 }
 
 psi::Analysis run_analysis(const std::vector<psi::Map>& frames, const psi::Mask& mask,
@@ -122,7 +122,7 @@ psi::Analysis run_analysis(const std::vector<psi::Map>& frames, const psi::Mask&
   try {
     return psi::analyze_frames(frames, mask, ao);
   } catch (const std::invalid_argument& e) {
-    throw io::InputError(fmt::format("psi: {}", e.what()));
+    throw core::InputError(fmt::format("psi: {}", e.what()));
   }
 }
 
@@ -187,8 +187,8 @@ int run_analyze(const PsiOptions& o) {
   if (!o.steps_rad.empty()) {
     ao.phase.steps_rad = parse_list(o.steps_rad, "--steps-rad");
     if (ao.phase.steps_rad.size() != frames.size())
-      throw io::InputError(fmt::format("--steps-rad: {} values for {} frames",
-                                       ao.phase.steps_rad.size(), frames.size()));
+      throw core::InputError(fmt::format("--steps-rad: {} values for {} frames",
+                                         ao.phase.steps_rad.size(), frames.size()));
   }
   const psi::Analysis a = run_analysis(frames, mask, ao);
   const Json j = write_analysis(a, alg, o.wavelength_nm, o.out);
@@ -208,7 +208,7 @@ psi::StepCalibration recover_steps(const PsiOptions& o, std::span<const psi::Map
       o.algorithm.empty() ? psi::Algorithm::kAia : psi::parse_algorithm(o.algorithm);
   if (alg != psi::Algorithm::kAia && alg != psi::Algorithm::kTiltAia &&
       alg != psi::Algorithm::kCarre)
-    throw io::InputError(
+    throw core::InputError(
         fmt::format("--algorithm {}: calibration needs aia, tilt-aia or carre", o.algorithm));
   check_count(alg, frames.size());
   psi::PhaseOptions po;
@@ -220,7 +220,7 @@ psi::StepCalibration recover_steps(const PsiOptions& o, std::span<const psi::Map
     r = psi::wrapped_phase(frames, mask, po);
     psi::modulated_pixels(r, mask, psi::AnalysisOptions{});
   } catch (const std::invalid_argument& e) {
-    throw io::InputError(fmt::format("psi calibrate: {}", e.what()));
+    throw core::InputError(fmt::format("psi calibrate: {}", e.what()));
   }
   psi::StepCalibration c = psi::calibrate_steps(r.steps_rad, o.nominal_step_rad, o.wavelength_nm);
   c.algorithm = std::string(psi::algorithm_name(alg));
@@ -233,7 +233,7 @@ psi::StepCalibration recover_steps(const PsiOptions& o, std::span<const psi::Map
                               {"converged", false},
                               {"reason", problem}}
                              .dump(2));
-    throw experiments::ProcedureFailed(fmt::format("psi calibrate: {}", problem));
+    throw rig::ProcedureFailed(fmt::format("psi calibrate: {}", problem));
   }
   return c;
 }
@@ -242,7 +242,7 @@ int run_calibrate(const PsiOptions& o) {
   check_wavelength(o.wavelength_nm);
   if (!(o.nominal_step_rad >= psi::kMinNominalStepRad &&
         o.nominal_step_rad <= psi::kMaxNominalStepRad))
-    throw io::InputError(fmt::format(
+    throw core::InputError(fmt::format(
         "--nominal-step-rad {}: must be in [{:g}, pi - {:g}] = [{:g}, {:.4f}] rad",
         o.nominal_step_rad, psi::kMinNominalStepRad, std::numbers::pi - psi::kMaxNominalStepRad,
         psi::kMinNominalStepRad, psi::kMaxNominalStepRad));
@@ -291,7 +291,7 @@ int run_simulate(const PsiOptions& o) {
   if (!o.surface.empty())
     p.surface = psi::parse_surface_spec(o.surface);
   if (o.size_px < 32 || o.size_px > 2048)
-    throw io::InputError(fmt::format("--size {}: must be in 32..2048", o.size_px));
+    throw core::InputError(fmt::format("--size {}: must be in 32..2048", o.size_px));
   p.fizeau.width_px = p.fizeau.height_px = o.size_px;
   p.fizeau.pupil_radius_px = 0.47 * o.size_px;
   p.fizeau.wavelength_nm = o.wavelength_nm;

@@ -9,7 +9,7 @@
 
 #include "command.hpp"
 #include "piezoshift/config/project_config.hpp"
-#include "piezoshift/io/input_error.hpp"
+#include "piezoshift/core/input_error.hpp"
 #include "piezoshift/reproduction/report.hpp"
 #include "piezoshift/reproduction/reproduction.hpp"
 #include "piezoshift/reproduction/summary.hpp"
@@ -57,7 +57,7 @@ int run(const Options& o) {
   fmt::print("piezoshift reproduce: {:.0f} s simulated in {:.2f} s\n", t.simulated_time_s,
              t.wall_time_s);
   // A row that is not valid shows why, never a number.
-  const auto row = [](const char* name, const experiments::Validity& v, const std::string& value,
+  const auto row = [](const char* name, const rig::Validity& v, const std::string& value,
                       const char* paper) {
     if (v.valid)
       fmt::print("  {:<16} {:<46} (paper: {})\n", name, value, paper);
@@ -77,14 +77,14 @@ int run(const Options& o) {
                   t.linearity.metrics.linearity_zero_end_pct,
                   t.linearity.metrics.linearity_best_fit_pct),
       "0.21 %");
-  experiments::Validity repeat = t.repeat_5um.validity;
+  rig::Validity repeat = t.repeat_5um.validity;
   if (!t.repeat_10um.validity.valid)
     repeat.fail(t.repeat_10um.validity.reason);
   row("repeatability", repeat,
       fmt::format("{:.2f} nm at 5 um, {:.2f} nm at 10 um", t.repeat_5um.metrics.repeatability_nm,
                   t.repeat_10um.metrics.repeatability_nm),
       "2, 3 nm");
-  experiments::Validity oracle;
+  rig::Validity oracle;
   if (!t.oracle.table4_valid())
     oracle.fail(t.oracle.invalid_reasons().front());
   row("oracle", oracle,

@@ -27,7 +27,7 @@
 #include "loop_stack.hpp"
 #include "piezoshift/calibration/calibration_file.hpp"
 #include "piezoshift/config/project_config.hpp"
-#include "piezoshift/io/input_error.hpp"
+#include "piezoshift/core/input_error.hpp"
 #include "piezoshift/runtime/control_loop.hpp"
 #include "piezoshift/runtime/csv_logger.hpp"
 #include "piezoshift/runtime/fault_injection.hpp"
@@ -313,7 +313,7 @@ LoopStackOptions stack_options(const RunOptions& o) {
 int run(const RunOptions& o) {
   check_loop_rate(o.rate_Hz);
   if (!(o.duration_s > 0.0) || o.duration_s > kMaxRunDurationS)
-    throw io::InputError(
+    throw core::InputError(
         fmt::format("--duration-s {}: must be in (0, {}] s", o.duration_s, kMaxRunDurationS));
   SetpointProfile profile = !o.profile.empty() ? SetpointProfile::load_csv(o.profile)
                                                : SetpointProfile::step(o.step_um.value_or(0.0));
@@ -326,7 +326,7 @@ int run(const RunOptions& o) {
   const LoopCalibration cal =
       resolve_calibration(o.calibration, o.daq, project, o.seed, 1.0 / o.rate_Hz);
   if (o.step_um && cal.travel_z_max_um && *o.step_um > *cal.travel_z_max_um)
-    throw io::InputError(
+    throw core::InputError(
         fmt::format("--step-um {}: beyond the calibrated semi-closed-loop "
                     "travel, {} um ({})",
                     *o.step_um, *cal.travel_z_max_um, cal.source));

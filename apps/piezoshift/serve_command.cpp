@@ -27,13 +27,13 @@
 #include "loop_stack.hpp"
 #include "piezoshift/calibration/calibration_file.hpp"
 #include "piezoshift/config/project_config.hpp"
+#include "piezoshift/core/input_error.hpp"
 #include "piezoshift/host/dashboard.hpp"
 #include "piezoshift/host/gcs_interpreter.hpp"
 #include "piezoshift/host/http_server.hpp"
 #include "piezoshift/host/line_server.hpp"
 #include "piezoshift/host/locked_line_handler.hpp"
 #include "piezoshift/host/stage_model.hpp"
-#include "piezoshift/io/input_error.hpp"
 #include "piezoshift/io/input_file.hpp"
 #include "piezoshift/runtime/control_loop.hpp"
 #include "piezoshift/runtime/csv_logger.hpp"
@@ -79,7 +79,7 @@ struct ServeOptions {
 
 void check(bool ok, const std::string& message) {
   if (!ok)
-    throw io::InputError(message);
+    throw core::InputError(message);
 }
 
 // A token file holds one line; it is read as every input file is (a regular file, bounded), so
@@ -95,7 +95,7 @@ std::string http_token(const ServeOptions& o) {
     std::string text;
     try {
       text = io::read_input_file(o.http_token_file, kMaxTokenFileBytes);
-    } catch (const io::InputError& e) {
+    } catch (const core::InputError& e) {
       check(false, fmt::format("--http-token-file: {}", e.what()));
     }
     token = text.substr(0, text.find('\n'));
@@ -126,7 +126,7 @@ host::StageModel make_stage_model(const ServeOptions& o, const config::ProjectCo
     return host::StageModel(mp);
   } catch (const std::invalid_argument& e) {
     // The calibration's A and the config's geometry meet here: name both.
-    throw io::InputError(fmt::format(
+    throw core::InputError(fmt::format(
         "{} with {}: {}", o.calibration.empty() ? "built-in calibration" : o.calibration,
         o.config.empty() ? "the built-in configuration" : o.config, e.what()));
   }

@@ -1,6 +1,6 @@
 // `piezoshift simulate`: runs the digital twin (docs/twin.md) open loop or with the paper's
 // semi-closed-loop controller, through the loop `run` and `serve` ship (the simulated bench,
-// experiments/bench.hpp: DAQ read, controller, safety supervisor, DAQ write), and reports where
+// rig/bench.hpp: DAQ read, controller, safety supervisor, DAQ write), and reports where
 // the plate ended up, the target and the error. The controller is `run`'s: --calibration FILE,
 // or else the twin calibrated first by the paper's procedure (loop_setup.hpp,
 // resolve_calibration), so that the two commands agree. A supervisor fault ends the run's control
@@ -30,12 +30,12 @@
 #include "loop_setup.hpp"
 #include "piezoshift/config/project_config.hpp"
 #include "piezoshift/control/semi_closed_loop.hpp"
-#include "piezoshift/experiments/bench.hpp"
+#include "piezoshift/core/input_error.hpp"
 #include "piezoshift/io/csv_table.hpp"
 #include "piezoshift/io/csv_writer.hpp"
-#include "piezoshift/io/input_error.hpp"
 #include "piezoshift/plant/simulation_cost.hpp"
 #include "piezoshift/plant/twin.hpp"
+#include "piezoshift/rig/bench.hpp"
 #include "piezoshift/runtime/safety_ranges.hpp"
 #include "piezoshift/runtime/safety_supervisor.hpp"
 #include "piezoshift/runtime/setpoint_profile.hpp"
@@ -97,19 +97,19 @@ void check_options(const SimulateOptions& opt) {
   const int modes = (opt.open_loop_volts.empty() ? 0 : 1) + (opt.step_um ? 1 : 0) +
                     (opt.profile_path.empty() ? 0 : 1);
   if (modes != 1) {
-    throw io::InputError("simulate: give exactly one of --open-loop-volts, --step-um, --profile");
+    throw core::InputError("simulate: give exactly one of --open-loop-volts, --step-um, --profile");
   }
   if (!std::isfinite(opt.duration_s) || !(opt.duration_s > 0.0))
-    throw io::InputError(fmt::format("--duration-s = {} must be positive", opt.duration_s));
+    throw core::InputError(fmt::format("--duration-s = {} must be positive", opt.duration_s));
   if (!(opt.max_physics_steps >= 1.0 && opt.max_physics_steps <= 1e15))
-    throw io::InputError(
+    throw core::InputError(
         fmt::format("--max-physics-steps = {} must be in [1, 1e15]", opt.max_physics_steps));
   if (!std::isfinite(opt.step_at_s) || opt.step_at_s < 0.0)
-    throw io::InputError(fmt::format("--step-at-s = {} must be >= 0", opt.step_at_s));
+    throw core::InputError(fmt::format("--step-at-s = {} must be >= 0", opt.step_at_s));
   if (opt.step_um && !std::isfinite(*opt.step_um))
-    throw io::InputError("--step-um must be a finite number");
+    throw core::InputError("--step-um must be a finite number");
   if (!opt.calibration.empty() && !opt.open_loop_volts.empty())
-    throw io::InputError("--calibration: open loop (--open-loop-volts) runs no controller");
+    throw core::InputError("--calibration: open loop (--open-loop-volts) runs no controller");
 }
 
 // The supervisor (the bench's, as `run`'s, with the config's [safety]) passes 0 to 10 DAQ volts by
@@ -119,7 +119,7 @@ Vec3 open_loop_volts(const SimulateOptions& opt, const runtime::SafetyLimits& li
   for (std::size_t i = 0; i < 3; ++i) {
     const double v = opt.open_loop_volts[i];
     if (!std::isfinite(v) || v < limits.output_min_V || v > limits.output_max_V) {
-      throw io::InputError(
+      throw core::InputError(
           fmt::format("--open-loop-volts: V{} = {} is outside the supervisor's {} to {} V", i + 1,
                       v, limits.output_min_V, limits.output_max_V));
     }
@@ -134,7 +134,7 @@ void check_cost(const SimulateOptions& opt, const config::ProjectConfig& config)
   if (const std::string p =
           plant::simulation_budget_problem(cost, opt.max_physics_steps, "--max-physics-steps");
       !p.empty()) {
-    throw io::InputError(
+    throw core::InputError(
         fmt::format("--duration-s {} with physics_rate_Hz {} and sample_time_s {} ({}): {}",
                     opt.duration_s, config.twin.physics_rate_Hz, config.twin.daq.sample_time_s,
                     opt.config_path.empty() ? "built-in configuration" : opt.config_path, p));
@@ -142,7 +142,7 @@ void check_cost(const SimulateOptions& opt, const config::ProjectConfig& config)
 }
 
 // One log row: the tick's signals and the twin's state at its end (log_columns' order).
-void log_tick(io::CsvWriter& log, std::vector<double>& row, const experiments::Bench& bench,
+void log_tick(io::CsvWriter& log, std::vector<double>& row, const rig::Bench& bench,
               bool closed_loop, const Vec3& zd) {
   const plant::Twin& twin = bench.twin();
   const runtime::CycleSample& c = bench.last_cycle();
@@ -178,8 +178,8 @@ struct SimulateRun {
   std::string calibration;  // closed loop: where the controller came from
 };
 
-int report(const SimulateOptions& opt, const config::ProjectConfig& config,
-           const experiments::Bench& bench, const SimulateRun& run) {
+int report(const SimulateOptions& opt, const config::ProjectConfig& config, const rig::Bench& bench,
+           const SimulateRun& run) {
   const plant::Twin& twin = bench.twin();
   const bool closed_loop = opt.open_loop_volts.empty();
   const double period_s = run.period_s;
@@ -285,8 +285,8 @@ int run_simulate(const SimulateOptions& opt) {
   check_cost(opt, config);
   run.ticks = static_cast<std::uint64_t>(std::llround(opt.duration_s / period_s));
   if (run.ticks < 1)
-    throw io::InputError(fmt::format("--duration-s = {} is shorter than one control period ({} s)",
-                                     opt.duration_s, period_s));
+    throw core::InputError(fmt::format(
+        "--duration-s = {} is shorter than one control period ({} s)", opt.duration_s, period_s));
 
   // `run`'s controller: the file, or the twin calibrated first (open loop needs none).
   control::SemiClosedLoopParams cp;
@@ -297,16 +297,16 @@ int run_simulate(const SimulateOptions& opt) {
     run.calibration = lc.source;
   }
   cp.sample_time_s = period_s;  // the gains re-expressed at the twin's DAQ period
-  std::unique_ptr<experiments::Bench> made;
+  std::unique_ptr<rig::Bench> made;
   try {
-    experiments::BenchOptions bo;
+    rig::BenchOptions bo;
     bo.limits = limits;
-    made = std::make_unique<experiments::Bench>(config, cp, opt.seed, bo);
+    made = std::make_unique<rig::Bench>(config, cp, opt.seed, bo);
   } catch (const std::invalid_argument& e) {
-    throw io::InputError(fmt::format(
+    throw core::InputError(fmt::format(
         "{}: {}", opt.config_path.empty() ? "configuration" : opt.config_path, e.what()));
   }
-  experiments::Bench& bench = *made;
+  rig::Bench& bench = *made;
 
   std::unique_ptr<io::CsvWriter> log;
   if (!opt.log_path.empty()) {

@@ -14,6 +14,7 @@
 #include "bindings.hpp"
 #include "piezoshift/control/parameter_check.hpp"
 #include "piezoshift/control/semi_closed_loop.hpp"
+#include "piezoshift/core/input_error.hpp"
 #include "values.hpp"
 
 namespace py = pybind11;
@@ -37,14 +38,14 @@ template <std::size_t N>
 void check_list(const std::vector<double>& v, const char* name, bool (*ok)(double),
                 const char* rule, bool increasing = false) {
   if (v.size() > N)
-    throw ps::io::InputError(std::string(name) + ": at most " + std::to_string(N) +
-                             " values, not " + std::to_string(v.size()));
+    throw ps::core::InputError(std::string(name) + ": at most " + std::to_string(N) +
+                               " values, not " + std::to_string(v.size()));
   for (std::size_t i = 0; i < v.size(); ++i) {
     if (ok(v[i]) && !(increasing && i > 0 && !(v[i] > v[i - 1])))
       continue;
     std::ostringstream what;
     what << name << "[" << i << "] = " << v[i] << ": " << rule;
-    throw ps::io::InputError(what.str());
+    throw ps::core::InputError(what.str());
   }
 }
 
@@ -78,9 +79,9 @@ void set_weights(Hc& p, const std::vector<double>& w) {
 void set_same_count(Hc& p, const std::vector<double>& v, const char* name,
                     void (*set)(Hc&, const std::vector<double>&)) {
   if (v.size() != p.operators)
-    throw ps::io::InputError(std::string(name) + ": " + std::to_string(v.size()) + " values for " +
-                             std::to_string(p.operators) +
-                             " operators (set_operators(threshold_um, weight) changes how many)");
+    throw ps::core::InputError(std::string(name) + ": " + std::to_string(v.size()) +
+                               " values for " + std::to_string(p.operators) +
+                               " operators (set_operators(threshold_um, weight) changes how many)");
   set(p, v);
 }
 
@@ -104,8 +105,9 @@ void bind_model(py::module_& m) {
           "set_operators",
           [](Hc& p, const std::vector<double>& r, const std::vector<double>& w) {
             if (r.size() != w.size())
-              throw ps::io::InputError("set_operators: " + std::to_string(w.size()) +
-                                       " weights for " + std::to_string(r.size()) + " thresholds");
+              throw ps::core::InputError("set_operators: " + std::to_string(w.size()) +
+                                         " weights for " + std::to_string(r.size()) +
+                                         " thresholds");
             Hc q = p;  // p unchanged when a list is refused
             set_thresholds(q, r);
             set_weights(q, w);
@@ -156,8 +158,8 @@ void bind_improved(py::module_& m) {
           },
           [](c::ShaperParams& s, const std::vector<double>& w) {
             if (w.empty() || w.size() > c::kMaxShaperTaps)
-              throw ps::io::InputError("taps: 1 to " + std::to_string(c::kMaxShaperTaps) +
-                                       " weights");
+              throw ps::core::InputError("taps: 1 to " + std::to_string(c::kMaxShaperTaps) +
+                                         " weights");
             s.weight = {};
             std::copy(w.begin(), w.end(), s.weight.begin());
             s.taps = w.size();

@@ -1,4 +1,4 @@
-// Bindings of the errors bad input raises, with the C++ message: io::InputError becomes
+// Bindings of the errors bad input raises, with the C++ message: core::InputError becomes
 // piezoshift.InputError, a ValueError so that `except ValueError` catches bad input too;
 // calibration::FitError and experiments::MetricsError become FitError and MetricsError, both
 // InputErrors. std::invalid_argument is pybind11's own ValueError.
@@ -8,14 +8,14 @@
 
 #include "bindings.hpp"
 #include "piezoshift/calibration/fit_error.hpp"
+#include "piezoshift/core/input_error.hpp"
 #include "piezoshift/experiments/metrics_error.hpp"
-#include "piezoshift/io/input_error.hpp"
 
 namespace piezoshift::python {
 
 void bind_errors(py::module_& m) {
   namespace ps = piezoshift;
-  static py::exception<ps::io::InputError> input_error(m, "InputError", PyExc_ValueError);
+  static py::exception<ps::core::InputError> input_error(m, "InputError", PyExc_ValueError);
   static py::exception<ps::calibration::FitError> fit_error(m, "FitError", input_error.ptr());
   static py::exception<ps::experiments::MetricsError> metrics_error(m, "MetricsError",
                                                                     input_error.ptr());
@@ -27,7 +27,7 @@ void bind_errors(py::module_& m) {
       fit_error(e.what());
     } catch (const ps::experiments::MetricsError& e) {
       metrics_error(e.what());
-    } catch (const ps::io::InputError& e) {
+    } catch (const ps::core::InputError& e) {
       input_error(e.what());
     }
   });

@@ -9,11 +9,11 @@
 
 #include "bindings.hpp"
 #include "piezoshift/config/project_config.hpp"
-#include "piezoshift/experiments/bench.hpp"
 #include "piezoshift/experiments/metrics_linearity.hpp"
 #include "piezoshift/experiments/metrics_repeatability.hpp"
 #include "piezoshift/experiments/metrics_step_response.hpp"
 #include "piezoshift/experiments/paper_experiments.hpp"
+#include "piezoshift/rig/bench.hpp"
 #include "values.hpp"
 
 namespace piezoshift::python {
@@ -21,35 +21,36 @@ namespace piezoshift::python {
 namespace {
 
 namespace ex = ps::experiments;
+namespace rig = ps::rig;
 using Scl = ps::control::SemiClosedLoopParams;
 
 void bind_bench(py::module_& m) {
-  py::enum_<ex::DriveMode>(m, "DriveMode")
-      .value("OPEN_LOOP", ex::DriveMode::kOpenLoop)
-      .value("ACTUATORS", ex::DriveMode::kActuators)
-      .value("POINTS", ex::DriveMode::kPoints);
-  using Sm = ex::StaticMeasurement;
+  py::enum_<rig::DriveMode>(m, "DriveMode")
+      .value("OPEN_LOOP", rig::DriveMode::kOpenLoop)
+      .value("ACTUATORS", rig::DriveMode::kActuators)
+      .value("POINTS", rig::DriveMode::kPoints);
+  using Sm = rig::StaticMeasurement;
   py::class_<Sm>(m, "StaticMeasurement")
       .PS_V3(Sm, points_um)
       .PS_V3(Sm, sgs_um)
       .PS_RO(Sm, window_end_s);
 
-  py::class_<ex::Bench>(m, "Bench")
+  py::class_<rig::Bench>(m, "Bench")
       .def(py::init<const ps::config::ProjectConfig&, const Scl&, std::uint64_t>(),
            py::arg("config"), py::arg("controller"), py::arg("seed"))
-      .def("set_controller", &ex::Bench::set_controller, py::arg("params"))
-      .def("controller_params", &ex::Bench::controller_params)
-      .def("drive_open_loop", &ex::Bench::drive_open_loop, py::arg("ao_V"))
-      .def("drive_actuators", &ex::Bench::drive_actuators, py::arg("target_um"))
-      .def("drive_points", &ex::Bench::drive_points, py::arg("zd_um"))
+      .def("set_controller", &rig::Bench::set_controller, py::arg("params"))
+      .def("controller_params", &rig::Bench::controller_params)
+      .def("drive_open_loop", &rig::Bench::drive_open_loop, py::arg("ao_V"))
+      .def("drive_actuators", &rig::Bench::drive_actuators, py::arg("target_um"))
+      .def("drive_points", &rig::Bench::drive_points, py::arg("zd_um"))
       .def(
-          "run", [](ex::Bench& b, double duration_s) { b.run(duration_s); }, py::arg("duration_s"))
+          "run", [](rig::Bench& b, double duration_s) { b.run(duration_s); }, py::arg("duration_s"))
       .def(
           "record",
-          [](ex::Bench& b, double duration_s) {
+          [](rig::Bench& b, double duration_s) {
             // run() with every tick's time, true mean of P1..P3 and SGS feedback kept.
             std::vector<double> t, z, fb;
-            b.run(duration_s, [&](const ex::Bench& bb) {
+            b.run(duration_s, [&](const rig::Bench& bb) {
               const auto& p = bb.twin().truth().points_um;
               t.push_back(bb.time_s());
               z.push_back((p[0] + p[1] + p[2]) / 3.0);
@@ -64,13 +65,13 @@ void bind_bench(py::module_& m) {
           },
           py::arg("duration_s"),
           "run() recording per tick: time_s, true mean of P1..P3 and mean SGS feedback [um]")
-      .def("measure_static", &ex::Bench::measure_static)
-      .def_property_readonly("twin", &ex::Bench::twin, py::return_value_policy::reference_internal)
-      .def("last_output", &ex::Bench::last_output)
-      .def_property_readonly("mode", &ex::Bench::mode)
-      .def_property_readonly("time_s", &ex::Bench::time_s)
-      .def_property_readonly("sample_time_s", &ex::Bench::sample_time_s)
-      .def_property_readonly("ticks", &ex::Bench::ticks);
+      .def("measure_static", &rig::Bench::measure_static)
+      .def_property_readonly("twin", &rig::Bench::twin, py::return_value_policy::reference_internal)
+      .def("last_output", &rig::Bench::last_output)
+      .def_property_readonly("mode", &rig::Bench::mode)
+      .def_property_readonly("time_s", &rig::Bench::time_s)
+      .def_property_readonly("sample_time_s", &rig::Bench::sample_time_s)
+      .def_property_readonly("ticks", &rig::Bench::ticks);
 }
 
 void bind_metric_results(py::module_& m) {

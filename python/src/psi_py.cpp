@@ -11,7 +11,7 @@
 
 #include "bindings.hpp"
 #include "piezoshift/config/project_config.hpp"
-#include "piezoshift/io/input_error.hpp"
+#include "piezoshift/core/input_error.hpp"
 #include "piezoshift/psi/analysis.hpp"
 #include "piezoshift/psi/simulation.hpp"
 #include "piezoshift/psi/unwrap.hpp"
@@ -32,7 +32,7 @@ py::array_t<double> to_numpy(const psi::Map& m) {
 
 psi::Map map_from(const In& a, const char* name) {
   if (a.ndim() != 2)
-    throw piezoshift::io::InputError(std::string(name) + ": expected a 2-D array");
+    throw piezoshift::core::InputError(std::string(name) + ": expected a 2-D array");
   psi::Map m(static_cast<int>(a.shape(1)), static_cast<int>(a.shape(0)));
   std::copy(a.data(), a.data() + a.size(), m.v.begin());
   return m;
@@ -40,10 +40,10 @@ psi::Map map_from(const In& a, const char* name) {
 
 std::vector<psi::Map> frames_from(const In& a) {
   if (a.ndim() != 3 || a.shape(0) < 3)
-    throw piezoshift::io::InputError("frames: expected an (N, H, W) array with N >= 3");
+    throw piezoshift::core::InputError("frames: expected an (N, H, W) array with N >= 3");
   const auto h = a.shape(1), w = a.shape(2);
   if (h < 1 || w < 1 || h > 2048 || w > 2048)
-    throw piezoshift::io::InputError("frames: each side 1..2048 pixels");
+    throw piezoshift::core::InputError("frames: each side 1..2048 pixels");
   std::vector<psi::Map> frames;
   for (py::ssize_t k = 0; k < a.shape(0); ++k) {
     psi::Map m(static_cast<int>(w), static_cast<int>(h));
@@ -58,7 +58,7 @@ psi::Mask mask_from(const py::object& o, int w, int h) {
     return psi::Mask(w, h, 1);
   const psi::Map m = map_from(o.cast<In>(), "mask");
   if (m.width != w || m.height != h)
-    throw piezoshift::io::InputError("mask: not the frames' size");
+    throw piezoshift::core::InputError("mask: not the frames' size");
   psi::Mask mask(w, h, 0);
   for (std::size_t p = 0; p < m.size(); ++p)
     mask.v[p] = m.v[p] != 0.0 ? 1 : 0;
@@ -91,7 +91,7 @@ psi::Analysis analyze(const std::vector<psi::Map>& frames, const psi::Mask& mask
   try {
     return psi::analyze_frames(frames, mask, o);
   } catch (const std::invalid_argument& e) {
-    throw piezoshift::io::InputError(std::string("psi: ") + e.what());
+    throw piezoshift::core::InputError(std::string("psi: ") + e.what());
   }
 }
 
@@ -110,8 +110,8 @@ void bind_psi(py::module_& m) {
         o.phase.algorithm = psi::parse_algorithm(algorithm);
         const int need = psi::required_frames(o.phase.algorithm);
         if (need > 0 && static_cast<std::size_t>(need) != frames.size())
-          throw piezoshift::io::InputError(algorithm + " needs " + std::to_string(need) +
-                                           " frames");
+          throw piezoshift::core::InputError(algorithm + " needs " + std::to_string(need) +
+                                             " frames");
         o.phase.steps_rad = steps_rad;
         o.wavelength_nm = wavelength_nm;
         o.removal = remove_power ? psi::Removal::kTiltAndPower : psi::Removal::kTilt;
@@ -130,7 +130,7 @@ void bind_psi(py::module_& m) {
         psi::SimulationParams p;
         p.algorithm = psi::parse_algorithm(algorithm);
         if (size_px < 32 || size_px > 2048)
-          throw piezoshift::io::InputError("size_px: must be in 32..2048");
+          throw piezoshift::core::InputError("size_px: must be in 32..2048");
         p.fizeau.width_px = p.fizeau.height_px = size_px;
         p.fizeau.pupil_radius_px = 0.47 * size_px;
         p.seed = seed;
@@ -179,7 +179,7 @@ void bind_psi(py::module_& m) {
         try {
           return psi::fit_zernike(s, mask, terms);
         } catch (const std::invalid_argument& e) {
-          throw piezoshift::io::InputError(std::string("zernike_fit: ") + e.what());
+          throw piezoshift::core::InputError(std::string("zernike_fit: ") + e.what());
         }
       },
       py::arg("surface"), py::arg("mask") = py::none(), py::arg("terms") = 37,

@@ -10,7 +10,7 @@
 #include <vector>
 
 #include "piezoshift/control/vec3.hpp"
-#include "piezoshift/io/input_error.hpp"
+#include "piezoshift/core/input_error.hpp"
 
 namespace piezoshift::python {
 
@@ -59,14 +59,14 @@ inline Array to_numpy(const std::vector<Vec3>& rows) {
 // A 1-D float array from anything numpy can convert (lists, arrays of any dtype).
 inline std::vector<double> from_numpy_1d(const InArray& a, const char* name) {
   if (a.ndim() != 1)
-    throw ps::io::InputError(std::string(name) + ": expected a 1-D array");
+    throw ps::core::InputError(std::string(name) + ": expected a 1-D array");
   return {a.data(), a.data() + a.size()};
 }
 
 // An n x 3 array (rows P1..P3 or S1..S3) into Vec3 rows.
 inline std::vector<Vec3> from_numpy_n3(const InArray& a, const char* name) {
   if (a.ndim() != 2 || a.shape(1) != 3) {
-    throw ps::io::InputError(std::string(name) + ": expected an n x 3 array");
+    throw ps::core::InputError(std::string(name) + ": expected an n x 3 array");
   }
   std::vector<Vec3> rows(static_cast<std::size_t>(a.shape(0)));
   auto r = a.unchecked<2>();

@@ -9,9 +9,10 @@
 #include <fmt/core.h>
 
 #include "piezoshift/calibration/controller_ranges.hpp"
+#include "piezoshift/core/bounds.hpp"
+#include "piezoshift/core/input_error.hpp"
 #include "piezoshift/io/atomic_file.hpp"
 #include "piezoshift/io/config_file.hpp"
-#include "piezoshift/io/input_error.hpp"
 
 namespace piezoshift::calibration {
 
@@ -19,7 +20,7 @@ namespace {
 
 [[noreturn]] void fail(const io::ConfigFile& file, std::string_view section, std::string_view key,
                        const std::string& why) {
-  throw io::InputError(fmt::format("{}: [{}] {}: {}", file.source(), section, key, why));
+  throw core::InputError(fmt::format("{}: [{}] {}: {}", file.source(), section, key, why));
 }
 
 // Reads each number of the field list (controller_ranges.hpp) that the file holds, within its
@@ -28,20 +29,20 @@ class FieldReader {
  public:
   explicit FieldReader(const io::ConfigFile& file) : file_(file) {}
 
-  void operator()(std::string_view section, std::string_view key, double& v, const io::Bounds& b,
+  void operator()(std::string_view section, std::string_view key, double& v, const core::Bounds& b,
                   std::string_view note) const {
     if (!file_.section(section).read(key, v, b) && note.starts_with("required"))
       fail(file_, section, key, fmt::format("missing ({})", note));
   }
   void operator()(std::string_view section, std::string_view key, std::size_t& v,
-                  const io::Bounds& b, std::string_view) const {
+                  const core::Bounds& b, std::string_view) const {
     auto whole = static_cast<std::int64_t>(v);
     if (file_.section(section).read(key, whole, b))
       v = static_cast<std::size_t>(whole);
   }
   template <class Count>
   void operator()(std::string_view section, std::string_view key, const ListField<double, Count>& f,
-                  const io::Bounds& b, std::string_view) const {
+                  const core::Bounds& b, std::string_view) const {
     std::vector<double> values;
     const bool present = file_.section(section).read(key, values, f.capacity, b);
     if (f.same_count_as != nullptr && values.size() != *f.count)
@@ -84,13 +85,13 @@ class FieldWriter {
   explicit FieldWriter(std::string& out) : out_(out) {}
 
   template <class Value>
-  void operator()(std::string_view, std::string_view key, const Value& v, const io::Bounds&,
+  void operator()(std::string_view, std::string_view key, const Value& v, const core::Bounds&,
                   std::string_view note) const {
     out_ += fmt::format("{} = {}{}\n", key, v, comment(note));
   }
   template <class Count>
   void operator()(std::string_view, std::string_view key, const ListField<const double, Count>& f,
-                  const io::Bounds&, std::string_view note) const {
+                  const core::Bounds&, std::string_view note) const {
     out_ += fmt::format("{} = {}{}\n", key, number_list(f.values, *f.count), comment(note));
   }
 
@@ -144,15 +145,15 @@ control::SemiClosedLoopParams load_calibration_file(const std::string& path,
   control::SemiClosedLoopParams params;
   read_controller_section(file, params);
   double z_max_um = 0.0, z_min_um = 0.0;
-  const bool has_max = file.section("travel").read("z_max_um", z_max_um, io::Bounds::positive());
+  const bool has_max = file.section("travel").read("z_max_um", z_max_um, core::Bounds::positive());
   const bool has_min =
-      file.section("travel").read("z_min_um", z_min_um, io::Bounds::non_negative());
+      file.section("travel").read("z_min_um", z_min_um, core::Bounds::non_negative());
   file.reject_unknown();
   if (const std::string why = controller_problem(params, own_sample_time_s(params)); !why.empty())
-    throw io::InputError(fmt::format("{}: {}", path, why));
+    throw core::InputError(fmt::format("{}: {}", path, why));
   if (has_min && has_max && !(z_min_um < z_max_um))
-    throw io::InputError(fmt::format("{}: [travel] z_min_um = {} must be below z_max_um = {}", path,
-                                     z_min_um, z_max_um));
+    throw core::InputError(fmt::format("{}: [travel] z_min_um = {} must be below z_max_um = {}",
+                                       path, z_min_um, z_max_um));
   if (travel_z_max_um != nullptr)
     *travel_z_max_um = has_max ? std::optional<double>(z_max_um) : std::nullopt;
   if (travel_z_min_um != nullptr)

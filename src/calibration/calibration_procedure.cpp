@@ -2,7 +2,7 @@
 
 #include <fmt/core.h>
 
-#include "piezoshift/io/input_error.hpp"
+#include "piezoshift/core/input_error.hpp"
 
 namespace piezoshift::calibration {
 
@@ -18,7 +18,7 @@ CalibrationOptions CalibrationOptions::paper_gains_only() {
 
 CalibrationWithTravel calibrate_with_travel(const config::ProjectConfig& config, std::uint64_t seed,
                                             const CalibrationOptions& options,
-                                            const experiments::Progress& progress) {
+                                            const rig::Progress& progress) {
   CalibrationWithTravel out;
   control::SemiClosedLoopParams base;
   base.sample_time_s = config.twin.daq.sample_time_s;  // the controller runs at the DAQ's rate
@@ -26,7 +26,7 @@ CalibrationWithTravel calibrate_with_travel(const config::ProjectConfig& config,
   out.travel =
       experiments::run_travel_range(config, out.calibration.controller, seed + 3, options.travel);
   if (!(out.travel.single_move_um > 0.0))
-    throw experiments::ProcedureFailed(
+    throw rig::ProcedureFailed(
         fmt::format("calibration: the calibrated loop has no semi-closed-loop travel: {}",
                     out.travel.validity.reason));
   return out;
@@ -34,8 +34,7 @@ CalibrationWithTravel calibrate_with_travel(const config::ProjectConfig& config,
 
 CalibrationOutcome calibrate(const config::ProjectConfig& config,
                              const control::SemiClosedLoopParams& base, std::uint64_t seed,
-                             const CalibrationOptions& options,
-                             const experiments::Progress& progress) {
+                             const CalibrationOptions& options, const rig::Progress& progress) {
   CalibrationOutcome out;
   // Stage 1: the inner loops.
   out.pid = tune_pid(config, base, seed, options.pid_tuning, progress);
@@ -47,24 +46,24 @@ CalibrationOutcome calibrate(const config::ProjectConfig& config,
   out.controller.polynomial = control::CubicPolynomial::identity();
   out.controller.matrix = control::TransmissionMatrix::identity();
   // A stage whose supervisor tripped measured nothing: the calibration cannot go on.
-  const auto check = [](const experiments::Bench& bench, const char* stage) {
+  const auto check = [](const rig::Bench& bench, const char* stage) {
     if (bench.faulted()) {
       const runtime::FaultRecord& f = bench.fault();
-      throw experiments::ProcedureFailed(
+      throw rig::ProcedureFailed(
           fmt::format("calibration {}: the safety supervisor tripped ({}, channel {}, at {:.3f} s)",
                       stage, runtime::to_string(f.reason), f.channel + 1,
                       static_cast<double>(f.tick) * bench.sample_time_s()));
     }
   };
   {
-    experiments::Bench bench(config, out.controller, seed + 1);
+    rig::Bench bench(config, out.controller, seed + 1);
     out.matrix = identify_matrix(bench, options.matrix, progress);
     check(bench, "stage 2 (matrix A)");
   }
   out.controller.matrix = out.matrix.fit.a;
   // Stage 3: p, with the gains and A in place.
   {
-    experiments::Bench bench(config, out.controller, seed + 2);
+    rig::Bench bench(config, out.controller, seed + 2);
     out.polynomial = identify_polynomial(bench, options.polynomial, progress);
     check(bench, "stage 3 (polynomial p)");
   }

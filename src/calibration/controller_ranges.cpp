@@ -11,6 +11,7 @@
 
 #include "piezoshift/calibration/stability_margins.hpp"
 #include "piezoshift/control/parameter_check.hpp"
+#include "piezoshift/core/bounds.hpp"
 
 namespace piezoshift::calibration {
 
@@ -22,22 +23,22 @@ class RangeCheck {
   std::string problem;
 
   void operator()(std::string_view section, std::string_view key, const double& v,
-                  const io::Bounds& b, std::string_view) {
-    note(section, key, design::range_problem(key, v, b));
+                  const core::Bounds& b, std::string_view) {
+    note(section, key, core::range_problem(key, v, b));
   }
   void operator()(std::string_view section, std::string_view key, const std::size_t& v,
-                  const io::Bounds& b, std::string_view) {
-    note(section, key, design::range_problem(key, static_cast<std::int64_t>(v), b));
+                  const core::Bounds& b, std::string_view) {
+    note(section, key, core::range_problem(key, static_cast<std::int64_t>(v), b));
   }
   template <class Value, class Count>
   void operator()(std::string_view section, std::string_view key, const ListField<Value, Count>& f,
-                  const io::Bounds& b, std::string_view) {
+                  const core::Bounds& b, std::string_view) {
     if (*f.count > f.capacity) {
       note(section, key, fmt::format("{}: {} values, at most {}", key, *f.count, f.capacity));
       return;
     }
     for (std::size_t i = 0; i < *f.count && problem.empty(); ++i)
-      note(section, key, design::range_problem(fmt::format("{}[{}]", key, i), f.values[i], b));
+      note(section, key, core::range_problem(fmt::format("{}[{}]", key, i), f.values[i], b));
   }
 
  private:

@@ -6,8 +6,8 @@
 #include <fmt/core.h>
 #include <Eigen/Dense>
 
-#include "piezoshift/experiments/validity.hpp"
-#include "piezoshift/io/input_error.hpp"
+#include "piezoshift/core/input_error.hpp"
+#include "piezoshift/rig/validity.hpp"
 
 namespace piezoshift::calibration {
 
@@ -42,7 +42,7 @@ std::string instruction(const GuidedStep& s) {
 
 // Why the reading is implausible, or nothing.
 std::optional<std::string> check(const std::vector<GuidedStep>& plan, const GuidedSession& session,
-                                 std::size_t k, double reading, const RigWindow& w,
+                                 std::size_t k, double reading, const rig::RigWindow& w,
                                  const control::Mat3& a0, const GuidedOptions& o) {
   const GuidedStep& s = plan[k];
   if (s.stage == 2 && !s.moved) {
@@ -165,7 +165,7 @@ std::string describe(const GuidedStep& s, const GuidedOptions& o) {
                             s.actuator + 1));
 }
 
-GuidedOutcome run_guided_calibration(GuidedRig& stage2, GuidedRig& stage3,
+GuidedOutcome run_guided_calibration(rig::GuidedRig& stage2, rig::GuidedRig& stage3,
                                      const control::SemiClosedLoopParams& base,
                                      GuidedSession& session, GuidedIo& io, const GuidedOptions& o) {
   const std::vector<GuidedStep> plan = guided_plan(o);
@@ -187,16 +187,16 @@ GuidedOutcome run_guided_calibration(GuidedRig& stage2, GuidedRig& stage3,
   inner.polynomial = control::CubicPolynomial::identity();
   stage2.set_controller(inner);
 
-  const auto fail_on_fault = [](const GuidedRig& rig, int stage) {
-    const std::string f = rig.fault();
+  const auto fail_on_fault = [](const rig::GuidedRig& driven, int stage) {
+    const std::string f = driven.fault();
     if (!f.empty())
-      throw experiments::ProcedureFailed(fmt::format("calibration stage {} ({}): {}", stage,
-                                                     stage == 2 ? "matrix A" : "polynomial p", f));
+      throw rig::ProcedureFailed(fmt::format("calibration stage {} ({}): {}", stage,
+                                             stage == 2 ? "matrix A" : "polynomial p", f));
   };
 
   for (std::size_t k = 0; k < plan.size(); ++k) {
     const GuidedStep& s = plan[k];
-    GuidedRig& rig = s.stage == 2 ? stage2 : stage3;
+    rig::GuidedRig& driven = s.stage == 2 ? stage2 : stage3;
     const bool first_of_stage3 = s.stage == 3 && plan[k - 1].stage == 2;  // stage 2 comes first
     if (first_of_stage3) {
       out.matrix = fit_stage2(session, o);
@@ -206,20 +206,20 @@ GuidedOutcome run_guided_calibration(GuidedRig& stage2, GuidedRig& stage3,
       stage3.set_controller(p);
     }
     const bool taking = k >= recorded;
-    if (!taking && !rig.replays())
+    if (!taking && !driven.replays())
       continue;
     const bool new_position = k == 0 || plan[k - 1].optics != s.optics || k == recorded;
     if (taking && new_position)
       io.say(instruction(s));
     if (first_of_stage3)
-      rig.rest(o.polynomial.settle_s);
+      driven.rest(o.polynomial.settle_s);
     if (s.stage == 2)
-      rig.drive_actuators(s.setpoint_um);
+      driven.drive_actuators(s.setpoint_um);
     else
-      rig.drive_points(s.setpoint_um);
-    rig.settle(s.stage == 2 ? o.matrix.settle_s : o.polynomial.settle_s);
-    const RigWindow w = rig.measure();
-    fail_on_fault(rig, s.stage);
+      driven.drive_points(s.setpoint_um);
+    driven.settle(s.stage == 2 ? o.matrix.settle_s : o.polynomial.settle_s);
+    const rig::RigWindow w = driven.measure();
+    fail_on_fault(driven, s.stage);
     if (!taking)
       continue;
 
@@ -247,8 +247,8 @@ GuidedOutcome run_guided_calibration(GuidedRig& stage2, GuidedRig& stage3,
           break;
         }
         if (!io.source.can_retry())
-          throw io::InputError(fmt::format("{}: reading {} ({}) refused: {}", io.source.name(),
-                                           k + 1, req.what, *why));
+          throw core::InputError(fmt::format("{}: reading {} ({}) refused: {}", io.source.name(),
+                                             k + 1, req.what, *why));
         io.source.refuse(*why);
       }
     }

@@ -7,8 +7,8 @@
 #include <fmt/core.h>
 #include <nlohmann/json.hpp>
 
+#include "piezoshift/core/input_error.hpp"
 #include "piezoshift/io/atomic_file.hpp"
-#include "piezoshift/io/input_error.hpp"
 
 namespace piezoshift::calibration {
 
@@ -23,17 +23,17 @@ std::optional<GuidedSession> load_guided_session(const std::string& path) {
     return std::nullopt;
   const auto size = std::filesystem::file_size(path, ec);
   if (ec || size > kMaxBytes)
-    throw io::InputError(
+    throw core::InputError(
         fmt::format("{}: not a readable session file of at most {} bytes", path, kMaxBytes));
   std::ifstream in(path, std::ios::binary);
   std::stringstream text;
   text << in.rdbuf();
   if (!in && !in.eof())
-    throw io::InputError(fmt::format("{}: cannot read the session file", path));
+    throw core::InputError(fmt::format("{}: cannot read the session file", path));
   try {
     const nlohmann::json j = nlohmann::json::parse(text.str());
     if (j.at("format").get<std::string>() != kFormat)
-      throw io::InputError(fmt::format("{}: not a {}", path, kFormat));
+      throw core::InputError(fmt::format("{}: not a {}", path, kFormat));
     GuidedSession s;
     s.plan = j.at("plan").get<std::string>();
     s.steps = j.at("steps").get<std::size_t>();
@@ -45,20 +45,20 @@ std::optional<GuidedSession> load_guided_session(const std::string& path) {
         e.reading_um = r.at("reading_um").get<double>();
       const auto& sgs = r.at("sgs_um");
       if (sgs.size() != 3)
-        throw io::InputError(fmt::format("{}: step {}: sgs_um needs 3 numbers", path, e.step));
+        throw core::InputError(fmt::format("{}: step {}: sgs_um needs 3 numbers", path, e.step));
       for (std::size_t i = 0; i < 3; ++i)
         e.sgs_um[i] = sgs.at(i).get<double>();
       e.window_start_s = r.at("window_start_s").get<double>();
       e.window_end_s = r.at("window_end_s").get<double>();
       e.saturated = r.at("saturated").get<bool>();
       if (e.step != s.readings.size() || e.step >= s.steps)
-        throw io::InputError(
+        throw core::InputError(
             fmt::format("{}: step {} out of order (expected {})", path, e.step, s.readings.size()));
       s.readings.push_back(e);
     }
     return s;
   } catch (const nlohmann::json::exception& e) {
-    throw io::InputError(fmt::format("{}: not a session file: {}", path, e.what()));
+    throw core::InputError(fmt::format("{}: not a session file: {}", path, e.what()));
   }
 }
 

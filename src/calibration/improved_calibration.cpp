@@ -6,9 +6,9 @@
 #include <cmath>
 #include <numbers>
 
-#include "piezoshift/experiments/bench.hpp"
-#include "piezoshift/experiments/validity.hpp"
 #include "piezoshift/plant/amplifier.hpp"
+#include "piezoshift/rig/bench.hpp"
+#include "piezoshift/rig/validity.hpp"
 
 namespace piezoshift::calibration {
 
@@ -125,14 +125,14 @@ ImprovedCalibrationOutcome calibrate_improved(const config::ProjectConfig& confi
                                               const control::SemiClosedLoopParams& base,
                                               std::uint64_t seed,
                                               const ImprovedCalibrationOptions& options,
-                                              const experiments::Progress& progress) {
+                                              const rig::Progress& progress) {
   ImprovedCalibrationOutcome out;
   out.static_map = calibrate(config, base, seed, options.paper, progress);
   const control::SemiClosedLoopParams& paper = out.static_map.controller;
 
   // Stage 4: the channel models from an open-loop excitation.
   {
-    experiments::Bench bench(config, paper, seed + 4);
+    rig::Bench bench(config, paper, seed + 4);
     const double T = bench.sample_time_s();
     const auto ticks = static_cast<std::size_t>(std::llround(improved_excitation_duration_s() / T));
     for (std::size_t k = 0; k < ticks; ++k) {
@@ -151,7 +151,7 @@ ImprovedCalibrationOutcome calibrate_improved(const config::ProjectConfig& confi
       }
     }
     if (bench.faulted())
-      throw experiments::ProcedureFailed(
+      throw rig::ProcedureFailed(
           fmt::format("improved calibration: the excitation tripped the supervisor ({})",
                       runtime::to_string(bench.fault().reason)));
     for (std::size_t i = 0; i < 3; ++i)
@@ -164,7 +164,7 @@ ImprovedCalibrationOutcome calibrate_improved(const config::ProjectConfig& confi
   // samples: x_k = a1 x_{k-1} + a2 x_{k-2} + c, a damped cosine's recursion, gives cos(theta)
   // = a1 / (2 sqrt(-a2)) at the interferometer's rate, folded like any sampled mode.
   {
-    experiments::Bench bench(config, paper, seed + 5);
+    rig::Bench bench(config, paper, seed + 5);
     const auto volts = [&](double u) {
       control::Vec3 v{};
       for (std::size_t i = 0; i < 3; ++i)
@@ -176,7 +176,7 @@ ImprovedCalibrationOutcome calibrate_improved(const config::ProjectConfig& confi
     bench.drive_open_loop(volts(options.mode_step_from_um + options.mode_step_um));
     double last_t = -1.0;
     const double step_t = bench.time_s();
-    bench.run(options.mode_record_s, [&](const experiments::Bench& b) {
+    bench.run(options.mode_record_s, [&](const rig::Bench& b) {
       const plant::InterferometerReading& r = b.twin().interferometer();
       if (r.dynamic_time_s != last_t) {
         last_t = r.dynamic_time_s;

@@ -9,10 +9,12 @@
 
 #include <fmt/core.h>
 
+#include "piezoshift/core/input_error.hpp"
 #include "piezoshift/io/csv_table.hpp"
-#include "piezoshift/io/input_error.hpp"
 
 namespace piezoshift::calibration {
+
+using control::Vec3;
 
 const char* to_string(Optics optics) noexcept {
   switch (optics) {
@@ -94,7 +96,7 @@ std::optional<double> LogFileSource::read(const ReadingRequest& r) {
   std::error_code ec;
   const auto size = std::filesystem::file_size(path_, ec);
   if (!ec && size > max_bytes_)
-    throw io::InputError(fmt::format("{}: the log is larger than {} bytes", path_, max_bytes_));
+    throw core::InputError(fmt::format("{}: the log is larger than {} bytes", path_, max_bytes_));
   const io::CsvTable t = io::CsvTable::load(path_);
   t.require_columns({"t_s", "displacement_um"});
   const std::vector<double> time = t.column("t_s");
@@ -109,12 +111,12 @@ std::optional<double> LogFileSource::read(const ReadingRequest& r) {
     }
   }
   if (last < r.window.end_s)
-    throw io::InputError(
+    throw core::InputError(
         fmt::format("{}: the log ends at t_s {:.3f}, before the end of the window {:.3f} s ({})",
                     path_, last, r.window.end_s, r.what));
   if (n == 0)
-    throw io::InputError(fmt::format("{}: no row with t_s between {:.3f} and {:.3f} s ({})", path_,
-                                     r.window.start_s, r.window.end_s, r.what));
+    throw core::InputError(fmt::format("{}: no row with t_s between {:.3f} and {:.3f} s ({})",
+                                       path_, r.window.start_s, r.window.end_s, r.what));
   return sum / static_cast<double>(n);
 }
 

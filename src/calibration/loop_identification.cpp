@@ -8,9 +8,9 @@
 #include <Eigen/Dense>
 
 #include "piezoshift/calibration/fit_error.hpp"
-#include "piezoshift/experiments/bench.hpp"
-#include "piezoshift/experiments/validity.hpp"
 #include "piezoshift/plant/random.hpp"
+#include "piezoshift/rig/bench.hpp"
+#include "piezoshift/rig/validity.hpp"
 
 namespace piezoshift::calibration {
 
@@ -97,7 +97,7 @@ LoopIdentification identify_loop(const config::ProjectConfig& config,
   if (!(o.operating_um >= 0.0 && o.settle_s >= 0.0 && o.amplitude_um > 0.0 && o.duration_s > 0.0 &&
         o.hold_ticks >= 1))
     throw std::invalid_argument("identify_loop: bad options");
-  experiments::Bench bench(config, controller, seed);
+  rig::Bench bench(config, controller, seed);
   bench.drive_actuators(control::Vec3{o.operating_um, o.operating_um, o.operating_um});
   bench.run(o.settle_s);
   LoopIdentification r;
@@ -129,7 +129,7 @@ LoopIdentification identify_loop(const config::ProjectConfig& config,
       y[i].push_back(scaling[i].sgs_to_um(s.ai_V[i]));
   }
   if (bench.faulted())
-    throw experiments::ProcedureFailed(
+    throw rig::ProcedureFailed(
         fmt::format("loop identification: the safety supervisor tripped ({})",
                     runtime::to_string(bench.fault().reason)));
   // y[k] was read at the start of the tick that wrote u[k]: the pair the ARX model expects.

@@ -6,9 +6,8 @@ namespace piezoshift::calibration {
 
 using control::Vec3;
 
-MatrixIdentificationResult identify_matrix(experiments::Bench& bench,
-                                           const MatrixIdentificationOptions& o,
-                                           const experiments::Progress& progress) {
+MatrixIdentificationResult identify_matrix(rig::Bench& bench, const MatrixIdentificationOptions& o,
+                                           const rig::Progress& progress) {
   if (!(o.repeats >= 1) || !(o.move_um > 0.0) || !(o.base_um >= 0.0) || !(o.settle_s >= 0.0)) {
     throw std::invalid_argument("matrix identification: repeats >= 1, move > 0, base >= 0");
   }
@@ -19,12 +18,12 @@ MatrixIdentificationResult identify_matrix(experiments::Bench& bench,
     for (std::size_t i = 0; i < 3; ++i) {
       bench.drive_actuators(base);
       bench.run(o.settle_s);
-      const experiments::StaticMeasurement m0 = bench.measure_static();
+      const rig::StaticMeasurement m0 = bench.measure_static();
       Vec3 moved = base;
       moved[i] += o.move_um;
       bench.drive_actuators(moved);
       bench.run(o.settle_s);
-      const experiments::StaticMeasurement m1 = bench.measure_static();
+      const rig::StaticMeasurement m1 = bench.measure_static();
       Vec3 ds{}, dz{};
       for (std::size_t j = 0; j < 3; ++j) {
         ds[j] = m1.sgs_um[j] - m0.sgs_um[j];

@@ -7,8 +7,9 @@
 #include <stdexcept>
 
 #include "piezoshift/calibration/controller_ranges.hpp"
-#include "piezoshift/experiments/bench.hpp"
+#include "piezoshift/rig/bench.hpp"
 #include "piezoshift/experiments/metrics_step_response.hpp"
+#include "piezoshift/rig/bench.hpp"
 
 namespace piezoshift::calibration {
 namespace {
@@ -57,7 +58,7 @@ Vec3 maximum_step_targets(const config::ProjectConfig& config,
   if (!(step_fraction > 0.0 && step_fraction < 1.0)) {
     throw std::invalid_argument("PID tuning: step_fraction must be in (0, 1)");
   }
-  experiments::Bench bench(config, base, seed);
+  rig::Bench bench(config, base, seed);
   bench.drive_open_loop(Vec3{10.0, 10.0, 10.0});
   bench.run(1.0);
   Vec3 sum{};
@@ -80,7 +81,7 @@ PidTrial score_pid_gains(const config::ProjectConfig& config,
   control::SemiClosedLoopParams params = base;
   params.gains = gains;
   params.gains_sample_time_s = base.sample_time_s;
-  experiments::Bench bench(config, params, seed);
+  rig::Bench bench(config, params, seed);
   PidTrial trial;
   trial.gains = gains;
   const double rest_s = 0.2;
@@ -96,7 +97,7 @@ PidTrial score_pid_gains(const config::ProjectConfig& config,
   double plate_max = plate_0;
   const double t_step = bench.time_s();
   bench.drive_actuators(step_target_um);
-  bench.run(options.step_duration_s, [&](const experiments::Bench& b) {
+  bench.run(options.step_duration_s, [&](const rig::Bench& b) {
     t.push_back(b.time_s());
     for (std::size_t i = 0; i < 3; ++i)
       y[i].push_back(b.last_output().feedback_um[i]);
@@ -134,7 +135,7 @@ PidTrial score_pid_gains(const config::ProjectConfig& config,
 
 PidTuningResult tune_pid(const config::ProjectConfig& config,
                          const control::SemiClosedLoopParams& base, std::uint64_t seed,
-                         const PidTuningOptions& options, const experiments::Progress& progress) {
+                         const PidTuningOptions& options, const rig::Progress& progress) {
   if (options.kp_values.empty() || options.ki_values.empty() || options.kd_values.empty()) {
     throw std::invalid_argument("PID tuning: every gain needs at least one candidate value");
   }

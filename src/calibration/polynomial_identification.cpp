@@ -6,9 +6,9 @@ namespace piezoshift::calibration {
 
 using control::Vec3;
 
-PolynomialIdentificationResult identify_polynomial(experiments::Bench& bench,
+PolynomialIdentificationResult identify_polynomial(rig::Bench& bench,
                                                    const PolynomialIdentificationOptions& o,
-                                                   const experiments::Progress& progress) {
+                                                   const rig::Progress& progress) {
   if (o.points < kPolyFitMinPoints || !(o.max_um > 0.0) || !(o.settle_s >= 0.0)) {
     throw std::invalid_argument("polynomial identification: at least 5 points and max > 0");
   }
@@ -20,7 +20,7 @@ PolynomialIdentificationResult identify_polynomial(experiments::Bench& bench,
     const double c = o.max_um * static_cast<double>(k) / static_cast<double>(o.points - 1);
     bench.drive_points(Vec3{c, c, c});
     bench.run(o.settle_s);
-    const experiments::StaticMeasurement m = bench.measure_static();
+    const rig::StaticMeasurement m = bench.measure_static();
     if (bench.last_output().saturated_mask != 0) {
       ++r.saturated_points;
     } else {

@@ -5,8 +5,9 @@
 
 #include <fmt/core.h>
 
+#include "piezoshift/core/bounds.hpp"
+#include "piezoshift/core/input_error.hpp"
 #include "piezoshift/design/design_ranges.hpp"
-#include "piezoshift/io/input_error.hpp"
 #include "piezoshift/plant/twin_ranges.hpp"
 
 namespace piezoshift::config {
@@ -18,7 +19,7 @@ struct RangedReader {
   const io::ConfigFile& file;
 
   template <typename T>
-  void operator()(const char* section, const char* key, T& value, io::Bounds bounds) const {
+  void operator()(const char* section, const char* key, T& value, core::Bounds bounds) const {
     const io::ConfigSection s = file.section(section);
     if constexpr (std::is_same_v<T, std::optional<double>>) {
       if (double v = 0.0; s.read(key, v, bounds))
@@ -35,7 +36,7 @@ void read_design_sections(const io::ConfigFile& file, design::DesignInputs& desi
   design::visit_design_values(design, RangedReader{file});
   // The geometry involves two keys (one perhaps left at its default); the message names both.
   if (const std::string problem = design::hinge_geometry_problem(design.hinge); !problem.empty())
-    throw io::InputError(fmt::format("{}: {}", file.source(), problem));
+    throw core::InputError(fmt::format("{}: {}", file.source(), problem));
 }
 
 void read_twin_sections(const io::ConfigFile& file, const design::DesignInputs& design,
@@ -50,14 +51,14 @@ void read_twin_sections(const io::ConfigFile& file, const design::DesignInputs& 
     else if (shape == "wave")
       t.sgs.nonlinearity_shape = plant::SgsNonlinearityShape::kWave;
     else
-      throw io::InputError(
+      throw core::InputError(
           fmt::format("{}: twin.sgs.nonlinearity_shape: '{}' is not one of bow, s_curve, wave",
                       file.source(), shape));
   }
 
   // What one key's bounds cannot say (rates that must divide, the contact identification, A).
   if (const std::string problem = plant::twin_params_problem(design, t); !problem.empty())
-    throw io::InputError(fmt::format("{}: {}", file.source(), problem));
+    throw core::InputError(fmt::format("{}: {}", file.source(), problem));
 }
 
 ProjectConfig load_project_config(const std::string& path) {

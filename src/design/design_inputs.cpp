@@ -1,4 +1,5 @@
 #include "piezoshift/design/design_inputs.hpp"
+#include "piezoshift/core/bounds.hpp"
 
 #include <fmt/core.h>
 
@@ -24,9 +25,9 @@ std::string hinge_geometry_problem(const HingeParams& hinge) {
 
 std::string design_inputs_problem(const DesignInputs& in) {
   std::string problem;
-  visit_design_values(in, [&](const char* section, const char* key, double value, Bounds b) {
+  visit_design_values(in, [&](const char* section, const char* key, double value, core::Bounds b) {
     if (problem.empty())
-      problem = range_problem(fmt::format("{}.{}", section, key), value, b);
+      problem = core::range_problem(fmt::format("{}.{}", section, key), value, b);
   });
   if (!problem.empty())
     return problem;

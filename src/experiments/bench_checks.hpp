@@ -5,14 +5,14 @@
 
 #include <fmt/core.h>
 
-#include "piezoshift/experiments/bench.hpp"
-#include "piezoshift/experiments/validity.hpp"
+#include "piezoshift/rig/bench.hpp"
+#include "piezoshift/rig/validity.hpp"
 
 namespace piezoshift::experiments::detail {
 
 // "" when the loop is in authority at Z_d, else why not: a PID at its upper output limit, or at
 // its lower one above Z_d = 0 (at rest, 0 V is where the stage sits).
-inline std::string saturation_problem(const Bench& bench, double zd_um) {
+inline std::string saturation_problem(const rig::Bench& bench, double zd_um) {
   const control::ControllerOutput& out = bench.last_output();
   const control::SemiClosedLoopParams& p = bench.controller_params();
   for (std::size_t i = 0; i < 3; ++i) {
@@ -26,7 +26,7 @@ inline std::string saturation_problem(const Bench& bench, double zd_um) {
 }
 
 // Marks v invalid when the bench's supervisor has latched a fault.
-inline void check_fault(const Bench& bench, Validity& v, const char* during) {
+inline void check_fault(const rig::Bench& bench, rig::Validity& v, const char* during) {
   if (bench.faulted()) {
     const runtime::FaultRecord& f = bench.fault();
     v.fail(fmt::format("the safety supervisor tripped ({}, channel {}, at {:.3f} s) {}",

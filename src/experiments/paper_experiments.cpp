@@ -35,13 +35,13 @@ using detail::saturation_problem;
 TravelRangeResult run_travel_range(const config::ProjectConfig& config,
                                    const control::SemiClosedLoopParams& controller,
                                    std::uint64_t seed, const TravelRangeOptions& o,
-                                   const Progress& progress) {
+                                   const rig::Progress& progress) {
   require(o.increment_um > 0.0 && o.max_um > o.start_um && o.hold_s >= 0.0 &&
               o.tolerance_um > 0.0 && o.open_loop_settle_s >= 0.0,
           "travel range: increment > 0, max > start, tolerance > 0");
   TravelRangeResult r;
   {
-    Bench open(config, controller, seed, o.bench);
+    rig::Bench open(config, controller, seed, o.bench);
     open.drive_open_loop(all(10.0));
     open.run(o.open_loop_settle_s);
     r.open_loop_points_um = open.measure_static().points_um;
@@ -59,7 +59,7 @@ TravelRangeResult run_travel_range(const config::ProjectConfig& config,
       start -= o.coarse_step_um;
     if (start <= 0.0)
       break;
-    Bench bench(config, controller, seed + 1, o.bench);
+    rig::Bench bench(config, controller, seed + 1, o.bench);
     const auto levels = static_cast<int>(std::floor((o.max_um - start) / o.increment_um + 1e-9));
     for (int k = 0; k <= levels; ++k) {
       const double zd = start + o.increment_um * k;
@@ -92,7 +92,7 @@ TravelRangeResult run_travel_range(const config::ProjectConfig& config,
   // level needs, which a single move does not wait for.
   for (std::size_t k = r.validity.valid ? r.tracked_levels.size() : 0; k-- > 0;) {
     const double z = r.tracked_levels[k];
-    Bench single(config, controller, seed + 2, o.bench);
+    rig::Bench single(config, controller, seed + 2, o.bench);
     single.drive_points(all(0.0));
     single.run(0.2);
     single.drive_points(all(z));
@@ -112,7 +112,7 @@ TravelRangeResult run_travel_range(const config::ProjectConfig& config,
   // leaves them above zero at 0 V, which the 0..150 V amplifier cannot undo.
   for (int k = 0; r.single_move_um > 0.0 && k * o.min_increment_um < r.single_move_um; ++k) {
     const double z = k * o.min_increment_um;
-    Bench down(config, controller, seed + 3, o.bench);
+    rig::Bench down(config, controller, seed + 3, o.bench);
     down.drive_points(all(r.single_move_um));
     down.run(o.hold_s);
     down.drive_points(all(z));
@@ -132,9 +132,9 @@ TravelRangeResult run_travel_range(const config::ProjectConfig& config,
 StepExperimentResult run_step_response(const config::ProjectConfig& config,
                                        const control::SemiClosedLoopParams& controller,
                                        std::uint64_t seed, const StepExperimentOptions& o,
-                                       const Progress& progress) {
+                                       const rig::Progress& progress) {
   require(o.step_um > 0.0 && o.pre_s > 0.0 && o.record_s > 0.0, "step response: bad options");
-  Bench bench(config, controller, seed, o.bench);
+  rig::Bench bench(config, controller, seed, o.bench);
   bench.drive_points(all(0.0));
   bench.run(o.pre_s);
   StepExperimentResult r;
@@ -146,7 +146,7 @@ StepExperimentResult run_step_response(const config::ProjectConfig& config,
   r.truth_um.push_back(mean3(bench.twin().truth().points_um));
   double truth_peak = r.truth_um.front();
   bench.drive_points(all(o.step_um));
-  bench.run(o.record_s, [&](const Bench& b) {
+  bench.run(o.record_s, [&](const rig::Bench& b) {
     r.time_s.push_back(b.time_s() - t0);
     r.measured_um.push_back(mean3(b.twin().interferometer().dynamic_um));
     r.desired_um.push_back(o.step_um);
@@ -191,10 +191,10 @@ StepExperimentResult run_step_response(const config::ProjectConfig& config,
 
 LinearityResult run_linearity(const config::ProjectConfig& config,
                               const control::SemiClosedLoopParams& controller, std::uint64_t seed,
-                              const LinearityOptions& o, const Progress& progress) {
+                              const LinearityOptions& o, const rig::Progress& progress) {
   require(o.max_um > 0.0 && o.increment_um > 0.0 && o.step_hold_s >= 1.0,
           "linearity: max > 0, increment > 0, at least 1 s per level");
-  Bench bench(config, controller, seed, o.bench);
+  rig::Bench bench(config, controller, seed, o.bench);
   const int levels = static_cast<int>(std::llround(o.max_um / o.increment_um));
   if (o.downward) {  // approach the top from below, as the upward sweep does
     bench.drive_points(all(0.0));
@@ -252,10 +252,10 @@ LinearityResult run_linearity(const config::ProjectConfig& config,
 RepeatabilityResult run_repeatability(const config::ProjectConfig& config,
                                       const control::SemiClosedLoopParams& controller,
                                       std::uint64_t seed, const RepeatabilityOptions& o,
-                                      const Progress& progress) {
+                                      const rig::Progress& progress) {
   require(o.moves >= 2 && o.target_um > 0.0 && o.rest_s >= 0.0 && o.settle_s >= 0.0,
           "repeatability: at least 2 moves and a positive target");
-  Bench bench(config, controller, seed, o.bench);
+  rig::Bench bench(config, controller, seed, o.bench);
   RepeatabilityResult r;
   r.target_um = o.target_um;
   const std::string label = fmt::format("repeat. {:g} um", o.target_um);

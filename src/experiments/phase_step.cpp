@@ -11,6 +11,8 @@
 
 namespace piezoshift::experiments {
 
+using control::Vec3;
+
 double exposure_settling_time_s(const std::vector<double>& time_s,
                                 const std::vector<double>& value_nm, double target_nm,
                                 double tolerance_nm) {
@@ -52,7 +54,7 @@ class ExposureWindow {
   explicit ExposureWindow(std::size_t per_exposure) : per_exposure_(per_exposure) {}
 
   //! Adds this tick's period average; returns the mean over the window [nm].
-  double add(const Bench& b) {
+  double add(const rig::Bench& b) {
     const double v = 1e3 * b.twin().truth().period_avg_mean_points_um;
     window_.push_back(v);
     sum_ += v;
@@ -111,8 +113,8 @@ struct Run {
 
 // One run: settle at start_um, hold (its exposure means' trend line gives the level before),
 // then drive to target_um and record. A PID at its limit before a step fails validity.
-Run run_once(Bench& on, const PhaseStepOptions& o, std::size_t per_exposure, double target_um,
-             Validity& validity) {
+Run run_once(rig::Bench& on, const PhaseStepOptions& o, std::size_t per_exposure, double target_um,
+             rig::Validity& validity) {
   const double z0_um = o.start_um;
   on.drive_points(Vec3{z0_um, z0_um, z0_um});
   on.run(o.settle_s);
@@ -121,7 +123,7 @@ Run run_once(Bench& on, const PhaseStepOptions& o, std::size_t per_exposure, dou
   // The hold: exposure means (once the window is full) and their least-squares line.
   std::vector<double> hold_t, hold_v;
   const double t_hold = on.time_s();
-  on.run(o.hold_s, [&](const Bench& b) {
+  on.run(o.hold_s, [&](const rig::Bench& b) {
     const double v = window.add(b);
     if (window.full()) {
       hold_t.push_back(b.time_s() - t_hold);
@@ -137,7 +139,7 @@ Run run_once(Bench& on, const PhaseStepOptions& o, std::size_t per_exposure, dou
     if (const std::string sat = detail::saturation_problem(on, z0_um); !sat.empty())
       validity.fail(sat + " before the step");
   on.drive_points(Vec3{target_um, target_um, target_um});
-  on.run(o.record_s, [&](const Bench& b) {
+  on.run(o.record_s, [&](const rig::Bench& b) {
     run.time_s.push_back(b.time_s() - t_step);
     run.mean_nm.push_back(window.add(b) - level_nm);
   });
@@ -145,7 +147,7 @@ Run run_once(Bench& on, const PhaseStepOptions& o, std::size_t per_exposure, dou
 }
 
 // The stepped run's settling time and final error, and whether it made the step asked for.
-void judge_step(PhaseStepResult& r, const Bench& bench, const PhaseStepOptions& o,
+void judge_step(PhaseStepResult& r, const rig::Bench& bench, const PhaseStepOptions& o,
                 std::size_t per_exposure, double z1_um) {
   r.settling_time_s =
       exposure_settling_time_s(r.time_s, r.exposure_mean_nm, r.step_nm, o.tolerance_nm);
@@ -169,7 +171,7 @@ void judge_step(PhaseStepResult& r, const Bench& bench, const PhaseStepOptions& 
 void compare_with_still_run(PhaseStepResult& r, const config::ProjectConfig& config,
                             const control::SemiClosedLoopParams& controller, std::uint64_t seed,
                             const PhaseStepOptions& o, std::size_t per_exposure) {
-  Bench still_bench(config, controller, seed, o.bench);
+  rig::Bench still_bench(config, controller, seed, o.bench);
   const Run still = run_once(still_bench, o, per_exposure, o.start_um, r.validity);
   r.simulated_time_s += still_bench.time_s();
   detail::check_fault(still_bench, r.validity, "during the phase step's run without the step");
@@ -186,12 +188,12 @@ void compare_with_still_run(PhaseStepResult& r, const config::ProjectConfig& con
 
 PhaseStepResult run_phase_step(const config::ProjectConfig& config,
                                const control::SemiClosedLoopParams& controller, std::uint64_t seed,
-                               const PhaseStepOptions& o, const Progress& progress) {
+                               const PhaseStepOptions& o, const rig::Progress& progress) {
   check_options(o);
   PhaseStepResult r;
   r.step_nm = o.step_nm();
   const double z1_um = o.start_um + 1e-3 * r.step_nm;
-  Bench bench(config, controller, seed, o.bench);
+  rig::Bench bench(config, controller, seed, o.bench);
   const std::size_t per_exposure = periods_per_exposure(o, bench.sample_time_s());
 
   const Run stepped = run_once(bench, o, per_exposure, z1_um, r.validity);

@@ -7,7 +7,7 @@
 
 #include <fmt/format.h>
 
-#include "piezoshift/io/input_error.hpp"
+#include "piezoshift/core/input_error.hpp"
 
 namespace piezoshift::host {
 
@@ -96,7 +96,7 @@ HttpServer::HttpServer(const HttpServerOptions& options, HttpHandler& handler)
     : options_(options), handler_(handler) {
   const std::string where = fmt::format("{}:{}", options.host, options.port);
   const auto fail = [&](const std::string& what) {
-    throw io::InputError(fmt::format("HTTP server on {}: {}", where, what));
+    throw core::InputError(fmt::format("HTTP server on {}: {}", where, what));
   };
   if (options.max_clients < 1 || options.max_request_bytes < 256 || options.max_body_bytes < 1 ||
       !(options.request_timeout_s > 0.0) || options.max_pending_output_bytes < 1)

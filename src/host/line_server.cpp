@@ -5,7 +5,7 @@
 
 #include <fmt/format.h>
 
-#include "piezoshift/io/input_error.hpp"
+#include "piezoshift/core/input_error.hpp"
 
 namespace piezoshift::host {
 
@@ -19,7 +19,7 @@ namespace {
 
 void check_limits(const LineServerLimits& limits, const std::string& where) {
   const auto fail = [&](const char* what) {
-    throw io::InputError(fmt::format("TCP server on {}: {}", where, what));
+    throw core::InputError(fmt::format("TCP server on {}: {}", where, what));
   };
   if (limits.max_clients < 1)
     fail("max_clients must be at least 1");
@@ -53,7 +53,7 @@ LineServer::LineServer(const ListenAddress& address, const LineServerLimits& lim
 
   const Ipv4Host ip = parse_ipv4_host(address.host, "TCP server", where);
   if (!ip.loopback && !address.allow_remote)
-    throw io::InputError(fmt::format(
+    throw core::InputError(fmt::format(
         "TCP server on {} refuses non-loopback address {} without --allow-remote (GCS has no "
         "authentication: anyone who reaches the port moves the stage)",
         where, address.host));

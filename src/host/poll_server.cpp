@@ -12,7 +12,7 @@
 
 #include <fmt/format.h>
 
-#include "piezoshift/io/input_error.hpp"
+#include "piezoshift/core/input_error.hpp"
 
 namespace piezoshift::host {
 
@@ -31,7 +31,7 @@ bool would_block(int err) {
 const PollServerLimits& checked(const PollServerLimits& limits, const std::string& name,
                                 const std::string& where) {
   const auto fail = [&](const char* what) {
-    throw io::InputError(fmt::format("{} on {}: {}", name, where, what));
+    throw core::InputError(fmt::format("{} on {}: {}", name, where, what));
   };
   if (limits.max_clients < 1)
     fail("max_clients must be at least 1");

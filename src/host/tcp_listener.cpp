@@ -12,7 +12,7 @@
 
 #include <fmt/core.h>
 
-#include "piezoshift/io/input_error.hpp"
+#include "piezoshift/core/input_error.hpp"
 
 namespace piezoshift::host {
 namespace {
@@ -30,8 +30,8 @@ Ipv4Host parse_ipv4_host(const std::string& host, const std::string& server,
   Ipv4Host h;
   h.numeric = host == "localhost" ? "127.0.0.1" : host;
   if (::inet_pton(AF_INET, h.numeric.c_str(), &h.address) != 1)
-    throw io::InputError(fmt::format("{} on {}: '{}' is not a numeric IPv4 address (nor localhost)",
-                                     server, where, host));
+    throw core::InputError(fmt::format(
+        "{} on {}: '{}' is not a numeric IPv4 address (nor localhost)", server, where, host));
   h.loopback = (ntohl(h.address.s_addr) >> 24) == 127;
   return h;
 }
@@ -54,10 +54,10 @@ TcpListener::TcpListener(const Ipv4Host& host, std::uint16_t port, const std::st
     sa.sin_port = htons(port);
     sa.sin_addr = host.address;
     if (::bind(listen_fd_, reinterpret_cast<const sockaddr*>(&sa), sizeof sa) != 0)
-      throw io::InputError(
+      throw core::InputError(
           fmt::format("{} cannot bind {}: {}", server, where, std::strerror(errno)));
     if (::listen(listen_fd_, SOMAXCONN) != 0)
-      throw io::InputError(
+      throw core::InputError(
           fmt::format("{} cannot listen on {}: {}", server, where, std::strerror(errno)));
     socklen_t len = sizeof sa;
     if (::getsockname(listen_fd_, reinterpret_cast<sockaddr*>(&sa), &len) != 0)

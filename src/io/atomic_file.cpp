@@ -13,13 +13,13 @@
 
 #include <fmt/core.h>
 
-#include "piezoshift/io/input_error.hpp"
+#include "piezoshift/core/input_error.hpp"
 
 namespace piezoshift::io {
 
 namespace {
 [[noreturn]] void fail(const std::string& path, const char* what, int err) {
-  throw io::InputError(
+  throw core::InputError(
       fmt::format("{}: cannot replace the file ({}): {}", path, what, std::strerror(err)));
 }
 

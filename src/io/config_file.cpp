@@ -1,4 +1,5 @@
 #include "piezoshift/io/config_file.hpp"
+#include "piezoshift/core/bounds.hpp"
 
 #include <algorithm>
 #include <cmath>
@@ -10,7 +11,7 @@
 #include <fmt/core.h>
 #include <toml++/toml.h>
 
-#include "piezoshift/io/input_error.hpp"
+#include "piezoshift/core/input_error.hpp"
 #include "piezoshift/io/input_file.hpp"
 
 namespace piezoshift::io {
@@ -24,10 +25,10 @@ struct ConfigFileImpl {
   [[noreturn]] void fail(const std::string& path, const toml::source_region& where,
                          const std::string& reason) const {
     if (where.begin.line > 0) {
-      throw InputError(fmt::format("{}:{}:{}: {}: {}", source, where.begin.line, where.begin.column,
-                                   path, reason));
+      throw core::InputError(fmt::format("{}:{}:{}: {}: {}", source, where.begin.line,
+                                         where.begin.column, path, reason));
     }
-    throw InputError(fmt::format("{}: {}: {}", source, path, reason));
+    throw core::InputError(fmt::format("{}: {}: {}", source, path, reason));
   }
 
   // The node of section.key, marked as read (so reject_unknown() passes it); nullptr when absent.
@@ -49,7 +50,7 @@ struct ConfigFileImpl {
     return table->as_table()->get(key);
   }
 
-  double number(const std::string& path, const toml::node& n, Bounds b) const {
+  double number(const std::string& path, const toml::node& n, core::Bounds b) const {
     double v = 0.0;
     if (const auto* f = n.as_floating_point()) {
       v = f->get();
@@ -126,7 +127,7 @@ ConfigFile ConfigFile::load(const std::string& path) {
     impl->root = toml::parse(text, path);
   } catch (const toml::parse_error& e) {
     const auto& b = e.source().begin;
-    throw InputError(
+    throw core::InputError(
         fmt::format("{}:{}:{}: syntax error: {}", path, b.line, b.column, e.description()));
   }
   return ConfigFile(std::move(impl));
@@ -139,7 +140,7 @@ ConfigFile ConfigFile::parse(std::string_view text, const std::string& source_na
     impl->root = toml::parse(text, source_name);
   } catch (const toml::parse_error& e) {
     const auto& b = e.source().begin;
-    throw InputError(
+    throw core::InputError(
         fmt::format("{}:{}:{}: syntax error: {}", source_name, b.line, b.column, e.description()));
   }
   return ConfigFile(std::move(impl));
@@ -181,7 +182,7 @@ bool ConfigSection::has(std::string_view key) const {
   return file_->find(name_, key) != nullptr;
 }
 
-bool ConfigSection::read(std::string_view key, double& value, Bounds bounds) const {
+bool ConfigSection::read(std::string_view key, double& value, core::Bounds bounds) const {
   const auto& impl = *file_;
   std::string path;
   const toml::node* n = impl.take(name_, key, path);
@@ -191,7 +192,7 @@ bool ConfigSection::read(std::string_view key, double& value, Bounds bounds) con
   return true;
 }
 
-bool ConfigSection::read(std::string_view key, std::int64_t& value, Bounds bounds) const {
+bool ConfigSection::read(std::string_view key, std::int64_t& value, core::Bounds bounds) const {
   const auto& impl = *file_;
   std::string path;
   const toml::node* n = impl.take(name_, key, path);
@@ -239,7 +240,7 @@ namespace {
 // A list of exactly N numbers, each within bounds; path names the key for messages.
 template <std::size_t N>
 std::array<double, N> number_list(const ConfigFileImpl& impl, const std::string& path,
-                                  const toml::node& n, Bounds bounds) {
+                                  const toml::node& n, core::Bounds bounds) {
   static constexpr const char* kCount[] = {"zero", "one", "two", "three", "four"};
   const auto* a = n.as_array();
   if (a == nullptr || a->size() != N) {
@@ -254,7 +255,8 @@ std::array<double, N> number_list(const ConfigFileImpl& impl, const std::string&
 
 }  // namespace
 
-bool ConfigSection::read(std::string_view key, std::array<double, 3>& value, Bounds bounds) const {
+bool ConfigSection::read(std::string_view key, std::array<double, 3>& value,
+                         core::Bounds bounds) const {
   std::string path;
   const toml::node* n = file_->take(name_, key, path);
   if (n == nullptr)
@@ -263,7 +265,8 @@ bool ConfigSection::read(std::string_view key, std::array<double, 3>& value, Bou
   return true;
 }
 
-bool ConfigSection::read(std::string_view key, std::array<double, 4>& value, Bounds bounds) const {
+bool ConfigSection::read(std::string_view key, std::array<double, 4>& value,
+                         core::Bounds bounds) const {
   std::string path;
   const toml::node* n = file_->take(name_, key, path);
   if (n == nullptr)
@@ -273,7 +276,7 @@ bool ConfigSection::read(std::string_view key, std::array<double, 4>& value, Bou
 }
 
 bool ConfigSection::read(std::string_view key, std::vector<double>& value, std::size_t max_count,
-                         Bounds bounds) const {
+                         core::Bounds bounds) const {
   const auto& impl = *file_;
   std::string path;
   const toml::node* n = impl.take(name_, key, path);
@@ -289,7 +292,7 @@ bool ConfigSection::read(std::string_view key, std::vector<double>& value, std::
 }
 
 bool ConfigSection::read(std::string_view key, std::array<std::array<double, 3>, 3>& value,
-                         Bounds bounds) const {
+                         core::Bounds bounds) const {
   const auto& impl = *file_;
   std::string path;
   const toml::node* n = impl.take(name_, key, path);

@@ -6,7 +6,7 @@
 
 #include <fmt/core.h>
 
-#include "piezoshift/io/input_error.hpp"
+#include "piezoshift/core/input_error.hpp"
 #include "piezoshift/io/input_file.hpp"
 
 namespace piezoshift::io {
@@ -79,8 +79,8 @@ void CsvTable::read_header(std::string_view line, std::size_t line_no) {
   // Counted before it is split, so a line of millions of commas costs no memory.
   const auto fields = static_cast<std::size_t>(std::count(line.begin(), line.end(), ',')) + 1;
   if (fields > kMaxColumns) {
-    throw InputError(fmt::format("{}:{}: the header has {} fields, more than the limit of {}",
-                                 source_, line_no, fields, kMaxColumns));
+    throw core::InputError(fmt::format("{}:{}: the header has {} fields, more than the limit of {}",
+                                       source_, line_no, fields, kMaxColumns));
   }
   header_ = split_fields(line);
   for (std::size_t i = 0; i < header_.size(); ++i) {
@@ -88,7 +88,7 @@ void CsvTable::read_header(std::string_view line, std::size_t line_no) {
     if (name.size() >= 2 && name.front() == '"' && name.back() == '"')
       name = std::string(trim(std::string_view(name).substr(1, name.size() - 2)));
     if (name.empty()) {
-      throw InputError(
+      throw core::InputError(
           fmt::format("{}:{}: header field {} is empty (a trailing comma?); the header names the "
                       "columns, e.g. s1_um,s2_um,s3_um",
                       source_, line_no, i + 1));
@@ -122,13 +122,14 @@ CsvTable CsvTable::from_text(std::string text, const std::string& source_name) {
     // Counted, not split: the cells are found again by column().
     const auto fields = static_cast<std::size_t>(std::count(line.begin(), line.end(), ',')) + 1;
     if (fields != t.header_.size()) {
-      throw InputError(fmt::format("{}:{}: {} fields, but the header (line {}) has {}", source_name,
-                                   line_no, fields, t.header_line_, t.header_.size()));
+      throw core::InputError(fmt::format("{}:{}: {} fields, but the header (line {}) has {}",
+                                         source_name, line_no, fields, t.header_line_,
+                                         t.header_.size()));
     }
     t.rows_.push_back(Row{begin, line_no});
   }
   if (t.header_.empty()) {
-    throw InputError(
+    throw core::InputError(
         fmt::format("{}: no header row: the file is empty or has only comments", source_name));
   }
   return t;
@@ -165,8 +166,8 @@ void CsvTable::require_columns(std::initializer_list<std::string_view> names) co
     }
   }
   if (count > 0) {
-    throw InputError(fmt::format("{}:{}: missing column{} {} (the header has: {})", source_,
-                                 header_line_, count > 1 ? "s" : "", missing, join(header_)));
+    throw core::InputError(fmt::format("{}:{}: missing column{} {} (the header has: {})", source_,
+                                       header_line_, count > 1 ? "s" : "", missing, join(header_)));
   }
 }
 
@@ -176,14 +177,14 @@ std::size_t CsvTable::index_of(std::string_view name) const {
     if (header_[i] != name)
       continue;
     if (found != header_.size()) {
-      throw InputError(fmt::format("{}:{}: column '{}' appears twice (fields {} and {})", source_,
-                                   header_line_, name, found + 1, i + 1));
+      throw core::InputError(fmt::format("{}:{}: column '{}' appears twice (fields {} and {})",
+                                         source_, header_line_, name, found + 1, i + 1));
     }
     found = i;
   }
   if (found == header_.size()) {
-    throw InputError(fmt::format("{}:{}: missing column '{}' (the header has: {})", source_,
-                                 header_line_, name, join(header_)));
+    throw core::InputError(fmt::format("{}:{}: missing column '{}' (the header has: {})", source_,
+                                       header_line_, name, join(header_)));
   }
   return found;
 }
@@ -198,7 +199,7 @@ std::vector<double> CsvTable::column(std::string_view name) const {
     double any = 0.0;
     const auto [end, ec] = std::from_chars(cell.data(), cell.data() + cell.size(), any);
     const bool non_finite = ec == std::errc() && end == cell.data() + cell.size();
-    throw InputError(
+    throw core::InputError(
         fmt::format("{}:{}: column '{}' (field {}): {}", source_, rows_[r].line, name, c + 1,
                     cell.empty() ? std::string("empty cell, expected a number")
                     : non_finite ? fmt::format("'{}' is not a finite number", shown(cell))

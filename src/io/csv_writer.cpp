@@ -7,8 +7,8 @@
 
 #include <fmt/core.h>
 
+#include "piezoshift/core/input_error.hpp"
 #include "piezoshift/io/atomic_file.hpp"
-#include "piezoshift/io/input_error.hpp"
 
 namespace piezoshift::io {
 
@@ -32,7 +32,7 @@ CsvWriter::CsvWriter(const std::string& path, std::vector<std::string> columns, 
   if (!atomic_) {
     file_ = std::fopen(path.c_str(), "w");
     if (file_ == nullptr)
-      throw InputError(fmt::format("{}: cannot create: {}", path, std::strerror(errno)));
+      throw core::InputError(fmt::format("{}: cannot create: {}", path, std::strerror(errno)));
   }
   put(header);
 }
@@ -44,7 +44,7 @@ CsvWriter::~CsvWriter() {
 
 void CsvWriter::check_write(bool ok) {
   if (!ok)
-    throw InputError(fmt::format("{}: write failed: {}", path_, std::strerror(errno)));
+    throw core::InputError(fmt::format("{}: write failed: {}", path_, std::strerror(errno)));
 }
 
 void CsvWriter::put(const std::string& text) {

@@ -9,7 +9,7 @@
 
 #include <fmt/core.h>
 
-#include "piezoshift/io/input_error.hpp"
+#include "piezoshift/core/input_error.hpp"
 
 namespace piezoshift::io {
 
@@ -42,16 +42,17 @@ std::string read_input_file(const std::string& path, std::uintmax_t max_bytes) {
   // O_NONBLOCK: opening a FIFO without a writer must not wait; regular files ignore it.
   const Fd f{::open(path.c_str(), O_RDONLY | O_NONBLOCK | O_CLOEXEC)};
   if (f.fd < 0)
-    throw InputError(fmt::format("{}: cannot open: {}", path, std::strerror(errno)));
+    throw core::InputError(fmt::format("{}: cannot open: {}", path, std::strerror(errno)));
   struct stat st {};
   if (::fstat(f.fd, &st) != 0)
-    throw InputError(fmt::format("{}: cannot read: {}", path, std::strerror(errno)));
+    throw core::InputError(fmt::format("{}: cannot read: {}", path, std::strerror(errno)));
   if (!S_ISREG(st.st_mode))
-    throw InputError(fmt::format("{}: is {}; expected a regular file", path, kind_of(st.st_mode)));
+    throw core::InputError(
+        fmt::format("{}: is {}; expected a regular file", path, kind_of(st.st_mode)));
   const auto size = static_cast<std::uintmax_t>(st.st_size);
   if (size > max_bytes) {
-    throw InputError(fmt::format("{}: {} bytes is more than the limit of {} bytes for this file",
-                                 path, size, max_bytes));
+    throw core::InputError(fmt::format(
+        "{}: {} bytes is more than the limit of {} bytes for this file", path, size, max_bytes));
   }
   // One byte more than stat() said, so that the read which finds the end needs no reallocation
   // (growing the string would double it: 3 times the file's size at once).
@@ -67,14 +68,14 @@ std::string read_input_file(const std::string& path, std::uintmax_t max_bytes) {
     if (n < 0 && errno == EINTR)
       continue;
     if (n < 0)
-      throw InputError(fmt::format("{}: cannot read: {}", path, std::strerror(errno)));
+      throw core::InputError(fmt::format("{}: cannot read: {}", path, std::strerror(errno)));
     if (n == 0)
       break;
     got += static_cast<std::size_t>(n);
   }
   if (got > max_bytes) {
-    throw InputError(fmt::format("{}: grew past the limit of {} bytes for this file while read",
-                                 path, max_bytes));
+    throw core::InputError(fmt::format(
+        "{}: grew past the limit of {} bytes for this file while read", path, max_bytes));
   }
   data.resize(got);
   return data;

@@ -15,7 +15,7 @@
 
 #include <fmt/core.h>
 
-#include "piezoshift/io/input_error.hpp"
+#include "piezoshift/core/input_error.hpp"
 
 namespace piezoshift::io {
 namespace fs = std::filesystem;
@@ -251,13 +251,13 @@ void check_output_path(const fs::path& path, std::string_view option) {
   const fs::path stem = strip_format_extension(path);
   const fs::path name = path.filename();
   if (name == ".png" || name == ".svg")  // an extension alone: it would draw ".png.png"
-    throw InputError(fmt::format("{} {}: has no name before {}; give one, e.g. {}", option,
-                                 path.string(), name.string(),
-                                 (path.parent_path() / ("figure" + name.string())).string()));
+    throw core::InputError(fmt::format("{} {}: has no name before {}; give one, e.g. {}", option,
+                                       path.string(), name.string(),
+                                       (path.parent_path() / ("figure" + name.string())).string()));
   if (!names_a_file(stem)) {
     const fs::path folder = path.has_filename() ? path : path.parent_path();
-    throw InputError(fmt::format("{} {}: names a folder; give a file, e.g. {}", option,
-                                 path.string(), (folder / "figure.png").string()));
+    throw core::InputError(fmt::format("{} {}: names a folder; give a file, e.g. {}", option,
+                                       path.string(), (folder / "figure.png").string()));
   }
   // The folder is created when the figure is drawn: what must exist now is the nearest folder on
   // its way, and it must take a file.
@@ -269,18 +269,19 @@ void check_output_path(const fs::path& path, std::string_view option) {
   if (existing.empty())
     existing = ".";
   if (!fs::is_directory(existing, ec))
-    throw InputError(
+    throw core::InputError(
         fmt::format("{} {}: {} is not a folder", option, path.string(), existing.string()));
   if (const std::error_code e = can_create_in(existing))
-    throw InputError(fmt::format("{} {}: cannot create a file in {}: {}", option, path.string(),
-                                 existing.string(), e.message()));
+    throw core::InputError(fmt::format("{} {}: cannot create a file in {}: {}", option,
+                                       path.string(), existing.string(), e.message()));
 }
 
 PlotFiles write_plot_files(const Figure& figure, const fs::path& stem_in) {
   validate(figure);
   const fs::path stem = strip_format_extension(stem_in);
   if (!names_a_file(stem))
-    throw InputError(fmt::format("plot output {}: names a folder, not a file", stem_in.string()));
+    throw core::InputError(
+        fmt::format("plot output {}: names a folder, not a file", stem_in.string()));
   const fs::path dir = stem.parent_path();
   if (!dir.empty()) {
     std::error_code ec;

@@ -1,4 +1,5 @@
 #include "piezoshift/plant/twin_ranges.hpp"
+#include "piezoshift/core/bounds.hpp"
 
 #include <fmt/core.h>
 
@@ -7,9 +8,9 @@ namespace piezoshift::plant {
 std::string twin_ranges_problem(const TwinParams& twin) {
   std::string problem;
   visit_twin_values(
-      twin, [&](const char* section, const char* key, const auto& value, design::Bounds bounds) {
+      twin, [&](const char* section, const char* key, const auto& value, core::Bounds bounds) {
         if (problem.empty())
-          problem = design::range_problem(fmt::format("{}.{}", section, key), value, bounds);
+          problem = core::range_problem(fmt::format("{}.{}", section, key), value, bounds);
       });
   return problem;
 }

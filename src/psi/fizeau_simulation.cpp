@@ -8,7 +8,7 @@
 
 #include <fmt/core.h>
 
-#include "piezoshift/io/input_error.hpp"
+#include "piezoshift/core/input_error.hpp"
 #include "piezoshift/psi/zernike.hpp"
 
 namespace piezoshift::psi {
@@ -20,7 +20,7 @@ SurfaceSpec parse_surface_spec(std::string_view spec) {
   if (spec == "flat")
     return s;
   auto fail = [&](std::string_view item, std::string_view why) {
-    return io::InputError(fmt::format(
+    return core::InputError(fmt::format(
         "--surface '{}': '{}' {} (expected e.g. Z4=40,Z5=-20,rough=0.5)", spec, item, why));
   };
   std::size_t at = 0;

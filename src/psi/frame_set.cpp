@@ -2,17 +2,17 @@
 
 #include <fmt/core.h>
 
-#include "piezoshift/io/input_error.hpp"
+#include "piezoshift/core/input_error.hpp"
 #include "piezoshift/psi/png_image.hpp"
 
 namespace piezoshift::psi {
 
 std::vector<Map> read_frame_set(std::span<const std::string> paths, const FrameSetLimits& limits) {
   if (paths.size() < kMinFrames)
-    throw io::InputError(
+    throw core::InputError(
         fmt::format("psi: {} frame(s) given, at least {} are needed", paths.size(), kMinFrames));
   if (paths.size() > limits.max_frames)
-    throw io::InputError(fmt::format("psi: {} frames given, at most {} are read (docs/psi.md)",
+    throw core::InputError(fmt::format("psi: {} frames given, at most {} are read (docs/psi.md)",
                                      paths.size(), limits.max_frames));
   std::vector<Map> frames;
   for (const std::string& p : paths) {
@@ -22,12 +22,12 @@ std::vector<Map> read_frame_set(std::span<const std::string> paths, const FrameS
       const std::uint64_t pixels = static_cast<std::uint64_t>(g.counts.width) *
                                    static_cast<std::uint64_t>(g.counts.height) * paths.size();
       if (pixels > limits.max_pixels)
-        throw io::InputError(fmt::format(
+        throw core::InputError(fmt::format(
             "{}: {} frames of {} x {} pixels are {} pixels, at most {} are read (docs/psi.md)", p,
             paths.size(), g.counts.width, g.counts.height, pixels, limits.max_pixels));
       frames.reserve(paths.size());
     } else if (g.counts.width != frames[0].width || g.counts.height != frames[0].height) {
-      throw io::InputError(fmt::format("{}: {} x {} pixels, but {} is {} x {}", p, g.counts.width,
+      throw core::InputError(fmt::format("{}: {} x {} pixels, but {} is {} x {}", p, g.counts.width,
                                        g.counts.height, paths[0], frames[0].width,
                                        frames[0].height));
     }

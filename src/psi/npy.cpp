@@ -6,8 +6,8 @@
 
 #include <fmt/core.h>
 
+#include "piezoshift/core/input_error.hpp"
 #include "piezoshift/io/atomic_file.hpp"
-#include "piezoshift/io/input_error.hpp"
 #include "piezoshift/io/input_file.hpp"
 
 namespace piezoshift::psi {
@@ -38,18 +38,18 @@ void write_npy(const std::string& path, const Map& map) {
 Map read_npy(const std::string& path) {
   const std::string data = io::read_input_file(path, io::kMaxFrameFileBytes);
   if (data.size() < 10 || data.compare(0, 6, "\x93NUMPY") != 0)
-    throw io::InputError(fmt::format("{}: not a .npy file", path));
+    throw core::InputError(fmt::format("{}: not a .npy file", path));
   if (data[6] != 1)
-    throw io::InputError(
+    throw core::InputError(
         fmt::format("{}: .npy version {} (only 1.0 is read)", path, static_cast<int>(data[6])));
   const std::size_t len = static_cast<unsigned char>(data[8]) |
                           (static_cast<std::size_t>(static_cast<unsigned char>(data[9])) << 8);
   if (data.size() < 10 + len)
-    throw io::InputError(fmt::format("{}: truncated header", path));
+    throw core::InputError(fmt::format("{}: truncated header", path));
   const std::string header = data.substr(10, len);
   if (header.find("'descr': '<f8'") == std::string::npos ||
       header.find("'fortran_order': False") == std::string::npos)
-    throw io::InputError(fmt::format("{}: only little-endian float64 in C order is read", path));
+    throw core::InputError(fmt::format("{}: only little-endian float64 in C order is read", path));
   std::smatch m;
   const std::regex shape2(R"('shape': \((\d+), (\d+)\))"), shape1(R"('shape': \((\d+),\))");
   Map map;
@@ -58,11 +58,11 @@ Map read_npy(const std::string& path) {
   } else if (std::regex_search(header, m, shape1)) {
     map = Map(std::stoi(m[1].str()), 1);
   } else {
-    throw io::InputError(fmt::format("{}: only 1-D or 2-D arrays are read", path));
+    throw core::InputError(fmt::format("{}: only 1-D or 2-D arrays are read", path));
   }
   const std::size_t bytes = map.v.size() * sizeof(double);
   if (data.size() != 10 + len + bytes)
-    throw io::InputError(
+    throw core::InputError(
         fmt::format("{}: {} data bytes, expected {}", path, data.size() - 10 - len, bytes));
   if (bytes > 0)
     std::memcpy(map.v.data(), data.data() + 10 + len, bytes);

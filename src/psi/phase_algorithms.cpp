@@ -9,7 +9,7 @@
 #include <fmt/core.h>
 #include <Eigen/Dense>
 
-#include "piezoshift/io/input_error.hpp"
+#include "piezoshift/core/input_error.hpp"
 
 namespace piezoshift::psi {
 namespace {
@@ -377,7 +377,7 @@ Algorithm parse_algorithm(std::string_view name) {
       return a;
     names += (names.empty() ? "" : ", ") + std::string(algorithm_name(a));
   }
-  throw io::InputError(fmt::format("--algorithm {}: unknown (one of {})", name, names));
+  throw core::InputError(fmt::format("--algorithm {}: unknown (one of {})", name, names));
 }
 
 int required_frames(Algorithm a) {

@@ -11,8 +11,8 @@
 
 #include <fmt/core.h>
 
+#include "piezoshift/core/input_error.hpp"
 #include "piezoshift/io/atomic_file.hpp"
-#include "piezoshift/io/input_error.hpp"
 #include "piezoshift/io/input_file.hpp"
 
 namespace piezoshift::psi {
@@ -56,7 +56,7 @@ void write_png(const std::string& path, int width, int height, int bit_depth, in
   png_infop info = png ? png_create_info_struct(png) : nullptr;
   if (!png || !info) {
     png_destroy_write_struct(&png, &info);
-    throw io::InputError(fmt::format("{}: libpng could not start", path));
+    throw core::InputError(fmt::format("{}: libpng could not start", path));
   }
   try {
     png_set_write_fn(png, &out, write_to_memory, flush_nothing);
@@ -69,7 +69,7 @@ void write_png(const std::string& path, int width, int height, int bit_depth, in
     png_write_end(png, nullptr);
   } catch (const PngFailure& e) {
     png_destroy_write_struct(&png, &info);
-    throw io::InputError(fmt::format("{}: {}", path, e.what()));
+    throw core::InputError(fmt::format("{}: {}", path, e.what()));
   }
   png_destroy_write_struct(&png, &info);
   io::write_file_atomically(path, out);
@@ -94,12 +94,12 @@ std::array<png_byte, 3> colour(double t) {
 GrayImage read_png_gray(const std::string& path) {
   const std::string data = io::read_input_file(path, io::kMaxDataFileBytes);
   if (data.size() < 8 || png_sig_cmp(reinterpret_cast<png_const_bytep>(data.data()), 0, 8) != 0)
-    throw io::InputError(fmt::format("{}: not a PNG file", path));
+    throw core::InputError(fmt::format("{}: not a PNG file", path));
   png_structp png = png_create_read_struct(PNG_LIBPNG_VER_STRING, nullptr, on_error, on_warning);
   png_infop info = png ? png_create_info_struct(png) : nullptr;
   if (!png || !info) {
     png_destroy_read_struct(&png, &info, nullptr);
-    throw io::InputError(fmt::format("{}: libpng could not start", path));
+    throw core::InputError(fmt::format("{}: libpng could not start", path));
   }
   Reader reader{&data, 0};
   GrayImage img;
@@ -130,7 +130,7 @@ GrayImage read_png_gray(const std::string& path) {
     }
   } catch (const PngFailure& e) {
     png_destroy_read_struct(&png, &info, nullptr);
-    throw io::InputError(fmt::format("{}: {}", path, e.what()));
+    throw core::InputError(fmt::format("{}: {}", path, e.what()));
   }
   png_destroy_read_struct(&png, &info, nullptr);
   return img;
@@ -167,7 +167,7 @@ Mask read_mask_png(const std::string& path) {
   for (std::size_t p = 0; p < m.size(); ++p)
     m.v[p] = g.counts.v[p] > 0.0 ? 1 : 0;
   if (m.count() == 0)
-    throw io::InputError(fmt::format("{}: the mask is empty (no nonzero pixel)", path));
+    throw core::InputError(fmt::format("{}: the mask is empty (no nonzero pixel)", path));
   return m;
 }
 

@@ -6,9 +6,9 @@
 
 #include <fmt/core.h>
 
-#include "piezoshift/experiments/bench.hpp"
-#include "piezoshift/io/input_error.hpp"
+#include "piezoshift/core/input_error.hpp"
 #include "piezoshift/plant/random.hpp"
+#include "piezoshift/rig/bench.hpp"
 
 namespace piezoshift::psi {
 
@@ -16,18 +16,19 @@ SimulationResult simulate_psi(const config::ProjectConfig& config,
                               const control::SemiClosedLoopParams& controller,
                               const SimulationParams& p) {
   if (const std::string e = fizeau_problem(p.fizeau); !e.empty())
-    throw io::InputError("psi simulate: " + e);
+    throw core::InputError("psi simulate: " + e);
   if (const std::string e = camera_problem(p.camera); !e.empty())
-    throw io::InputError("psi simulate: " + e);
+    throw core::InputError("psi simulate: " + e);
   const int need = required_frames(p.algorithm);
   const int nf = p.frames > 0 ? p.frames : (need > 0 ? need : 5);
   if (need > 0 && nf != need)
-    throw io::InputError(fmt::format("psi simulate: --frames {}: {} needs {}", nf,
-                                     algorithm_name(p.algorithm), need));
+    throw core::InputError(fmt::format("psi simulate: --frames {}: {} needs {}", nf,
+                                       algorithm_name(p.algorithm), need));
   if (nf < 3 || nf > 64)
-    throw io::InputError(fmt::format("psi simulate: --frames {}: must be in 3..64", nf));
+    throw core::InputError(fmt::format("psi simulate: --frames {}: must be in 3..64", nf));
   if (!(p.base_um > 0.0 && p.base_um < 11.0))
-    throw io::InputError(fmt::format("psi simulate: base_um = {}: must be in (0, 11)", p.base_um));
+    throw core::InputError(
+        fmt::format("psi simulate: base_um = {}: must be in (0, 11)", p.base_um));
 
   SimulationResult r;
   r.mask = disk_mask(p.fizeau.width_px, p.fizeau.height_px, p.fizeau.pupil_radius_px);
@@ -36,7 +37,7 @@ SimulationResult simulate_psi(const config::ProjectConfig& config,
 
   control::SemiClosedLoopParams cp = controller;
   cp.sample_time_s = config.twin.daq.sample_time_s;  // the gains re-expressed at the DAQ period
-  experiments::Bench bench(config, cp, p.seed);
+  rig::Bench bench(config, cp, p.seed);
   BenchStage stage(bench, p.base_um);
   AcquisitionParams ap;
   ap.frames = nf;

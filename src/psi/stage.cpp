@@ -4,11 +4,11 @@
 #include <array>
 #include <cmath>
 
-#include "piezoshift/experiments/bench.hpp"
+#include "piezoshift/rig/bench.hpp"
 
 namespace piezoshift::psi {
 
-BenchStage::BenchStage(experiments::Bench& bench, double base_um, double settle_s)
+BenchStage::BenchStage(rig::Bench& bench, double base_um, double settle_s)
     : bench_(bench), base_um_(base_um) {
   bench_.drive_points({base_um_, base_um_, base_um_});
   bench_.run(settle_s);

@@ -13,7 +13,7 @@
 namespace piezoshift::reproduction {
 namespace {
 
-using experiments::Validity;
+using rig::Validity;
 
 FigureValue figure(double value, const Validity& v) {
   FigureValue f;
@@ -87,7 +87,7 @@ experiments::PhaseStepResult phase_step_at_10kHz(const config::ProjectConfig& co
                                                  const control::SemiClosedLoopParams& controller,
                                                  std::uint64_t seed,
                                                  const experiments::PhaseStepOptions& options,
-                                                 const experiments::Progress& progress) {
+                                                 const rig::Progress& progress) {
   config::ProjectConfig at = config;
   control::SemiClosedLoopParams c = controller;
   at.twin.daq.sample_time_s = c.sample_time_s = kFastSampleTime_s;
@@ -262,7 +262,7 @@ template <class Calibrate>
 void calibrate_or_fail(Validity& validity, const char* what, Calibrate&& calibrate) {
   try {
     calibrate();
-  } catch (const experiments::ProcedureFailed& e) {
+  } catch (const rig::ProcedureFailed& e) {
     validity.fail(fmt::format("{}: {}", what, e.what()));
   } catch (const calibration::FitError& e) {  // the twin's records, not the user's input
     validity.fail(fmt::format("{}: a fit failed: {}", what, e.what()));
@@ -273,7 +273,7 @@ void calibrate_or_fail(Validity& validity, const char* what, Calibrate&& calibra
 // the lambda/8 step with the loop at that rate.
 void run_at_10kHz(const config::ProjectConfig& config, const control::SemiClosedLoopParams& base,
                   std::uint64_t seed, const Schedule& s, LoopVariant k, VariantRun& run,
-                  const experiments::Progress& progress) {
+                  const rig::Progress& progress) {
   // The paper's gains are re-expressed per sample at 10 kHz (as reproduce() does); the
   // improved controller's models are sampled at their rate, so its own procedure calibrates
   // it again there (same seeds) for the 10 kHz figures.
@@ -315,12 +315,12 @@ void run_at_10kHz(const config::ProjectConfig& config, const control::SemiClosed
 // The three variants on one seed: the paper's and the improved controller each calibrated by its
 // own procedure, the oracle feedback on the paper's calibration.
 SeedComparison compare_seed(const config::ProjectConfig& config, std::uint64_t seed,
-                            const Schedule& s, const experiments::Progress& progress) {
+                            const Schedule& s, const rig::Progress& progress) {
   control::SemiClosedLoopParams base{};
   base.sample_time_s = config.twin.daq.sample_time_s;  // as reproduce(): the DAQ's rate
   SeedComparison sc;
   sc.seed = seed;
-  const auto labelled = [&](LoopVariant k) -> experiments::Progress {
+  const auto labelled = [&](LoopVariant k) -> rig::Progress {
     if (!progress)
       return {};
     return [&progress, seed, k](double done, double total, std::string_view label) {
@@ -353,7 +353,7 @@ SeedComparison compare_seed(const config::ProjectConfig& config, std::uint64_t s
   oracle.controller.polynomial = control::CubicPolynomial::identity();
   paper.simulated_time_s = paper_calibration_s;
 
-  const Schedule oracle_schedule = with_feedback(s, experiments::Feedback::kOracle);
+  const Schedule oracle_schedule = with_feedback(s, rig::Feedback::kOracle);
   for (LoopVariant k : kLoopVariants) {
     VariantRun& run = sc.runs[static_cast<std::size_t>(k)];
     if (!run.calibration.valid)
@@ -462,7 +462,7 @@ ComparisonResult summarize_comparison(const config::ProjectConfig& config,
 }
 
 ComparisonResult compare(const config::ProjectConfig& config, const CompareOptions& options,
-                         const experiments::Progress& progress) {
+                         const rig::Progress& progress) {
   if (options.seeds.empty())
     throw std::invalid_argument("compare: no seed");
   const auto start = std::chrono::steady_clock::now();

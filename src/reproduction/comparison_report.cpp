@@ -6,9 +6,9 @@
 
 #include <fmt/core.h>
 
+#include "piezoshift/core/input_error.hpp"
 #include "piezoshift/experiments/metrics_figures.hpp"
 #include "piezoshift/io/csv_writer.hpp"
-#include "piezoshift/io/input_error.hpp"
 #include "piezoshift/io/plot.hpp"
 #include "piezoshift/reproduction/document.hpp"
 

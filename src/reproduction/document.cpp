@@ -6,7 +6,7 @@
 
 #include <fmt/core.h>
 
-#include "piezoshift/io/input_error.hpp"
+#include "piezoshift/core/input_error.hpp"
 
 namespace piezoshift::reproduction {
 namespace {
@@ -135,14 +135,14 @@ void write_text(const std::filesystem::path& path, const std::string& text) {
   f << text;
   f.close();
   if (!f)
-    throw io::InputError(fmt::format("{}: cannot write", path.string()));
+    throw core::InputError(fmt::format("{}: cannot write", path.string()));
 }
 
 void create_report_folder(const std::filesystem::path& dir) {
   std::error_code ec;
   std::filesystem::create_directories(dir, ec);
   if (ec)
-    throw io::InputError(
+    throw core::InputError(
         fmt::format("{}: cannot create the folder: {}", dir.string(), ec.message()));
 }
 

@@ -9,10 +9,10 @@
 #include <fmt/core.h>
 
 #include "piezoshift/calibration/calibration_file.hpp"
+#include "piezoshift/core/input_error.hpp"
 #include "piezoshift/experiments/metrics_figures.hpp"
 #include "piezoshift/io/atomic_file.hpp"
 #include "piezoshift/io/csv_writer.hpp"
-#include "piezoshift/io/input_error.hpp"
 #include "piezoshift/io/plot.hpp"
 #include "piezoshift/reproduction/document.hpp"
 #include "piezoshift/reproduction/summary.hpp"
@@ -249,7 +249,7 @@ bool write_figures(const ReproductionResult& r, const fs::path& dir, ReportFiles
 }
 
 // A cell whose experiment is not valid says so, never a number.
-std::string valid_or(const experiments::Validity& v, std::string text) {
+std::string valid_or(const rig::Validity& v, std::string text) {
   return v.valid ? text : "NOT VALID: " + v.reason;
 }
 

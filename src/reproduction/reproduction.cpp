@@ -49,7 +49,7 @@ constexpr double kFastSampleTime_s = 1e-4;  // 10 kHz, the issue's second loop r
 
 }  // namespace
 
-Schedule with_feedback(Schedule s, experiments::Feedback f) {
+Schedule with_feedback(Schedule s, rig::Feedback f) {
   s.travel.bench.feedback = f;
   s.step.bench.feedback = f;
   s.linearity.bench.feedback = f;
@@ -63,7 +63,7 @@ Schedule with_feedback(Schedule s, experiments::Feedback f) {
 
 ExperimentSet run_experiment_set(const config::ProjectConfig& config,
                                  const control::SemiClosedLoopParams& c, std::uint64_t seed,
-                                 const Schedule& s, const experiments::Progress& progress) {
+                                 const Schedule& s, const rig::Progress& progress) {
   namespace ex = experiments;
   ExperimentSet r;
   r.travel = ex::run_travel_range(config, c, seed + 10, s.travel, progress);
@@ -124,7 +124,7 @@ InnerLoopAnalysis analyze_inner_loop_at(const config::ProjectConfig& config,
     }
   } catch (const std::invalid_argument& e) {  // e.g. a physics rate 10 kHz does not divide
     a.validity.fail(e.what());
-  } catch (const experiments::ProcedureFailed& e) {
+  } catch (const rig::ProcedureFailed& e) {
     a.validity.fail(e.what());
   }
   return a;
@@ -165,7 +165,7 @@ bool ExperimentSet::table4_valid() const {
 
 std::vector<std::string> ExperimentSet::invalid_reasons() const {
   std::vector<std::string> out;
-  const auto add = [&](const char* name, const experiments::Validity& v) {
+  const auto add = [&](const char* name, const rig::Validity& v) {
     if (!v.valid)
       out.push_back(std::string(name) + ": " + v.reason);
   };
@@ -181,7 +181,7 @@ std::vector<std::string> ExperimentSet::invalid_reasons() const {
 }
 
 ReproductionResult reproduce(const config::ProjectConfig& config, const ReproduceOptions& options,
-                             const experiments::Progress& progress) {
+                             const rig::Progress& progress) {
   const auto start = std::chrono::steady_clock::now();
   Schedule s = options.quick ? Schedule::quick() : Schedule::paper();
   s.calibration.pid = options.pid;
@@ -203,7 +203,7 @@ ReproductionResult reproduce(const config::ProjectConfig& config, const Reproduc
   r.inner_loop = analyze_inner_loop(config, r.calibration.controller, seed);
   // The oracle: the same loop, gains and A, fed the plate's truth; nothing left for p to correct.
   r.oracle = run_experiment_set(config, r.oracle_controller, seed,
-                                with_feedback(s, experiments::Feedback::kOracle), progress);
+                                with_feedback(s, rig::Feedback::kOracle), progress);
   r.simulated_time_s =
       r.calibration.pid.simulated_time_s + r.calibration.matrix.simulated_time_s +
       r.calibration.polynomial.simulated_time_s + r.experiments_simulated_time_s() +

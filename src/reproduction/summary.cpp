@@ -70,7 +70,7 @@ void set_json(nlohmann::json& j, const std::string& prefix, const ExperimentSet&
   j[prefix + "phase_step_still_wander_nm"] = e.phase_step.still_wander_nm;
   j[prefix + "valid"] = e.table4_valid();
   j[prefix + "invalid_reasons"] = e.invalid_reasons();
-  const auto validity = [](const experiments::Validity& v) {
+  const auto validity = [](const rig::Validity& v) {
     return nlohmann::json{{"valid", v.valid}, {"reason", v.reason}};
   };
   j[prefix + "validity"] = {{"travel", validity(e.travel.validity)},

@@ -4,7 +4,7 @@
 
 #include <fmt/core.h>
 
-#include "piezoshift/io/input_error.hpp"
+#include "piezoshift/core/input_error.hpp"
 
 #ifdef PIEZOSHIFT_HAVE_COMEDI
 #include <comedilib.h>
@@ -57,7 +57,7 @@ void ComediBackend::configure() {
   const std::string& path = options_.device;
   impl->dev = comedi_open(path.c_str());
   if (impl->dev == nullptr) {
-    throw io::InputError(
+    throw core::InputError(
         fmt::format("{}: cannot open the DAQ device: {} (is the board's comedi driver loaded, "
                     "e.g. ni_pcimio for the PCI-6229, and the device readable?)",
                     path, comedi_error()));
@@ -65,8 +65,8 @@ void ComediBackend::configure() {
   impl->ai_subdev = comedi_find_subdevice_by_type(impl->dev, COMEDI_SUBD_AI, 0);
   impl->ao_subdev = comedi_find_subdevice_by_type(impl->dev, COMEDI_SUBD_AO, 0);
   if (impl->ai_subdev < 0 || impl->ao_subdev < 0)
-    throw io::InputError(fmt::format("{}: the device has no analog {} subdevice", path,
-                                     impl->ai_subdev < 0 ? "input" : "output"));
+    throw core::InputError(fmt::format("{}: the device has no analog {} subdevice", path,
+                                       impl->ai_subdev < 0 ? "input" : "output"));
   const auto ai_sub = static_cast<unsigned>(impl->ai_subdev);
   const auto ao_sub = static_cast<unsigned>(impl->ao_subdev);
 
@@ -79,7 +79,7 @@ void ComediBackend::configure() {
     std::free(cal_path);
     impl->calibration = comedi_parse_calibration_file(cal.c_str());
     if (impl->calibration == nullptr) {
-      throw io::InputError(fmt::format(
+      throw core::InputError(fmt::format(
           "{}: the board is software-calibrated but its calibration file {} cannot be read; run "
           "comedi_soft_calibrate first",
           path, cal));
@@ -91,10 +91,10 @@ void ComediBackend::configure() {
                          lsampl_t& maxdata, double& range_lo, double& range_hi) -> unsigned {
     const int n = comedi_get_n_channels(impl->dev, sub);
     if (n < 0 || ch >= static_cast<unsigned>(n))
-      throw io::InputError(fmt::format("{}: subdevice {} has no channel {}", path, sub, ch));
+      throw core::InputError(fmt::format("{}: subdevice {} has no channel {}", path, sub, ch));
     const int range = comedi_find_range(impl->dev, sub, ch, UNIT_volt, lo, hi);
     if (range < 0) {
-      throw io::InputError(
+      throw core::InputError(
           fmt::format("{}: subdevice {} channel {} has no range holding "
                       "[{}, {}] V",
                       path, sub, ch, lo, hi));
@@ -103,15 +103,16 @@ void ComediBackend::configure() {
     const comedi_range* info = comedi_get_range(impl->dev, sub, ch, r);
     maxdata = comedi_get_maxdata(impl->dev, sub, ch);
     if (info == nullptr || maxdata == 0)
-      throw io::InputError(fmt::format("{}: cannot query subdevice {} channel {}", path, sub, ch));
+      throw core::InputError(
+          fmt::format("{}: cannot query subdevice {} channel {}", path, sub, ch));
     range_lo = info->min;
     range_hi = info->max;
     const int ok = soft ? comedi_get_softcal_converter(sub, ch, r, dir, impl->calibration, &poly)
                         : comedi_get_hardcal_converter(impl->dev, sub, ch, r, dir, &poly);
     if (ok < 0) {
-      throw io::InputError(fmt::format("{}: no {} converter for subdevice {} channel {}: {}", path,
-                                       soft ? "software-calibration" : "range", sub, ch,
-                                       comedi_error()));
+      throw core::InputError(fmt::format("{}: no {} converter for subdevice {} channel {}: {}",
+                                         path, soft ? "software-calibration" : "range", sub, ch,
+                                         comedi_error()));
     }
     return r;
   };
@@ -145,14 +146,14 @@ void ComediBackend::configure() {
 
 void ComediBackend::activate() {
   if (!impl_)
-    throw io::InputError(fmt::format("{}: activate() before configure()", options_.device));
+    throw core::InputError(fmt::format("{}: activate() before configure()", options_.device));
   impl_->active = true;
   Vec3 ai{};
   write(CycleTime{}, Vec3{});
   if (read(CycleTime{}, ai) != DaqStatus::kOk) {
     impl_->active = false;
-    throw io::InputError(fmt::format("{}: the first read/write transaction failed: {}",
-                                     options_.device, comedi_error()));
+    throw core::InputError(fmt::format("{}: the first read/write transaction failed: {}",
+                                       options_.device, comedi_error()));
   }
 }
 
@@ -220,7 +221,7 @@ struct ComediBackend::Impl {};
 ComediBackend::ComediBackend(ComediOptions options) : options_(std::move(options)) {}
 ComediBackend::~ComediBackend() = default;
 void ComediBackend::configure() {
-  throw io::InputError(fmt::format(
+  throw core::InputError(fmt::format(
       "{}: this piezoshift was built without libcomedi (install libcomedi-dev and rebuild)",
       options_.device));
 }

@@ -10,7 +10,7 @@
 
 #include <fmt/format.h>
 
-#include "piezoshift/io/input_error.hpp"
+#include "piezoshift/core/input_error.hpp"
 #include "piezoshift/runtime/safety_supervisor.hpp"
 
 namespace piezoshift::runtime {
@@ -56,7 +56,7 @@ CsvLogger::CsvLogger(CsvLoggerOptions options)
     : options_(std::move(options)), ring_(options_.ring_capacity) {
   fd_ = ::open(options_.path.c_str(), O_WRONLY | O_CREAT | O_TRUNC | O_CLOEXEC, 0644);
   if (fd_ < 0) {
-    throw io::InputError(
+    throw core::InputError(
         fmt::format("{}: cannot create the log file: {}", options_.path, std::strerror(errno)));
   }
   buffer_ = header(options_.with_truth) + "\n";
@@ -64,7 +64,7 @@ CsvLogger::CsvLogger(CsvLoggerOptions options)
   if (!flush_buffer()) {
     ::close(fd_);
     fd_ = -1;
-    throw io::InputError(fmt::format("{}: cannot write the log file: {}", options_.path, error_));
+    throw core::InputError(fmt::format("{}: cannot write the log file: {}", options_.path, error_));
   }
 }
 

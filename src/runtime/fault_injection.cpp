@@ -5,7 +5,7 @@
 
 #include <fmt/core.h>
 
-#include "piezoshift/io/input_error.hpp"
+#include "piezoshift/core/input_error.hpp"
 
 namespace piezoshift::runtime {
 
@@ -46,7 +46,7 @@ const char* to_string(FaultKind kind) noexcept {
 
 FaultSpec parse_fault_spec(std::string_view text) {
   const auto bad = [&text](const std::string& why) {
-    return io::InputError(fmt::format(
+    return core::InputError(fmt::format(
         "--fault '{}': {} (expected KIND@T_S[:CHANNEL], e.g. sgs-open@0.2:1)", text, why));
   };
   const std::size_t at = text.find('@');
@@ -105,11 +105,11 @@ FaultInjectingBackend::FaultInjectingBackend(DaqBackend& inner, LoopClock& clock
   for (std::size_t i = 0; i < faults_.size(); ++i) {
     const FaultSpec& f = faults_[i];
     if (f.kind == FaultKind::kActuatorCrack && hooks_ == nullptr) {
-      throw io::InputError(
+      throw core::InputError(
           fmt::format("--fault {}: needs a plant model (the sim backend)", to_string(f.kind)));
     }
     if (f.kind != FaultKind::kOverrunBurst && (f.channel < 0 || f.channel > 2))
-      throw io::InputError(fmt::format("--fault {}: channel must be 1..3", to_string(f.kind)));
+      throw core::InputError(fmt::format("--fault {}: channel must be 1..3", to_string(f.kind)));
     start_ns_[i] = static_cast<std::int64_t>(std::llround(f.time_s * 1e9));
   }
 }

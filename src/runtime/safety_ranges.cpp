@@ -1,20 +1,21 @@
 #include "piezoshift/runtime/safety_ranges.hpp"
+#include "piezoshift/core/bounds.hpp"
 
 #include <type_traits>
 
 #include <fmt/core.h>
 
-#include "piezoshift/io/input_error.hpp"
+#include "piezoshift/core/input_error.hpp"
 
 namespace piezoshift::runtime {
 
 std::string safety_limits_problem(const SafetyLimits& l) {
   std::string problem;
   visit_safety_limits(
-      l, [&](const char* section, const char* key, const auto& value, design::Bounds bounds) {
+      l, [&](const char* section, const char* key, const auto& value, core::Bounds bounds) {
         if (problem.empty()) {
-          problem = design::range_problem(fmt::format("{}.{}", section, key),
-                                          static_cast<double>(value), bounds);
+          problem = core::range_problem(fmt::format("{}.{}", section, key),
+                                        static_cast<double>(value), bounds);
         }
       });
   if (!problem.empty())
@@ -36,17 +37,16 @@ std::string safety_limits_problem(const SafetyLimits& l) {
 
 void read_safety_section(const io::ConfigFile& file, SafetyLimits& limits) {
   const io::ConfigSection s = file.section("safety");
-  visit_safety_limits(
-      limits, [&](const char*, const char* key, auto& value, design::Bounds bounds) {
-        if constexpr (std::is_same_v<std::remove_reference_t<decltype(value)>, std::uint32_t>) {
-          if (std::int64_t v = 0; s.read(key, v, bounds))
-            value = static_cast<std::uint32_t>(v);  // within bounds, so within uint32
-        } else {
-          s.read(key, value, bounds);
-        }
-      });
+  visit_safety_limits(limits, [&](const char*, const char* key, auto& value, core::Bounds bounds) {
+    if constexpr (std::is_same_v<std::remove_reference_t<decltype(value)>, std::uint32_t>) {
+      if (std::int64_t v = 0; s.read(key, v, bounds))
+        value = static_cast<std::uint32_t>(v);  // within bounds, so within uint32
+    } else {
+      s.read(key, value, bounds);
+    }
+  });
   if (const std::string problem = safety_limits_problem(limits); !problem.empty())
-    throw io::InputError(fmt::format("{}: {}", file.source(), problem));
+    throw core::InputError(fmt::format("{}: {}", file.source(), problem));
 }
 
 InstallationConfig load_installation_config(const std::string& path) {

@@ -4,14 +4,14 @@
 
 #include <fmt/core.h>
 
+#include "piezoshift/core/input_error.hpp"
 #include "piezoshift/io/csv_table.hpp"
-#include "piezoshift/io/input_error.hpp"
 
 namespace piezoshift::runtime {
 
 SetpointProfile SetpointProfile::step(double z_um, double max_z_um) {
   if (!(z_um >= 0.0 && z_um <= max_z_um)) {
-    throw io::InputError(
+    throw core::InputError(
         fmt::format("--step-um: {} um is outside [0, {}] um (the nominal stroke)", z_um, max_z_um));
   }
   return from_samples({0.0}, {Vec3{z_um, z_um, z_um}}, "--step-um", max_z_um);
@@ -20,19 +20,19 @@ SetpointProfile SetpointProfile::step(double z_um, double max_z_um) {
 SetpointProfile SetpointProfile::from_samples(std::vector<double> t_s, std::vector<Vec3> z_um,
                                               const std::string& source, double max_z_um) {
   if (t_s.empty() || t_s.size() != z_um.size())
-    throw io::InputError(fmt::format("{}: a profile needs at least one sample", source));
+    throw core::InputError(fmt::format("{}: a profile needs at least one sample", source));
   for (std::size_t i = 0; i < t_s.size(); ++i) {
     if (!std::isfinite(t_s[i]) || t_s[i] < 0.0)
-      throw io::InputError(
+      throw core::InputError(
           fmt::format("{}: sample {}: t_s = {} is not >= 0", source, i + 1, t_s[i]));
     if (i > 0 && !(t_s[i] > t_s[i - 1])) {
-      throw io::InputError(fmt::format("{}: sample {}: t_s = {} does not increase (previous {})",
-                                       source, i + 1, t_s[i], t_s[i - 1]));
+      throw core::InputError(fmt::format("{}: sample {}: t_s = {} does not increase (previous {})",
+                                         source, i + 1, t_s[i], t_s[i - 1]));
     }
     for (double z : z_um[i]) {
       if (!(z >= 0.0 && z <= max_z_um)) {
-        throw io::InputError(fmt::format("{}: sample {}: z = {} um is outside [0, {}] um", source,
-                                         i + 1, z, max_z_um));
+        throw core::InputError(fmt::format("{}: sample {}: z = {} um is outside [0, {}] um", source,
+                                           i + 1, z, max_z_um));
       }
     }
   }
@@ -45,13 +45,14 @@ SetpointProfile SetpointProfile::from_samples(std::vector<double> t_s, std::vect
 SetpointProfile SetpointProfile::load_csv(const std::string& path, double max_z_um) {
   const io::CsvTable table = io::CsvTable::load(path);
   if (table.rows() == 0)
-    throw io::InputError(fmt::format("{}: the profile has no data rows", path));
+    throw core::InputError(fmt::format("{}: the profile has no data rows", path));
   const std::vector<double> t = table.column("t_s");
   std::vector<Vec3> z(t.size());
   // The column vocabulary of docs/files.md: zd_um for all three points, or zd1_um..zd3_um.
   if (table.has_column("zd_um")) {
     if (table.has_column("zd1_um"))
-      throw io::InputError(fmt::format("{}: give either zd_um or zd1_um..zd3_um, not both", path));
+      throw core::InputError(
+          fmt::format("{}: give either zd_um or zd1_um..zd3_um, not both", path));
     const std::vector<double> c = table.column("zd_um");
     for (std::size_t i = 0; i < c.size(); ++i)
       z[i] = Vec3{c[i], c[i], c[i]};
@@ -67,13 +68,13 @@ SetpointProfile SetpointProfile::load_csv(const std::string& path, double max_z_
   for (std::size_t i = 0; i < t.size(); ++i) {
     const std::string where = fmt::format("{}:{}", path, table.line_of_row(i));
     if (t[i] < 0.0)
-      throw io::InputError(fmt::format("{}: t_s = {} is negative", where, t[i]));
+      throw core::InputError(fmt::format("{}: t_s = {} is negative", where, t[i]));
     if (i > 0 && !(t[i] > t[i - 1]))
-      throw io::InputError(
+      throw core::InputError(
           fmt::format("{}: t_s = {} does not increase (previous row: {})", where, t[i], t[i - 1]));
     for (double v : z[i]) {
       if (!(v >= 0.0 && v <= max_z_um))
-        throw io::InputError(fmt::format(
+        throw core::InputError(fmt::format(
             "{}: Z_d = {} um is outside [0, {}] um (the nominal stroke)", where, v, max_z_um));
     }
   }

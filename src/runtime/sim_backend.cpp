@@ -5,7 +5,7 @@
 
 #include <fmt/core.h>
 
-#include "piezoshift/io/input_error.hpp"
+#include "piezoshift/core/input_error.hpp"
 
 namespace piezoshift::runtime {
 
@@ -14,7 +14,7 @@ SimBackend::~SimBackend() = default;
 
 void SimBackend::configure() {
   if (!(options_.rate_Hz > 0.0) || !std::isfinite(options_.rate_Hz))
-    throw io::InputError(fmt::format("sim: rate {} Hz is not > 0", options_.rate_Hz));
+    throw core::InputError(fmt::format("sim: rate {} Hz is not > 0", options_.rate_Hz));
   period_ns_ = std::llround(1e9 / options_.rate_Hz);
   plant::TwinParams p = options_.twin;
   p.daq.sample_time_s = static_cast<double>(period_ns_) * 1e-9;
@@ -24,8 +24,8 @@ void SimBackend::configure() {
   // The config was valid at its own DAQ period; at the loop's rate it may not be (the physics
   // rate rounded up past its range, or no longer a multiple of the interferometer's).
   const auto cannot = [&](const std::string& why) {
-    return io::InputError(fmt::format("sim at {} Hz: the twin of {} cannot be built: {}",
-                                      options_.rate_Hz, options_.source, why));
+    return core::InputError(fmt::format("sim at {} Hz: the twin of {} cannot be built: {}",
+                                        options_.rate_Hz, options_.source, why));
   };
   if (const std::string problem = plant::twin_params_problem(options_.design, p); !problem.empty())
     throw cannot(problem);
@@ -38,7 +38,7 @@ void SimBackend::configure() {
 
 void SimBackend::activate() {
   if (!twin_)
-    throw io::InputError("sim: activate() before configure()");
+    throw core::InputError("sim: activate() before configure()");
   staged_ = Vec3{};
   twin_->write_ao(staged_);
   active_ = true;

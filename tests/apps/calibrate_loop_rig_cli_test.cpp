@@ -1,4 +1,4 @@
-// Runs the guided calibration through the real-time loop (calibration/loop_rig.hpp) on the twin,
+// Runs the guided calibration through the real-time loop (rig/loop_rig.hpp) on the twin,
 // paced by the procedure (`calibrate --daq sim-rt --free-run`): the loop in its own thread, the
 // procedure talking to it only through the host link. Its A and p must be those of `calibrate`
 // on the twin within 0.002 (issue 14); the twin's readings typed back at the prompt and read

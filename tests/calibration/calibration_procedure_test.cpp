@@ -8,7 +8,7 @@
 
 #include "piezoshift/calibration/calibration_file.hpp"
 #include "piezoshift/calibration/calibration_procedure.hpp"
-#include "piezoshift/io/input_error.hpp"
+#include "piezoshift/core/input_error.hpp"
 
 namespace piezoshift::calibration {
 namespace {
@@ -71,7 +71,7 @@ TEST(PidTuning, SearchPrefersFasterAcceptableGainsAndRejectsOvershootBetweenTick
 // the procedure must give that A back (the twin's fidelity target 5: +-0.05 per element).
 TEST(MatrixIdentification, RecoversThePapersMatrixFromTheTwin) {
   const config::ProjectConfig config;
-  experiments::Bench bench(config, control::SemiClosedLoopParams{}, 11);
+  rig::Bench bench(config, control::SemiClosedLoopParams{}, 11);
   MatrixIdentificationOptions o;
   o.repeats = 2;
   const MatrixIdentificationResult r = identify_matrix(bench, o);
@@ -101,7 +101,7 @@ TEST(MatrixIdentification, FindsThePlantsOwnMatrixWhenTheGaugeGainsDiffer) {
       truth[i][j] = d[i] * paper.a[i][j];
   }
   config.twin.geometry.transmission_matrix = truth;
-  experiments::Bench bench(config, control::SemiClosedLoopParams{}, 12);
+  rig::Bench bench(config, control::SemiClosedLoopParams{}, 12);
   MatrixIdentificationOptions o;
   o.repeats = 2;
   const MatrixIdentificationResult r = identify_matrix(bench, o);
@@ -120,7 +120,7 @@ TEST(MatrixIdentification, FindsThePlantsOwnMatrixWhenTheGaugeGainsDiffer) {
   const auto spread_nm = [&](const control::Mat3& a) {
     control::SemiClosedLoopParams c;
     c.matrix.a = a;
-    experiments::Bench b(config, c, 13);
+    rig::Bench b(config, c, 13);
     b.drive_points(Vec3{6.0, 6.0, 6.0});
     b.run(1.0);
     const auto m = b.measure_static();
@@ -147,7 +147,7 @@ TEST(Calibration, IdentifiedFeedforwardMakesTheRealDisplacementTheDesiredOne) {
   const CalibrationOutcome c = calibrate(config, control::SemiClosedLoopParams{}, 3, o);
   EXPECT_DOUBLE_EQ(c.controller.gains.kp, 0.6);
   EXPECT_GE(c.polynomial.fit.points, 10U);  // the paper: 10 or more
-  experiments::Bench bench(config, c.controller, 99);
+  rig::Bench bench(config, c.controller, 99);
   for (double zd : {3.5, 7.25, 10.0}) {
     bench.drive_points(Vec3{zd, zd, zd});
     bench.run(1.0);
@@ -181,7 +181,7 @@ TEST(CalibrationFile, WritesAtomicallyAndReadsBackTheSameDoubles) {
     files += e.is_regular_file();
   EXPECT_EQ(files, 1U);
   EXPECT_THROW(write_calibration_file((dir / "no" / "such" / "dir.toml").string(), p, ""),
-               io::InputError);
+               core::InputError);
   std::filesystem::remove_all(dir);
 }
 
@@ -224,7 +224,7 @@ TEST(CalibrationWithTravel, APlantThePapersProcedureCannotCalibrateIsAFailureWit
   try {
     (void)calibrate_with_travel(config, 5, o);
     FAIL() << "calibrated a plant whose stage 2 saturates";
-  } catch (const experiments::ProcedureFailed& e) {
+  } catch (const rig::ProcedureFailed& e) {
     const std::string why = e.what();
     EXPECT_NE(why.find("stage 2"), std::string::npos) << why;
     EXPECT_NE(why.find("saturation"), std::string::npos) << why;

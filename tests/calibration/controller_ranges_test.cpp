@@ -12,7 +12,8 @@
 
 #include "piezoshift/calibration/calibration_file.hpp"
 #include "piezoshift/calibration/controller_ranges.hpp"
-#include "piezoshift/io/input_error.hpp"
+#include "piezoshift/core/bounds.hpp"
+#include "piezoshift/core/input_error.hpp"
 #include "temp_dir_test.hpp"
 
 namespace piezoshift::calibration {
@@ -24,16 +25,16 @@ using control::SemiClosedLoopParams;
 struct Collect {
   std::vector<std::pair<std::string, double>> values;
   void operator()(std::string_view section, std::string_view key, const double& v,
-                  const io::Bounds&, std::string_view) {
+                  const core::Bounds&, std::string_view) {
     values.emplace_back(fmt(section, key, -1), v);
   }
   void operator()(std::string_view section, std::string_view key, const std::size_t& v,
-                  const io::Bounds&, std::string_view) {
+                  const core::Bounds&, std::string_view) {
     values.emplace_back(fmt(section, key, -1), static_cast<double>(v));
   }
   template <class Value, class Count>
   void operator()(std::string_view section, std::string_view key, const ListField<Value, Count>& f,
-                  const io::Bounds&, std::string_view) {
+                  const core::Bounds&, std::string_view) {
     for (std::size_t i = 0; i < *f.count; ++i)
       values.emplace_back(fmt(section, key, static_cast<int>(i)), f.values[i]);
   }
@@ -139,7 +140,7 @@ TEST_F(ControllerFile, EachNumberOutsideItsRangeIsNamed) {
   try {
     load_calibration_file(file);
     ADD_FAILURE() << "a negative ki was accepted";
-  } catch (const io::InputError& e) {
+  } catch (const core::InputError& e) {
     EXPECT_NE(std::string(e.what()).find("bad.toml"), std::string::npos) << e.what();
     EXPECT_NE(std::string(e.what()).find("ki"), std::string::npos) << e.what();
   }
@@ -199,7 +200,7 @@ TEST_F(ControllerFile, GainsOutsideTheStableRegionAreRefusedAtLoad) {
   try {
     load_calibration_file(file);
     ADD_FAILURE() << "kp 5, ki 3, kd 2 was accepted";
-  } catch (const io::InputError& e) {
+  } catch (const core::InputError& e) {
     EXPECT_NE(std::string(e.what()).find("unstable.toml"), std::string::npos) << e.what();
     EXPECT_NE(std::string(e.what()).find("kp = 5, ki = 3, kd = 2"), std::string::npos) << e.what();
   }

@@ -7,7 +7,7 @@
 #include <string>
 #include <vector>
 
-#include "piezoshift/io/input_error.hpp"
+#include "piezoshift/core/input_error.hpp"
 
 #include "../support/temp_dir_test.hpp"
 #include "heap_peak.hpp"
@@ -20,7 +20,7 @@ std::string error_of(std::string_view text, std::string_view column = {}) {
     const CsvTable t = CsvTable::parse(text, "data.csv");
     if (!column.empty())
       t.column(column);
-  } catch (const InputError& e) {
+  } catch (const core::InputError& e) {
     return e.what();
   }
   return "no error";
@@ -89,7 +89,7 @@ TEST(CsvTable, RequireColumnsListsEveryMissingName) {
   try {
     t.require_columns({"s1_um", "s2_um", "z1_um", "z3_um"});
     FAIL() << "no error";
-  } catch (const InputError& e) {
+  } catch (const core::InputError& e) {
     EXPECT_STREQ(e.what(),
                  "poses.csv:1: missing columns 's2_um', 'z3_um' (the header has: s1_um,z1_um)");
   }
@@ -99,7 +99,7 @@ TEST(CsvTable, MissingFileNamesThePath) {
   try {
     CsvTable::load("/nonexistent/dir/poses.csv");
     FAIL() << "no error";
-  } catch (const InputError& e) {
+  } catch (const core::InputError& e) {
     EXPECT_EQ(std::string(e.what()),
               "/nonexistent/dir/poses.csv: cannot open: No such file or directory");
   }
@@ -131,7 +131,7 @@ TEST_F(CsvTableMemory, ARowOfMillionsOfEmptyCellsIsRefusedAtItsLineInTheTextsMem
   const testing::HeapPeak peak;
   try {
     CsvTable::load(file);
-  } catch (const InputError& e) {
+  } catch (const core::InputError& e) {
     message = e.what();
   }
   const std::size_t bytes = peak.bytes();
@@ -160,7 +160,7 @@ TEST_F(CsvTableMemory, RowsOfEmptyCellsAsWideAsTheHeaderCostNoMemoryPerCell) {
   try {
     t.column("c7");
     ADD_FAILURE() << "no error";
-  } catch (const InputError& e) {
+  } catch (const core::InputError& e) {
     EXPECT_EQ(std::string(e.what()),
               file + ":2: column 'c7' (field 8): empty cell, expected a number");
   }

@@ -7,8 +7,8 @@
 #include <fstream>
 #include <sstream>
 
+#include "piezoshift/core/input_error.hpp"
 #include "piezoshift/io/csv_table.hpp"
-#include "piezoshift/io/input_error.hpp"
 
 namespace piezoshift::io {
 namespace {
@@ -49,14 +49,14 @@ TEST(CsvWriter, NonFiniteValuesAreWrittenAndThenRefusedByTheReader) {
   try {
     t.column("z_um");
     FAIL() << "no error";
-  } catch (const InputError& e) {
+  } catch (const core::InputError& e) {
     EXPECT_EQ(std::string(e.what()),
               path.string() + ":2: column 'z_um' (field 1): 'nan' is not a finite number");
   }
 }
 
 TEST(CsvWriter, UncreatableFileIsAnInputErrorNamingIt) {
-  EXPECT_THROW(CsvWriter("/nonexistent/dir/log.csv", {"z_um"}), InputError);
+  EXPECT_THROW(CsvWriter("/nonexistent/dir/log.csv", {"z_um"}), core::InputError);
 }
 
 // A record replaced atomically: the old file stays whole until close() writes every row at once
@@ -96,7 +96,7 @@ TEST(CsvWriter, ReplaceAtomicallyKeepsTheOldFileUntilClose) {
         CsvWriter bad("/nonexistent/dir/r.csv", {"z_um"}, 6, CsvWriter::Mode::kReplaceAtomically);
         bad.close();
       },
-      InputError);
+      core::InputError);
 }
 
 }  // namespace

@@ -7,6 +7,7 @@
 #include "piezoshift/calibration/calibration_file.hpp"
 #include "piezoshift/calibration/improved_calibration.hpp"
 #include "piezoshift/calibration/loop_identification.hpp"
+#include "piezoshift/core/input_error.hpp"
 #include "piezoshift/experiments/paper_experiments.hpp"
 #include "piezoshift/experiments/phase_step.hpp"
 #include "piezoshift/io/config_file.hpp"
@@ -129,7 +130,7 @@ TEST(ImprovedController, CalibrationFileRoundTripsAndRefusesAnotherRate) {
     const io::ConfigFile f = io::ConfigFile::parse(bad, "bad.toml");
     read_controller_section(f, back);
     FAIL() << "accepted";
-  } catch (const io::InputError& e) {
+  } catch (const core::InputError& e) {
     EXPECT_NE(std::string(e.what()).find("shaper_taps"), std::string::npos) << e.what();
   }
 }

@@ -9,8 +9,8 @@
 #include "piezoshift/calibration/fit_error.hpp"
 #include "piezoshift/calibration/loop_identification.hpp"
 #include "piezoshift/calibration/stability_margins.hpp"
-#include "piezoshift/experiments/bench.hpp"
 #include "piezoshift/plant/random.hpp"
+#include "piezoshift/rig/bench.hpp"
 
 namespace piezoshift::calibration {
 namespace {
@@ -110,7 +110,7 @@ TEST(LoopIdentification, TheTwinsModelPredictsTheClosedLoopStep) {
     EXPECT_LT(m.dc_gain(), 1.0);
   }
   const double s0 = 5.0, s1 = 5.1;
-  experiments::Bench bench(config, c, 22);
+  rig::Bench bench(config, c, 22);
   bench.drive_actuators(control::Vec3{s0, s0, s0});
   bench.run(1.0);
   const std::size_t n = 60;

@@ -6,7 +6,7 @@
 
 #include <gtest/gtest.h>
 
-#include "piezoshift/io/input_error.hpp"
+#include "piezoshift/core/input_error.hpp"
 
 #include "../support/temp_dir_test.hpp"
 #include "../support/test_paths.hpp"
@@ -26,12 +26,12 @@ class ProjectConfigTest : public piezoshift::testing::TempDirTest {
     const std::string path = write(text);
     try {
       load_project_config(path);
-    } catch (const InputError& e) {
+    } catch (const core::InputError& e) {
       const std::string m = e.what();
       EXPECT_NE(m.find(path), std::string::npos) << m;
       return m;
     }
-    ADD_FAILURE() << "no InputError for:\n" << text;
+    ADD_FAILURE() << "no core::InputError for:\n" << text;
     return "";
   }
 };
@@ -141,7 +141,7 @@ TEST_F(ProjectConfigTest, SyntaxErrorAndMissingFile) {
   try {
     load_project_config(missing);
     ADD_FAILURE() << "no error for a missing file";
-  } catch (const InputError& e) {
+  } catch (const core::InputError& e) {
     EXPECT_TRUE(contains(e.what(), missing)) << e.what();
   }
 }
@@ -152,7 +152,7 @@ TEST_F(ProjectConfigTest, ReadDesignSectionsLeavesUnknownKeysToTheCaller) {
   design::DesignInputs d;
   read_design_sections(f, d);
   EXPECT_EQ(d.hinge.width_m, 9e-3);
-  EXPECT_THROW(f.reject_unknown(), InputError);  // [twin] was nobody's
+  EXPECT_THROW(f.reject_unknown(), core::InputError);  // [twin] was nobody's
 }
 
 }  // namespace

@@ -37,7 +37,7 @@ TEST(PaperExperiments, TheOracleHoldsThePlateWhereTheGaugeFedLoopCannot) {
   const StepExperimentResult gauges = run_step_response(config, paper, 4, o);
   control::SemiClosedLoopParams oracle_params = paper;
   oracle_params.polynomial = control::CubicPolynomial::identity();
-  o.bench.feedback = Feedback::kOracle;
+  o.bench.feedback = rig::Feedback::kOracle;
   const StepExperimentResult oracle = run_step_response(config, oracle_params, 4, o);
   EXPECT_TRUE(oracle.validity.valid) << oracle.validity.reason;
   EXPECT_NEAR(oracle.metrics.final_um, 5.0, 0.005);

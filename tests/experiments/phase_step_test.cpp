@@ -32,7 +32,7 @@ TEST(PhaseStep, TheGaugesNoiseIsInThePlateAndTheOracleIsNot) {
   const config::ProjectConfig config;
   PhaseStepOptions o;
   const PhaseStepResult gauges = run_phase_step(config, c, 81, o);
-  o.bench.feedback = Feedback::kOracle;
+  o.bench.feedback = rig::Feedback::kOracle;
   const PhaseStepResult oracle = run_phase_step(config, c, 81, o);
   ASSERT_TRUE(gauges.validity.valid) << gauges.validity.reason;
   ASSERT_TRUE(oracle.validity.valid) << oracle.validity.reason;

@@ -16,7 +16,7 @@
 
 #include "../support/descriptor_exhaustion.hpp"
 #include "../support/http_client.hpp"
-#include "piezoshift/io/input_error.hpp"
+#include "piezoshift/core/input_error.hpp"
 
 namespace {
 
@@ -169,11 +169,11 @@ TEST(HttpBind, ANonLoopbackAddressNeedsAToken) {
   EchoHandler h;
   HttpServerOptions o;
   o.host = "0.0.0.0";
-  EXPECT_THROW(HttpServer(o, h), piezoshift::io::InputError);
+  EXPECT_THROW(HttpServer(o, h), piezoshift::core::InputError);
   o.token = "0123456789abcdef";
   EXPECT_NO_THROW(HttpServer(o, h));
   o.host = "not-an-address";
-  EXPECT_THROW(HttpServer(o, h), piezoshift::io::InputError);
+  EXPECT_THROW(HttpServer(o, h), piezoshift::core::InputError);
 }
 
 TEST_F(Http, OneClientTooManyGets503) {

@@ -22,11 +22,11 @@
 #include <vector>
 
 #include "../support/descriptor_exhaustion.hpp"
+#include "piezoshift/core/input_error.hpp"
 #include "piezoshift/host/gcs_client.hpp"
 #include "piezoshift/host/gcs_interpreter.hpp"
 #include "piezoshift/host/line_server.hpp"
 #include "piezoshift/host/locked_line_handler.hpp"
-#include "piezoshift/io/input_error.hpp"
 #include "piezoshift/plant/geometry.hpp"
 
 namespace piezoshift::host {
@@ -552,7 +552,7 @@ TEST(LineServerAddress, NonLoopbackNeedsAllowRemote) {
   try {
     LineServer server(ListenAddress{"0.0.0.0", 0, false}, LineServerLimits{}, handler);
     FAIL() << "0.0.0.0 was accepted without allow_remote";
-  } catch (const io::InputError& e) {
+  } catch (const core::InputError& e) {
     EXPECT_NE(std::string(e.what()).find("--allow-remote"), std::string::npos) << e.what();
     EXPECT_NE(std::string(e.what()).find("0.0.0.0:0"), std::string::npos) << e.what();
   }
@@ -569,16 +569,16 @@ TEST(LineServerAddress, UnparsableAddressOrBadLimitsThrow) {
     try {
       LineServer server(ListenAddress{host, 0, true}, LineServerLimits{}, handler);
       ADD_FAILURE() << "'" << host << "' was accepted";
-    } catch (const io::InputError& e) {
+    } catch (const core::InputError& e) {
       EXPECT_NE(std::string(e.what()).find("'"s + host + "'"), std::string::npos) << e.what();
     }
   }
   LineServerLimits no_clients;
   no_clients.max_clients = 0;
-  EXPECT_THROW(LineServer(ListenAddress{"127.0.0.1", 0}, no_clients, handler), io::InputError);
+  EXPECT_THROW(LineServer(ListenAddress{"127.0.0.1", 0}, no_clients, handler), core::InputError);
   LineServerLimits zero_idle;
   zero_idle.idle_timeout_s = 0.0;
-  EXPECT_THROW(LineServer(ListenAddress{"127.0.0.1", 0}, zero_idle, handler), io::InputError);
+  EXPECT_THROW(LineServer(ListenAddress{"127.0.0.1", 0}, zero_idle, handler), core::InputError);
 }
 
 TEST(LineServerAddress, PortInUseThrowsNamingThePort) {
@@ -588,7 +588,7 @@ TEST(LineServerAddress, PortInUseThrowsNamingThePort) {
   try {
     LineServer second(ListenAddress{"127.0.0.1", first.port()}, LineServerLimits{}, handler);
     FAIL() << "a second server bound port " << port;
-  } catch (const io::InputError& e) {
+  } catch (const core::InputError& e) {
     EXPECT_NE(std::string(e.what()).find("127.0.0.1:" + port), std::string::npos) << e.what();
     EXPECT_NE(std::string(e.what()).find("in use"), std::string::npos) << e.what();
   }

@@ -1,4 +1,5 @@
 #include "piezoshift/io/config_file.hpp"
+#include "piezoshift/core/bounds.hpp"
 
 #include <sys/stat.h>
 
@@ -9,7 +10,7 @@
 
 #include <gtest/gtest.h>
 
-#include "piezoshift/io/input_error.hpp"
+#include "piezoshift/core/input_error.hpp"
 #include "piezoshift/io/input_file.hpp"
 
 #include "../support/temp_dir_test.hpp"
@@ -22,10 +23,10 @@ template <typename F>
 std::string error_of(F&& f) {
   try {
     f();
-  } catch (const InputError& e) {
+  } catch (const core::InputError& e) {
     return e.what();
   }
-  ADD_FAILURE() << "no InputError thrown";
+  ADD_FAILURE() << "no core::InputError thrown";
   return "";
 }
 
@@ -89,22 +90,22 @@ TEST(ConfigFile, BoundsAreEnforcedAndDescribed) {
       ConfigFile::parse("[s]\nzero = 0.0\nneg = -1\nhalf = 0.5\nok = 0.25\nbig = 11\n", "b.toml");
   const ConfigSection s = f.section("s");
   double v = 0.0;
-  std::string m = error_of([&] { s.read("zero", v, Bounds::positive()); });
+  std::string m = error_of([&] { s.read("zero", v, core::Bounds::positive()); });
   EXPECT_TRUE(contains(m, "b.toml:2:")) << m;
   EXPECT_TRUE(contains(m, "s.zero: value 0 is not allowed: must be > 0")) << m;
-  m = error_of([&] { s.read("neg", v, Bounds::non_negative()); });
+  m = error_of([&] { s.read("neg", v, core::Bounds::non_negative()); });
   EXPECT_TRUE(contains(m, "must be >= 0")) << m;
-  m = error_of([&] { s.read("half", v, Bounds::open(0.0, 0.5)); });
+  m = error_of([&] { s.read("half", v, core::Bounds::open(0.0, 0.5)); });
   EXPECT_TRUE(contains(m, "must be in (0, 0.5)")) << m;
-  EXPECT_TRUE(s.read("half", v, Bounds::closed(0.0, 0.5)));
+  EXPECT_TRUE(s.read("half", v, core::Bounds::closed(0.0, 0.5)));
   EXPECT_DOUBLE_EQ(v, 0.5);
-  EXPECT_TRUE(s.read("ok", v, Bounds::open(0.0, 0.5)));
+  EXPECT_TRUE(s.read("ok", v, core::Bounds::open(0.0, 0.5)));
   EXPECT_DOUBLE_EQ(v, 0.25);
   std::int64_t i = 0;
-  m = error_of([&] { s.read("big", i, Bounds::closed(1, 10)); });
+  m = error_of([&] { s.read("big", i, core::Bounds::closed(1, 10)); });
   EXPECT_TRUE(contains(m, "s.big: value 11 is not allowed: must be in [1, 10]")) << m;
-  EXPECT_EQ(Bounds::any().describe(), "a finite number");
-  const Bounds below3{.lo = -1e308, .hi = 3.0, .hi_open = true};
+  EXPECT_EQ(core::Bounds::any().describe(), "a finite number");
+  const core::Bounds below3{.lo = -1e308, .hi = 3.0, .hi_open = true};
   EXPECT_EQ(below3.describe(), "< 3");
 }
 
@@ -115,7 +116,7 @@ TEST(ConfigFile, NanAndInfinityAreRejectedEvenWithoutBounds) {
   EXPECT_TRUE(contains(m, "n.toml:1:")) << m;
   EXPECT_TRUE(contains(m, "x: value nan is not allowed: not a finite number")) << m;
   EXPECT_TRUE(contains(error_of([&] { f.section("").read("y", v); }), "not a finite number"));
-  EXPECT_TRUE(contains(error_of([&] { f.section("").read("z", v, Bounds::positive()); }),
+  EXPECT_TRUE(contains(error_of([&] { f.section("").read("z", v, core::Bounds::positive()); }),
                        "not a finite number"));
   EXPECT_DOUBLE_EQ(v, 1.0);  // untouched by the failed reads
 }
@@ -248,7 +249,7 @@ TEST(ConfigFile, ThreeVectors) {
   EXPECT_TRUE(contains(error_of([&] { k.read("short", v); }), "k.short: expected a list of three"));
   std::string m = error_of([&] { k.read("bad", v); });
   EXPECT_TRUE(contains(m, "k.bad[1]: expected a number, found string")) << m;
-  m = error_of([&] { k.read("pos", v, Bounds::positive()); });
+  m = error_of([&] { k.read("pos", v, core::Bounds::positive()); });
   EXPECT_TRUE(contains(m, "k.pos[1]: value 0 is not allowed: must be > 0")) << m;
   EXPECT_DOUBLE_EQ(v[1], 2.5);  // a failed read leaves the whole vector alone
 }

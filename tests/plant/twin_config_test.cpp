@@ -7,7 +7,8 @@
 #include <unistd.h>
 
 #include "piezoshift/config/project_config.hpp"
-#include "piezoshift/io/input_error.hpp"
+#include "piezoshift/core/bounds.hpp"
+#include "piezoshift/core/input_error.hpp"
 #include "piezoshift/plant/twin_ranges.hpp"
 
 #include "../support/test_paths.hpp"
@@ -29,7 +30,7 @@ std::string error_for(const std::string& name, const std::string& text) {
   const std::string path = write_temp(name, text);
   try {
     load_project_config(path);
-  } catch (const InputError& e) {
+  } catch (const core::InputError& e) {
     std::filesystem::remove(path);
     return e.what();
   }
@@ -115,7 +116,7 @@ TEST(TwinConfig, TheRangesListCoversTheDefaultsAndChecksStructsBuiltInCode) {
   EXPECT_EQ(plant::twin_ranges_problem(plant::TwinParams{}), "");
   int values = 0;
   plant::TwinParams t;
-  plant::visit_twin_values(t, [&](const char*, const char*, auto&, design::Bounds) { ++values; });
+  plant::visit_twin_values(t, [&](const char*, const char*, auto&, core::Bounds) { ++values; });
   // every key of configs/paper.toml's twin sections but nonlinearity_shape (a name, read apart)
   EXPECT_EQ(values, 58);
   t.sgs.offset_V[2] = 200.0;

@@ -1,6 +1,6 @@
 // The twin's open-loop fidelity targets, each against the paper (docs/twin.md, "Fidelity").
 // Target 4 (the mechanism's mode) is in mechanics_test.cpp; the closed-loop targets 5 and 6 in
-// tests/experiments/loop_fidelity_test.cpp.
+// tests/rig/loop_fidelity_test.cpp.
 #include <algorithm>
 #include <cmath>
 #include <vector>
@@ -134,7 +134,7 @@ TEST(Fidelity3, OpenLoopCreepAfterAStepIsOneToTwoPercentPerDecade) {
 }
 
 // Targets 5 (A by the paper's procedure) and 6 (one seed, one output) close the loop: they run
-// through the loop every command ships, in tests/experiments/loop_fidelity_test.cpp.
+// through the loop every command ships, in tests/rig/loop_fidelity_test.cpp.
 
 }  // namespace
 }  // namespace piezoshift::plant

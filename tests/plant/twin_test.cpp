@@ -1,5 +1,5 @@
 // The twin as a whole: its DAQ view, sensors, faults and the checks on its parameters (closed
-// loops go through the shipping loop: tests/experiments/loop_fidelity_test.cpp).
+// loops go through the shipping loop: tests/rig/loop_fidelity_test.cpp).
 #include <cmath>
 #include <vector>
 

@@ -7,7 +7,7 @@
 #include <string>
 #include <vector>
 
-#include "piezoshift/io/input_error.hpp"
+#include "piezoshift/core/input_error.hpp"
 #include "piezoshift/psi/analysis.hpp"
 #include "piezoshift/psi/frame_set.hpp"
 #include "piezoshift/psi/npy.hpp"
@@ -61,10 +61,10 @@ TEST(PsiFilesTest, Png16RoundTripAndBadFilesNameThemselves) {
   try {
     read_png_gray((d / "bad.png").string());
     FAIL();
-  } catch (const io::InputError& e) {
+  } catch (const core::InputError& e) {
     EXPECT_NE(std::string(e.what()).find("bad.png"), std::string::npos);
   }
-  EXPECT_THROW(read_png_gray((d / "missing.png").string()), io::InputError);
+  EXPECT_THROW(read_png_gray((d / "missing.png").string()), core::InputError);
   fs::remove_all(d);
 }
 
@@ -92,7 +92,7 @@ template <class F>
 std::string input_error(F&& f) {
   try {
     f();
-  } catch (const io::InputError& e) {
+  } catch (const core::InputError& e) {
     return e.what();
   }
   return "";

@@ -6,9 +6,9 @@
 #include <cmath>
 #include <numbers>
 
-#include "piezoshift/experiments/bench.hpp"
 #include "piezoshift/psi/error_budget.hpp"
 #include "piezoshift/psi/step_calibration.hpp"
+#include "piezoshift/rig/bench.hpp"
 
 namespace piezoshift::psi {
 namespace {
@@ -21,7 +21,7 @@ control::SemiClosedLoopParams paper_controller(const config::ProjectConfig& conf
 
 TEST(PsiAcquisitionTest, BenchStageStepsByLambdaOverEightAndComesOnTarget) {
   const config::ProjectConfig config;
-  experiments::Bench bench(config, paper_controller(config), 3);
+  rig::Bench bench(config, paper_controller(config), 3);
   BenchStage stage(bench);
   AcquisitionParams ap;
   const Acquisition a = acquire(stage, ap);

@@ -5,7 +5,7 @@
 #include <gtest/gtest.h>
 
 #include "fake_backend.hpp"
-#include "piezoshift/io/input_error.hpp"
+#include "piezoshift/core/input_error.hpp"
 
 namespace piezoshift::runtime {
 namespace {
@@ -34,7 +34,7 @@ TEST(FaultSpec, RejectsMalformedTextNamingIt) {
     try {
       parse_fault_spec(bad);
       ADD_FAILURE() << bad << " accepted";
-    } catch (const io::InputError& e) {
+    } catch (const core::InputError& e) {
       EXPECT_NE(std::string(e.what()).find(bad), std::string::npos) << e.what();
     }
   }
@@ -132,7 +132,7 @@ TEST(FaultInjection, CrackNeedsAPlantModel) {
   SimulatedClock clock;
   EXPECT_THROW(
       FaultInjectingBackend(daq, clock, 1'000'000, {FaultSpec{FaultKind::kActuatorCrack, 0.1, 0}}),
-      io::InputError);
+      core::InputError);
 }
 
 }  // namespace

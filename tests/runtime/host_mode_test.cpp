@@ -136,7 +136,7 @@ TEST(HostMode, ServoOffHoldsTheAppliedVolts) {
 }
 
 TEST(HostMode, ActuatorTargetsHoldTheSgsOnSAndAreNoZd) {
-  // The guided calibration's stage 2 (calibration/loop_rig.hpp): the PIDs alone on S.
+  // The guided calibration's stage 2 (rig/loop_rig.hpp): the PIDs alone on S.
   const Vec3 s_um{2.0, 9.0, 2.0};
   const HostRun r = run_host({actuators_command(1, s_um)}, 0.3);
   EXPECT_FALSE(r.result.fault_detected) << to_string(r.result.fault.reason);

@@ -1,13 +1,14 @@
 // The [safety] section: every limit has a range, the pairs are checked, the file names the key,
 // and the supervisor refuses what the reader refuses (one list, safety_ranges.hpp).
 #include "piezoshift/runtime/safety_ranges.hpp"
+#include "piezoshift/core/bounds.hpp"
 
 #include <stdexcept>
 #include <string>
 
 #include <gtest/gtest.h>
 
-#include "piezoshift/io/input_error.hpp"
+#include "piezoshift/core/input_error.hpp"
 
 namespace piezoshift::runtime {
 namespace {
@@ -16,7 +17,7 @@ std::string error_of(const std::string& toml) {
   try {
     SafetyLimits l;
     read_safety_section(io::ConfigFile::parse(toml, "site.toml"), l);
-  } catch (const io::InputError& e) {
+  } catch (const core::InputError& e) {
     return e.what();
   }
   return {};
@@ -26,7 +27,7 @@ TEST(SafetyRanges, DefaultsAreInRangeAndEveryLimitIsListed) {
   EXPECT_EQ(safety_limits_problem(SafetyLimits{}), "");
   int n = 0;
   SafetyLimits l;
-  visit_safety_limits(l, [&](const char*, const char*, auto&, design::Bounds) { ++n; });
+  visit_safety_limits(l, [&](const char*, const char*, auto&, core::Bounds) { ++n; });
   EXPECT_EQ(n, 22);  // every field of SafetyLimits
 }
 

@@ -9,8 +9,8 @@
 #include <gtest/gtest.h>
 
 #include "piezoshift/calibration/calibration_file.hpp"
+#include "piezoshift/core/input_error.hpp"
 #include "piezoshift/io/atomic_file.hpp"
-#include "piezoshift/io/input_error.hpp"
 #include "piezoshift/runtime/setpoint_profile.hpp"
 
 #include "../support/temp_dir_test.hpp"
@@ -51,16 +51,16 @@ TEST_F(SetpointProfileTest, RefusesOutOfStrokeAndNonIncreasingTimesWithLine) {
       {
         try {
           SetpointProfile::load_csv(a);
-        } catch (const io::InputError& e) {
+        } catch (const core::InputError& e) {
           EXPECT_NE(std::string(e.what()).find("a.csv:3"), std::string::npos) << e.what();
           throw;
         }
       },
-      io::InputError);
+      core::InputError);
   const std::string b = write("b.csv", "t_s,zd_um\n0,1\n0,2\n");
-  EXPECT_THROW(SetpointProfile::load_csv(b), io::InputError);
-  EXPECT_THROW(SetpointProfile::step(-0.1), io::InputError);
-  EXPECT_THROW(SetpointProfile::step(16.5), io::InputError);
+  EXPECT_THROW(SetpointProfile::load_csv(b), core::InputError);
+  EXPECT_THROW(SetpointProfile::step(-0.1), core::InputError);
+  EXPECT_THROW(SetpointProfile::step(16.5), core::InputError);
 }
 
 TEST_F(ControllerConfigTest, ReadsGainsPolynomialAndMatrix) {
@@ -92,11 +92,11 @@ TEST_F(ControllerConfigTest, AbsentKeysKeepThePapersValues) {
 
 TEST_F(ControllerConfigTest, RejectsUnknownKeyAndShortPolynomial) {
   EXPECT_THROW(calibration::load_calibration_file(write("a.toml", "[controller]\nkq = 1\n")),
-               io::InputError);
+               core::InputError);
   try {
     calibration::load_calibration_file(write("b.toml", "[controller]\np = [1, 2, 3]\n"));
     FAIL();
-  } catch (const io::InputError& e) {
+  } catch (const core::InputError& e) {
     EXPECT_NE(std::string(e.what()).find("controller.p"), std::string::npos) << e.what();
   }
 }
@@ -113,7 +113,7 @@ TEST_F(ControllerConfigTest, TravelSectionIsOptionalAndRoundTrips) {
   try {
     calibration::load_calibration_file(write("bad.toml", "[travel]\nz_max_um = -1\n"));
     FAIL();
-  } catch (const io::InputError& e) {
+  } catch (const core::InputError& e) {
     EXPECT_NE(std::string(e.what()).find("travel.z_max_um"), std::string::npos) << e.what();
   }
 }
@@ -163,7 +163,7 @@ TEST_F(AtomicFileTest, APlantedSymlinkAtTheTemporarysNameIsNotWrittenThrough) {
 TEST_F(AtomicFileTest, FailureLeavesTheOldFileIntact) {
   const std::string path = write("cal.toml", "old\n");
   EXPECT_THROW(io::write_file_atomically((dir_ / "missing" / "cal.toml").string(), "x"),
-               io::InputError);
+               core::InputError);
   EXPECT_EQ(read_text(path), "old\n");
 }
 

@@ -1,7 +1,7 @@
 #pragma once
 // Open-loop plant tests: one control period of the twin with the DAQ volts held, in the twin's
 // own order (plant/twin.hpp): write_ao, advance, read_ai. A closed loop goes through the loop
-// every command ships (runtime/control_loop.hpp, experiments/bench.hpp), never through this.
+// every command ships (runtime/control_loop.hpp, rig/bench.hpp), never through this.
 #include "piezoshift/control/vec3.hpp"
 #include "piezoshift/plant/twin.hpp"
 

@@ -20,7 +20,7 @@
 //                              # hysteresis at 0 V); `serve`'s TMN? Z
 //
 // Every key is optional (absent: the paper's value, Section 4); an unknown key or section, a
-// wrong type or a bad value throws io::InputError naming file, key and reason. The run's own
+// wrong type or a bad value throws core::InputError naming file, key and reason. The run's own
 // sample time is set by the loop, not here. Files are written whole to a temporary file and
 // renamed over the old one (io/atomic_file.hpp), with 17 significant digits so that reading
 // back gives the same doubles.
@@ -48,7 +48,7 @@ std::string format_calibration(const control::SemiClosedLoopParams& params,
                                const std::string& header,
                                std::optional<double> travel_z_max_um = std::nullopt,
                                std::optional<double> travel_z_min_um = std::nullopt);
-//! Writes format_calibration() atomically; throws io::InputError when the path is not writable.
+//! Writes format_calibration() atomically; throws core::InputError when the path is not writable.
 void write_calibration_file(const std::string& path, const control::SemiClosedLoopParams& params,
                             const std::string& header,
                             std::optional<double> travel_z_max_um = std::nullopt,

@@ -11,7 +11,7 @@
 #include "piezoshift/calibration/pid_tuning.hpp"
 #include "piezoshift/calibration/polynomial_identification.hpp"
 #include "piezoshift/experiments/paper_experiments.hpp"
-#include "piezoshift/experiments/progress.hpp"
+#include "piezoshift/rig/progress.hpp"
 
 namespace piezoshift::calibration {
 
@@ -51,12 +51,12 @@ struct CalibrationWithTravel {
 CalibrationOutcome calibrate(const config::ProjectConfig& config,
                              const control::SemiClosedLoopParams& base, std::uint64_t seed,
                              const CalibrationOptions& options = {},
-                             const experiments::Progress& progress = {});
+                             const rig::Progress& progress = {});
 
-//! calibrate() at the twin's DAQ rate, then the travel. Throws io::InputError when the calibrated
+//! calibrate() at the twin's DAQ rate, then the travel. Throws core::InputError when the calibrated
 //! loop cannot track even the travel search's first level (no travel to advertise).
 CalibrationWithTravel calibrate_with_travel(const config::ProjectConfig& config, std::uint64_t seed,
                                             const CalibrationOptions& options = {},
-                                            const experiments::Progress& progress = {});
+                                            const rig::Progress& progress = {});
 
 }  // namespace piezoshift::calibration

@@ -32,6 +32,7 @@
 #include <string_view>
 
 #include "piezoshift/control/semi_closed_loop.hpp"
+#include "piezoshift/core/bounds.hpp"
 #include "piezoshift/io/config_file.hpp"
 
 namespace piezoshift::calibration {
@@ -59,7 +60,7 @@ ListField(Value*, Count*, std::size_t, const char*) -> ListField<Value, Count>;
 //! is the writer's comment ("" none) or, for a required key, starts with "required". Const or not.
 template <class Params, class Visit>
 void visit_controller_fields(Params& p, Visit&& visit) {
-  using B = io::Bounds;
+  using B = core::Bounds;
   visit("controller", "kp", p.gains.kp, B::non_negative(), "per-sample gains, Eq. 7");
   visit("controller", "ki", p.gains.ki, B::non_negative(), "");
   visit("controller", "kd", p.gains.kd, B::non_negative(), "");
@@ -69,7 +70,7 @@ void visit_controller_fields(Params& p, Visit&& visit) {
 //! [improved]'s numbers, as visit_controller_fields.
 template <class Improved, class Visit>
 void visit_improved_fields(Improved& im, Visit&& visit) {
-  using B = io::Bounds;
+  using B = core::Bounds;
   visit("improved", "sample_time_s", im.sample_time_s, B::positive(),
         "required when kind = \"improved\"");
   visit("improved", "reference_delay_ticks", im.reference_delay_ticks,
@@ -89,7 +90,7 @@ void visit_improved_fields(Improved& im, Visit&& visit) {
 //! One [improved.channelN]'s numbers (section: its name), as visit_controller_fields.
 template <class Model, class Visit>
 void visit_model_fields(Model& m, std::string_view section, Visit&& visit) {
-  using B = io::Bounds;
+  using B = core::Bounds;
   visit(section, "offset_um", m.offset_um, B::closed(-100.0, 100.0), "");
   visit(section, "linear_weight", m.linear_weight, B::closed(1e-3, 100.0), "required");
   visit(section, "thresholds_um",

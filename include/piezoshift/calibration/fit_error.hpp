@@ -1,17 +1,17 @@
 #pragma once
 // Data that cannot give a calibration: too few rows, a rank-deficient design, a non-finite value,
 // sizes that do not match. It is bad user input (exit status 2 in the CLI), so it is an
-// io::InputError; the message says what is wrong with the data but not which file it came from,
+// core::InputError; the message says what is wrong with the data but not which file it came from,
 // which the caller (who knows) puts in front.
 #include <string>
 
-#include "piezoshift/io/input_error.hpp"
+#include "piezoshift/core/input_error.hpp"
 
 namespace piezoshift::calibration {
 
-class FitError : public io::InputError {
+class FitError : public core::InputError {
  public:
-  explicit FitError(const std::string& message) : io::InputError(message) {}
+  explicit FitError(const std::string& message) : core::InputError(message) {}
 };
 
 //! Relative threshold for numerical rank: a design matrix whose singular values satisfy

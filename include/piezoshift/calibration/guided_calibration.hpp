@@ -31,13 +31,15 @@
 #include <string>
 #include <vector>
 
-#include "piezoshift/calibration/guided_rig.hpp"
 #include "piezoshift/calibration/guided_session.hpp"
 #include "piezoshift/calibration/interferometer_source.hpp"
 #include "piezoshift/calibration/matrix_identification.hpp"
 #include "piezoshift/calibration/polynomial_identification.hpp"
+#include "piezoshift/rig/guided_rig.hpp"
 
 namespace piezoshift::calibration {
+
+using control::Vec3;
 
 struct GuidedOptions {
   MatrixIdentificationOptions matrix{};
@@ -76,10 +78,10 @@ struct GuidedOutcome {
   PolynomialIdentificationResult polynomial;
 };
 
-//! Runs the plan, resuming session. Throws experiments::ProcedureFailed when a rig's supervisor
-//! trips, io::InputError for a refused reading from a source that cannot retry, FitError when
+//! Runs the plan, resuming session. Throws rig::ProcedureFailed when a rig's supervisor
+//! trips, core::InputError for a refused reading from a source that cannot retry, FitError when
 //! the data cannot give A or p. stage2 and stage3 may be the same rig (hardware).
-GuidedOutcome run_guided_calibration(GuidedRig& stage2, GuidedRig& stage3,
+GuidedOutcome run_guided_calibration(rig::GuidedRig& stage2, rig::GuidedRig& stage3,
                                      const control::SemiClosedLoopParams& base,
                                      GuidedSession& session, GuidedIo& io,
                                      const GuidedOptions& options = {});

@@ -34,10 +34,10 @@ struct GuidedSession {
   std::vector<SessionReading> readings;
 };
 
-//! Nothing when the file does not exist; io::InputError naming the file for anything malformed
+//! Nothing when the file does not exist; core::InputError naming the file for anything malformed
 //! (and for a file larger than 16 MiB).
 std::optional<GuidedSession> load_guided_session(const std::string& path);
-//! Replaces the file atomically; io::InputError naming it when it cannot be written.
+//! Replaces the file atomically; core::InputError naming it when it cannot be written.
 void save_guided_session(const std::string& path, const GuidedSession& session);
 
 }  // namespace piezoshift::calibration

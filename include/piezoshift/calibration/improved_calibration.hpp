@@ -1,6 +1,6 @@
 #pragma once
 // Calibration of the improved controller (control/semi_closed_loop.hpp, kind = kImproved; issue
-// 12), on the twin through the shipping loop (experiments/bench.hpp), each step on a bench of its
+// 12), on the twin through the shipping loop (rig/bench.hpp), each step on a bench of its
 // own:
 //   1-3. the paper's procedure (calibration_procedure.hpp): A and p, the gauge-to-plate map the
 //        improved controller keeps as its feedforward          seeds seed .. seed + 2
@@ -55,13 +55,13 @@ struct ImprovedDesign {
   bool shaped = false;  //!< the shaper nulls the mode (false: no mode, or one it cannot place)
 };
 
-//! base supplies the sample time, limits and scaling. Throws experiments::ProcedureFailed when a
+//! base supplies the sample time, limits and scaling. Throws rig::ProcedureFailed when a
 //! stage trips the supervisor, FitError when a fit fails.
 ImprovedCalibrationOutcome calibrate_improved(const config::ProjectConfig& config,
                                               const control::SemiClosedLoopParams& base,
                                               std::uint64_t seed,
                                               const ImprovedCalibrationOptions& options = {},
-                                              const experiments::Progress& progress = {});
+                                              const rig::Progress& progress = {});
 
 //! Stage 6 alone, from the other stages' results however they were obtained (the twin above, or
 //! recorded bench files through `piezoshift fit improved`): paper supplies A, p, the scaling, the

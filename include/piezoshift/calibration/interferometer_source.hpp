@@ -17,7 +17,7 @@
 #include <optional>
 #include <string>
 
-#include "piezoshift/calibration/guided_rig.hpp"
+#include "piezoshift/rig/guided_rig.hpp"
 
 namespace piezoshift::calibration {
 
@@ -31,7 +31,7 @@ struct ReadingRequest {
   std::size_t total = 0;
   Optics optics = Optics::kP1;
   std::string what;  //!< the pose, in words ("P2, repeat 1, actuator 3 moved by 7 um")
-  RigWindow window;
+  rig::RigWindow window;
 };
 
 class InterferometerSource {
@@ -68,7 +68,7 @@ class LogFileSource final : public InterferometerSource {
   //! The log is read whole at each reading; a file larger than max_bytes is refused.
   explicit LogFileSource(std::string path, std::size_t max_bytes = std::size_t{64} << 20)
       : path_(std::move(path)), max_bytes_(max_bytes) {}
-  //! Throws io::InputError naming the file for a bad file, a log that ends before the window
+  //! Throws core::InputError naming the file for a bad file, a log that ends before the window
   //! does, or no row inside the window.
   std::optional<double> read(const ReadingRequest& request) override;
   bool can_retry() const override { return false; }

@@ -1,6 +1,6 @@
 #pragma once
 // The inner loop's plant as the PID sees it, identified on the bench through the shipping tick
-// (experiments/bench.hpp), so that its model carries the tick's real delays: from the PID's
+// (rig/bench.hpp), so that its model carries the tick's real delays: from the PID's
 // output u (um of command, control/signal_scaling.hpp) to the SGS feedback y (um), per actuator,
 // at the loop's sample time, as an ARX model
 //   y_k = a_1 y_{k-1} + ... + a_na y_{k-na} + b_1 u_{k-1} + ... + b_nb u_{k-nb} + c
@@ -60,7 +60,7 @@ struct LoopIdentification {
 };
 
 //! On a fresh bench with `controller` (its scaling and sample time; its PIDs hold the operating
-//! point, then the loop is opened). Throws experiments::ProcedureFailed when the supervisor trips.
+//! point, then the loop is opened). Throws rig::ProcedureFailed when the supervisor trips.
 LoopIdentification identify_loop(const config::ProjectConfig& config,
                                  const control::SemiClosedLoopParams& controller,
                                  std::uint64_t seed, const LoopIdentificationOptions& options = {});

@@ -11,8 +11,8 @@
 #include <vector>
 
 #include "piezoshift/calibration/matrix_fit.hpp"
-#include "piezoshift/experiments/bench.hpp"
-#include "piezoshift/experiments/progress.hpp"
+#include "piezoshift/rig/bench.hpp"
+#include "piezoshift/rig/progress.hpp"
 
 namespace piezoshift::calibration {
 
@@ -34,8 +34,8 @@ struct MatrixIdentificationResult {
 
 //! Runs the procedure on the bench (which must have its PID gains set); throws FitError when the
 //! data cannot give A.
-MatrixIdentificationResult identify_matrix(experiments::Bench& bench,
+MatrixIdentificationResult identify_matrix(rig::Bench& bench,
                                            const MatrixIdentificationOptions& options = {},
-                                           const experiments::Progress& progress = {});
+                                           const rig::Progress& progress = {});
 
 }  // namespace piezoshift::calibration

@@ -1,7 +1,7 @@
 #pragma once
 // Calibration stage 1 (paper, Section 3, first step): the PID gains, by the paper's trial and
 // error made systematic. For every candidate (kp, ki, kd) on a grid, on a fresh bench (the
-// shipping loop, supervisor included: experiments/bench.hpp):
+// shipping loop, supervisor included: rig/bench.hpp):
 //   the three inner loops step together (the stage moves as in use), each SGS target from 0 to
 //   its maximum nominal displacement S_max,i, held step_duration_s; scored
 //     per actuator, from its SGS feedback y(t) at the ticks (experiments/metrics_step_response.hpp,
@@ -29,7 +29,7 @@
 
 #include "piezoshift/config/project_config.hpp"
 #include "piezoshift/control/semi_closed_loop.hpp"
-#include "piezoshift/experiments/progress.hpp"
+#include "piezoshift/rig/progress.hpp"
 
 namespace piezoshift::calibration {
 
@@ -87,7 +87,6 @@ control::Vec3 maximum_step_targets(const config::ProjectConfig& config,
 //! The full grid search; throws std::invalid_argument for an empty grid or a bad option.
 PidTuningResult tune_pid(const config::ProjectConfig& config,
                          const control::SemiClosedLoopParams& base, std::uint64_t seed,
-                         const PidTuningOptions& options = {},
-                         const experiments::Progress& progress = {});
+                         const PidTuningOptions& options = {}, const rig::Progress& progress = {});
 
 }  // namespace piezoshift::calibration

@@ -11,8 +11,8 @@
 #include <vector>
 
 #include "piezoshift/calibration/poly_fit.hpp"
-#include "piezoshift/experiments/bench.hpp"
-#include "piezoshift/experiments/progress.hpp"
+#include "piezoshift/rig/bench.hpp"
+#include "piezoshift/rig/progress.hpp"
 
 namespace piezoshift::calibration {
 
@@ -34,7 +34,7 @@ struct PolynomialIdentificationResult {
 //! A (its polynomial is replaced by the identity for the run and left so). Throws FitError when
 //! the data cannot give p.
 PolynomialIdentificationResult identify_polynomial(
-    experiments::Bench& bench, const PolynomialIdentificationOptions& options = {},
-    const experiments::Progress& progress = {});
+    rig::Bench& bench, const PolynomialIdentificationOptions& options = {},
+    const rig::Progress& progress = {});
 
 }  // namespace piezoshift::calibration

@@ -15,7 +15,7 @@
 // Every number must be within its range (design/design_ranges.hpp and plant/twin_ranges.hpp,
 // the one list the reader, the model builders and the Python bindings share), and the hinge
 // buildable (t < 2R, L > 2R). An unknown section or key, a wrong type, a value out of range or a
-// syntax error throws io::InputError naming the file, the key and the reason.
+// syntax error throws core::InputError naming the file, the key and the reason.
 #include <string>
 
 #include "piezoshift/design/design_inputs.hpp"

@@ -33,7 +33,7 @@ struct DesignEvaluation {
 };
 
 //! Evaluates a design. Throws std::invalid_argument when design_inputs_problem() finds one (the
-//! configuration loader reports such inputs as io::InputError before they get here).
+//! configuration loader reports such inputs as core::InputError before they get here).
 DesignEvaluation evaluate_design(const DesignInputs& inputs);
 
 }  // namespace piezoshift::design

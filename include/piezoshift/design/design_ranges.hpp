@@ -6,7 +6,7 @@
 //
 //   visit_design_values(inputs, [](const char* section, const char* key, auto& value,
 //                                  Bounds bounds) { ... });
-#include "piezoshift/design/bounds.hpp"
+#include "piezoshift/core/bounds.hpp"
 #include "piezoshift/design/design_inputs.hpp"
 
 namespace piezoshift::design {
@@ -15,23 +15,28 @@ namespace piezoshift::design {
 //! of configs/paper.toml. section and key are the TOML names ("actuator", "stiffness_N_per_um").
 template <typename Inputs, typename Visit>
 void visit_design_values(Inputs& in, Visit&& visit) {
-  visit("actuator", "stiffness_N_per_um", in.actuator.stiffness_N_per_um, Bounds::above(0, 1e6));
-  visit("actuator", "nominal_stroke_um", in.actuator.nominal_stroke_um, Bounds::above(0, 1e4));
-  visit("actuator", "pushing_force_N", in.actuator.pushing_force_N, Bounds::above(0, 1e7));
-  visit("actuator", "pulling_force_N", in.actuator.pulling_force_N, Bounds::above(0, 1e7));
-  visit("actuator", "capacitance_F", in.actuator.capacitance_F, Bounds::above(0, 1.0));
+  visit("actuator", "stiffness_N_per_um", in.actuator.stiffness_N_per_um,
+        core::Bounds::above(0, 1e6));
+  visit("actuator", "nominal_stroke_um", in.actuator.nominal_stroke_um,
+        core::Bounds::above(0, 1e4));
+  visit("actuator", "pushing_force_N", in.actuator.pushing_force_N, core::Bounds::above(0, 1e7));
+  visit("actuator", "pulling_force_N", in.actuator.pulling_force_N, core::Bounds::above(0, 1e7));
+  visit("actuator", "capacitance_F", in.actuator.capacitance_F, core::Bounds::above(0, 1.0));
   visit("actuator", "resonance_frequency_Hz", in.actuator.resonance_frequency_Hz,
-        Bounds::above(0, 1e8));
-  visit("actuator", "length_m", in.actuator.length_m, Bounds::above(0, 10.0));
-  visit("material", "elastic_modulus_Pa", in.material.elastic_modulus_Pa, Bounds::above(0, 1e13));
-  visit("material", "poisson_ratio", in.material.poisson_ratio, Bounds::open(0.0, 0.5));
-  visit("material", "density_kg_per_m3", in.material.density_kg_per_m3, Bounds::above(0, 1e5));
-  visit("material", "allowable_stress_Pa", in.material.allowable_stress_Pa, Bounds::above(0, 1e11));
-  visit("hinge", "width_m", in.hinge.width_m, Bounds::above(0, 1.0));
-  visit("hinge", "thickness_m", in.hinge.thickness_m, Bounds::above(0, 1.0));
-  visit("hinge", "radius_m", in.hinge.radius_m, Bounds::above(0, 1.0));
-  visit("hinge", "link_length_m", in.hinge.link_length_m, Bounds::above(0, 10.0));
-  visit("mechanism", "moving_mass_kg", in.mechanism.moving_mass_kg, Bounds::above(0, 1e4));
+        core::Bounds::above(0, 1e8));
+  visit("actuator", "length_m", in.actuator.length_m, core::Bounds::above(0, 10.0));
+  visit("material", "elastic_modulus_Pa", in.material.elastic_modulus_Pa,
+        core::Bounds::above(0, 1e13));
+  visit("material", "poisson_ratio", in.material.poisson_ratio, core::Bounds::open(0.0, 0.5));
+  visit("material", "density_kg_per_m3", in.material.density_kg_per_m3,
+        core::Bounds::above(0, 1e5));
+  visit("material", "allowable_stress_Pa", in.material.allowable_stress_Pa,
+        core::Bounds::above(0, 1e11));
+  visit("hinge", "width_m", in.hinge.width_m, core::Bounds::above(0, 1.0));
+  visit("hinge", "thickness_m", in.hinge.thickness_m, core::Bounds::above(0, 1.0));
+  visit("hinge", "radius_m", in.hinge.radius_m, core::Bounds::above(0, 1.0));
+  visit("hinge", "link_length_m", in.hinge.link_length_m, core::Bounds::above(0, 10.0));
+  visit("mechanism", "moving_mass_kg", in.mechanism.moving_mass_kg, core::Bounds::above(0, 1e4));
 }
 
 }  // namespace piezoshift::design

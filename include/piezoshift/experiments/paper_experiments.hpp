@@ -37,12 +37,12 @@
 
 #include "piezoshift/config/project_config.hpp"
 #include "piezoshift/control/semi_closed_loop.hpp"
-#include "piezoshift/experiments/bench.hpp"
 #include "piezoshift/experiments/metrics_linearity.hpp"
 #include "piezoshift/experiments/metrics_repeatability.hpp"
 #include "piezoshift/experiments/metrics_step_response.hpp"
-#include "piezoshift/experiments/progress.hpp"
-#include "piezoshift/experiments/validity.hpp"
+#include "piezoshift/rig/bench.hpp"
+#include "piezoshift/rig/progress.hpp"
+#include "piezoshift/rig/validity.hpp"
 
 namespace piezoshift::experiments {
 
@@ -56,7 +56,7 @@ struct TravelRangeOptions {
   double min_increment_um = 0.05;  //!< grid of the lowest level reached from the top
   //! When start_um is not tracked, the search starts again this much lower (down to > 0).
   double coarse_step_um = 1.0;
-  BenchOptions bench{};  //!< feedback (gauges or oracle) and the supervisor's limits
+  rig::BenchOptions bench{};  //!< feedback (gauges or oracle) and the supervisor's limits
 };
 
 struct TravelRangeResult {
@@ -73,7 +73,7 @@ struct TravelRangeResult {
   std::vector<double> tracked_levels;  //!< the levels tracked, in order (semi_closed_um last)
   std::vector<double> measured_um;     //!< mean of P1..P3
   std::vector<int> saturated_mask;     //!< controller saturation at the end of each level
-  Validity validity;                   //!< see validity.hpp and the header comment
+  rig::Validity validity;              //!< see validity.hpp and the header comment
   double simulated_time_s = 0.0;
 };
 
@@ -86,7 +86,7 @@ struct StepExperimentOptions {
   //! Final value (mean of the record's last samples) within this of the step, else not reached.
   //! The travel search's tracking tolerance.
   double target_tolerance_um = 0.05;
-  BenchOptions bench{};  //!< feedback (gauges or oracle) and the supervisor's limits
+  rig::BenchOptions bench{};  //!< feedback (gauges or oracle) and the supervisor's limits
 };
 
 struct StepExperimentResult {
@@ -98,7 +98,7 @@ struct StepExperimentResult {
   //! Overshoot of the true plate over every physics step, between the ticks included [% of the
   //! step]: what the 1 kHz samples can miss.
   double truth_overshoot_pct = 0.0;
-  Validity validity;  //!< see validity.hpp and the header comment
+  rig::Validity validity;  //!< see validity.hpp and the header comment
   double simulated_time_s = 0.0;
 };
 
@@ -114,7 +114,7 @@ struct LinearityOptions {
   //! A level further than this from Z_d was not reached (5 % of the span: far beyond any
   //! nonlinearity, so only a loop out of authority or a wrong calibration gets there).
   double reach_tolerance_um = 0.5;
-  BenchOptions bench{};  //!< feedback (gauges or oracle) and the supervisor's limits
+  rig::BenchOptions bench{};  //!< feedback (gauges or oracle) and the supervisor's limits
 };
 
 struct LinearityResult {
@@ -124,7 +124,7 @@ struct LinearityResult {
   std::vector<double> sample_desired_um;
   std::vector<double> sample_measured_um;
   LinearityMetrics metrics;
-  Validity validity;  //!< see validity.hpp and the header comment
+  rig::Validity validity;  //!< see validity.hpp and the header comment
   double simulated_time_s = 0.0;
 };
 
@@ -135,32 +135,33 @@ struct RepeatabilityOptions {
   double settle_s = 0.5;
   //! A reading further than this from the target means the move did not reach it.
   double target_tolerance_um = 0.05;
-  BenchOptions bench{};  //!< feedback (gauges or oracle) and the supervisor's limits
+  rig::BenchOptions bench{};  //!< feedback (gauges or oracle) and the supervisor's limits
 };
 
 struct RepeatabilityResult {
   double target_um = 0.0;
   std::vector<double> measured_um;  //!< z_i
   RepeatabilityMetrics metrics;
-  Validity validity;  //!< see validity.hpp and the header comment
+  rig::Validity validity;  //!< see validity.hpp and the header comment
   double simulated_time_s = 0.0;
 };
 
 TravelRangeResult run_travel_range(const config::ProjectConfig& config,
                                    const control::SemiClosedLoopParams& controller,
                                    std::uint64_t seed, const TravelRangeOptions& options = {},
-                                   const Progress& progress = {});
+                                   const rig::Progress& progress = {});
 StepExperimentResult run_step_response(const config::ProjectConfig& config,
                                        const control::SemiClosedLoopParams& controller,
                                        std::uint64_t seed,
                                        const StepExperimentOptions& options = {},
-                                       const Progress& progress = {});
+                                       const rig::Progress& progress = {});
 LinearityResult run_linearity(const config::ProjectConfig& config,
                               const control::SemiClosedLoopParams& controller, std::uint64_t seed,
-                              const LinearityOptions& options = {}, const Progress& progress = {});
+                              const LinearityOptions& options = {},
+                              const rig::Progress& progress = {});
 RepeatabilityResult run_repeatability(const config::ProjectConfig& config,
                                       const control::SemiClosedLoopParams& controller,
                                       std::uint64_t seed, const RepeatabilityOptions& options = {},
-                                      const Progress& progress = {});
+                                      const rig::Progress& progress = {});
 
 }  // namespace piezoshift::experiments

@@ -12,7 +12,7 @@
 //                   +-tolerance_nm of the target (the level before the step + step_nm), within
 //                   record_s; infinite when the record ends outside the band.
 // The level before the step is the hold's trend line at the step instant. Seeds and the loop are
-// the other experiments' (experiments/bench.hpp): the shipping tick, supervisor included.
+// the other experiments' (rig/bench.hpp): the shipping tick, supervisor included.
 //   own settling    the same, for the stepped run minus a second run of the same seed without
 //                   the step: a controller's own step with the wander the plant brings to a
 //                   held plate (the gauges' drift, which a semi-closed loop follows) removed. It
@@ -26,9 +26,9 @@
 
 #include "piezoshift/config/project_config.hpp"
 #include "piezoshift/control/semi_closed_loop.hpp"
-#include "piezoshift/experiments/bench.hpp"
-#include "piezoshift/experiments/progress.hpp"
-#include "piezoshift/experiments/validity.hpp"
+#include "piezoshift/rig/bench.hpp"
+#include "piezoshift/rig/progress.hpp"
+#include "piezoshift/rig/validity.hpp"
 
 namespace piezoshift::experiments {
 
@@ -41,7 +41,7 @@ struct PhaseStepOptions {
   double exposure_s = 1e-3;          //!< a camera exposure; a whole number of control periods
   double tolerance_nm = 1.0;         //!< the settling band
   double target_tolerance_nm = 5.0;  //!< beyond it the step did not reach its target
-  BenchOptions bench{};
+  rig::BenchOptions bench{};
 
   double step_nm() const { return wavelength_nm / 8.0; }
 };
@@ -60,7 +60,7 @@ struct PhaseStepResult {
   std::vector<double> still_exposure_mean_nm;
   double still_wander_nm = 0.0;  //!< largest |still_exposure_mean_nm|
   double own_settling_time_s = 0.0;
-  Validity validity;
+  rig::Validity validity;
   double simulated_time_s = 0.0;
 };
 
@@ -73,6 +73,6 @@ double exposure_settling_time_s(const std::vector<double>& time_s,
 
 PhaseStepResult run_phase_step(const config::ProjectConfig& config,
                                const control::SemiClosedLoopParams& controller, std::uint64_t seed,
-                               const PhaseStepOptions& options, const Progress& progress = {});
+                               const PhaseStepOptions& options, const rig::Progress& progress = {});
 
 }  // namespace piezoshift::experiments

@@ -94,7 +94,7 @@ class HttpServer : private PollProtocol {
   //! Bytes read from one client per round at most (PollServerLimits::read_budget_bytes).
   static constexpr std::size_t kReadChunkBytes = 16 * 1024;
 
-  //! Binds and listens. Throws io::InputError naming host:port for a bad address, a non-loopback
+  //! Binds and listens. Throws core::InputError naming host:port for a bad address, a non-loopback
   //! one without a token, bad limits or a failed bind.
   HttpServer(const HttpServerOptions& options, HttpHandler& handler);
   ~HttpServer() override;

@@ -102,9 +102,9 @@ class LineServer : private PollProtocol {
   //! Bytes read from one client per round at most (PollServerLimits::read_budget_bytes).
   static constexpr std::size_t kReadChunkBytes = 64 * 1024;
 
-  //! Binds and listens (SO_REUSEADDR, non-blocking). Throws io::InputError naming host:port for an
-  //! unparsable address, a non-loopback address without allow_remote, invalid limits, or a failed
-  //! bind/listen (with the system's reason, e.g. "Address already in use").
+  //! Binds and listens (SO_REUSEADDR, non-blocking). Throws core::InputError naming host:port for
+  //! an unparsable address, a non-loopback address without allow_remote, invalid limits, or a
+  //! failed bind/listen (with the system's reason, e.g. "Address already in use").
   LineServer(const ListenAddress& address, const LineServerLimits& limits, LineHandler& handler);
   //! Closes all sockets (without handler calls: run() has already reported its disconnections).
   ~LineServer() override;

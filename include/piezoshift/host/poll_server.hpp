@@ -131,7 +131,7 @@ class PollServer {
   using Clock = std::chrono::steady_clock;
 
   //! Binds and listens (tcp_listener.hpp). name and where ("TCP server", "127.0.0.1:50000") name
-  //! the source of errors; invalid limits throw io::InputError.
+  //! the source of errors; invalid limits throw core::InputError.
   PollServer(const Ipv4Host& host, std::uint16_t port, const std::string& name,
              const std::string& where, const PollServerLimits& limits, PollProtocol& protocol);
   //! Closes all sockets (without protocol calls: run() has already reported its disconnections).

@@ -18,7 +18,7 @@
 //   wake()                  async-signal-safe: makes wake_fd() readable; errno is kept
 //   drain_wake()            after poll() reports wake_fd() readable
 //
-// Errors name the server and the address: io::InputError for what the user chose (an address
+// Errors name the server and the address: core::InputError for what the user chose (an address
 // that is not IPv4, a port that cannot be bound), std::runtime_error for the system refusing a
 // descriptor.
 #include <netinet/in.h>

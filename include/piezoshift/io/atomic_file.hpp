@@ -5,7 +5,7 @@
 // Used for calibration files: a half-written calibration would silently mis-drive the stage.
 // A writer killed mid-write (SIGKILL) leaves its temporary file; the next write of the same file
 // removes every such "<dir>/.<name>.tmp.<pid>" whose process no longer exists.
-// Set-up only (does I/O); throws io::InputError naming the path and the reason; the temporary
+// Set-up only (does I/O); throws core::InputError naming the path and the reason; the temporary
 // file is removed on failure and the old file is left untouched.
 #include <string>
 #include <string_view>

@@ -3,12 +3,12 @@
 //
 //   io::ConfigFile cfg = io::ConfigFile::load("my.toml");
 //   io::ConfigSection a = cfg.section("actuator");
-//   a.read("stiffness_N_per_um", params.stiffness_N_per_um, io::Bounds::positive());
+//   a.read("stiffness_N_per_um", params.stiffness_N_per_um, core::Bounds::positive());
 //   cfg.reject_unknown();   // every key in the file must have been read by someone
 //
 // A key that is absent leaves the struct's default (the paper's value) untouched. A wrong type, a
 // value out of bounds, NaN or infinity, a syntax error, and (through reject_unknown) a key or
-// section nobody asked for each throw io::InputError naming the file, the key and the reason.
+// section nobody asked for each throw core::InputError naming the file, the key and the reason.
 #include <array>
 #include <cstdint>
 #include <memory>
@@ -16,12 +16,9 @@
 #include <string_view>
 #include <vector>
 
-#include "piezoshift/design/bounds.hpp"
+#include "piezoshift/core/bounds.hpp"
 
 namespace piezoshift::io {
-
-//! Allowed range for a number (design/bounds.hpp, shared with the parameter structs' ranges).
-using Bounds = design::Bounds;
 
 class ConfigFile;
 struct ConfigFileImpl;  // the parsed document; lives on the heap, so sections survive a move
@@ -30,21 +27,22 @@ struct ConfigFileImpl;  // the parsed document; lives on the heap, so sections s
 class ConfigSection {
  public:
   //! Each read() leaves value untouched when the key is absent; returns whether it was present.
-  bool read(std::string_view key, double& value, Bounds bounds = Bounds::any()) const;
-  bool read(std::string_view key, std::int64_t& value, Bounds bounds = Bounds::any()) const;
+  bool read(std::string_view key, double& value, core::Bounds bounds = core::Bounds::any()) const;
+  bool read(std::string_view key, std::int64_t& value,
+            core::Bounds bounds = core::Bounds::any()) const;
   bool read(std::string_view key, bool& value) const;
   bool read(std::string_view key, std::string& value) const;
   bool read(std::string_view key, std::array<double, 3>& value,
-            Bounds bounds = Bounds::any()) const;
+            core::Bounds bounds = core::Bounds::any()) const;
   //! A list of four numbers (e.g. the cubic's p = [p3, p2, p1, p0]).
   bool read(std::string_view key, std::array<double, 4>& value,
-            Bounds bounds = Bounds::any()) const;
+            core::Bounds bounds = core::Bounds::any()) const;
   //! A list of 1 to max_count numbers.
   bool read(std::string_view key, std::vector<double>& value, std::size_t max_count,
-            Bounds bounds = Bounds::any()) const;
+            core::Bounds bounds = core::Bounds::any()) const;
   //! A 3x3 matrix as a list of three rows.
   bool read(std::string_view key, std::array<std::array<double, 3>, 3>& value,
-            Bounds bounds = Bounds::any()) const;
+            core::Bounds bounds = core::Bounds::any()) const;
 
   bool has(std::string_view key) const;
   const std::string& name() const { return name_; }

@@ -14,7 +14,7 @@
 //   - a cell read through column() must be, as a whole, a finite number in the grammar of
 //     std::from_chars (decimal or scientific, optional leading '+' or '-'); "nan", "inf",
 //     "1.5um", "" and "1,5" are rejected rather than guessed at.
-// Every violation throws io::InputError naming the file, the line (1-based, counting every
+// Every violation throws core::InputError naming the file, the line (1-based, counting every
 // physical line) and, for a cell, the column, e.g.
 //   poses.csv:7: column 'z2_um' (field 5): 'abc' is not a number
 // Memory: the text and 16 bytes a data row, however many cells a row has (a row is counted, not

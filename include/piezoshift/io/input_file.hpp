@@ -2,7 +2,7 @@
 // Reading a user's input file (configuration, calibration, data) whole, in bounded time and
 // memory: only a regular file is read, and only up to a size limit. A directory used to read as
 // an empty file (its keys silently defaulted), and /dev/zero or a FIFO was read until memory ran
-// out. Each refusal throws io::InputError naming the path and the reason.
+// out. Each refusal throws core::InputError naming the path and the reason.
 #include <cstdint>
 #include <string>
 

@@ -7,11 +7,11 @@
 // estimate before they start (plant/simulation_cost.hpp). docs/twin.md lists them.
 //
 //   visit_twin_values(params, [](const char* section, const char* key, auto& value,
-//                                design::Bounds bounds) { ... });
+//                                core::Bounds bounds) { ... });
 #include <cstdint>
 #include <string>
 
-#include "piezoshift/design/bounds.hpp"
+#include "piezoshift/core/bounds.hpp"
 #include "piezoshift/plant/twin_params.hpp"
 
 namespace piezoshift::plant {
@@ -26,7 +26,7 @@ inline constexpr double kMaxPhysicsStepsPerTick = 10000.0;
 //! std::optional<double> or a 3x3 matrix; each element is checked against bounds.
 template <typename Twin, typename Visit>
 void visit_twin_values(Twin& t, Visit&& visit) {
-  using B = design::Bounds;
+  using B = core::Bounds;
   // Timing: the 20 kHz default; up to 10 MHz (with the per-tick limit above) and down to 1 Hz.
   visit("twin", "physics_rate_Hz", t.physics_rate_Hz, B::closed(1.0, 1e7));
   // 10 us (100 kHz) to 1 s: the PCI-6229's fastest loop to the slowest useful one.

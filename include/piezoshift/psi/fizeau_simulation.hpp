@@ -35,7 +35,7 @@ struct SurfaceSpec {
 };
 
 //! "Z4=40,Z5=25,rough=0.5" (Noll index = nm; rough = nm RMS; "flat" for none). Throws
-//! io::InputError naming the spec and the offending item.
+//! core::InputError naming the spec and the offending item.
 SurfaceSpec parse_surface_spec(std::string_view spec);
 //! The surface [nm] over the mask (NaN outside). Roughness draws from rng.
 Map make_surface_nm(const SurfaceSpec& spec, const Mask& mask, plant::Rng& rng);

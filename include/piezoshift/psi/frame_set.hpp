@@ -4,7 +4,7 @@
 // pixel: 512 MiB, e.g. 16 frames of 2048 x 2048 or 64 of 1024 x 1024). The count is checked
 // before any file is read, the pixels once the first frame gives the size (every frame has it),
 // before the others are decoded: 150 copies of one PNG used to end in std::bad_alloc.
-// Set-up only; every refusal is io::InputError naming the file or the count and the limit.
+// Set-up only; every refusal is core::InputError naming the file or the count and the limit.
 #include <cstddef>
 #include <cstdint>
 #include <span>

@@ -11,10 +11,10 @@
 
 namespace piezoshift::psi {
 
-//! Writes map as a (height, width) float64 array, atomically. Throws io::InputError naming path.
+//! Writes map as a (height, width) float64 array, atomically. Throws core::InputError naming path.
 void write_npy(const std::string& path, const Map& map);
 
-//! Reads a 2-D (or 1-D, as one row) '<f8' C-order array. Throws io::InputError naming path.
+//! Reads a 2-D (or 1-D, as one row) '<f8' C-order array. Throws core::InputError naming path.
 Map read_npy(const std::string& path);
 
 }  // namespace piezoshift::psi

@@ -72,7 +72,7 @@ enum class Algorithm : std::uint8_t {
 
 //! 4step, carre, hariharan5, degroot7, frame13, lsq, aia, tilt-aia
 std::string_view algorithm_name(Algorithm a);
-//! Throws io::InputError naming the value and the valid names.
+//! Throws core::InputError naming the value and the valid names.
 Algorithm parse_algorithm(std::string_view name);
 std::vector<Algorithm> all_algorithms();
 //! Frames the algorithm needs: its fixed count, or 0 when any count >= 3 works.

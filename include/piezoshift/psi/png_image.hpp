@@ -8,7 +8,7 @@
 //   write_false_colour_png: a height map drawn with a blue-white-red scale, NaN as gray, and a
 //     scale bar (colour ramp with tick marks every quarter of the range) on the right; the range
 //     is printed by the caller (the PNG holds no text).
-// Set-up only; every error is io::InputError naming the file.
+// Set-up only; every error is core::InputError naming the file.
 #include <string>
 
 #include "piezoshift/psi/grid.hpp"

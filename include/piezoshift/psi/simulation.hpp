@@ -56,7 +56,7 @@ struct SimulationResult {
   double stage_error_rms_nm = 0.0;
 };
 
-//! Throws io::InputError for parameters out of range (naming the field).
+//! Throws core::InputError for parameters out of range (naming the field).
 SimulationResult simulate_psi(const config::ProjectConfig& config,
                               const control::SemiClosedLoopParams& controller,
                               const SimulationParams& params);

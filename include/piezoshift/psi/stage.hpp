@@ -1,7 +1,7 @@
 #pragma once
 // The phase shifter as the PSI acquisition sees it: move, wait until on target, expose. A real
 // DAQ variant implements the same three calls; BenchStage drives the simulated bench
-// (experiments/bench.hpp) with the paper's controller.
+// (rig/bench.hpp) with the paper's controller.
 //
 // BenchStage:
 //   move(piston_nm)          drive_points(Z_d) with Z_d = base_um + piston_nm / 1000 on P1..P3
@@ -19,7 +19,7 @@
 
 #include "piezoshift/psi/fizeau_simulation.hpp"
 
-namespace piezoshift::experiments {
+namespace piezoshift::rig {
 class Bench;
 }
 
@@ -54,7 +54,7 @@ class BenchStage final : public Stage {
  public:
   //! Drives the bench to base_um on all points (the reference position, mid travel) and lets it
   //! settle for settle_s; poses are reported relative to the pose reached then.
-  BenchStage(experiments::Bench& bench, double base_um = 5.0, double settle_s = 0.5);
+  BenchStage(rig::Bench& bench, double base_um = 5.0, double settle_s = 0.5);
   void move(double piston_nm) override;
   bool wait_on_target(const OnTarget& criterion) override;
   std::vector<PoseSample> expose(double exposure_s) override;
@@ -65,7 +65,7 @@ class BenchStage final : public Stage {
   PoseSample pose() const;
   void tick();
 
-  experiments::Bench& bench_;
+  rig::Bench& bench_;
   double base_um_;
   double command_nm_ = 0.0;
   PoseSample origin_{};

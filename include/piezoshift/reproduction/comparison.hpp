@@ -53,9 +53,9 @@ const char* variant_label(LoopVariant k);
 //! One variant of the loop on one seed.
 struct VariantRun {
   control::SemiClosedLoopParams controller;
-  //! Not valid when its calibration failed (experiments::ProcedureFailed, or calibration::FitError
+  //! Not valid when its calibration failed (rig::ProcedureFailed, or calibration::FitError
   //! on the twin's records); nothing ran then.
-  experiments::Validity calibration;
+  rig::Validity calibration;
   ExperimentSet set;
   std::vector<InnerLoopAnalysis> inner_loop;  //!< empty for the oracle
   //! The lambda/8 step again with the loop at 10 kHz (seed + 85): the twin's DAQ at 0.1 ms; the
@@ -79,7 +79,7 @@ struct SeedComparison {
 //! valid with its reason, or not measured for that variant (the oracle's margins).
 struct FigureValue {
   double value = std::numeric_limits<double>::quiet_NaN();
-  experiments::Validity validity;
+  rig::Validity validity;
   bool measured = true;
 };
 
@@ -138,6 +138,6 @@ ComparisonResult summarize_comparison(const config::ProjectConfig& config,
 
 //! Throws std::invalid_argument on an empty seed list.
 ComparisonResult compare(const config::ProjectConfig& config, const CompareOptions& options,
-                         const experiments::Progress& progress = {});
+                         const rig::Progress& progress = {});
 
 }  // namespace piezoshift::reproduction

@@ -12,7 +12,7 @@
 //     compare_repeatability.png        histograms at 5 and 10 um, one per controller
 //     per_seed_<controller>.csv        one row per seed, one column per figure (nan: not valid)
 //     comparison.json                  comparison_json()
-// Throws io::InputError when the folder cannot be written and io::PlotError when gnuplot fails.
+// Throws core::InputError when the folder cannot be written and io::PlotError when gnuplot fails.
 #include <filesystem>
 #include <string>
 

@@ -30,9 +30,9 @@ struct Document {
 std::string to_markdown(const std::vector<Block>& blocks);
 //! A standalone page; text is escaped.
 std::string to_html(const std::vector<Block>& blocks, const std::string& title);
-//! Throws io::InputError naming the path when it cannot be written.
+//! Throws core::InputError naming the path when it cannot be written.
 void write_text(const std::filesystem::path& path, const std::string& text);
-//! Creates dir and its parents; throws io::InputError naming it when that fails.
+//! Creates dir and its parents; throws core::InputError naming it when that fails.
 void create_report_folder(const std::filesystem::path& dir);
 
 }  // namespace piezoshift::reproduction

@@ -10,7 +10,7 @@
 //   calibration.toml          the calibrated controller (calibration_file.hpp), written atomically
 //   *.csv                     every experiment's data, in the formats `piezoshift fit` and
 //                             `piezoshift analyze` read, so the numbers can be re-derived
-// Throws io::InputError when the folder cannot be written and io::PlotError when gnuplot fails.
+// Throws core::InputError when the folder cannot be written and io::PlotError when gnuplot fails.
 #include <filesystem>
 #include <string>
 #include <vector>

@@ -13,14 +13,14 @@
 //   inner loop identified   seed + 90 at the DAQ's rate, seed + 91 at 10 kHz, with the margins
 //                           of the calibrated PID on it (calibration/loop_identification.hpp)
 // all with the calibrated controller (the paper's structure: PID, A, p), through the loop `run`
-// and `serve` ship (experiments/bench.hpp), supervisor included. Then the same experiments, same
+// and `serve` ship (rig/bench.hpp), supervisor included. Then the same experiments, same
 // seeds, with the oracle (runtime/oracle_backend.hpp): the same loop fed the plate's true point
 // displacements, with the calibrated A and an identity polynomial. Impossible on hardware, it is
 // the floor no controller fed by the strain gauges can beat. Deterministic: the same
 // configuration, seed and schedule give the same numbers bit for bit.
 //
 // valid() is false when any Table 4 experiment of the paper's controller is not valid
-// (experiments/validity.hpp); `reproduce` then exits with kExitInvalidExperiment.
+// (rig/validity.hpp); `reproduce` then exits with kExitInvalidExperiment.
 //
 // Schedules: the full one is the paper's (230 moves per target, 10 s per linearity level, the
 // full PID grid); the quick one keeps every step but shortens the calibration, the travel search
@@ -59,7 +59,7 @@ struct Schedule {
 };
 
 //! Exit status of `reproduce` when a Table 4 experiment is not valid.
-inline constexpr int kExitInvalidExperiment = experiments::kExitNotValid;
+inline constexpr int kExitInvalidExperiment = rig::kExitNotValid;
 
 //! Table 4's experiments and the two extra linearity sweeps, for one controller.
 struct ExperimentSet {
@@ -90,7 +90,7 @@ struct InnerLoopAnalysis {
   std::array<calibration::StabilityMargins, 3> margins{};
   //! Not valid when the twin cannot run at this rate (its physics rate is not a whole multiple)
   //! or the identification tripped the supervisor; plant and margins are then empty.
-  experiments::Validity validity;
+  rig::Validity validity;
 
   //! The worst of the three channels: the smallest gain margin, the smallest phase margin and
   //! its gain crossover.
@@ -98,14 +98,14 @@ struct InnerLoopAnalysis {
 };
 
 //! The schedule with every experiment's feedback set to f (the oracle: Feedback::kOracle).
-Schedule with_feedback(Schedule s, experiments::Feedback f);
+Schedule with_feedback(Schedule s, rig::Feedback f);
 
 //! Every experiment of the set with one controller, each on its own seed (the table above:
 //! seed + 10 ... seed + 80). reproduce() and compare() run their controllers through this.
 ExperimentSet run_experiment_set(const config::ProjectConfig& config,
                                  const control::SemiClosedLoopParams& controller,
                                  std::uint64_t seed, const Schedule& schedule,
-                                 const experiments::Progress& progress = {});
+                                 const rig::Progress& progress = {});
 
 //! The loop rates the inner loop is analysed at: the DAQ's, and 10 kHz unless that is the DAQ's.
 std::vector<double> inner_loop_sample_times_s(const config::ProjectConfig& config);
@@ -144,6 +144,6 @@ struct ReproductionResult : ExperimentSet {
 };
 
 ReproductionResult reproduce(const config::ProjectConfig& config, const ReproduceOptions& options,
-                             const experiments::Progress& progress = {});
+                             const rig::Progress& progress = {});
 
 }  // namespace piezoshift::reproduction

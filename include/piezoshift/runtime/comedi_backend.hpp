@@ -2,7 +2,7 @@
 // The hardware backend: a Comedi device (libcomedi), e.g. the paper's NI PCI-6229 through the
 // ni_pcimio driver. Three AI (differential, the SGS conditioners) and three AO (the amplifiers).
 //
-//   configure():  comedi_open(path)                       -> io::InputError naming the path
+//   configure():  comedi_open(path)                       -> core::InputError naming the path
 //                 AI/AO subdevices, channel counts, ranges (smallest range holding the span asked
 //                 for: AI [-0.5, 10] V -> +-10 V, AO [0, 10] V on the PCI-6229)
 //                 converters: soft-calibrated subdevices (SDF_SOFT_CALIBRATED, M-series boards)

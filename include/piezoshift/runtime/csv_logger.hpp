@@ -44,7 +44,7 @@ struct CsvLoggerOptions {
 
 class CsvLogger {
  public:
-  //! Set-up: creates (truncates) the file and writes the header, flushed. Throws io::InputError
+  //! Set-up: creates (truncates) the file and writes the header, flushed. Throws core::InputError
   //! naming the file when it cannot be created.
   explicit CsvLogger(CsvLoggerOptions options);
   CsvLogger(const CsvLogger&) = delete;

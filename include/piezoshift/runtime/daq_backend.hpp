@@ -43,7 +43,7 @@ class DaqBackend {
  public:
   virtual ~DaqBackend() = default;
 
-  //! Set-up: open and query the device. Throws io::InputError naming the device when it cannot.
+  //! Set-up: open and query the device. Throws core::InputError naming the device when it cannot.
   virtual void configure() = 0;
   //! Outputs to 0 V, ready for read()/write(). Throws on a device error.
   virtual void activate() = 0;

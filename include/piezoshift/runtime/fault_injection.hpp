@@ -59,7 +59,7 @@ struct FaultSpec {
 //! time (later times overflowed the nanosecond clock and were injected at tick 0).
 inline constexpr double kMaxRunDurationS = 1e6;
 
-//! Parses "KIND@T_S[:CHANNEL]", T_S in [0, kMaxRunDurationS]; throws io::InputError naming the
+//! Parses "KIND@T_S[:CHANNEL]", T_S in [0, kMaxRunDurationS]; throws core::InputError naming the
 //! text and what is wrong.
 FaultSpec parse_fault_spec(std::string_view text);
 
@@ -86,7 +86,7 @@ class FaultInjectingBackend final : public DaqBackend {
  public:
   static constexpr std::uint64_t kNotYet = std::numeric_limits<std::uint64_t>::max();
 
-  //! hooks may be null: actuator-crack is then refused here (io::InputError).
+  //! hooks may be null: actuator-crack is then refused here (core::InputError).
   FaultInjectingBackend(DaqBackend& inner, LoopClock& clock, std::int64_t period_ns,
                         std::vector<FaultSpec> faults, FaultInjectionParams params = {},
                         PlantFaultHooks* hooks = nullptr);

@@ -2,7 +2,7 @@
 // A free-running loop time (as SimulatedClock: sleep_until() jumps to the deadline, no sleeping)
 // that another thread paces: sleep_until_ns() waits until that thread has allowed time up to the
 // deadline (allow_until_ns()). A procedure that drives the real-time loop through its host link
-// (calibration/loop_rig.hpp) on the twin runs as fast as the CPU allows and still knows at which
+// (rig/loop_rig.hpp) on the twin runs as fast as the CPU allows and still knows at which
 // tick each of its commands is applied: the loop is held before the next tick while the
 // procedure pushes them. Deterministic, for tests and `calibrate --daq sim-rt --free-run`.
 //

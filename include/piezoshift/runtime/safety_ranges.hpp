@@ -11,7 +11,7 @@
 #include <string>
 
 #include "piezoshift/config/project_config.hpp"
-#include "piezoshift/design/bounds.hpp"
+#include "piezoshift/core/bounds.hpp"
 #include "piezoshift/io/config_file.hpp"
 #include "piezoshift/runtime/safety_supervisor.hpp"
 
@@ -26,7 +26,7 @@ inline constexpr std::uint32_t kMaxConsecutiveOverruns = 1000000;
 //! +-10 V a DAQ writes, times from one tick to a minute.
 template <typename Limits, typename Visit>
 void visit_safety_limits(Limits& l, Visit&& visit) {
-  using B = design::Bounds;
+  using B = core::Bounds;
   visit("safety", "output_min_V", l.output_min_V, B::closed(-10.0, 0.0));
   visit("safety", "output_max_V", l.output_max_V, B::above(0.0, 10.0));
   visit("safety", "max_slew_V_per_s", l.max_slew_V_per_s, B::above(0.0, 1e6));

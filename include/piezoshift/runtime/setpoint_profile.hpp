@@ -7,7 +7,7 @@
 //                    piecewise linear between rows, the first row's value before it, the last
 //                    row's after it. Times strictly increasing.
 // Every value must lie in [0, max_z_um] (default: the 16 um nominal stroke, Section 2.1): a value
-// outside is refused with io::InputError naming the file and line, never clamped.
+// outside is refused with core::InputError naming the file and line, never clamped.
 //
 // at() is real-time safe (no heap; amortised O(1) for increasing t through a cursor). Loading
 // allocates and throws.
@@ -25,7 +25,7 @@ class SetpointProfile {
  public:
   static constexpr double kMaxZ_um = 16.0;  //!< nominal stroke, Section 2.1
 
-  //! Z_d = [z, z, z] from t = 0. Throws io::InputError when z is outside [0, max_z_um].
+  //! Z_d = [z, z, z] from t = 0. Throws core::InputError when z is outside [0, max_z_um].
   static SetpointProfile step(double z_um, double max_z_um = kMaxZ_um);
   static SetpointProfile load_csv(const std::string& path, double max_z_um = kMaxZ_um);
   //! From samples (tests); same checks, source names the origin in messages.

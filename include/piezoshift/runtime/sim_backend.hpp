@@ -19,7 +19,7 @@
 // which only fault-injection runs ever do.
 //
 // read()/write()/truth() are real-time safe; configure() builds the twin (allocates, throws
-// io::InputError for parameters that cannot make one).
+// core::InputError for parameters that cannot make one).
 #include <cstdint>
 #include <memory>
 #include <string>

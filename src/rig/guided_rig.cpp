@@ -1,8 +1,8 @@
-#include "piezoshift/calibration/guided_rig.hpp"
+#include "piezoshift/rig/guided_rig.hpp"
 
 #include <fmt/core.h>
 
-namespace piezoshift::calibration {
+namespace piezoshift::rig {
 
 void BenchRig::set_controller(const control::SemiClosedLoopParams& params) {
   bench_.set_controller(params);
@@ -16,7 +16,7 @@ void BenchRig::rest(double settle_s) {
 }
 
 RigWindow BenchRig::measure() {
-  const experiments::StaticMeasurement m = bench_.measure_static();
+  const rig::StaticMeasurement m = bench_.measure_static();
   RigWindow w;
   w.sgs_um = m.sgs_um;
   const double offset = continues_ != nullptr ? continues_->clock_s() : 0.0;
@@ -36,4 +36,4 @@ std::string BenchRig::fault() const {
                      static_cast<double>(f.tick) * bench_.sample_time_s());
 }
 
-}  // namespace piezoshift::calibration
+}  // namespace piezoshift::rig

@@ -9,9 +9,9 @@
 #include <gtest/gtest.h>
 #include <Eigen/Dense>
 
-#include "piezoshift/experiments/bench.hpp"
+#include "piezoshift/rig/bench.hpp"
 
-namespace piezoshift::experiments {
+namespace piezoshift::rig {
 namespace {
 
 Bench paper_bench(std::uint64_t seed) {
@@ -133,4 +133,4 @@ TEST(ClosedLoop, PapersControllerSettlesATenMicronStepWellWithinPointThreeSecond
 }
 
 }  // namespace
-}  // namespace piezoshift::experiments
+}  // namespace piezoshift::rig

@@ -2,14 +2,14 @@
 // The valid range of one parameter value, and the check every reader of that value shares (the
 // TOML reader, the Python bindings, the model builders). It lives in the lowest module so that
 // each parameter struct can state its ranges next to itself (design_ranges.hpp,
-// plant/twin_ranges.hpp); io::Bounds is this type.
+// plant/twin_ranges.hpp) and io::ConfigSection reads every value against it.
 #include <array>
 #include <cstdint>
 #include <optional>
 #include <string>
 #include <string_view>
 
-namespace piezoshift::design {
+namespace piezoshift::core {
 
 //! Allowed range for a number; the bound is open (excluded) where the flag says so. NaN and
 //! infinity are never contained.
@@ -42,4 +42,4 @@ std::string range_problem(std::string_view path, const std::array<std::array<dou
 std::string range_problem(std::string_view path, const std::optional<double>& value,
                           const Bounds& bounds);
 
-}  // namespace piezoshift::design
+}  // namespace piezoshift::core

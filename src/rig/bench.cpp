@@ -1,4 +1,4 @@
-#include "piezoshift/experiments/bench.hpp"
+#include "piezoshift/rig/bench.hpp"
 
 #include <algorithm>
 #include <cmath>
@@ -6,9 +6,9 @@
 #include <stdexcept>
 #include <string>
 
-#include "piezoshift/io/input_error.hpp"
+#include "piezoshift/core/input_error.hpp"
 
-namespace piezoshift::experiments {
+namespace piezoshift::rig {
 
 const char* to_string(Feedback feedback) noexcept {
   return feedback == Feedback::kOracle ? "oracle" : "gauges";
@@ -29,7 +29,7 @@ Bench::Bench(const config::ProjectConfig& config, const control::SemiClosedLoopP
   sim_ = std::make_unique<runtime::SimBackend>(so);
   try {
     sim_->configure();
-  } catch (const io::InputError& e) {
+  } catch (const core::InputError& e) {
     throw std::invalid_argument(e.what());
   }
   daq_ = sim_.get();
@@ -110,4 +110,4 @@ StaticMeasurement Bench::measure_static() {
   return m;
 }
 
-}  // namespace piezoshift::experiments
+}  // namespace piezoshift::rig

@@ -28,14 +28,14 @@
 #include <string>
 #include <thread>
 
-#include "piezoshift/calibration/guided_rig.hpp"
+#include "piezoshift/rig/guided_rig.hpp"
 #include "piezoshift/runtime/control_loop.hpp"
 #include "piezoshift/runtime/daq_backend.hpp"
 #include "piezoshift/runtime/paced_clock.hpp"
 #include "piezoshift/runtime/realtime.hpp"
 #include "piezoshift/runtime/safety_supervisor.hpp"
 
-namespace piezoshift::calibration {
+namespace piezoshift::rig {
 
 struct LoopRigOptions {
   double rate_Hz = 1000.0;  //!< the loop's rate
@@ -127,4 +127,4 @@ class LoopRig final : public GuidedRig {
   bool window_truth_ = true;
 };
 
-}  // namespace piezoshift::calibration
+}  // namespace piezoshift::rig

@@ -4,9 +4,9 @@
 // oscillation rule trips within a stated time, on the shipping loop.
 #include <gtest/gtest.h>
 
-#include "piezoshift/experiments/bench.hpp"
+#include "piezoshift/rig/bench.hpp"
 
-namespace piezoshift::experiments {
+namespace piezoshift::rig {
 namespace {
 
 TEST(UnstableLoop, TheSupervisorNamesAnOscillationWithinTwentyMilliseconds) {
@@ -33,4 +33,4 @@ TEST(UnstableLoop, ThePapersGainsStepAndHoldWithoutAnOscillationFault) {
 }
 
 }  // namespace
-}  // namespace piezoshift::experiments
+}  // namespace piezoshift::rig

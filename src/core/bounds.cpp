@@ -1,10 +1,10 @@
-#include "piezoshift/design/bounds.hpp"
+#include "piezoshift/core/bounds.hpp"
 
 #include <cmath>
 
 #include <fmt/core.h>
 
-namespace piezoshift::design {
+namespace piezoshift::core {
 
 bool Bounds::contains(double v) const {
   if (!std::isfinite(v))
@@ -63,4 +63,4 @@ std::string range_problem(std::string_view path, const std::optional<double>& va
   return value ? range_problem(path, *value, bounds) : std::string{};
 }
 
-}  // namespace piezoshift::design
+}  // namespace piezoshift::core

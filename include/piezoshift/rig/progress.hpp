@@ -4,8 +4,8 @@
 #include <functional>
 #include <string_view>
 
-namespace piezoshift::experiments {
+namespace piezoshift::rig {
 
 using Progress = std::function<void(double done, double total, std::string_view label)>;
 
-}  // namespace piezoshift::experiments
+}  // namespace piezoshift::rig

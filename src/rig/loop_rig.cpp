@@ -1,4 +1,4 @@
-#include "piezoshift/calibration/loop_rig.hpp"
+#include "piezoshift/rig/loop_rig.hpp"
 
 #include <algorithm>
 #include <chrono>
@@ -8,7 +8,7 @@
 
 #include <fmt/core.h>
 
-namespace piezoshift::calibration {
+namespace piezoshift::rig {
 
 namespace {
 
@@ -259,4 +259,4 @@ std::string LoopRig::fault() const {
   return fault_;
 }
 
-}  // namespace piezoshift::calibration
+}  // namespace piezoshift::rig

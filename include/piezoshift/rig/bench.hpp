@@ -33,7 +33,7 @@
 #include "piezoshift/runtime/safety_supervisor.hpp"
 #include "piezoshift/runtime/sim_backend.hpp"
 
-namespace piezoshift::experiments {
+namespace piezoshift::rig {
 
 using control::Vec3;
 using runtime::DriveMode;
@@ -107,4 +107,4 @@ class Bench {
   std::unique_ptr<runtime::ControlLoop> loop_;
 };
 
-}  // namespace piezoshift::experiments
+}  // namespace piezoshift::rig

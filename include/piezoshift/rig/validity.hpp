@@ -6,7 +6,7 @@
 #include <stdexcept>
 #include <string>
 
-namespace piezoshift::experiments {
+namespace piezoshift::rig {
 
 struct Validity {
   bool valid = true;
@@ -31,4 +31,4 @@ class ProcedureFailed : public std::runtime_error {
 //! bad input, 3 a supervisor fault of `run` and `simulate`).
 inline constexpr int kExitNotValid = 4;
 
-}  // namespace piezoshift::experiments
+}  // namespace piezoshift::rig

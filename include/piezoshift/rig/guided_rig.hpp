@@ -1,7 +1,7 @@
 #pragma once
 // The stage as the guided calibration (guided_calibration.hpp) drives it: poses held by the one
 // control tick (runtime/control_cycle.hpp), settling, and one averaging window of the strain
-// gauges per reading. BenchRig is the twin through experiments::Bench (simulated clock, `--daq
+// gauges per reading. BenchRig is the twin through rig::Bench (simulated clock, `--daq
 // sim`); LoopRig (loop_rig.hpp) is runtime::ControlLoop in its own real-time thread, the
 // operator's prompt in the main one (`--daq comedi:/dev/comediN`, and the twin as `--daq
 // sim-rt`). A window's times are on the rig's clock, which is what an interferometer log file is
@@ -10,9 +10,9 @@
 #include <string>
 
 #include "piezoshift/control/semi_closed_loop.hpp"
-#include "piezoshift/experiments/bench.hpp"
+#include "piezoshift/rig/bench.hpp"
 
-namespace piezoshift::calibration {
+namespace piezoshift::rig {
 
 using control::Vec3;
 
@@ -54,7 +54,7 @@ class BenchRig final : public GuidedRig {
   //! continues: the rig of the stage before, on a bench of its own; this rig's clock starts
   //! where that one's stands, so that window times never repeat within a session (a log file
   //! matched by time needs one time line).
-  BenchRig(experiments::Bench& bench, double window_s, const BenchRig* continues = nullptr)
+  BenchRig(rig::Bench& bench, double window_s, const BenchRig* continues = nullptr)
       : bench_(bench), window_s_(window_s), continues_(continues) {}
   //! Seconds on this rig's clock.
   double clock_s() const {
@@ -73,9 +73,9 @@ class BenchRig final : public GuidedRig {
   bool replays() const override { return true; }
 
  private:
-  experiments::Bench& bench_;
+  rig::Bench& bench_;
   double window_s_;
   const BenchRig* continues_;
 };
 
-}  // namespace piezoshift::calibration
+}  // namespace piezoshift::rig

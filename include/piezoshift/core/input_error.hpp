@@ -5,7 +5,7 @@
 #include <stdexcept>
 #include <string>
 
-namespace piezoshift::io {
+namespace piezoshift::core {
 
 class InputError : public std::runtime_error {
  public:
@@ -15,4 +15,4 @@ class InputError : public std::runtime_error {
 //! Exit status for bad input (configuration, data, command line).
 inline constexpr int kExitBadInput = 2;
 
-}  // namespace piezoshift::io
+}  // namespace piezoshift::core
