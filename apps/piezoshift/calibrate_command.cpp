@@ -20,16 +20,16 @@
 #include "piezoshift/calibration/calibration_file.hpp"
 #include "piezoshift/calibration/calibration_procedure.hpp"
 #include "piezoshift/calibration/guided_calibration.hpp"
-#include "piezoshift/rig/guided_rig.hpp"
 #include "piezoshift/calibration/guided_session.hpp"
 #include "piezoshift/calibration/improved_calibration.hpp"
 #include "piezoshift/calibration/interferometer_source.hpp"
-#include "piezoshift/rig/loop_rig.hpp"
 #include "piezoshift/config/project_config.hpp"
-#include "piezoshift/rig/bench.hpp"
+#include "piezoshift/core/input_error.hpp"
 #include "piezoshift/experiments/paper_experiments.hpp"
 #include "piezoshift/io/csv_writer.hpp"
-#include "piezoshift/core/input_error.hpp"
+#include "piezoshift/rig/bench.hpp"
+#include "piezoshift/rig/guided_rig.hpp"
+#include "piezoshift/rig/loop_rig.hpp"
 #include "piezoshift/runtime/safety_ranges.hpp"
 #include "progress_bar.hpp"
 #include "whole_number.hpp"
@@ -168,9 +168,9 @@ class GuidedRigs {
     lo.unix_time = stack_->clock().real_time();
     signals_.emplace();  // Ctrl-C ramps the stage to 0 V instead of leaving it driven
     lo.stop_signal = &g_stop_signal;
-    loop_rig_ = std::make_unique<rig::LoopRig>(
-        stack_->daq(), stack_->clock(), stack_->paced(), base,
-        loop_safety_limits(installation.safety, std::nullopt), lo);
+    loop_rig_ =
+        std::make_unique<rig::LoopRig>(stack_->daq(), stack_->clock(), stack_->paced(), base,
+                                       loop_safety_limits(installation.safety, std::nullopt), lo);
     for (const std::string& refusal : loop_rig_->realtime().refusals)
       fmt::print(stderr, "piezoshift: warning: the loop runs without real-time treatment: {}\n",
                  refusal);

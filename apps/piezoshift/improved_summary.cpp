@@ -8,8 +8,8 @@
 
 #include <fmt/core.h>
 
-#include "piezoshift/io/csv_writer.hpp"
 #include "piezoshift/core/input_error.hpp"
+#include "piezoshift/io/csv_writer.hpp"
 #include "piezoshift/io/input_file.hpp"
 
 namespace piezoshift::app {

@@ -7,7 +7,6 @@
 #include <stdexcept>
 
 #include "piezoshift/calibration/controller_ranges.hpp"
-#include "piezoshift/rig/bench.hpp"
 #include "piezoshift/experiments/metrics_step_response.hpp"
 #include "piezoshift/rig/bench.hpp"
 

@@ -13,7 +13,7 @@ std::vector<Map> read_frame_set(std::span<const std::string> paths, const FrameS
         fmt::format("psi: {} frame(s) given, at least {} are needed", paths.size(), kMinFrames));
   if (paths.size() > limits.max_frames)
     throw core::InputError(fmt::format("psi: {} frames given, at most {} are read (docs/psi.md)",
-                                     paths.size(), limits.max_frames));
+                                       paths.size(), limits.max_frames));
   std::vector<Map> frames;
   for (const std::string& p : paths) {
     GrayImage g = read_png_gray(p);
@@ -28,8 +28,8 @@ std::vector<Map> read_frame_set(std::span<const std::string> paths, const FrameS
       frames.reserve(paths.size());
     } else if (g.counts.width != frames[0].width || g.counts.height != frames[0].height) {
       throw core::InputError(fmt::format("{}: {} x {} pixels, but {} is {} x {}", p, g.counts.width,
-                                       g.counts.height, paths[0], frames[0].width,
-                                       frames[0].height));
+                                         g.counts.height, paths[0], frames[0].width,
+                                         frames[0].height));
     }
     frames.push_back(std::move(g.counts));
   }
