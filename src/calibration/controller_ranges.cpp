@@ -98,8 +98,9 @@ double nominal_gain_margin_dB(const control::SemiClosedLoopParams& params) {
   const control::PidParams pid = params.pid_params();
   const double t = params.sample_time_s;
   const auto loop = [&pid, t](double f) {
-    // G = 1 behind the DAQ contract's two ticks: z^-2 = e^{-j 2 w T}.
-    const std::complex<double> delay = std::polar(1.0, -2.0 * 2.0 * std::numbers::pi * f * t);
+    // G behind the DAQ contract's two ticks: G z^-2 = G e^{-j 2 w T}.
+    const std::complex<double> delay =
+        std::polar(kNominalPlantGain, -2.0 * 2.0 * std::numbers::pi * f * t);
     return pid_frequency_response(pid, f, t) * delay;
   };
   return stability_margins(loop, 0.01, 0.5 / t).gain_margin_dB;
@@ -138,9 +139,9 @@ std::string controller_problem(const control::SemiClosedLoopParams& in, double l
   if (!(margin_dB > 0.0))
     return fmt::format(
         "[controller] kp = {}, ki = {}, kd = {}: unstable on the nominal inner loop (gain margin "
-        "{:.2f} dB at a plant gain of 1 behind two ticks of delay; the gains must keep it above "
-        "0 dB, docs/calibration.md)",
-        params.gains.kp, params.gains.ki, params.gains.kd, margin_dB);
+        "{:.2f} dB with a plant gain of {} behind two ticks of delay; the gains must keep it "
+        "above 0 dB, docs/calibration.md)",
+        params.gains.kp, params.gains.ki, params.gains.kd, margin_dB, kNominalPlantGain);
   return "";
 }
 

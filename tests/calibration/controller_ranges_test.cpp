@@ -176,17 +176,24 @@ TEST(ControllerProblem, AnAThatIsSubnormalSingularOrIllConditionedIsRefused) {
 }
 
 // The nominal loop's gain margin against an independent evaluation (a Python script on a
-// 200 000-point linear grid, unwrapped phase, the incremental PID's C(z) times z^-2): the paper's
-// gains 2.99 dB at 1 kHz and 4.15 dB at 10 kHz; kp 1, ki 0.5, kd 0.01: -2.19 dB.
+// 200 000-point linear grid, unwrapped phase, the incremental PID's C(z) times z^-2, then
+// 20 log10(1 / 0.7) = 3.10 dB for the plant gain): the paper's gains 2.99 + 3.10 dB at 1 kHz and
+// 4.15 + 3.10 dB at 10 kHz; kp 1, ki 0.5, kd 0.01 (the stage-1 grid's corner, stable on the twin)
+// -2.19 + 3.10 dB; kp 1.8, ki 0.2, kd 0 (which oscillates on the twin) -5.59 + 3.10 dB.
 TEST(ControllerProblem, NominalGainMarginMatchesAnIndependentEvaluation) {
+  const double plant_dB = 20.0 * std::log10(1.0 / kNominalPlantGain);
   SemiClosedLoopParams p;
   p.sample_time_s = 1e-3;
-  EXPECT_NEAR(nominal_gain_margin_dB(p), 2.99, 0.01);
+  EXPECT_NEAR(nominal_gain_margin_dB(p), 2.99 + plant_dB, 0.01);
   p.sample_time_s = 1e-4;
-  EXPECT_NEAR(nominal_gain_margin_dB(p), 4.15, 0.01);
+  EXPECT_NEAR(nominal_gain_margin_dB(p), 4.15 + plant_dB, 0.01);
   p.sample_time_s = 1e-3;
   p.gains = {1.0, 0.5, 0.01};
-  EXPECT_NEAR(nominal_gain_margin_dB(p), -2.19, 0.01);
+  EXPECT_NEAR(nominal_gain_margin_dB(p), -2.19 + plant_dB, 0.01);
+  EXPECT_EQ(controller_problem(p, 1e-3), "");
+  p.gains = {1.8, 0.2, 0.0};
+  EXPECT_NEAR(nominal_gain_margin_dB(p), -5.59 + plant_dB, 0.01);
+  EXPECT_NE(controller_problem(p, 1e-3).find("unstable"), std::string::npos);
 }
 
 // Issue 27: kp 5, ki 3, kd 2 ran with the plate swinging between 2.3 and 7.0 um and no fault.

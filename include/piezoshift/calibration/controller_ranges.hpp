@@ -19,13 +19,14 @@
 //   A          an entry that is not finite or is subnormal (POS? answered -nan), or an A whose
 //              2-norm condition number exceeds kMaxMatrixCondition (an all-zero or singular A
 //              cannot be inverted for the positions the gauges show)
-//   gains      PIDs that are unstable on the nominal inner loop: the plant a gain G in (0, 1]
-//              (gauge um per um of command: a stack delivers at most the free stroke the signal
-//              scaling is made for, control.md) behind the DAQ contract's two ticks of delay,
-//              P(z) = G z^-2; the loop C(z) P(z) must keep a gain margin > 0 dB at G = 1, i.e.
-//              stay stable for every G up to 1. The nominal plant has no dynamics of its own,
-//              so this refuses what cannot be stable, not everything that is not: the identified
-//              loop's margins (loop_identification.hpp) say how far a stable set is from the edge.
+//   gains      PIDs that are unstable on the nominal inner loop: the plant a gain G (gauge um
+//              per um of command) behind the DAQ contract's two ticks of delay, P(z) = G z^-2,
+//              with G = kNominalPlantGain; the loop C(z) P(z) must keep a gain margin > 0 dB.
+//              The twin's identified small-signal gain is 0.60 to 0.67 (docs/calibration.md),
+//              and its amplifier and conditioner attenuate it further at the phase crossover, so
+//              a flat 0.7 refuses gains that cannot be stable on this stage, not all that are not:
+//              the identified loop's margins (loop_identification.hpp) say how far a set is from
+//              the edge.
 //   loop       what the loop itself refuses at its own sample time (control/parameter_check.hpp)
 #include <cstddef>
 #include <string>
@@ -40,6 +41,9 @@ namespace piezoshift::calibration {
 //! Largest 2-norm condition number of A a calibration may hold. The paper's A (Eq. 8) has 1.03;
 //! a tripod whose A reaches 100 turns 1 nm of gauge noise into up to 100 nm of computed position.
 inline constexpr double kMaxMatrixCondition = 100.0;
+
+//! The nominal inner loop's plant gain (header comment): the identified 0.60 to 0.67, rounded up.
+inline constexpr double kNominalPlantGain = 0.7;
 
 //! A list of numbers held in a fixed array and a count (the controller holds no heap).
 template <class Value, class Count>
@@ -118,9 +122,8 @@ std::string controller_problem(const control::SemiClosedLoopParams& params,
 //! design rate, else the rate the gains were tuned at.
 double own_sample_time_s(const control::SemiClosedLoopParams& params);
 
-//! The gain margin (dB) of the PIDs, at params.sample_time_s, on the nominal inner loop at G = 1
-//! (header comment): > 0 when stable for every G in (0, 1]; +infinity when the phase never
-//! reaches -180 deg.
+//! The gain margin (dB) of the PIDs, at params.sample_time_s, on the nominal inner loop (header
+//! comment): > 0 when stable there; +infinity when the phase never reaches -180 deg.
 double nominal_gain_margin_dB(const control::SemiClosedLoopParams& params);
 
 }  // namespace piezoshift::calibration
