@@ -114,8 +114,10 @@ StopSignals::~StopSignals() {
   sigaction(SIGTERM, &saved_->old_term, nullptr);
 }
 
-const char* signal_name(int signo) {
-  switch (signo) {
+std::string stop_reason_text(const runtime::LoopResult& result) {
+  if (result.stop_reason != runtime::StopReason::kSignal)
+    return runtime::to_string(result.stop_reason);
+  switch (result.signal) {
     case SIGINT:
       return "SIGINT";
     case SIGTERM:

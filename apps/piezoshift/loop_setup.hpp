@@ -13,6 +13,7 @@
 
 #include "piezoshift/config/project_config.hpp"
 #include "piezoshift/control/semi_closed_loop.hpp"
+#include "piezoshift/runtime/control_loop.hpp"
 #include "piezoshift/runtime/realtime.hpp"
 #include "piezoshift/runtime/safety_ranges.hpp"
 #include "piezoshift/runtime/safety_supervisor.hpp"
@@ -68,8 +69,9 @@ class StopSignals {
   std::unique_ptr<Saved> saved_;
 };
 
-//! "SIGINT", "SIGTERM" or "signal".
-const char* signal_name(int signo);
+//! Why a loop stopped, for its summary: "duration", "fault", or the signal ("SIGINT", "SIGTERM",
+//! "signal").
+std::string stop_reason_text(const runtime::LoopResult& result);
 
 //! Asks for real-time treatment of the calling thread (runtime/realtime.hpp) and prints one
 //! warning naming what was refused.

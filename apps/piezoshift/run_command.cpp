@@ -141,11 +141,6 @@ std::optional<std::uint64_t> injected_before_fault(const RunRecord& run) {
   return std::nullopt;
 }
 
-std::string stop_reason_of(const LoopResult& r) {
-  return r.stop_reason == StopReason::kSignal ? std::string(signal_name(r.signal))
-                                              : std::string(to_string(r.stop_reason));
-}
-
 // The tracking error S - SGS the PIDs saw at the end of the controlled part.
 Vec3 end_tracking_um(const LoopResult& r) {
   Vec3 tracking{};
@@ -231,7 +226,7 @@ nlohmann::json run_json(const RunRecord& run) {
   j["clock"] = o.free_run ? "free-run" : "realtime";
   j["duration_s"] = o.duration_s;
   j["ticks"] = r.ticks;
-  j["stop_reason"] = stop_reason_of(r);
+  j["stop_reason"] = stop_reason_text(r);
   j.update(timing_json(run.loop.stats()));
   j["realtime"] = {{"sched_fifo", rt.fifo},
                    {"mlockall", rt.memory_locked},
@@ -256,7 +251,7 @@ void print_run(const RunRecord& run) {
   const LoopResult& r = run.result;
   const LoopStats& st = run.loop.stats();
   fmt::print("run: {} at {} Hz ({} clock), {} ticks, stopped by {}\n", run.stack.name(), o.rate_Hz,
-             o.free_run ? "free-running" : "real-time", r.ticks, stop_reason_of(r));
+             o.free_run ? "free-running" : "real-time", r.ticks, stop_reason_text(r));
   fmt::print("period error   p50 {:.1f} us  p99 {:.1f} us  p99.9 {:.1f} us  max {:.1f} us\n",
              us(st.period_error.percentile_ns(0.5)), us(st.period_error.percentile_ns(0.99)),
              us(st.period_error.percentile_ns(0.999)), us(st.period_error.max_ns()));

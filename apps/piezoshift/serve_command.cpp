@@ -267,9 +267,7 @@ void print_serve_summary(const ServeOptions& o, Network& net, const std::string&
   const host::GcsStats& gs = net.gcs().stats();
   const host::LineServerStats ns = net.server().stats();
   const runtime::LoopStats& st = loop.stats();
-  std::string stop_reason = runtime::to_string(r.stop_reason);
-  if (r.stop_reason == runtime::StopReason::kSignal)
-    stop_reason = signal_name(r.signal);
+  const std::string stop_reason = stop_reason_text(r);
   if (!o.json) {
     fmt::print(
         "serve: {} ticks, stopped by {}; {} clients ({} refused), {} lines, {} GCS errors, {} "

@@ -24,25 +24,25 @@ class RangeCheck {
 
   void operator()(std::string_view section, std::string_view key, const double& v,
                   const core::Bounds& b, std::string_view) {
-    note(section, key, core::range_problem(key, v, b));
+    note(section, core::range_problem(key, v, b));
   }
   void operator()(std::string_view section, std::string_view key, const std::size_t& v,
                   const core::Bounds& b, std::string_view) {
-    note(section, key, core::range_problem(key, static_cast<std::int64_t>(v), b));
+    note(section, core::range_problem(key, static_cast<std::int64_t>(v), b));
   }
   template <class Value, class Count>
   void operator()(std::string_view section, std::string_view key, const ListField<Value, Count>& f,
                   const core::Bounds& b, std::string_view) {
     if (*f.count > f.capacity) {
-      note(section, key, fmt::format("{}: {} values, at most {}", key, *f.count, f.capacity));
+      note(section, fmt::format("{}: {} values, at most {}", key, *f.count, f.capacity));
       return;
     }
     for (std::size_t i = 0; i < *f.count && problem.empty(); ++i)
-      note(section, key, core::range_problem(fmt::format("{}[{}]", key, i), f.values[i], b));
+      note(section, core::range_problem(fmt::format("{}[{}]", key, i), f.values[i], b));
   }
 
  private:
-  void note(std::string_view section, std::string_view, const std::string& why) {
+  void note(std::string_view section, const std::string& why) {
     if (problem.empty() && !why.empty())
       problem = fmt::format("[{}] {}", section, why);
   }

@@ -18,12 +18,6 @@ namespace piezoshift::host {
 
 namespace {
 
-void close_fd(int& fd) noexcept {
-  if (fd >= 0)
-    ::close(fd);
-  fd = -1;
-}
-
 bool would_block(int err) {
   return err == EAGAIN || err == EWOULDBLOCK;
 }

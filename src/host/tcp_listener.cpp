@@ -15,15 +15,12 @@
 #include "piezoshift/core/input_error.hpp"
 
 namespace piezoshift::host {
-namespace {
 
 void close_fd(int& fd) noexcept {
   if (fd >= 0)
     ::close(fd);
   fd = -1;
 }
-
-}  // namespace
 
 Ipv4Host parse_ipv4_host(const std::string& host, const std::string& server,
                          const std::string& where) {

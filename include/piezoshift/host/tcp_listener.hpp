@@ -36,6 +36,9 @@ struct Ipv4Host {
   bool loopback = false;
 };
 
+//! Closes fd when it is open and marks it closed (-1); the listener's and the clients' sockets.
+void close_fd(int& fd) noexcept;
+
 //! server and where ("TCP server", "127.0.0.1:50000") name the error's source.
 Ipv4Host parse_ipv4_host(const std::string& host, const std::string& server,
                          const std::string& where);
