@@ -77,6 +77,7 @@ void ControlLoop::start() noexcept {
   previous_wake_ns_ = start_ns_;
   previous_overran_ = false;
   stop_requested_ = false;
+  finish_requested_ = false;
   done_ = false;
   previous_ao_V_ = Vec3{};
   // Host and owner modes: servo off at 0 V until told otherwise. The profile is followed from the
@@ -123,7 +124,7 @@ bool ControlLoop::tick() noexcept {
 void ControlLoop::check_stop() noexcept {
   if (stop_requested_)
     return;
-  if (tick_ >= duration_ticks_) {
+  if (tick_ >= duration_ticks_ || finish_requested_) {
     stop_requested_ = true;
     result_.stop_reason = StopReason::kDuration;
   } else if (config_.stop_signal != nullptr &&

@@ -126,10 +126,15 @@ class ControlLoop {
     return cycle_.try_configure(params);
   }
 
+  //! Owner mode, between ticks: the controlled part ends at the next tick, as the duration would
+  //! end it (the safe ramp to 0 V follows; tick() returns false once it is done).
+  void finish() noexcept { finish_requested_ = true; }
   //! Any thread: ask the loop to clear a latched fault at its next tick.
   void request_clear() noexcept { clear_requested_.store(true, std::memory_order_release); }
 
   std::int64_t period_ns() const noexcept { return period_ns_; }
+  //! The loop's clock keeps wall time (false: a simulated clock, ticks as fast as they run).
+  bool real_time() const noexcept { return clock_.real_time(); }
   std::uint64_t duration_ticks() const noexcept { return duration_ticks_; }
   const LoopStats& stats() const noexcept { return stats_; }
   const SafetySupervisor& supervisor() const noexcept { return cycle_.supervisor(); }
@@ -178,6 +183,7 @@ class ControlLoop {
   std::int64_t previous_wake_ns_ = 0;
   bool previous_overran_ = false;
   bool stop_requested_ = false;
+  bool finish_requested_ = false;
   bool done_ = false;
   Vec3 previous_ao_V_{};
   // Host mode: the host's Z_d, its wave generators (fixed-size; the tables are the host's),

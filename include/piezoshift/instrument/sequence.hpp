@@ -1,0 +1,92 @@
+#pragma once
+// A phase-shifting sequence through the shipping loop: the stage steps, the camera exposes only
+// once the stage has settled, and every frame is stored with the stage's state over its exposure.
+//
+// The caller owns a ControlLoop in owner mode (LoopConfig::owner_drives) and this thread ticks it
+// (on a real-time clock the ticks keep their deadlines; nothing here blocks between two ticks):
+//
+//   servo on at Z_d = base_um on P1..P3; settle for initial_settle_s
+//   for each average a, each frame k:
+//     Z_d = base_um + piston_k on P1..P3, piston_k = steps_rad[k] lambda / (4 pi)  (reflection)
+//     tick until settled: on every channel the controller's own estimate, the SGS tracking error
+//       S - feedback averaged over the last hold_s, within band_nm (OnTarget; never the twin's
+//       truth); not settled within timeout_s is a failure, never a frame taken anyway
+//     tick until the camera can expose (its readout of the previous frame is over)
+//     camera.trigger(t); tick through the exposure, each tick's plate pose to the camera
+//       (observe_plate: the twin camera renders from it) and to the exposure's record
+//   tick, holding the last position, until every frame has arrived (frame_timeout_s)
+//   the loop's controlled part ends; tick through its ramp to 0 V
+//
+// Frames are polled between ticks (lock-free: camera.hpp). A fault the supervisor latches, a
+// step that does not settle, a frame lost or late, or a stop signal ends the sequence with
+// valid = false and the first reason; the loop still ramps to 0 V. The wall-time floor is
+// frames x (settle + exposure + readout), with settle the hold time the criterion needs.
+#include <cstdint>
+#include <vector>
+
+#include "piezoshift/camera/camera.hpp"
+#include "piezoshift/plant/twin.hpp"
+#include "piezoshift/psi/stage.hpp"
+#include "piezoshift/rig/progress.hpp"
+#include "piezoshift/rig/validity.hpp"
+#include "piezoshift/runtime/control_loop.hpp"
+
+namespace piezoshift::instrument {
+
+struct SequenceParams {
+  std::vector<double> steps_rad;  //!< the phase steps of one measurement, steps_rad[0] = 0
+  double wavelength_nm = 632.8;   //!< HeNe, the usual Fizeau source
+  double base_um = 5.0;           //!< Z_d of P1..P3 at frame 0 (mid travel)
+  double initial_settle_s = 0.2;  //!< after the servo closes at the base, before frame 0
+  psi::OnTarget on_target{};      //!< the settle criterion (band, hold time, timeout)
+  int averages = 1;               //!< measurements taken one after the other
+  double frame_timeout_s = 2.0;   //!< after its exposure, for a frame to arrive
+};
+
+//! Why p cannot be run ("" when it can): 3 to 64 steps, finite, the first 0; wavelength, base,
+//! times and averages in range.
+std::string sequence_problem(const SequenceParams& p);
+
+//! One exposure: what was commanded, when, and where the stage was while the camera integrated.
+struct ExposureRecord {
+  int average = 0;
+  int frame = 0;
+  double commanded_step_rad = 0.0;
+  double commanded_piston_nm = 0.0;  //!< relative to the base
+  double move_time_s = 0.0;          //!< loop time of the move
+  double settled_time_s = 0.0;       //!< loop time the criterion was met
+  double trigger_time_s = 0.0;       //!< loop time the exposure started
+  double exposure_end_s = 0.0;
+  //! The controller's estimate over the exposure: per channel the mean of S - feedback; the
+  //! largest magnitude of the three, and the largest single-tick magnitude [nm].
+  double gauge_error_mean_nm = 0.0;
+  double gauge_error_max_nm = 0.0;
+  // The twin's truth over the exposure (has_truth), relative to the pose at the base.
+  bool has_truth = false;
+  double truth_piston_nm = 0.0;   //!< mean piston at the pupil centre
+  double truth_blur_nm = 0.0;     //!< its range over the exposure
+  double truth_tip_urad = 0.0;    //!< mean theta_x
+  double truth_tilt_urad = 0.0;   //!< mean theta_y
+  std::uint64_t frame_id = 0;     //!< the frame that arrived for it
+  double arrival_wall_s = 0.0;    //!< wall time from the sequence's start to its arrival
+};
+
+struct SequenceResult {
+  std::vector<camera::Frame> frames;  //!< averages x steps, in order
+  std::vector<ExposureRecord> exposures;
+  double loop_time_s = 0.0;  //!< loop time from the first move to the last frame
+  double wall_time_s = 0.0;  //!< the same span in wall time
+  double floor_s = 0.0;      //!< frames x (hold + exposure + readout)
+  std::uint64_t overruns = 0;
+  std::uint64_t ticks = 0;
+  rig::Validity validity;
+};
+
+//! Runs the sequence (see the header). twin: the twin whose true plate pose feeds the camera and
+//! the records (nullptr on hardware). loop must be in owner mode and not started; the DAQ
+//! backend must be active. Throws core::InputError for parameters sequence_problem() refuses.
+SequenceResult run_sequence(runtime::ControlLoop& loop, const plant::Twin* twin,
+                            camera::Camera& camera, const SequenceParams& params,
+                            const rig::Progress& progress = {});
+
+}  // namespace piezoshift::instrument

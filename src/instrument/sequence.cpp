@@ -1,0 +1,359 @@
+#include "piezoshift/instrument/sequence.hpp"
+
+#include <algorithm>
+#include <array>
+#include <chrono>
+#include <cmath>
+#include <numbers>
+#include <string>
+
+#include <fmt/core.h>
+
+#include "piezoshift/core/input_error.hpp"
+
+namespace piezoshift::instrument {
+
+namespace {
+
+using Clock = std::chrono::steady_clock;
+
+double seconds_since(Clock::time_point t0) {
+  return std::chrono::duration<double>(Clock::now() - t0).count();
+}
+
+// Drives one sequence: the loop's ticks, the settle criterion, the camera's triggers and frames.
+class Runner {
+ public:
+  Runner(runtime::ControlLoop& loop, const plant::Twin* twin, camera::Camera& camera,
+         const SequenceParams& p, const rig::Progress& progress)
+      : loop_(loop),
+        twin_(twin),
+        camera_(camera),
+        p_(p),
+        progress_(progress),
+        period_s_(static_cast<double>(loop.period_ns()) * 1e-9),
+        total_(static_cast<std::size_t>(p.averages) * p.steps_rad.size()) {
+    result_.frames.reserve(total_);
+    result_.exposures.reserve(total_);
+    const auto hold = std::max(1L, std::lround(p.on_target.hold_s / period_s_));
+    window_.resize(static_cast<std::size_t>(hold));
+  }
+
+  SequenceResult run() {
+    loop_.start();
+    const double z = p_.base_um;
+    loop_.drive_points({z, z, z});
+    if (run_for(p_.initial_settle_s) && settle()) {
+      origin_ = raw_pose();
+      start_wall_ = Clock::now();
+      start_loop_s_ = now_s();
+      for (int a = 0; a < p_.averages && ok(); ++a)
+        for (std::size_t k = 0; k < p_.steps_rad.size() && ok(); ++k)
+          take_frame(a, static_cast<int>(k));
+      if (ok())
+        collect_remaining_frames();
+      result_.loop_time_s = now_s() - start_loop_s_;
+      result_.wall_time_s = seconds_since(start_wall_);
+    }
+    finish_loop();
+    result_.floor_s = static_cast<double>(total_) *
+                      (static_cast<double>(window_.size()) * period_s_ +
+                       camera_.settings().exposure_s + camera_.settings().readout_s);
+    return std::move(result_);
+  }
+
+ private:
+  bool ok() const { return result_.validity.valid; }
+  double now_s() const { return static_cast<double>(loop_.ticks()) * period_s_; }
+
+  void fail(const std::string& why) { result_.validity.fail(why); }
+
+  camera::PlatePose raw_pose() const {
+    if (twin_ == nullptr)
+      return {now_s(), 0.0, 0.0, 0.0};
+    const plant::TwinTruth& t = twin_->truth();
+    return {now_s(), 1000.0 * t.plate_z_um, t.theta_x_urad, t.theta_y_urad};
+  }
+
+  camera::PlatePose pose() const {
+    const camera::PlatePose r = raw_pose();
+    return {r.time_s, r.piston_nm - origin_.piston_nm, r.theta_x_urad - origin_.theta_x_urad,
+            r.theta_y_urad - origin_.theta_y_urad};
+  }
+
+  // One loop tick, then the plate's pose to the camera and any frame that has arrived.
+  bool tick() {
+    if (!loop_.tick()) {
+      ended_ = true;
+      note_loop_end();
+      return false;
+    }
+    camera_.observe_plate(pose());
+    poll_frames();
+    if (loop_.result().fault_detected) {
+      note_loop_end();
+      return false;
+    }
+    return ok();
+  }
+
+  void note_loop_end() {
+    const runtime::LoopResult& r = loop_.result();
+    if (r.fault_detected)
+      fail(fmt::format("the safety supervisor latched {} at {:.3f} s{}",
+                       runtime::to_string(r.fault.reason),
+                       static_cast<double>(r.fault.tick) * period_s_,
+                       r.fault.channel >= 0 ? fmt::format(" on channel {}", r.fault.channel + 1)
+                                            : std::string()));
+    else if (r.stop_reason == runtime::StopReason::kSignal)
+      fail(fmt::format("stopped by signal {}", r.signal));
+    else if (ended_)
+      fail("the loop ended before the sequence did");
+  }
+
+  bool run_for(double duration_s) {
+    const auto n = std::max(0L, std::lround(duration_s / period_s_));
+    for (long k = 0; k < n; ++k)
+      if (!tick())
+        return false;
+    return true;
+  }
+
+  // Ticks until the windowed mean of S - feedback is within the band on every channel.
+  bool settle() {
+    const double t0 = now_s();
+    std::size_t filled = 0, next = 0;
+    while (now_s() - t0 < p_.on_target.timeout_s) {
+      if (!tick())
+        return false;
+      const control::ControllerOutput& out = loop_.last_cycle().controller;
+      for (std::size_t i = 0; i < 3; ++i)
+        window_[next][i] = 1000.0 * (out.target_um[i] - out.feedback_um[i]);
+      next = (next + 1) % window_.size();
+      filled = std::min(filled + 1, window_.size());
+      if (filled == window_.size() && windowed_error_nm() <= p_.on_target.band_nm)
+        return true;
+    }
+    fail(fmt::format("the stage did not settle within {} nm (mean over {} s) in {} s at {:.3f} s",
+                     p_.on_target.band_nm, p_.on_target.hold_s, p_.on_target.timeout_s, now_s()));
+    return false;
+  }
+
+  double windowed_error_nm() const {
+    double worst = 0.0;
+    for (std::size_t i = 0; i < 3; ++i) {
+      double sum = 0.0;
+      for (const auto& w : window_)
+        sum += w[i];
+      worst = std::max(worst, std::fabs(sum / static_cast<double>(window_.size())));
+    }
+    return worst;
+  }
+
+  void take_frame(int average, int frame) {
+    ExposureRecord rec;
+    rec.average = average;
+    rec.frame = frame;
+    rec.commanded_step_rad = p_.steps_rad[static_cast<std::size_t>(frame)];
+    rec.commanded_piston_nm = rec.commanded_step_rad * p_.wavelength_nm / (4.0 * std::numbers::pi);
+    rec.move_time_s = now_s();
+    const double z = p_.base_um + rec.commanded_piston_nm * 1e-3;
+    loop_.drive_points({z, z, z});
+    if (!settle())
+      return;
+    rec.settled_time_s = now_s();
+    if (!trigger_when_ready(rec))
+      return;
+    // Recorded from the trigger on: the frame may arrive before the exposure's last tick ends.
+    result_.exposures.push_back(rec);
+    if (!expose(result_.exposures.back()))
+      return;
+    if (!loop_.real_time())
+      wait_for_frames(result_.exposures.size());
+    if (progress_)
+      progress_(static_cast<double>(result_.exposures.size()), static_cast<double>(total_),
+                "frames");
+  }
+
+  // The camera refuses a trigger while it reads out the previous frame: tick until it takes one.
+  bool trigger_when_ready(ExposureRecord& rec) {
+    const double t0 = now_s();
+    while (!camera_.trigger(now_s())) {
+      if (now_s() - t0 > p_.frame_timeout_s) {
+        fail(fmt::format("camera {} took no trigger for {} s: {}", camera_.name(),
+                         p_.frame_timeout_s, camera_.message()));
+        return false;
+      }
+      if (!tick())
+        return false;
+    }
+    rec.trigger_time_s = now_s();
+    camera_.observe_plate(pose());  // the exposure's first instant
+    return true;
+  }
+
+  // Ticks through the exposure, the stage's state recorded tick by tick.
+  bool expose(ExposureRecord& rec) {
+    const auto n = std::max(1L, std::lround(camera_.settings().exposure_s / period_s_));
+    std::array<double, 3> sum{};
+    double piston_sum = 0.0, tip_sum = 0.0, tilt_sum = 0.0;
+    double lo = pose().piston_nm, hi = lo;
+    for (long k = 0; k < n; ++k) {
+      if (!tick())
+        return false;
+      const control::ControllerOutput& out = loop_.last_cycle().controller;
+      for (std::size_t i = 0; i < 3; ++i) {
+        const double e = 1000.0 * (out.target_um[i] - out.feedback_um[i]);
+        sum[i] += e;
+        rec.gauge_error_max_nm = std::max(rec.gauge_error_max_nm, std::fabs(e));
+      }
+      const camera::PlatePose q = pose();
+      piston_sum += q.piston_nm;
+      tip_sum += q.theta_x_urad;
+      tilt_sum += q.theta_y_urad;
+      lo = std::min(lo, q.piston_nm);
+      hi = std::max(hi, q.piston_nm);
+    }
+    const double dn = static_cast<double>(n);
+    for (double s : sum)
+      rec.gauge_error_mean_nm = std::max(rec.gauge_error_mean_nm, std::fabs(s / dn));
+    rec.exposure_end_s = now_s();
+    rec.has_truth = twin_ != nullptr;
+    if (rec.has_truth) {
+      rec.truth_piston_nm = piston_sum / dn;
+      rec.truth_blur_nm = hi - lo;
+      rec.truth_tip_urad = tip_sum / dn;
+      rec.truth_tilt_urad = tilt_sum / dn;
+    }
+    return true;
+  }
+
+  void poll_frames() {
+    camera::Frame f;
+    for (;;) {
+      const camera::FrameStatus s = camera_.poll(f);
+      if (s == camera::FrameStatus::kNone)
+        return;
+      if (!accept(s, f))
+        return;
+    }
+  }
+
+  bool accept(camera::FrameStatus s, camera::Frame& f) {
+    if (s == camera::FrameStatus::kLost) {
+      fail(fmt::format("camera {} lost frame {}", camera_.name(), f.frame_id));
+      return false;
+    }
+    if (s != camera::FrameStatus::kOk) {
+      fail(fmt::format("camera {}: {} ({})", camera_.name(), camera::to_string(s),
+                       camera_.message()));
+      return false;
+    }
+    const std::size_t k = result_.frames.size();
+    if (k >= result_.exposures.size()) {
+      fail(fmt::format("camera {} delivered frame {} that no trigger asked for", camera_.name(),
+                       f.frame_id));
+      return false;
+    }
+    result_.exposures[k].frame_id = f.frame_id;
+    result_.exposures[k].arrival_wall_s = seconds_since(start_wall_);
+    result_.frames.push_back(std::move(f));
+    return true;
+  }
+
+  // Off a real-time clock only: the loop's time stands still while this thread waits.
+  void wait_for_frames(std::size_t count) {
+    while (ok() && result_.frames.size() < count) {
+      camera::Frame f;
+      const camera::FrameStatus s = camera_.wait(f, p_.frame_timeout_s);
+      if (s == camera::FrameStatus::kTimeout) {
+        fail(fmt::format("camera {}: frame {} did not arrive within {} s", camera_.name(),
+                         result_.frames.size(), p_.frame_timeout_s));
+        return;
+      }
+      accept(s, f);
+    }
+  }
+
+  // On a real-time clock the loop keeps holding the last position while the frames come in.
+  void collect_remaining_frames() {
+    if (!loop_.real_time()) {
+      wait_for_frames(total_);
+      return;
+    }
+    const auto t0 = Clock::now();
+    while (ok() && result_.frames.size() < total_) {
+      if (seconds_since(t0) > p_.frame_timeout_s) {
+        fail(fmt::format("camera {}: {} of {} frames arrived within {} s of the last exposure",
+                         camera_.name(), result_.frames.size(), total_, p_.frame_timeout_s));
+        return;
+      }
+      tick();
+    }
+  }
+
+  void finish_loop() {
+    loop_.finish();
+    while (!ended_ && loop_.tick()) {
+    }
+    ended_ = true;
+    result_.ticks = loop_.result().ticks;
+    result_.overruns = loop_.stats().overruns;
+    if (ok() && loop_.result().fault_detected)
+      note_loop_end();
+  }
+
+  runtime::ControlLoop& loop_;
+  const plant::Twin* twin_;
+  camera::Camera& camera_;
+  const SequenceParams& p_;
+  const rig::Progress& progress_;
+  double period_s_;
+  std::size_t total_;
+  std::vector<std::array<double, 3>> window_;
+  camera::PlatePose origin_{};
+  Clock::time_point start_wall_ = Clock::now();
+  double start_loop_s_ = 0.0;
+  bool ended_ = false;
+  SequenceResult result_;
+};
+
+}  // namespace
+
+std::string sequence_problem(const SequenceParams& p) {
+  const std::size_t n = p.steps_rad.size();
+  if (n < 3 || n > 64)
+    return fmt::format("{} steps: a measurement takes 3 to 64 frames", n);
+  for (std::size_t k = 0; k < n; ++k)
+    if (!std::isfinite(p.steps_rad[k]) || std::fabs(p.steps_rad[k]) > 8.0 * std::numbers::pi)
+      return fmt::format("step {} = {} rad: must be finite, within +-8 pi", k, p.steps_rad[k]);
+  if (p.steps_rad[0] != 0.0)
+    return fmt::format("step 0 = {} rad: the first frame is the reference, 0", p.steps_rad[0]);
+  if (!(p.wavelength_nm >= 200.0 && p.wavelength_nm <= 2000.0))
+    return fmt::format("wavelength {} nm: must be in [200, 2000]", p.wavelength_nm);
+  if (!(p.base_um >= 0.0 && p.base_um <= 1000.0))
+    return fmt::format("base {} um: must be in [0, 1000]", p.base_um);
+  if (!(p.initial_settle_s >= 0.0 && p.initial_settle_s <= 60.0))
+    return fmt::format("initial settle {} s: must be in [0, 60]", p.initial_settle_s);
+  if (!(p.on_target.band_nm > 0.0 && p.on_target.band_nm <= 1000.0))
+    return fmt::format("settle band {} nm: must be in (0, 1000]", p.on_target.band_nm);
+  if (!(p.on_target.hold_s >= 0.0 && p.on_target.hold_s <= 10.0))
+    return fmt::format("settle hold {} s: must be in [0, 10]", p.on_target.hold_s);
+  if (!(p.on_target.timeout_s > 0.0 && p.on_target.timeout_s <= 60.0))
+    return fmt::format("settle timeout {} s: must be in (0, 60]", p.on_target.timeout_s);
+  if (p.averages < 1 || p.averages > 100)
+    return fmt::format("{} averages: must be 1 to 100", p.averages);
+  if (!(p.frame_timeout_s > 0.0 && p.frame_timeout_s <= 600.0))
+    return fmt::format("frame timeout {} s: must be in (0, 600]", p.frame_timeout_s);
+  return {};
+}
+
+SequenceResult run_sequence(runtime::ControlLoop& loop, const plant::Twin* twin,
+                            camera::Camera& camera, const SequenceParams& params,
+                            const rig::Progress& progress) {
+  if (const std::string why = sequence_problem(params); !why.empty())
+    throw core::InputError("measurement: " + why);
+  return Runner(loop, twin, camera, params, progress).run();
+}
+
+}  // namespace piezoshift::instrument

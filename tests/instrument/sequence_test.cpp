@@ -1,0 +1,228 @@
+// The measurement sequence through the shipping loop (owner mode, simulated clock, the twin as
+// the DAQ backend), with a scripted camera whose behaviour each test chooses.
+#include "piezoshift/instrument/sequence.hpp"
+
+#include <gtest/gtest.h>
+
+#include <cmath>
+#include <limits>
+#include <numbers>
+
+#include "piezoshift/config/project_config.hpp"
+#include "piezoshift/core/input_error.hpp"
+#include "piezoshift/runtime/loop_clock.hpp"
+#include "piezoshift/runtime/sim_backend.hpp"
+
+namespace piezoshift::instrument {
+namespace {
+
+// A camera that exposes over the loop's time: a trigger is taken when the previous readout is
+// over, the exposure's poses are recorded, and its frame (one pixel) is ready once the exposure
+// has ended. lose_frame: that frame is reported lost; refuse: no trigger is ever taken.
+class ScriptedCamera final : public camera::Camera {
+ public:
+  int lose_frame = -1;
+  bool refuse = false;
+  std::vector<std::vector<camera::PlatePose>> exposures;
+
+  void configure(const camera::CameraSettings& s) override { settings_ = s; }
+  void start() override {}
+  bool trigger(double t) noexcept override {
+    if (refuse || t < busy_until_s_ || exposing_)
+      return false;
+    start_s_ = t;
+    exposing_ = true;
+    busy_until_s_ = t + settings_.exposure_s + settings_.readout_s;
+    exposures.emplace_back();
+    return true;
+  }
+  void observe_plate(const camera::PlatePose& pose) noexcept override {
+    if (!exposing_)
+      return;
+    exposures.back().push_back(pose);
+    if (pose.time_s >= start_s_ + settings_.exposure_s - 1e-9) {
+      exposing_ = false;
+      ready_ = true;
+    }
+  }
+  camera::FrameStatus poll(camera::Frame& f) noexcept override {
+    if (!ready_)
+      return camera::FrameStatus::kNone;
+    ready_ = false;
+    f = camera::Frame{};
+    f.frame_id = next_id_++;
+    f.width_px = f.height_px = 1;
+    f.counts = {100};
+    f.trigger_time_s = start_s_;
+    return static_cast<int>(f.frame_id) == lose_frame ? camera::FrameStatus::kLost
+                                                     : camera::FrameStatus::kOk;
+  }
+  camera::FrameStatus wait(camera::Frame& f, double) override {
+    const camera::FrameStatus s = poll(f);
+    return s == camera::FrameStatus::kNone ? camera::FrameStatus::kTimeout : s;
+  }
+  void stop() noexcept override {}
+  std::string name() const override { return "scripted"; }
+  const camera::CameraSettings& settings() const override { return settings_; }
+  std::string message() const override { return refuse ? "refusing" : ""; }
+  std::uint64_t lost_frames() const noexcept override { return lose_frame >= 0 ? 1 : 0; }
+
+ private:
+  camera::CameraSettings settings_;
+  double start_s_ = 0.0;
+  double busy_until_s_ = 0.0;
+  bool exposing_ = false;
+  bool ready_ = false;
+  std::uint64_t next_id_ = 0;
+};
+
+// The twin behind the loop every command ships, in owner mode on a simulated clock.
+struct Rig {
+  config::ProjectConfig config;
+  runtime::SimBackend sim;
+  runtime::SimulatedClock clock;
+  runtime::ControlLoop loop;
+
+  static runtime::SimOptions sim_options(const config::ProjectConfig& c) {
+    runtime::SimOptions so;
+    so.design = c.design;
+    so.twin = c.twin;
+    so.seed = 7;
+    so.rate_Hz = 1.0 / c.twin.daq.sample_time_s;
+    return so;
+  }
+  static runtime::LoopConfig loop_config(const config::ProjectConfig& c) {
+    runtime::LoopConfig lc;
+    lc.rate_Hz = 1.0 / c.twin.daq.sample_time_s;
+    lc.duration_s = std::numeric_limits<double>::infinity();
+    lc.owner_drives = true;
+    return lc;
+  }
+  static control::SemiClosedLoopParams paper(const config::ProjectConfig& c) {
+    control::SemiClosedLoopParams p;
+    p.sample_time_s = c.twin.daq.sample_time_s;
+    return p;
+  }
+  Rig()
+      : sim(sim_options(config)),
+        loop(loop_config(config), paper(config), runtime::SafetyLimits{}, sim, clock,
+             runtime::SetpointProfile::step(0.0)) {
+    sim.configure();
+    sim.activate();
+  }
+  ~Rig() { sim.deactivate(); }
+};
+
+SequenceParams five_steps() {
+  SequenceParams p;
+  for (int k = 0; k < 5; ++k)
+    p.steps_rad.push_back(k * std::numbers::pi / 2.0);
+  return p;
+}
+
+TEST(SequenceTest, EachFrameIsExposedAfterSettlingAtItsCommandedPiston) {
+  Rig rig;
+  ScriptedCamera cam;
+  camera::CameraSettings cs;
+  cs.exposure_s = 0.002;
+  cs.readout_s = 0.010;
+  cam.configure(cs);
+  const SequenceParams p = five_steps();
+  const SequenceResult r = run_sequence(rig.loop, &rig.sim.twin(), cam, p);
+  ASSERT_TRUE(r.validity.valid) << r.validity.reason;
+  ASSERT_EQ(r.frames.size(), 5u);
+  ASSERT_EQ(r.exposures.size(), 5u);
+  for (std::size_t k = 0; k < 5; ++k) {
+    const ExposureRecord& e = r.exposures[k];
+    EXPECT_EQ(e.frame_id, k);
+    EXPECT_NEAR(e.commanded_piston_nm, k * 632.8 / 8.0, 1e-9);
+    EXPECT_GT(e.settled_time_s, e.move_time_s);
+    EXPECT_GE(e.trigger_time_s, e.settled_time_s);
+    EXPECT_NEAR(e.exposure_end_s - e.trigger_time_s, 0.002, 1e-9);
+    // The true piston within 10 nm of the commanded one: the gauges, not the interferometer,
+    // close this loop, and the paper's A and p are not this twin's calibration.
+    EXPECT_NEAR(e.truth_piston_nm, e.commanded_piston_nm, 10.0) << k;
+    // Settled on the 5 ms mean; over a 2-tick exposure the mean keeps the gauges' white noise,
+    // about 1.5 nm rms a sample (docs/twin.md), so 1.1 nm rms: the band plus 3 sigma.
+    EXPECT_LE(e.gauge_error_mean_nm, p.on_target.band_nm + 3.3) << k;
+    // The camera saw the exposure's first instant and one pose per tick after it.
+    ASSERT_EQ(cam.exposures[k].size(), 3u);
+    EXPECT_NEAR(cam.exposures[k].front().time_s, e.trigger_time_s, 1e-12);
+  }
+  // A frame's readout (10 ms) overlaps the next move and settle, so the floor counts each.
+  EXPECT_NEAR(r.floor_s, 5 * (0.005 + 0.002 + 0.010), 1e-9);
+  EXPECT_GE(r.loop_time_s, 5 * (0.005 + 0.002));
+  EXPECT_EQ(r.overruns, 0u);  // a simulated clock is never late
+}
+
+TEST(SequenceTest, AveragesRepeatTheWholeSequence) {
+  Rig rig;
+  ScriptedCamera cam;
+  cam.configure({});
+  SequenceParams p = five_steps();
+  p.averages = 3;
+  const SequenceResult r = run_sequence(rig.loop, &rig.sim.twin(), cam, p);
+  ASSERT_TRUE(r.validity.valid) << r.validity.reason;
+  ASSERT_EQ(r.exposures.size(), 15u);
+  EXPECT_EQ(r.exposures[14].average, 2);
+  EXPECT_EQ(r.exposures[14].frame, 4);
+  EXPECT_NEAR(r.exposures[10].truth_piston_nm, 0.0, 10.0);  // back to the base for average 3
+}
+
+TEST(SequenceTest, ALostFrameEndsTheSequenceAsNotValid) {
+  Rig rig;
+  ScriptedCamera cam;
+  cam.configure({});
+  cam.lose_frame = 2;
+  const SequenceResult r = run_sequence(rig.loop, &rig.sim.twin(), cam, five_steps());
+  EXPECT_FALSE(r.validity.valid);
+  EXPECT_NE(r.validity.reason.find("lost frame 2"), std::string::npos) << r.validity.reason;
+  EXPECT_EQ(r.frames.size(), 2u);  // never a silently short sequence: the two before it only
+  EXPECT_TRUE(rig.loop.result().stop_reason == runtime::StopReason::kDuration);
+}
+
+TEST(SequenceTest, AStageThatCannotSettleIsAFailureNotAFrame) {
+  Rig rig;
+  ScriptedCamera cam;
+  cam.configure({});
+  SequenceParams p = five_steps();
+  p.on_target.band_nm = 1e-6;  // far below the gauges' noise: never met
+  p.on_target.timeout_s = 0.05;
+  const SequenceResult r = run_sequence(rig.loop, &rig.sim.twin(), cam, p);
+  EXPECT_FALSE(r.validity.valid);
+  EXPECT_NE(r.validity.reason.find("did not settle"), std::string::npos) << r.validity.reason;
+  EXPECT_TRUE(r.frames.empty());
+}
+
+TEST(SequenceTest, ACameraThatTakesNoTriggerTimesOut) {
+  Rig rig;
+  ScriptedCamera cam;
+  cam.configure({});
+  cam.refuse = true;
+  SequenceParams p = five_steps();
+  p.frame_timeout_s = 0.1;
+  const SequenceResult r = run_sequence(rig.loop, &rig.sim.twin(), cam, p);
+  EXPECT_FALSE(r.validity.valid);
+  EXPECT_NE(r.validity.reason.find("took no trigger"), std::string::npos) << r.validity.reason;
+  EXPECT_NE(r.validity.reason.find("refusing"), std::string::npos) << r.validity.reason;
+}
+
+TEST(SequenceTest, ParametersOutOfRangeAreRefusedNamingTheValue) {
+  SequenceParams p = five_steps();
+  EXPECT_EQ(sequence_problem(p), "");
+  p.steps_rad = {0.0, 1.0};
+  EXPECT_NE(sequence_problem(p).find("3 to 64"), std::string::npos);
+  p.steps_rad = {0.5, 1.0, 2.0};
+  EXPECT_NE(sequence_problem(p).find("step 0 = 0.5"), std::string::npos);
+  p.steps_rad = {0.0, std::nan(""), 2.0};
+  EXPECT_NE(sequence_problem(p).find("step 1"), std::string::npos);
+  p = five_steps();
+  p.averages = 0;
+  EXPECT_NE(sequence_problem(p).find("0 averages"), std::string::npos);
+  Rig rig;
+  ScriptedCamera cam;
+  EXPECT_THROW(run_sequence(rig.loop, &rig.sim.twin(), cam, p), core::InputError);
+}
+
+}  // namespace
+}  // namespace piezoshift::instrument
