@@ -1,0 +1,346 @@
+// `piezoshift measure`: one phase-shifting measurement through the shipping loop (docs/measure.md):
+// the stage steps through the algorithm's sequence on the loop `run` and `serve` run, the camera
+// exposes once the stage has settled, then the analysis of `psi analyze`.
+//
+// Exit status: 0 a measurement was written; 2 bad input (options, files, a camera that cannot be
+// opened or cannot take the settings); 3 the safety supervisor latched a fault; 4 not valid: a
+// step that did not settle, a frame lost or late, a fit that did not converge (nothing written).
+#include <unistd.h>
+
+#include <cmath>
+#include <memory>
+#include <numbers>
+#include <optional>
+#include <string>
+#include <vector>
+
+#include <fmt/core.h>
+#include <nlohmann/json.hpp>
+
+#include "command.hpp"
+#include "loop_setup.hpp"
+#include "loop_stack.hpp"
+#include "measure_report.hpp"
+#include "piezoshift/camera/camera.hpp"
+#include "piezoshift/camera/camera_config.hpp"
+#include "piezoshift/camera/make_camera.hpp"
+#include "piezoshift/core/input_error.hpp"
+#include "piezoshift/instrument/measurement.hpp"
+#include "piezoshift/instrument/sequence.hpp"
+#include "piezoshift/plant/random.hpp"
+#include "piezoshift/psi/analysis.hpp"
+#include "piezoshift/psi/fizeau_simulation.hpp"
+#include "piezoshift/rig/validity.hpp"
+#include "piezoshift/runtime/control_loop.hpp"
+#include "piezoshift/runtime/safety_ranges.hpp"
+#include "progress_bar.hpp"
+#include "psi_options.hpp"
+#include "whole_number.hpp"
+
+namespace piezoshift::app {
+
+namespace {
+
+constexpr int kExitFault = 3;
+
+struct MeasureOptions {
+  std::string camera = "twin";
+  std::string daq = "sim";
+  double rate_Hz = 1000.0;
+  std::string calibration;
+  std::string config;
+  std::string algorithm = "hariharan5";
+  std::string steps_rad;
+  int averages = 1;
+  std::string surface;
+  std::string mask;
+  double base_um = 5.0;
+  psi::OnTarget on_target{};
+  double frame_timeout_s = 2.0;
+  std::uint64_t seed = 1;
+  bool free_run = false;
+  int cpu = -1;
+  std::string out;
+  bool json = false;
+};
+
+// The commanded steps: --steps-rad, or k times the algorithm's nominal step.
+std::vector<double> commanded_steps(const MeasureOptions& o, psi::Algorithm alg) {
+  if (!o.steps_rad.empty()) {
+    std::vector<double> steps = parse_list(o.steps_rad, "--steps-rad");
+    const bool free_steps = alg == psi::Algorithm::kLeastSquares ||
+                            alg == psi::Algorithm::kAia || alg == psi::Algorithm::kTiltAia;
+    if (!free_steps)
+      throw core::InputError(fmt::format(
+          "--steps-rad: {} has fixed steps; unequal steps need lsq, aia or tilt-aia",
+          psi::algorithm_name(alg)));
+    return steps;
+  }
+  const int n = psi::required_frames(alg) > 0 ? psi::required_frames(alg) : 5;
+  std::vector<double> steps;
+  for (int k = 0; k < n; ++k)
+    steps.push_back(k * psi::nominal_step_rad(alg));
+  return steps;
+}
+
+instrument::SequenceParams sequence_params(const MeasureOptions& o, psi::Algorithm alg,
+                                           double wavelength_nm) {
+  instrument::SequenceParams p;
+  p.steps_rad = commanded_steps(o, alg);
+  check_count(alg, p.steps_rad.size());
+  p.wavelength_nm = wavelength_nm;
+  p.base_um = o.base_um;
+  p.on_target = o.on_target;
+  p.averages = o.averages;
+  p.frame_timeout_s = o.frame_timeout_s;
+  if (const std::string why = instrument::sequence_problem(p); !why.empty())
+    throw core::InputError("measure: " + why);
+  return p;
+}
+
+LoopStackOptions stack_options(const MeasureOptions& o) {
+  LoopStackOptions so;
+  so.daq = o.daq;
+  so.rate_Hz = o.rate_Hz;
+  so.seed = o.seed;
+  so.config_path = o.config;
+  so.clock = o.free_run ? StackClock::kFreeRun : StackClock::kRealTime;
+  return so;
+}
+
+// The twin camera's scene: the --surface on a pupil of 0.47 of the frame's side (as `psi
+// simulate` draws it), rendered with the Fizeau's optics.
+camera::TwinScene twin_scene(const MeasureOptions& o, const camera::CameraConfig& cc,
+                             double wavelength_nm) {
+  camera::TwinScene scene;
+  scene.fizeau.width_px = cc.settings.width_px;
+  scene.fizeau.height_px = cc.settings.height_px;
+  scene.fizeau.pupil_radius_px = 0.47 * std::min(cc.settings.width_px, cc.settings.height_px);
+  scene.fizeau.wavelength_nm = wavelength_nm;
+  scene.mask = psi::disk_mask(scene.fizeau.width_px, scene.fizeau.height_px,
+                              scene.fizeau.pupil_radius_px);
+  const psi::SurfaceSpec spec =
+      o.surface.empty() ? psi::SurfaceSpec{} : psi::parse_surface_spec(o.surface);
+  plant::Rng rng(o.seed ^ 0x5u);
+  scene.surface_nm = psi::make_surface_nm(spec, scene.mask, rng);
+  scene.seed = o.seed;
+  return scene;
+}
+
+// Everything a measurement needs before the loop starts, checked in this order so that bad input
+// is named before anything runs: options, configuration, the stack (DAQ), the calibration, the
+// camera.
+struct MeasureSetup {
+  camera::InstrumentConfig config;
+  psi::Algorithm algorithm = psi::Algorithm::kHariharan5;
+  instrument::SequenceParams params;
+  std::optional<camera::TwinScene> scene;
+  LoopCalibration calibration;
+};
+
+void check_options(const MeasureOptions& o) {
+  check_loop_rate(o.rate_Hz);
+  if (o.out.empty())
+    throw core::InputError("--out: a folder for the measurement is required");
+  check_measure_out(o.out);
+  if (o.camera == "twin" && o.daq != "sim")
+    throw core::InputError(fmt::format(
+        "--camera twin renders the twin's plate: it needs --daq sim, not {}", o.daq));
+  if (o.camera != "twin" && !o.surface.empty())
+    throw core::InputError("--surface: the test surface of the twin camera only");
+}
+
+void check_travel(const MeasureSetup& s) {
+  double top_nm = 0.0;
+  for (double step : s.params.steps_rad)
+    top_nm = std::max(top_nm, step * s.params.wavelength_nm / (4.0 * std::numbers::pi));
+  const double top_um = s.params.base_um + top_nm * 1e-3;
+  if (s.calibration.travel_z_max_um && top_um > *s.calibration.travel_z_max_um)
+    throw core::InputError(fmt::format(
+        "--base-um {}: the sequence reaches {:.4f} um, beyond the calibrated travel {} um ({})",
+        s.params.base_um, top_um, *s.calibration.travel_z_max_um, s.calibration.source));
+}
+
+std::unique_ptr<camera::Camera> open_camera(const MeasureOptions& o, const MeasureSetup& s) {
+  std::unique_ptr<camera::Camera> cam =
+      camera::make_camera(o.camera, s.config.camera, s.scene ? &*s.scene : nullptr);
+  cam->start();
+  return cam;
+}
+
+psi::Mask measurement_mask(const MeasureOptions& o, const MeasureSetup& s,
+                           const instrument::SequenceResult& r) {
+  if (s.scene)
+    return s.scene->mask;
+  const std::vector<psi::Map> first = instrument::frame_maps({r.frames.front()});
+  return load_mask(o.mask, first.front());
+}
+
+struct Outcome {
+  instrument::SequenceResult sequence;
+  std::string camera_name;
+  std::string daq_name;
+  bool real_time = true;
+};
+
+// The loop, the camera and the sequence; the DAQ's outputs at 0 V whatever happens.
+Outcome acquire(const MeasureOptions& o, MeasureSetup& s, LoopStack& stack) {
+  runtime::LoopConfig lc;
+  lc.rate_Hz = o.rate_Hz;
+  lc.duration_s = std::numeric_limits<double>::infinity();
+  lc.stop_signal = &g_stop_signal;
+  lc.owner_drives = true;
+  const runtime::SafetyLimits limits =
+      loop_safety_limits(s.config.installation.safety, std::nullopt);
+  runtime::ControlLoop loop(lc, s.calibration.params, limits, stack.daq(), stack.clock(),
+                            runtime::SetpointProfile::step(0.0));
+  std::unique_ptr<camera::Camera> cam = open_camera(o, s);
+  StopSignals signals;
+  ProgressBar bar(1);
+  if (stack.clock().real_time())
+    request_realtime_or_warn(o.cpu);
+  const plant::Twin* twin = stack.sim() != nullptr ? &stack.sim()->twin() : nullptr;
+  Outcome out;
+  stack.daq().activate();
+  try {
+    out.sequence = instrument::run_sequence(loop, twin, *cam, s.params, bar.callback());
+  } catch (...) {
+    stack.daq().deactivate();
+    throw;
+  }
+  stack.daq().deactivate();
+  cam->stop();
+  out.camera_name = cam->name();
+  out.daq_name = stack.name();
+  out.real_time = stack.clock().real_time();
+  return out;
+}
+
+int measure(const MeasureOptions& o) {
+  check_options(o);
+  MeasureSetup s;
+  if (!o.config.empty())
+    s.config = camera::load_instrument_config(o.config);
+  const double wavelength_nm = 632.8;
+  s.algorithm = psi::parse_algorithm(o.algorithm);
+  s.params = sequence_params(o, s.algorithm, wavelength_nm);
+  if (o.camera == "twin")
+    s.scene = twin_scene(o, s.config.camera, wavelength_nm);
+  LoopStack stack(stack_options(o), s.config.installation.project);
+  s.calibration = resolve_calibration(o.calibration, o.daq, s.config.installation.project, o.seed,
+                                      1.0 / o.rate_Hz);
+  check_travel(s);
+
+  const Outcome acquired = acquire(o, s, stack);
+  const instrument::SequenceResult& r = acquired.sequence;
+  if (!r.validity.valid) {
+    if (o.json)
+      fmt::print("{}\n", nlohmann::json{{"valid", false}, {"reason", r.validity.reason}}.dump(2));
+    if (r.validity.reason.find("safety supervisor") != std::string::npos) {
+      fmt::print(stderr, "piezoshift: measure: {}\n", r.validity.reason);
+      return kExitFault;
+    }
+    throw rig::ProcedureFailed("measure: " + r.validity.reason);
+  }
+  const psi::Mask mask = measurement_mask(o, s, r);
+  psi::AnalysisOptions ao;
+  ao.phase.algorithm = s.algorithm;
+  ao.phase.steps_rad = s.params.steps_rad;
+  ao.wavelength_nm = wavelength_nm;
+  instrument::MeasurementAnalysis a;
+  try {
+    a = instrument::analyze_measurement(r, s.params, mask, ao);
+  } catch (const std::invalid_argument& e) {
+    throw rig::ProcedureFailed(fmt::format("measure: the frames carry no phase: {}", e.what()));
+  }
+  MeasureRecord rec{.camera = acquired.camera_name,
+                    .daq = acquired.daq_name,
+                    .algorithm = std::string(psi::algorithm_name(s.algorithm)),
+                    .calibration_source = s.calibration.source,
+                    .rate_Hz = o.rate_Hz,
+                    .real_time = acquired.real_time,
+                    .params = &s.params,
+                    .sequence = &r,
+                    .analysis = &a,
+                    .mask = &mask,
+                    .truth_nm = s.scene ? &s.scene->surface_nm : nullptr,
+                    .error_rms_nm = std::nullopt,
+                    .bit_depth = camera::bit_depth(s.config.camera.settings.format)};
+  if (s.scene)
+    rec.error_rms_nm = psi::surface_error_rms_nm(a.surface_nm, s.scene->surface_nm, a.valid);
+  if (!a.converged) {
+    if (o.json)
+      fmt::print("{}\n", measure_json(rec).dump(2));
+    throw rig::ProcedureFailed("measure: " + a.reason);
+  }
+  write_measurement(rec, o.out);
+  if (o.json) {
+    fmt::print("{}\n", measure_json(rec).dump(2));
+  } else {
+    fmt::print("measure: {} frames x {} on {} with camera {}: surface RMS {:.3f} nm, PV {:.3f} nm"
+               "{}\nsteps: worst recovered - true {}; wall time {:.3f} s (floor {:.3f} s); "
+               "overruns {}\nwritten: {}/\n",
+               s.params.steps_rad.size(), s.params.averages, rec.daq, rec.camera, a.figures.rms,
+               a.figures.pv,
+               rec.error_rms_nm ? fmt::format(", measured - true {:.3f} nm RMS", *rec.error_rms_nm)
+                                : std::string(),
+               a.true_steps_rad.empty() ? std::string("(no truth)")
+                                        : fmt::format("{:.2f} mrad", a.step_error_max_mrad),
+               r.wall_time_s, r.floor_s, r.overruns, o.out);
+  }
+  return 0;
+}
+
+}  // namespace
+
+void add_measure_command(CLI::App& app, Action& action) {
+  auto o = std::make_shared<MeasureOptions>();
+  CLI::App* cmd = app.add_subcommand(
+      "measure",
+      "Take a phase-shifting measurement: the stage steps through the shipping loop, the camera "
+      "exposes once it has settled, then the analysis (docs/measure.md)");
+  cmd->add_option("--camera", o->camera, "twin, files:DIR or aravis:ID (docs/camera.md)")
+      ->capture_default_str();
+  cmd->add_option("--daq", o->daq, "sim, or comedi:/dev/comediN")->capture_default_str();
+  cmd->add_option("--rate-hz", o->rate_Hz, "loop rate, 1000 (the paper) to 10000 Hz")
+      ->capture_default_str();
+  cmd->add_option("--calibration", o->calibration,
+                  "TOML with [controller] (the paper's or the improved controller)");
+  cmd->add_option("--config", o->config,
+                  "TOML configuration: the twin's sections, [safety] and [camera]");
+  cmd->add_option("--algorithm", o->algorithm,
+                  "4step, carre, hariharan5, degroot7, frame13, lsq, aia, tilt-aia")
+      ->capture_default_str();
+  cmd->add_option("--steps-rad", o->steps_rad,
+                  "commanded steps, comma-separated, the first 0 (lsq, aia, tilt-aia)");
+  cmd->add_option("--averages", o->averages, "measurements averaged, 1 to 100")
+      ->capture_default_str()
+      ->check(whole_number(1, 100));
+  cmd->add_option("--surface", o->surface,
+                  "the twin camera's test surface, as `psi simulate` takes it (Z4=40,rough=0.5)");
+  cmd->add_option("--mask", o->mask, "the pupil as a PNG (cameras other than the twin)");
+  cmd->add_option("--base-um", o->base_um, "Z_d of P1..P3 at frame 0 (um)")->capture_default_str();
+  cmd->add_option("--settle-band-nm", o->on_target.band_nm,
+                  "settled: mean S - feedback within this on every channel (nm)")
+      ->capture_default_str();
+  cmd->add_option("--settle-hold-s", o->on_target.hold_s, "... averaged over this long (s)")
+      ->capture_default_str();
+  cmd->add_option("--settle-timeout-s", o->on_target.timeout_s,
+                  "a step not settled by then ends the measurement (s)")
+      ->capture_default_str();
+  cmd->add_option("--frame-timeout-s", o->frame_timeout_s,
+                  "a frame not arrived by then ends the measurement (s)")
+      ->capture_default_str();
+  cmd->add_option("--seed", o->seed, "twin and camera noise seed")
+      ->capture_default_str()
+      ->check(whole_number(0, kAnyUnsigned));
+  cmd->add_flag("--free-run", o->free_run,
+                "sim only: simulated clock, as fast as possible (tests, benches)");
+  cmd->add_option("--cpu", o->cpu, "CPU to pin the loop to (-1: the last one, -2: none)")
+      ->capture_default_str();
+  cmd->add_option("--out", o->out, "a new folder for the measurement")->required();
+  cmd->add_flag("--json", o->json, "print the summary as JSON");
+  cmd->callback([&action, o] { action = [o] { return measure(*o); }; });
+}
+
+}  // namespace piezoshift::app

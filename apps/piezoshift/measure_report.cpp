@@ -1,0 +1,299 @@
+#include "measure_report.hpp"
+
+#include <unistd.h>
+
+#include <cmath>
+#include <filesystem>
+#include <numbers>
+#include <vector>
+
+#include <fmt/core.h>
+
+#include "piezoshift/core/input_error.hpp"
+#include "piezoshift/io/atomic_file.hpp"
+#include "piezoshift/io/csv_writer.hpp"
+#include "piezoshift/io/plot.hpp"
+#include "piezoshift/psi/npy.hpp"
+#include "piezoshift/psi/png_image.hpp"
+
+namespace piezoshift::app {
+
+namespace fs = std::filesystem;
+using Json = nlohmann::json;
+
+namespace {
+
+Json number_or_null(double v) {
+  return std::isfinite(v) ? Json(v) : Json(nullptr);
+}
+
+Json exposures_json(const instrument::SequenceResult& s) {
+  Json a = Json::array();
+  for (const instrument::ExposureRecord& e : s.exposures) {
+    Json j{{"average", e.average + 1},
+           {"frame", e.frame},
+           {"frame_id", e.frame_id},
+           {"commanded_step_rad", e.commanded_step_rad},
+           {"commanded_piston_nm", e.commanded_piston_nm},
+           {"move_time_s", e.move_time_s},
+           {"settle_s", e.settled_time_s - e.move_time_s},
+           {"trigger_time_s", e.trigger_time_s},
+           {"exposure_end_s", e.exposure_end_s},
+           {"gauge_error_mean_nm", e.gauge_error_mean_nm},
+           {"gauge_error_max_nm", e.gauge_error_max_nm},
+           {"arrival_wall_s", e.arrival_wall_s}};
+    if (e.has_truth) {
+      j["truth_piston_nm"] = e.truth_piston_nm;
+      j["truth_blur_nm"] = e.truth_blur_nm;
+      j["truth_tip_urad"] = e.truth_tip_urad;
+      j["truth_tilt_urad"] = e.truth_tilt_urad;
+    }
+    a.push_back(j);
+  }
+  return a;
+}
+
+// Finite range of a map, for its colour scale.
+std::pair<double, double> finite_range(const psi::Map& m) {
+  double lo = INFINITY, hi = -INFINITY;
+  for (double v : m.v)
+    if (std::isfinite(v)) {
+      lo = std::min(lo, v);
+      hi = std::max(hi, v);
+    }
+  return std::isfinite(lo) ? std::pair{lo, hi} : std::pair{0.0, 0.0};
+}
+
+void write_exposures_csv(const instrument::SequenceResult& s, const fs::path& path) {
+  io::CsvWriter csv(path.string(),
+                    {"average", "frame", "frame_id", "commanded_step_rad", "commanded_piston_nm",
+                     "move_time_s", "settle_s", "trigger_time_s", "exposure_end_s",
+                     "gauge_error_mean_nm", "gauge_error_max_nm", "truth_piston_nm",
+                     "truth_blur_nm", "truth_tip_urad", "truth_tilt_urad", "arrival_wall_s"},
+                    6, io::CsvWriter::Mode::kReplaceAtomically);
+  for (const instrument::ExposureRecord& e : s.exposures) {
+    const double nan = std::nan("");
+    csv.row({static_cast<double>(e.average + 1), static_cast<double>(e.frame),
+             static_cast<double>(e.frame_id), e.commanded_step_rad, e.commanded_piston_nm,
+             e.move_time_s, e.settled_time_s - e.move_time_s, e.trigger_time_s, e.exposure_end_s,
+             e.gauge_error_mean_nm, e.gauge_error_max_nm, e.has_truth ? e.truth_piston_nm : nan,
+             e.has_truth ? e.truth_blur_nm : nan, e.has_truth ? e.truth_tip_urad : nan,
+             e.has_truth ? e.truth_tilt_urad : nan, e.arrival_wall_s});
+  }
+  csv.close();
+}
+
+// Frames as 16-bit PNG, the counts MSB-aligned (as `psi simulate` writes them), so that
+// `psi analyze` and `--camera files:DIR` read them back.
+void write_frames(const MeasureRecord& r, const fs::path& dir) {
+  fs::create_directories(dir);
+  const double msb = std::ldexp(1.0, 16 - r.bit_depth);
+  const std::size_t n = r.params->steps_rad.size();
+  for (std::size_t i = 0; i < r.sequence->frames.size(); ++i) {
+    const camera::Frame& f = r.sequence->frames[i];
+    psi::Map m(f.width_px, f.height_px);
+    for (std::size_t p = 0; p < m.size(); ++p)
+      m.v[p] = f.counts[p] * msb;
+    psi::write_png_gray16(
+        (dir / fmt::format("frame_a{}_{:02}.png", i / n + 1, i % n)).string(), m);
+  }
+}
+
+io::Figure zernike_figure(const instrument::MeasurementAnalysis& a) {
+  io::Figure f;
+  f.width_px = 1000;
+  f.height_px = 500;
+  f.svg = true;
+  io::Panel p{.title = "Zernike coefficients of the measured surface (piston and tilt removed)",
+              .x_label = "Noll index j",
+              .y_label = "coefficient, RMS [nm]"};
+  std::vector<double> j, c, w;
+  for (std::size_t k = 3; k < a.zernike_nm.size(); ++k) {
+    j.push_back(static_cast<double>(k + 1));
+    c.push_back(a.zernike_nm[k]);
+    w.push_back(0.7);
+  }
+  io::Series bars{.title = "", .style = io::SeriesStyle::kBoxes, .x = j, .y = c, .w = w};
+  p.series.push_back(bars);
+  p.key = "off";
+  f.panels.push_back(p);
+  return f;
+}
+
+// The steps as commanded, as recovered from the fringes (AIA) and, on the twin, as made; below,
+// recovered minus true (or minus commanded without truth) in mrad.
+io::Figure steps_figure(const MeasureRecord& r) {
+  const instrument::MeasurementAnalysis& a = *r.analysis;
+  io::Figure f;
+  f.rows = 2;
+  f.width_px = 900;
+  f.height_px = 800;
+  f.svg = true;
+  io::Panel top{.title = "Phase steps, average 1",
+                .x_label = "frame",
+                .y_label = "step [rad]"};
+  io::Panel bottom{.title = a.true_steps_rad.empty() ? "recovered - commanded"
+                                                     : "recovered from the fringes - true",
+                   .x_label = "frame",
+                   .y_label = "difference [mrad]"};
+  std::vector<double> k, diff;
+  const std::vector<double>& rec = a.recovered_steps_rad.front();
+  const std::vector<double>& ref =
+      a.true_steps_rad.empty() ? r.params->steps_rad : a.true_steps_rad.front();
+  for (std::size_t i = 0; i < rec.size(); ++i) {
+    k.push_back(static_cast<double>(i));
+    diff.push_back(1000.0 * (rec[i] - ref[i]));
+  }
+  top.series.push_back(io::line_series("commanded", k, r.params->steps_rad));
+  top.series.push_back(io::point_series("recovered (AIA)", k, rec));
+  if (!a.true_steps_rad.empty())
+    top.series.push_back(io::point_series("true (twin)", k, a.true_steps_rad.front()));
+  top.key = "top left";
+  bottom.series.push_back(io::point_series("", k, diff));
+  bottom.markers.push_back({.vertical = false, .at = 0.0, .label = ""});
+  bottom.key = "off";
+  f.panels = {top, bottom};
+  return f;
+}
+
+// Where the stage was while each frame was exposed, against the commanded piston.
+io::Figure stage_figure(const MeasureRecord& r) {
+  io::Figure f;
+  f.width_px = 900;
+  f.height_px = 500;
+  f.svg = true;
+  io::Panel p{.title = "The stage during each exposure",
+              .x_label = "exposure",
+              .y_label = "error [nm]"};
+  std::vector<double> k, gauge, truth;
+  for (std::size_t i = 0; i < r.sequence->exposures.size(); ++i) {
+    const instrument::ExposureRecord& e = r.sequence->exposures[i];
+    k.push_back(static_cast<double>(i));
+    gauge.push_back(e.gauge_error_mean_nm);
+    if (e.has_truth)
+      truth.push_back(e.truth_piston_nm - e.commanded_piston_nm);
+  }
+  p.series.push_back(io::point_series("gauges: mean |S - feedback|, worst channel", k, gauge));
+  if (truth.size() == k.size())
+    p.series.push_back(io::point_series("true piston - commanded (twin)", k, truth));
+  p.markers.push_back({.vertical = false, .at = 0.0, .label = ""});
+  f.panels.push_back(p);
+  return f;
+}
+
+std::string report_markdown(const MeasureRecord& r) {
+  const instrument::MeasurementAnalysis& a = *r.analysis;
+  const instrument::SequenceResult& s = *r.sequence;
+  std::string md = fmt::format(
+      "# Phase-shifting measurement\n\n"
+      "Camera `{}`, DAQ `{}` at {} Hz ({} clock), algorithm `{}`, {} frames x {} averages; "
+      "calibration: {}.\n\n"
+      "| figure | value |\n|---|---|\n"
+      "| surface RMS | {:.3f} nm |\n| surface PV | {:.3f} nm |\n| surface PVr | {:.3f} nm |\n"
+      "| valid pixels | {} |\n| steps: worst recovered - true | {} |\n"
+      "| measurement, wall time | {:.3f} s (floor {:.3f} s, ratio {:.2f}) |\n"
+      "| loop overruns | {} |\n",
+      r.camera, r.daq, r.rate_Hz, r.real_time ? "real-time" : "simulated", r.algorithm,
+      r.params->steps_rad.size(), r.params->averages, r.calibration_source, a.figures.rms,
+      a.figures.pv, a.figures.pvr, a.figures.pixels,
+      a.true_steps_rad.empty() ? std::string("(no truth)")
+                               : fmt::format("{:.2f} mrad", a.step_error_max_mrad),
+      s.wall_time_s, s.floor_s, s.floor_s > 0 ? s.wall_time_s / s.floor_s : 0.0, s.overruns);
+  if (r.error_rms_nm)
+    md += fmt::format("| measured - true surface, RMS | {:.3f} nm |\n", *r.error_rms_nm);
+  md +=
+      "\n![surface](surface_nm.png)\n\n![Zernike](zernike.png)\n\n![steps](steps.png)\n\n"
+      "![stage](stage.png)\n";
+  return md;
+}
+
+}  // namespace
+
+// out must be absent or an empty folder: a measurement never mixes with another's files.
+void check_measure_out(const std::string& name) {
+  const fs::path out(name);
+  std::error_code ec;
+  if (!fs::exists(out, ec))
+    return;
+  if (!fs::is_directory(out, ec) || !fs::is_empty(out, ec))
+    throw core::InputError(fmt::format(
+        "--out {}: exists and is not an empty folder (a measurement is written whole into a "
+        "new one)",
+        out.string()));
+}
+
+Json measure_json(const MeasureRecord& r) {
+  const instrument::MeasurementAnalysis& a = *r.analysis;
+  const instrument::SequenceResult& s = *r.sequence;
+  Json j{{"camera", r.camera},
+         {"daq", r.daq},
+         {"rate_Hz", r.rate_Hz},
+         {"clock", r.real_time ? "realtime" : "free-run"},
+         {"calibration", r.calibration_source},
+         {"algorithm", r.algorithm},
+         {"wavelength_nm", r.params->wavelength_nm},
+         {"frames", r.params->steps_rad.size()},
+         {"averages", r.params->averages},
+         {"commanded_steps_rad", r.params->steps_rad},
+         {"recovered_steps_rad", a.recovered_steps_rad},
+         {"true_steps_rad", a.true_steps_rad.empty() ? Json(nullptr) : Json(a.true_steps_rad)},
+         {"step_error_max_mrad",
+          a.true_steps_rad.empty() ? Json(nullptr) : Json(a.step_error_max_mrad)},
+         {"converged", a.converged},
+         {"reason", a.reason.empty() ? Json(nullptr) : Json(a.reason)},
+         {"surface_rms_nm", a.figures.rms},
+         {"surface_pv_nm", a.figures.pv},
+         {"surface_pvr_nm", a.figures.pvr},
+         {"valid_pixels", a.figures.pixels},
+         {"zernike_nm", a.zernike_nm},
+         {"error_rms_nm", r.error_rms_nm ? Json(*r.error_rms_nm) : Json(nullptr)},
+         {"timing",
+          {{"wall_time_s", s.wall_time_s},
+           {"floor_s", s.floor_s},
+           {"ratio_to_floor", s.floor_s > 0.0 ? number_or_null(s.wall_time_s / s.floor_s)
+                                              : Json(nullptr)},
+           {"loop_time_s", s.loop_time_s},
+           {"ticks", s.ticks},
+           {"overruns", s.overruns}}},
+         {"exposures", exposures_json(s)}};
+  Json averages = Json::array();
+  for (const psi::SurfaceFigures& f : a.average_figures)
+    averages.push_back({{"rms_nm", f.rms}, {"pv_nm", f.pv}, {"pvr_nm", f.pvr}});
+  j["average_figures"] = averages;
+  return j;
+}
+
+void write_measurement(const MeasureRecord& r, const std::string& out_name) {
+  const fs::path out(out_name);
+  check_measure_out(out_name);
+  const fs::path tmp = out.string() + fmt::format(".partial-{}", ::getpid());
+  fs::remove_all(tmp);
+  fs::create_directories(tmp);
+  try {
+    write_frames(r, tmp / "frames");
+    psi::write_mask_png((tmp / "mask.png").string(), *r.mask);
+    psi::write_npy((tmp / "surface_nm.npy").string(), r.analysis->surface_nm);
+    const auto [lo, hi] = finite_range(r.analysis->surface_nm);
+    psi::write_false_colour_png((tmp / "surface_nm.png").string(), r.analysis->surface_nm, lo,
+                                hi);
+    if (r.truth_nm != nullptr)
+      psi::write_npy((tmp / "surface_truth_nm.npy").string(), *r.truth_nm);
+    write_exposures_csv(*r.sequence, tmp / "exposures.csv");
+    io::write_file_atomically((tmp / "measurement.json").string(), measure_json(r).dump(2) + "\n");
+    if (io::find_gnuplot()) {
+      io::render(zernike_figure(*r.analysis), tmp / "zernike");
+      io::render(steps_figure(r), tmp / "steps");
+      io::render(stage_figure(r), tmp / "stage");
+    }
+    io::write_file_atomically((tmp / "report.md").string(), report_markdown(r));
+    std::error_code ec;
+    fs::remove(out, ec);  // an empty folder (check_out) gives way to the whole measurement
+    fs::rename(tmp, out);
+  } catch (...) {
+    std::error_code ec;
+    fs::remove_all(tmp, ec);
+    throw;
+  }
+}
+
+}  // namespace piezoshift::app

@@ -1,0 +1,43 @@
+#pragma once
+// What `piezoshift measure` writes (docs/measure.md): into a folder of its own, renamed into
+// place only once everything is in it, so a measurement that fails leaves nothing half-written.
+#include <optional>
+#include <string>
+
+#include <nlohmann/json.hpp>
+
+#include "piezoshift/instrument/measurement.hpp"
+#include "piezoshift/instrument/sequence.hpp"
+#include "piezoshift/psi/grid.hpp"
+
+namespace piezoshift::app {
+
+struct MeasureRecord {
+  std::string camera;     //!< the camera's name ("twin", "aravis:Fake_1", ...)
+  std::string daq;        //!< the DAQ backend's name
+  std::string algorithm;  //!< psi's name of the analysis' algorithm
+  std::string calibration_source;
+  double rate_Hz = 1000.0;
+  bool real_time = true;
+  const instrument::SequenceParams* params = nullptr;
+  const instrument::SequenceResult* sequence = nullptr;
+  const instrument::MeasurementAnalysis* analysis = nullptr;
+  const psi::Mask* mask = nullptr;
+  const psi::Map* truth_nm = nullptr;          //!< the twin camera's surface, else nullptr
+  std::optional<double> error_rms_nm;          //!< measured - truth, piston and tilt removed
+  int bit_depth = 12;
+};
+
+//! The summary measure prints with --json and writes as measurement.json.
+nlohmann::json measure_json(const MeasureRecord& r);
+
+//! Refuses (InputError) an --out that exists and is not an empty folder: called before the
+//! measurement, and again by write_measurement.
+void check_measure_out(const std::string& out);
+
+//! Writes the measurement into out (which must not exist, or be an empty folder): frames,
+//! surface, truth, mask, exposures.csv, measurement.json, figures and report.md. Built in a
+//! sibling folder first and renamed into place at the end.
+void write_measurement(const MeasureRecord& r, const std::string& out);
+
+}  // namespace piezoshift::app

@@ -1,0 +1,71 @@
+#include "psi_options.hpp"
+
+#include <cmath>
+#include <sstream>
+#include <stdexcept>
+
+#include <fmt/core.h>
+
+#include "piezoshift/core/input_error.hpp"
+#include "piezoshift/psi/png_image.hpp"
+
+namespace piezoshift::app {
+
+std::vector<double> parse_list(const std::string& text, const std::string& option) {
+  std::vector<double> v;
+  std::stringstream ss(text);
+  std::string item;
+  while (std::getline(ss, item, ',')) {
+    try {
+      std::size_t used = 0;
+      const double x = std::stod(item, &used);
+      if (used != item.size() || !std::isfinite(x))
+        throw std::invalid_argument(item);
+      v.push_back(x);
+    } catch (const std::exception&) {
+      throw core::InputError(fmt::format("{} '{}': '{}' is not a number", option, text, item));
+    }
+  }
+  return v;
+}
+
+psi::Mask load_mask(const std::string& path, const psi::Map& frame) {
+  if (path.empty())
+    return psi::Mask(frame.width, frame.height, 1);
+  psi::Mask m = psi::read_mask_png(path);
+  if (m.width != frame.width || m.height != frame.height)
+    throw core::InputError(fmt::format("{}: mask is {} x {} pixels, the frames {} x {}", path,
+                                       m.width, m.height, frame.width, frame.height));
+  return m;
+}
+
+psi::Algorithm choose_algorithm(const std::string& name, std::size_t frames) {
+  if (!name.empty())
+    return psi::parse_algorithm(name);
+  switch (frames) {
+    case 4:
+      return psi::Algorithm::kFourStep;
+    case 5:
+      return psi::Algorithm::kHariharan5;
+    case 7:
+      return psi::Algorithm::kDeGroot7;
+    case 13:
+      return psi::Algorithm::kFrame13;
+    default:
+      return psi::Algorithm::kLeastSquares;
+  }
+}
+
+void check_count(psi::Algorithm a, std::size_t frames) {
+  const int need = psi::required_frames(a);
+  if (need > 0 && static_cast<std::size_t>(need) != frames)
+    throw core::InputError(fmt::format("--algorithm {} needs {} frames, {} given",
+                                       psi::algorithm_name(a), need, frames));
+}
+
+void check_wavelength(double nm) {
+  if (!(nm >= 100.0 && nm <= 20000.0))
+    throw core::InputError(fmt::format("--wavelength-nm {}: must be in 100..20000", nm));
+}
+
+}  // namespace piezoshift::app
