@@ -17,6 +17,8 @@
 #include "improved_summary.hpp"
 #include "loop_setup.hpp"
 #include "loop_stack.hpp"
+#include "physics_budget.hpp"
+#include "piezoshift/calibration/calibration_cost.hpp"
 #include "piezoshift/calibration/calibration_file.hpp"
 #include "piezoshift/calibration/calibration_procedure.hpp"
 #include "piezoshift/calibration/guided_calibration.hpp"
@@ -38,6 +40,7 @@ namespace piezoshift::app {
 namespace {
 
 struct Options {
+  double max_physics_steps = plant::kDefaultPhysicsStepBudget;
   std::string out = "calibration.toml";
   std::uint64_t seed = 1;
   std::string config;
@@ -326,6 +329,10 @@ int run_improved(const Options& o, const config::ProjectConfig& config) {
     throw core::InputError("--pid search: the improved controller has no PID to search");
   control::SemiClosedLoopParams base;
   base.sample_time_s = config.twin.daq.sample_time_s;
+  // The improved calibration, then the travel's share of the start-up calibration's cost.
+  const rig::ProcedureCost improved = calibration::improved_calibration_cost();
+  check_procedure_cost("calibrate --controller improved", improved, config.twin,
+                       o.max_physics_steps);
   calibration::ImprovedCalibrationOutcome ic;
   experiments::TravelRangeResult travel;
   {
@@ -392,6 +399,9 @@ int run(const Options& o) {
     return run_improved(o, config);
   calibration::CalibrationOptions co;
   co.pid = o.pid == "paper" ? calibration::PidChoice::kPaper : calibration::PidChoice::kSearch;
+  check_procedure_cost("calibrate",
+                       calibration::calibration_cost(co, config.twin.daq.sample_time_s),
+                       config.twin, o.max_physics_steps);
   calibration::CalibrationWithTravel ct;
   {
     ProgressBar bar(3);
@@ -446,6 +456,7 @@ void add_calibrate_command(CLI::App& app, Action& action) {
   CLI::App* cmd = app.add_subcommand(
       "calibrate", "The paper's three calibration stages on the twin; writes a calibration file");
   cmd->add_option("--out", o->out, "calibration file to write (TOML, replaced atomically)");
+  add_physics_budget_option(cmd, o->max_physics_steps);
   cmd->add_option("--seed", o->seed, "seed of the twin's random numbers")
       ->check(whole_number(0, kAnyUnsigned));
   cmd->add_option("--config", o->config, "TOML configuration (configs/paper.toml's sections)");

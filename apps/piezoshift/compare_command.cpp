@@ -12,9 +12,11 @@
 #include <fmt/core.h>
 
 #include "command.hpp"
+#include "physics_budget.hpp"
 #include "piezoshift/config/project_config.hpp"
 #include "piezoshift/reproduction/comparison.hpp"
 #include "piezoshift/reproduction/comparison_report.hpp"
+#include "piezoshift/reproduction/reproduction_cost.hpp"
 #include "piezoshift/runtime/safety_ranges.hpp"
 #include "progress_bar.hpp"
 
@@ -79,12 +81,16 @@ struct Options {
   std::string out;
   bool quick = false;
   bool json = false;
+  double max_physics_steps = plant::kDefaultPhysicsStepBudget;  // per seed
 };
 
 int run(const Options& o) {
   const config::ProjectConfig config = o.config.empty()
                                            ? config::ProjectConfig{}
                                            : runtime::load_installation_config(o.config).project;
+  // Per seed: the seeds run one after another, each a whole comparison of its own.
+  check_procedure_cost("compare, one seed", reproduction::compare_seed_cost(o.quick), config.twin,
+                       o.max_physics_steps);
   reproduction::CompareOptions co;
   co.seeds = *parse_seeds(o.seeds);  // checked by the option's validator
   co.quick = o.quick;
@@ -158,6 +164,7 @@ void add_compare_command(CLI::App& app, Action& action) {
                              text, kMaxSeeds);
           },
           "SEEDS"));
+  add_physics_budget_option(cmd, o->max_physics_steps);
   cmd->add_flag("--quick", o->quick, "shortened schedule (tests, a first look)");
   cmd->add_flag("--json", o->json, "print the JSON summary");
   cmd->add_option("--out", o->out,

@@ -6,6 +6,8 @@
 
 #include <fmt/core.h>
 
+#include "physics_budget.hpp"
+#include "piezoshift/calibration/calibration_cost.hpp"
 #include "piezoshift/calibration/calibration_file.hpp"
 #include "piezoshift/calibration/calibration_procedure.hpp"
 #include "piezoshift/calibration/controller_ranges.hpp"
@@ -51,7 +53,7 @@ nlohmann::json safety_json(const runtime::SafetyLimits& limits) {
 
 LoopCalibration resolve_calibration(const std::string& path, const std::string& daq,
                                     const config::ProjectConfig& config, std::uint64_t seed,
-                                    double loop_sample_time_s) {
+                                    double loop_sample_time_s, double max_physics_steps) {
   LoopCalibration c;
   if (!path.empty()) {
     c.params = calibration::load_calibration_file(path, &c.travel_z_max_um, &c.travel_z_min_um);
@@ -82,12 +84,17 @@ LoopCalibration resolve_calibration(const std::string& path, const std::string& 
     c.source = "the paper's values (Section 4)";
     return c;
   }
+  const calibration::CalibrationOptions startup =
+      calibration::CalibrationOptions::paper_gains_only();
+  check_procedure_cost("the start-up calibration of the twin (no --calibration)",
+                       calibration::calibration_cost(startup, config.twin.daq.sample_time_s),
+                       config.twin, max_physics_steps);
   fmt::print(stderr,
              "piezoshift: no --calibration: calibrating the twin first (the paper's procedure "
              "and gains, seed {})\n",
              seed);
-  const calibration::CalibrationWithTravel ct = calibration::calibrate_with_travel(
-      config, seed, calibration::CalibrationOptions::paper_gains_only());
+  const calibration::CalibrationWithTravel ct =
+      calibration::calibrate_with_travel(config, seed, startup);
   c.params = ct.calibration.controller;
   c.travel_z_max_um = ct.travel.single_move_um;
   c.travel_z_min_um = ct.travel.single_move_min_um;

@@ -13,6 +13,7 @@
 
 #include "piezoshift/config/project_config.hpp"
 #include "piezoshift/control/semi_closed_loop.hpp"
+#include "piezoshift/plant/simulation_cost.hpp"
 #include "piezoshift/runtime/control_loop.hpp"
 #include "piezoshift/runtime/realtime.hpp"
 #include "piezoshift/runtime/safety_ranges.hpp"
@@ -48,9 +49,12 @@ struct LoopCalibration {
 //! own values (Section 4) with a warning, since nothing else is known of the stage. A file of the
 //! improved controller calibrated at another rate than loop_sample_time_s is refused (its shaper
 //! and correction hold at one rate only).
+//! The start-up calibration is refused (InputError) when its estimated cost is above
+//! max_physics_steps (--max-physics-steps; rig/procedure_cost.hpp).
 LoopCalibration resolve_calibration(const std::string& path, const std::string& daq,
                                     const config::ProjectConfig& config, std::uint64_t seed,
-                                    double loop_sample_time_s);
+                                    double loop_sample_time_s,
+                                    double max_physics_steps = plant::kDefaultPhysicsStepBudget);
 
 //! Set by the handlers StopSignals installs: the signal number, 0 until one arrives.
 extern std::atomic<int> g_stop_signal;

@@ -21,6 +21,7 @@
 #include "loop_setup.hpp"
 #include "loop_stack.hpp"
 #include "measure_report.hpp"
+#include "physics_budget.hpp"
 #include "piezoshift/camera/camera.hpp"
 #include "piezoshift/camera/camera_config.hpp"
 #include "piezoshift/camera/make_camera.hpp"
@@ -44,6 +45,7 @@ namespace {
 constexpr int kExitFault = 3;
 
 struct MeasureOptions {
+  double max_physics_steps = plant::kDefaultPhysicsStepBudget;  // the start-up calibration
   std::string camera = "twin";
   std::string daq = "sim";
   double rate_Hz = 1000.0;
@@ -68,12 +70,12 @@ struct MeasureOptions {
 std::vector<double> commanded_steps(const MeasureOptions& o, psi::Algorithm alg) {
   if (!o.steps_rad.empty()) {
     std::vector<double> steps = parse_list(o.steps_rad, "--steps-rad");
-    const bool free_steps = alg == psi::Algorithm::kLeastSquares ||
-                            alg == psi::Algorithm::kAia || alg == psi::Algorithm::kTiltAia;
+    const bool free_steps = alg == psi::Algorithm::kLeastSquares || alg == psi::Algorithm::kAia ||
+                            alg == psi::Algorithm::kTiltAia;
     if (!free_steps)
-      throw core::InputError(fmt::format(
-          "--steps-rad: {} has fixed steps; unequal steps need lsq, aia or tilt-aia",
-          psi::algorithm_name(alg)));
+      throw core::InputError(
+          fmt::format("--steps-rad: {} has fixed steps; unequal steps need lsq, aia or tilt-aia",
+                      psi::algorithm_name(alg)));
     return steps;
   }
   const int n = psi::required_frames(alg) > 0 ? psi::required_frames(alg) : 5;
@@ -117,8 +119,8 @@ camera::TwinScene twin_scene(const MeasureOptions& o, const camera::CameraConfig
   scene.fizeau.height_px = cc.settings.height_px;
   scene.fizeau.pupil_radius_px = 0.47 * std::min(cc.settings.width_px, cc.settings.height_px);
   scene.fizeau.wavelength_nm = wavelength_nm;
-  scene.mask = psi::disk_mask(scene.fizeau.width_px, scene.fizeau.height_px,
-                              scene.fizeau.pupil_radius_px);
+  scene.mask =
+      psi::disk_mask(scene.fizeau.width_px, scene.fizeau.height_px, scene.fizeau.pupil_radius_px);
   const psi::SurfaceSpec spec =
       o.surface.empty() ? psi::SurfaceSpec{} : psi::parse_surface_spec(o.surface);
   plant::Rng rng(o.seed ^ 0x5u);
@@ -144,8 +146,8 @@ void check_options(const MeasureOptions& o) {
     throw core::InputError("--out: a folder for the measurement is required");
   check_measure_out(o.out);
   if (o.camera == "twin" && o.daq != "sim")
-    throw core::InputError(fmt::format(
-        "--camera twin renders the twin's plate: it needs --daq sim, not {}", o.daq));
+    throw core::InputError(
+        fmt::format("--camera twin renders the twin's plate: it needs --daq sim, not {}", o.daq));
   if (o.camera != "twin" && !o.surface.empty())
     throw core::InputError("--surface: the test surface of the twin camera only");
 }
@@ -228,7 +230,7 @@ int measure(const MeasureOptions& o) {
     s.scene = twin_scene(o, s.config.camera, wavelength_nm);
   LoopStack stack(stack_options(o), s.config.installation.project);
   s.calibration = resolve_calibration(o.calibration, o.daq, s.config.installation.project, o.seed,
-                                      1.0 / o.rate_Hz);
+                                      1.0 / o.rate_Hz, o.max_physics_steps);
   check_travel(s);
 
   const Outcome acquired = acquire(o, s, stack);
@@ -277,16 +279,17 @@ int measure(const MeasureOptions& o) {
   if (o.json) {
     fmt::print("{}\n", measure_json(rec).dump(2));
   } else {
-    fmt::print("measure: {} frames x {} on {} with camera {}: surface RMS {:.3f} nm, PV {:.3f} nm"
-               "{}\nsteps: worst recovered - true {}; wall time {:.3f} s (floor {:.3f} s); "
-               "overruns {}\nwritten: {}/\n",
-               s.params.steps_rad.size(), s.params.averages, rec.daq, rec.camera, a.figures.rms,
-               a.figures.pv,
-               rec.error_rms_nm ? fmt::format(", measured - true {:.3f} nm RMS", *rec.error_rms_nm)
-                                : std::string(),
-               a.true_steps_rad.empty() ? std::string("(no truth)")
-                                        : fmt::format("{:.2f} mrad", a.step_error_max_mrad),
-               r.wall_time_s, r.floor_s, r.overruns, o.out);
+    fmt::print(
+        "measure: {} frames x {} on {} with camera {}: surface RMS {:.3f} nm, PV {:.3f} nm"
+        "{}\nsteps: worst recovered - true {}; wall time {:.3f} s (floor {:.3f} s); "
+        "overruns {}\nwritten: {}/\n",
+        s.params.steps_rad.size(), s.params.averages, rec.daq, rec.camera, a.figures.rms,
+        a.figures.pv,
+        rec.error_rms_nm ? fmt::format(", measured - true {:.3f} nm RMS", *rec.error_rms_nm)
+                         : std::string(),
+        a.true_steps_rad.empty() ? std::string("(no truth)")
+                                 : fmt::format("{:.2f} mrad", a.step_error_max_mrad),
+        r.wall_time_s, r.floor_s, r.overruns, o.out);
   }
   return 0;
 }
@@ -331,6 +334,7 @@ void add_measure_command(CLI::App& app, Action& action) {
   cmd->add_option("--frame-timeout-s", o->frame_timeout_s,
                   "a frame not arrived by then ends the measurement (s)")
       ->capture_default_str();
+  add_physics_budget_option(cmd, o->max_physics_steps);
   cmd->add_option("--seed", o->seed, "twin and camera noise seed")
       ->capture_default_str()
       ->check(whole_number(0, kAnyUnsigned));

@@ -65,12 +65,12 @@ std::pair<double, double> finite_range(const psi::Map& m) {
 }
 
 void write_exposures_csv(const instrument::SequenceResult& s, const fs::path& path) {
-  io::CsvWriter csv(path.string(),
-                    {"average", "frame", "frame_id", "commanded_step_rad", "commanded_piston_nm",
-                     "move_time_s", "settle_s", "trigger_time_s", "exposure_end_s",
-                     "gauge_error_mean_nm", "gauge_error_max_nm", "truth_piston_nm",
-                     "truth_blur_nm", "truth_tip_urad", "truth_tilt_urad", "arrival_wall_s"},
-                    6, io::CsvWriter::Mode::kReplaceAtomically);
+  io::CsvWriter csv(
+      path.string(),
+      {"average", "frame", "frame_id", "commanded_step_rad", "commanded_piston_nm", "move_time_s",
+       "settle_s", "trigger_time_s", "exposure_end_s", "gauge_error_mean_nm", "gauge_error_max_nm",
+       "truth_piston_nm", "truth_blur_nm", "truth_tip_urad", "truth_tilt_urad", "arrival_wall_s"},
+      6, io::CsvWriter::Mode::kReplaceAtomically);
   for (const instrument::ExposureRecord& e : s.exposures) {
     const double nan = std::nan("");
     csv.row({static_cast<double>(e.average + 1), static_cast<double>(e.frame),
@@ -94,8 +94,7 @@ void write_frames(const MeasureRecord& r, const fs::path& dir) {
     psi::Map m(f.width_px, f.height_px);
     for (std::size_t p = 0; p < m.size(); ++p)
       m.v[p] = f.counts[p] * msb;
-    psi::write_png_gray16(
-        (dir / fmt::format("frame_a{}_{:02}.png", i / n + 1, i % n)).string(), m);
+    psi::write_png_gray16((dir / fmt::format("frame_a{}_{:02}.png", i / n + 1, i % n)).string(), m);
   }
 }
 
@@ -129,9 +128,7 @@ io::Figure steps_figure(const MeasureRecord& r) {
   f.width_px = 900;
   f.height_px = 800;
   f.svg = true;
-  io::Panel top{.title = "Phase steps, average 1",
-                .x_label = "frame",
-                .y_label = "step [rad]"};
+  io::Panel top{.title = "Phase steps, average 1", .x_label = "frame", .y_label = "step [rad]"};
   io::Panel bottom{.title = a.true_steps_rad.empty() ? "recovered - commanded"
                                                      : "recovered from the fringes - true",
                    .x_label = "frame",
@@ -162,9 +159,8 @@ io::Figure stage_figure(const MeasureRecord& r) {
   f.width_px = 900;
   f.height_px = 500;
   f.svg = true;
-  io::Panel p{.title = "The stage during each exposure",
-              .x_label = "exposure",
-              .y_label = "error [nm]"};
+  io::Panel p{
+      .title = "The stage during each exposure", .x_label = "exposure", .y_label = "error [nm]"};
   std::vector<double> k, gauge, truth;
   for (std::size_t i = 0; i < r.sequence->exposures.size(); ++i) {
     const instrument::ExposureRecord& e = r.sequence->exposures[i];
@@ -250,8 +246,8 @@ Json measure_json(const MeasureRecord& r) {
          {"timing",
           {{"wall_time_s", s.wall_time_s},
            {"floor_s", s.floor_s},
-           {"ratio_to_floor", s.floor_s > 0.0 ? number_or_null(s.wall_time_s / s.floor_s)
-                                              : Json(nullptr)},
+           {"ratio_to_floor",
+            s.floor_s > 0.0 ? number_or_null(s.wall_time_s / s.floor_s) : Json(nullptr)},
            {"loop_time_s", s.loop_time_s},
            {"ticks", s.ticks},
            {"overruns", s.overruns}}},
@@ -274,8 +270,7 @@ void write_measurement(const MeasureRecord& r, const std::string& out_name) {
     psi::write_mask_png((tmp / "mask.png").string(), *r.mask);
     psi::write_npy((tmp / "surface_nm.npy").string(), r.analysis->surface_nm);
     const auto [lo, hi] = finite_range(r.analysis->surface_nm);
-    psi::write_false_colour_png((tmp / "surface_nm.png").string(), r.analysis->surface_nm, lo,
-                                hi);
+    psi::write_false_colour_png((tmp / "surface_nm.png").string(), r.analysis->surface_nm, lo, hi);
     if (r.truth_nm != nullptr)
       psi::write_npy((tmp / "surface_truth_nm.npy").string(), *r.truth_nm);
     write_exposures_csv(*r.sequence, tmp / "exposures.csv");

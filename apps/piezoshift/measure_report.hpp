@@ -23,8 +23,8 @@ struct MeasureRecord {
   const instrument::SequenceResult* sequence = nullptr;
   const instrument::MeasurementAnalysis* analysis = nullptr;
   const psi::Mask* mask = nullptr;
-  const psi::Map* truth_nm = nullptr;          //!< the twin camera's surface, else nullptr
-  std::optional<double> error_rms_nm;          //!< measured - truth, piston and tilt removed
+  const psi::Map* truth_nm = nullptr;  //!< the twin camera's surface, else nullptr
+  std::optional<double> error_rms_nm;  //!< measured - truth, piston and tilt removed
   int bit_depth = 12;
 };
 

@@ -18,7 +18,6 @@
 #include <nlohmann/json.hpp>
 
 #include "command.hpp"
-#include "psi_options.hpp"
 #include "piezoshift/config/project_config.hpp"
 #include "piezoshift/core/input_error.hpp"
 #include "piezoshift/io/atomic_file.hpp"
@@ -32,6 +31,7 @@
 #include "piezoshift/psi/zernike.hpp"
 #include "piezoshift/rig/validity.hpp"
 #include "piezoshift/runtime/safety_ranges.hpp"
+#include "psi_options.hpp"
 #include "whole_number.hpp"
 
 namespace piezoshift::app {

@@ -8,10 +8,12 @@
 #include <fmt/core.h>
 
 #include "command.hpp"
+#include "physics_budget.hpp"
 #include "piezoshift/config/project_config.hpp"
 #include "piezoshift/core/input_error.hpp"
 #include "piezoshift/reproduction/report.hpp"
 #include "piezoshift/reproduction/reproduction.hpp"
+#include "piezoshift/reproduction/reproduction_cost.hpp"
 #include "piezoshift/reproduction/summary.hpp"
 #include "piezoshift/runtime/safety_ranges.hpp"
 #include "progress_bar.hpp"
@@ -27,12 +29,15 @@ struct Options {
   std::string pid = "paper";
   bool quick = false;
   bool json = false;
+  double max_physics_steps = plant::kDefaultPhysicsStepBudget;
 };
 
 int run(const Options& o) {
   const config::ProjectConfig config = o.config.empty()
                                            ? config::ProjectConfig{}
                                            : runtime::load_installation_config(o.config).project;
+  check_procedure_cost("reproduce", reproduction::reproduce_cost(o.quick), config.twin,
+                       o.max_physics_steps);
   reproduction::ReproduceOptions ro;
   ro.seed = o.seed;
   ro.quick = o.quick;
@@ -114,6 +119,7 @@ void add_reproduce_command(CLI::App& app, Action& action) {
   cmd->add_option("--config", o->config, "TOML configuration (configs/paper.toml's sections)");
   cmd->add_option("--pid", o->pid, "paper: the paper's gains; search: the stage-1 search's")
       ->check(CLI::IsMember({"paper", "search"}));
+  add_physics_budget_option(cmd, o->max_physics_steps);
   cmd->add_flag("--quick", o->quick, "shortened schedule (tests, a first look)");
   cmd->add_flag("--json", o->json, "print the JSON summary");
   cmd->callback([o, &action] { action = [o] { return run(*o); }; });

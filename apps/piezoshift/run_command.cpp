@@ -25,6 +25,7 @@
 #include "command.hpp"
 #include "loop_setup.hpp"
 #include "loop_stack.hpp"
+#include "physics_budget.hpp"
 #include "piezoshift/calibration/calibration_file.hpp"
 #include "piezoshift/config/project_config.hpp"
 #include "piezoshift/core/input_error.hpp"
@@ -45,6 +46,7 @@ using namespace piezoshift::runtime;
 constexpr int kExitFault = 3;
 
 struct RunOptions {
+  double max_physics_steps = plant::kDefaultPhysicsStepBudget;  // the start-up calibration
   std::string daq = "sim";
   double rate_Hz = 1000.0;
   std::string calibration;
@@ -318,8 +320,8 @@ int run(const RunOptions& o) {
   const config::ProjectConfig& project = installation.project;
   // The stack first: a bad --fault, --daq or device is named before the twin's calibration runs.
   LoopStack stack(stack_options(o), project);
-  const LoopCalibration cal =
-      resolve_calibration(o.calibration, o.daq, project, o.seed, 1.0 / o.rate_Hz);
+  const LoopCalibration cal = resolve_calibration(o.calibration, o.daq, project, o.seed,
+                                                  1.0 / o.rate_Hz, o.max_physics_steps);
   if (o.step_um && cal.travel_z_max_um && *o.step_um > *cal.travel_z_max_um)
     throw core::InputError(
         fmt::format("--step-um {}: beyond the calibrated semi-closed-loop "
@@ -394,6 +396,7 @@ void add_run_command(CLI::App& app, Action& action) {
   cmd->add_option("--fault", o->faults,
                   "inject KIND@T_S[:CHANNEL] into the twin (sgs-open, sgs-stuck, adc-nan, "
                   "adc-spike, amplifier-fail, actuator-crack, overrun-burst); repeatable");
+  add_physics_budget_option(cmd, o->max_physics_steps);
   cmd->add_option("--seed", o->seed, "twin noise seed")
       ->capture_default_str()
       ->check(whole_number(0, kAnyUnsigned));

@@ -25,6 +25,7 @@
 #include "dashboard_page.hpp"
 #include "loop_setup.hpp"
 #include "loop_stack.hpp"
+#include "physics_budget.hpp"
 #include "piezoshift/calibration/calibration_file.hpp"
 #include "piezoshift/config/project_config.hpp"
 #include "piezoshift/core/input_error.hpp"
@@ -50,6 +51,7 @@ namespace {
 constexpr int kNetworkFailed = -1;
 
 struct ServeOptions {
+  double max_physics_steps = plant::kDefaultPhysicsStepBudget;  // the start-up calibration
   std::string daq = "sim";
   std::string calibration;
   std::string config;
@@ -321,8 +323,8 @@ int serve(const ServeOptions& o) {
   const runtime::SafetyLimits safety = loop_safety_limits(installation.safety, o.max_overruns);
   // The stack first: a bad --fault, --daq or device is named before the twin's calibration runs.
   LoopStack stack(stack_options(o), config);
-  const LoopCalibration cal =
-      resolve_calibration(o.calibration, o.daq, config, o.seed, 1.0 / o.rate_Hz);
+  const LoopCalibration cal = resolve_calibration(o.calibration, o.daq, config, o.seed,
+                                                  1.0 / o.rate_Hz, o.max_physics_steps);
   const host::StageModel model = make_stage_model(o, config, cal.params, cal, safety);
 
   runtime::HostLink link;
@@ -380,6 +382,7 @@ void add_serve_command(CLI::App& app, Action& action) {
                 "allow a --bind address other than loopback (GCS has no authentication)");
   cmd->add_option("--rate-hz", o->rate_Hz, "loop rate, 1000 (the paper) to 10000 Hz")
       ->capture_default_str();
+  add_physics_budget_option(cmd, o->max_physics_steps);
   cmd->add_option("--seed", o->seed, "twin noise seed")
       ->capture_default_str()
       ->check(whole_number(0, kAnyUnsigned));

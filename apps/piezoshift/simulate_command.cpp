@@ -28,6 +28,7 @@
 
 #include "command.hpp"
 #include "loop_setup.hpp"
+#include "physics_budget.hpp"
 #include "piezoshift/config/project_config.hpp"
 #include "piezoshift/control/semi_closed_loop.hpp"
 #include "piezoshift/core/input_error.hpp"
@@ -101,9 +102,7 @@ void check_options(const SimulateOptions& opt) {
   }
   if (!std::isfinite(opt.duration_s) || !(opt.duration_s > 0.0))
     throw core::InputError(fmt::format("--duration-s = {} must be positive", opt.duration_s));
-  if (!(opt.max_physics_steps >= 1.0 && opt.max_physics_steps <= 1e15))
-    throw core::InputError(
-        fmt::format("--max-physics-steps = {} must be in [1, 1e15]", opt.max_physics_steps));
+  check_physics_budget(opt.max_physics_steps);
   if (!std::isfinite(opt.step_at_s) || opt.step_at_s < 0.0)
     throw core::InputError(fmt::format("--step-at-s = {} must be >= 0", opt.step_at_s));
   if (opt.step_um && !std::isfinite(*opt.step_um))
@@ -291,8 +290,8 @@ int run_simulate(const SimulateOptions& opt) {
   // `run`'s controller: the file, or the twin calibrated first (open loop needs none).
   control::SemiClosedLoopParams cp;
   if (closed_loop) {
-    const LoopCalibration lc =
-        resolve_calibration(opt.calibration, "sim", config, opt.seed, period_s);
+    const LoopCalibration lc = resolve_calibration(opt.calibration, "sim", config, opt.seed,
+                                                   period_s, opt.max_physics_steps);
     cp = lc.params;
     run.calibration = lc.source;
   }
@@ -369,9 +368,7 @@ void add_simulate_command(CLI::App& app, Action& action) {
       "--profile", opt->profile_path,
       "closed loop: CSV t_s and zd_um (or zd1_um..zd3_um), piecewise linear, as `run` reads");
   cmd->add_option("--log", opt->log_path, "CSV log, one row per control tick");
-  cmd->add_option(
-      "--max-physics-steps", opt->max_physics_steps,
-      "refuse a run estimated above this many physics steps (default 1e9, about a minute)");
+  add_physics_budget_option(cmd, opt->max_physics_steps);
   cmd->add_flag("--json", opt->json, "print a JSON summary instead of the text one");
   cmd->callback([&action, opt] { action = [opt] { return run_simulate(*opt); }; });
 }

@@ -1,12 +1,15 @@
 #include "piezoshift/rig/bench.hpp"
 
 #include <algorithm>
+#include <atomic>
 #include <cmath>
 #include <limits>
 #include <stdexcept>
 #include <string>
 
 #include "piezoshift/core/input_error.hpp"
+#include "piezoshift/plant/simulation_cost.hpp"
+#include "piezoshift/rig/simulation_meter.hpp"
 
 namespace piezoshift::rig {
 
@@ -16,7 +19,10 @@ const char* to_string(Feedback feedback) noexcept {
 
 Bench::Bench(const config::ProjectConfig& config, const control::SemiClosedLoopParams& controller,
              std::uint64_t seed, const BenchOptions& options)
-    : options_(options), sample_time_s_(config.twin.daq.sample_time_s) {
+    : options_(options),
+      sample_time_s_(config.twin.daq.sample_time_s),
+      steps_per_tick_(static_cast<std::uint64_t>(
+          plant::estimate_simulation_cost(config.twin, sample_time_s_).physics_steps + 0.5)) {
   if (std::fabs(controller.sample_time_s - sample_time_s_) > 1e-12 * sample_time_s_) {
     throw std::invalid_argument(
         "bench: the controller's sample time differs from the DAQ's period");
@@ -73,9 +79,27 @@ void Bench::drive_points(const Vec3& zd_um) {
   loop_->drive_points(zd_um);
 }
 
+namespace {
+// The process's totals (simulation_meter.hpp); ns of simulated time, to sum exactly.
+std::atomic<std::uint64_t> g_ticks{0}, g_simulated_ns{0}, g_static{0}, g_physics_steps{0};
+}  // namespace
+
+SimulationMeter simulation_meter() noexcept {
+  SimulationMeter m;
+  m.ticks = g_ticks.load(std::memory_order_relaxed);
+  m.simulated_s = static_cast<double>(g_simulated_ns.load(std::memory_order_relaxed)) * 1e-9;
+  m.static_measurements = g_static.load(std::memory_order_relaxed);
+  m.physics_steps = g_physics_steps.load(std::memory_order_relaxed);
+  return m;
+}
+
 void Bench::tick() {
   // The bench never asks the loop to stop, so the loop never ends a run on its own.
   loop_->tick();
+  g_ticks.fetch_add(1, std::memory_order_relaxed);
+  g_simulated_ns.fetch_add(static_cast<std::uint64_t>(loop_->period_ns()),
+                           std::memory_order_relaxed);
+  g_physics_steps.fetch_add(steps_per_tick_, std::memory_order_relaxed);
 }
 
 void Bench::run(double duration_s, const std::function<void(const Bench&)>& on_tick) {
@@ -88,6 +112,7 @@ void Bench::run(double duration_s, const std::function<void(const Bench&)>& on_t
 }
 
 StaticMeasurement Bench::measure_static() {
+  g_static.fetch_add(1, std::memory_order_relaxed);
   // The window in progress began before this call; the one after it is wholly ours.
   const plant::InterferometerReading& ifm = sim_->twin().interferometer();
   const std::uint64_t start = ifm.static_count;

@@ -129,4 +129,29 @@ TEST_F(BadInput, RunTimesBeyondTheLongestRunNameTheirLimit) {
           {"--fault 'sgs-open@1e10'", "beyond the longest run, 1000000 s"});
 }
 
+// Issue 27: in-range settings that made a procedure run for hours. Every command that runs the
+// twin's procedures estimates their cost first (rig/procedure_cost.hpp) and refuses it above the
+// budget, naming the settings and --max-physics-steps, before anything runs.
+TEST_F(BadInput, ProceduresThatWouldRunForHoursAreRefusedBeforeTheyStart) {
+  std::string cfg = write("slow.toml", "[twin.interferometer]\nstatic_average_s = 1e6\n");
+  const std::initializer_list<std::string> named{"static_average_s = 1e+06", "budget of 1e+09",
+                                                 "--max-physics-steps"};
+  for (const char* cmd : {"calibrate --out CAL", "calibrate --controller improved --out CAL",
+                          "run --daq sim --free-run --duration-s 1", "serve --daq sim --port 0",
+                          "simulate --step-um 1 --duration-s 1", "reproduce --quick --out REP",
+                          "compare --quick --seeds 1 --out CMP", "measure --free-run --out MEAS"}) {
+    std::string args = cmd;
+    for (const char* name : {"CAL", "REP", "CMP", "MEAS"})
+      if (const auto at = args.find(name); at != std::string::npos)
+        args.replace(at, std::string(name).size(), dir() + "/" + name);
+    refused(args + " --config '" + cfg + "'", named);
+  }
+  // A faster physics rate multiplies the steps: 1e7 Hz at 1e-5 s ran past 25 s in `calibrate`.
+  cfg = write("fast.toml", "[twin]\nphysics_rate_Hz = 1e7\n[twin.daq]\nsample_time_s = 1e-5\n");
+  refused("calibrate --out " + dir() + "/c.toml --config '" + cfg + "'",
+          {"physics_rate_Hz = 1e+07", "--max-physics-steps"});
+  refused("calibrate --max-physics-steps 0 --out " + dir() + "/c.toml",
+          {"--max-physics-steps = 0 must be in [1, 1e15]"});
+}
+
 }  // namespace

@@ -55,7 +55,7 @@ class ScriptedCamera final : public camera::Camera {
     f.counts = {100};
     f.trigger_time_s = start_s_;
     return static_cast<int>(f.frame_id) == lose_frame ? camera::FrameStatus::kLost
-                                                     : camera::FrameStatus::kOk;
+                                                      : camera::FrameStatus::kOk;
   }
   camera::FrameStatus wait(camera::Frame& f, double) override {
     const camera::FrameStatus s = poll(f);

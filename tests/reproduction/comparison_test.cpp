@@ -9,18 +9,34 @@
 #include "piezoshift/reproduction/comparison.hpp"
 #include "piezoshift/reproduction/comparison_report.hpp"
 #include "piezoshift/reproduction/reproduction.hpp"
+#include "piezoshift/reproduction/reproduction_cost.hpp"
+#include "piezoshift/rig/simulation_meter.hpp"
 
 namespace piezoshift::reproduction {
 namespace {
+
+// The simulated time the quick comparison took, by the simulation meter.
+double g_comparison_simulated_s = 0.0;
 
 const ComparisonResult& quick_comparison() {
   static const ComparisonResult r = [] {
     CompareOptions o;
     o.quick = true;
     o.seeds = {1};
-    return compare(config::ProjectConfig{}, o);
+    const double before = rig::simulation_meter().simulated_s;
+    ComparisonResult result = compare(config::ProjectConfig{}, o);
+    g_comparison_simulated_s = rig::simulation_meter().simulated_s - before;
+    return result;
   }();
   return r;
+}
+
+// The per-seed estimate `compare --quick` refuses by (reproduction_cost.hpp), within 2 %.
+TEST(Comparison, CostEstimateIsWhatOneSeedCost) {
+  quick_comparison();
+  const double estimate =
+      rig::estimate_cost(compare_seed_cost(true), config::ProjectConfig{}.twin).simulated_s;
+  EXPECT_NEAR(estimate, g_comparison_simulated_s, 0.02 * g_comparison_simulated_s);
 }
 
 std::size_t figure_index(const ComparisonResult& r, const std::string& key) {

@@ -9,19 +9,36 @@
 #include "piezoshift/io/plot.hpp"
 #include "piezoshift/reproduction/report.hpp"
 #include "piezoshift/reproduction/reproduction.hpp"
+#include "piezoshift/reproduction/reproduction_cost.hpp"
 #include "piezoshift/reproduction/summary.hpp"
+#include "piezoshift/rig/simulation_meter.hpp"
 
 namespace piezoshift::reproduction {
 namespace {
+
+// The simulated time the first quick run took, by the simulation meter.
+double g_quick_run_simulated_s = 0.0;
 
 const ReproductionResult& quick_run() {
   static const ReproductionResult r = [] {
     ReproduceOptions o;
     o.quick = true;
     o.seed = 1;
-    return reproduce(config::ProjectConfig{}, o);
+    const double before = rig::simulation_meter().simulated_s;
+    ReproductionResult result = reproduce(config::ProjectConfig{}, o);
+    g_quick_run_simulated_s = rig::simulation_meter().simulated_s - before;
+    return result;
   }();
   return r;
+}
+
+// The estimate `reproduce --quick` refuses by (reproduction_cost.hpp) is what it costs, within
+// 2 % (the static measurements' share of a window varies a little with what they wait for).
+TEST(Reproduction, CostEstimateIsWhatTheRunCost) {
+  quick_run();
+  const double estimate =
+      rig::estimate_cost(reproduce_cost(true), config::ProjectConfig{}.twin).simulated_s;
+  EXPECT_NEAR(estimate, g_quick_run_simulated_s, 0.02 * g_quick_run_simulated_s);
 }
 
 TEST(Reproduction, TravelRangeIsThePapers) {

@@ -63,12 +63,12 @@ struct ExposureRecord {
   double gauge_error_max_nm = 0.0;
   // The twin's truth over the exposure (has_truth), relative to the pose at the base.
   bool has_truth = false;
-  double truth_piston_nm = 0.0;   //!< mean piston at the pupil centre
-  double truth_blur_nm = 0.0;     //!< its range over the exposure
-  double truth_tip_urad = 0.0;    //!< mean theta_x
-  double truth_tilt_urad = 0.0;   //!< mean theta_y
-  std::uint64_t frame_id = 0;     //!< the frame that arrived for it
-  double arrival_wall_s = 0.0;    //!< wall time from the sequence's start to its arrival
+  double truth_piston_nm = 0.0;  //!< mean piston at the pupil centre
+  double truth_blur_nm = 0.0;    //!< its range over the exposure
+  double truth_tip_urad = 0.0;   //!< mean theta_x
+  double truth_tilt_urad = 0.0;  //!< mean theta_y
+  std::uint64_t frame_id = 0;    //!< the frame that arrived for it
+  double arrival_wall_s = 0.0;   //!< wall time from the sequence's start to its arrival
 };
 
 struct SequenceResult {

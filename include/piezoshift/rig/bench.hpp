@@ -100,6 +100,7 @@ class Bench {
 
   BenchOptions options_;
   double sample_time_s_;
+  std::uint64_t steps_per_tick_;  // the twin's physics steps per control tick
   std::unique_ptr<runtime::SimBackend> sim_;
   std::unique_ptr<runtime::OracleBackend> oracle_;
   runtime::DaqBackend* daq_ = nullptr;

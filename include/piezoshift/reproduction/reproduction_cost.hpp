@@ -1,0 +1,20 @@
+#pragma once
+// What `reproduce` and `compare` cost on the simulated bench (rig/procedure_cost.hpp), measured
+// with the simulation meter on the built-in configuration, seed 1, static_average_s = 1 and 2 s:
+//
+//                          fixed [s]   per second of static window [s]
+//   reproduce              3654.2      1020
+//   reproduce --quick      2298.5      1004
+//   compare, one seed      5619.6      1601
+//   compare --quick, seed  3502.9      1513.8
+//
+// (The default reproduction is 4674 s of simulated time, 9.3e7 physics steps.)
+#include "piezoshift/rig/procedure_cost.hpp"
+
+namespace piezoshift::reproduction {
+
+rig::ProcedureCost reproduce_cost(bool quick);
+//! One seed of compare(); the seeds run one after the other.
+rig::ProcedureCost compare_seed_cost(bool quick);
+
+}  // namespace piezoshift::reproduction

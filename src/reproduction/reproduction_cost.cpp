@@ -1,0 +1,13 @@
+#include "piezoshift/reproduction/reproduction_cost.hpp"
+
+namespace piezoshift::reproduction {
+
+rig::ProcedureCost reproduce_cost(bool quick) {
+  return quick ? rig::ProcedureCost{2298.5, 1004.0} : rig::ProcedureCost{3654.2, 1020.0};
+}
+
+rig::ProcedureCost compare_seed_cost(bool quick) {
+  return quick ? rig::ProcedureCost{3502.85, 1513.82} : rig::ProcedureCost{5619.59, 1601.0};
+}
+
+}  // namespace piezoshift::reproduction
