@@ -129,6 +129,7 @@ FrameStatus FilesCamera::poll(Frame& frame) noexcept {
                                   std::chrono::steady_clock::now().time_since_epoch())
                                   .count();
   if (k >= counts_.size()) {
+    frame.counts.clear();  // no stale image behind an error (keeps the capacity)
     frame.trigger_time_s = 0.0;
     error_frame_.store(k, std::memory_order_relaxed);
     failure_.store(Failure::kRanOut, std::memory_order_release);
@@ -138,6 +139,7 @@ FrameStatus FilesCamera::poll(Frame& frame) noexcept {
   try {
     frame.counts = counts_[k];
   } catch (...) {  // std::bad_alloc: the frame did not arrive
+    frame.counts.clear();
     error_frame_.store(k, std::memory_order_relaxed);
     failure_.store(Failure::kNoMemory, std::memory_order_release);
     return FrameStatus::kError;

@@ -265,6 +265,7 @@ FrameStatus TwinCamera::poll(Frame& frame) noexcept {
   if (status == FrameStatus::kOk) {
     std::swap(frame.counts, s.counts);  // the worker resizes what it gets back
   } else {
+    frame.counts.clear();  // no stale image behind an error (keeps the capacity)
     std::swap(frame_error_, s.error);
     last_was_frame_error_.store(true, std::memory_order_release);
   }

@@ -84,6 +84,7 @@ TEST_F(FilesCameraTest, ReplaysTheFilesInNameOrderThenReportsRunningOut) {
   ASSERT_TRUE(cam.trigger(0.5));
   ASSERT_EQ(cam.wait(f, 1.0), FrameStatus::kError);
   EXPECT_EQ(f.frame_id, 5u);
+  EXPECT_TRUE(f.counts.empty());  // not frame 4's image again
   EXPECT_NE(cam.message().find("frame 5 was triggered but the directory holds only 5 PNG"),
             std::string::npos)
       << cam.message();

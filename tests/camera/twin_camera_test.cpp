@@ -160,8 +160,10 @@ TEST(TwinCameraTest, ExposureWithoutAPoseIsAnErrorNotABlankFrame) {
   ASSERT_TRUE(cam.trigger(0.0));
   cam.observe_plate({0.002, 0.0, 0.0, 0.0});  // the first tick after the trigger is past the end
   Frame f;
+  f.counts.assign(4, 7);  // a previous image: not handed back as this frame's
   ASSERT_EQ(cam.wait(f, 10.0), FrameStatus::kError);
   EXPECT_EQ(f.frame_id, 0u);
+  EXPECT_TRUE(f.counts.empty());
   EXPECT_NE(cam.message().find("frame 0 saw no plate pose"), std::string::npos) << cam.message();
   // No pose at all before the next trigger: that exposure is an error too, the next one is not.
   ASSERT_TRUE(cam.trigger(0.01));
