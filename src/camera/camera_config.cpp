@@ -5,7 +5,6 @@
 
 #include <fmt/core.h>
 
-#include "piezoshift/config/project_config.hpp"
 #include "piezoshift/core/input_error.hpp"
 
 namespace piezoshift::camera {
@@ -83,18 +82,6 @@ void read_camera_section(const io::ConfigFile& file, CameraConfig& config) {
   }
   s.read("shot_noise", config.sensor.shot_noise);
   config.sensor = sensor_params(config);
-}
-
-InstrumentConfig load_instrument_config(const std::string& path) {
-  const io::ConfigFile file = io::ConfigFile::load(path);
-  InstrumentConfig c;
-  runtime::InstallationConfig& i = c.installation;
-  config::read_design_sections(file, i.project.design);
-  config::read_twin_sections(file, i.project.design, i.project.twin);
-  runtime::read_safety_section(file, i.safety);
-  read_camera_section(file, c.camera);
-  file.reject_unknown();
-  return c;
 }
 
 }  // namespace piezoshift::camera

@@ -4,6 +4,7 @@
 
 #include <string>
 
+#include "piezoshift/camera/instrument_config.hpp"
 #include "piezoshift/core/input_error.hpp"
 #include "temp_dir_test.hpp"
 #include "test_paths.hpp"

@@ -13,15 +13,15 @@
 // The section is read here, in the camera module, and not by config::load_project_config:
 // `config` sits below `psi` (whose CameraParams is the sensor model) and below `camera`, so it
 // cannot hold the section's struct; runtime::load_installation_config reads [safety] the same
-// way from above. load_instrument_config() reads the whole file (design, twin, safety, camera)
-// and then rejects unknown keys.
+// way from above. instrument_config.hpp reads the whole file (design, twin, safety, camera) and
+// then rejects unknown keys.
 #include <string>
+#include <string_view>
 
 #include "piezoshift/camera/settings.hpp"
 #include "piezoshift/core/bounds.hpp"
 #include "piezoshift/io/config_file.hpp"
 #include "piezoshift/psi/fizeau_simulation.hpp"
-#include "piezoshift/runtime/safety_ranges.hpp"
 
 namespace piezoshift::camera {
 
@@ -94,15 +94,5 @@ bool parse_pixel_format(std::string_view name, PixelFormat& format) noexcept;
 //! format and trigger by name ("Mono12"; "software", "line"); shot_noise as a bool. InputError
 //! naming the file and the key otherwise. Does not call reject_unknown().
 void read_camera_section(const io::ConfigFile& file, CameraConfig& config);
-
-//! One installation's configuration for a measurement: the design, twin and safety sections
-//! (runtime::InstallationConfig) and [camera].
-struct InstrumentConfig {
-  runtime::InstallationConfig installation;
-  CameraConfig camera;
-};
-
-//! Loads a configuration file as runtime::load_installation_config() does, with [camera] besides.
-InstrumentConfig load_instrument_config(const std::string& path);
 
 }  // namespace piezoshift::camera
