@@ -65,6 +65,19 @@ std::uint64_t frame_seed(std::uint64_t seed, std::uint64_t frame_id) noexcept {
   return mix(mix(seed) ^ frame_id);
 }
 
+TwinScene make_twin_scene(const psi::SurfaceSpec& surface, const psi::FizeauParams& fizeau,
+                          std::uint64_t seed) {
+  if (std::string p = psi::fizeau_problem(fizeau); !p.empty())
+    throw core::InputError("twin camera: " + p);
+  TwinScene s;
+  s.fizeau = fizeau;
+  s.mask = psi::disk_mask(fizeau.width_px, fizeau.height_px, fizeau.pupil_radius_px);
+  plant::Rng rng(seed);  // psi/simulation.cpp draws the truth the same way
+  s.surface_nm = psi::make_surface_nm(surface, s.mask, rng);
+  s.seed = seed;
+  return s;
+}
+
 TwinCamera::TwinCamera(TwinScene scene, const psi::CameraParams& sensor)
     : scene_(std::move(scene)), sensor_(sensor) {
   const psi::FizeauParams& f = scene_.fizeau;

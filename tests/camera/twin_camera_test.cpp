@@ -13,6 +13,7 @@
 #include "piezoshift/camera/camera_config.hpp"
 #include "piezoshift/core/input_error.hpp"
 #include "piezoshift/plant/random.hpp"
+#include "piezoshift/psi/simulation.hpp"
 
 namespace piezoshift::camera {
 namespace {
@@ -87,6 +88,30 @@ std::uint64_t splitmix64(std::uint64_t z) {
   z = (z ^ (z >> 30)) * 0xbf58476d1ce4e5b9ULL;
   z = (z ^ (z >> 27)) * 0x94d049bb133111ebULL;
   return z ^ (z >> 31);
+}
+
+TEST(TwinCameraTest, SceneIsPsiSimulatesTruthForTheSameSeed) {
+  psi::SimulationParams p;
+  p.fizeau.width_px = 48;
+  p.fizeau.height_px = 40;
+  p.fizeau.pupil_radius_px = 18.0;
+  p.surface = psi::parse_surface_spec("Z4=30,Z8=-5,rough=0.7");
+  p.seed = 11;
+  const TwinScene s = make_twin_scene(p.surface, p.fizeau, p.seed);
+  // psi simulate's truth, drawn as simulation.cpp does
+  const psi::Mask mask = psi::disk_mask(48, 40, 18.0);
+  plant::Rng rng(11);
+  const psi::Map truth = psi::make_surface_nm(p.surface, mask, rng);
+  EXPECT_EQ(s.mask.v, mask.v);
+  ASSERT_EQ(s.surface_nm.size(), truth.size());
+  for (std::size_t i = 0; i < truth.size(); ++i) {
+    if (mask.v[i]) {
+      ASSERT_EQ(s.surface_nm.v[i], truth.v[i]) << "pixel " << i;
+    }
+  }
+  EXPECT_EQ(s.seed, 11u);
+  p.fizeau.wavelength_nm = 10.0;
+  EXPECT_THROW(make_twin_scene(p.surface, p.fizeau, 1), core::InputError);
 }
 
 TEST(TwinCameraTest, FrameSeedIsSplitmixOfSeedThenFrame) {

@@ -53,6 +53,13 @@ struct TwinScene {
   double max_tick_rate_Hz = kTwinMaxTickRate_Hz;
 };
 
+//! The scene `psi simulate` renders for the same surface, optics and seed: the centred disk of
+//! fizeau.pupil_radius_px as the mask, the surface drawn from plant::Rng(seed) (so a
+//! measurement's truth equals psi simulate's), and seed for the frames' noise. Throws
+//! core::InputError for optics out of range (psi::fizeau_problem).
+TwinScene make_twin_scene(const psi::SurfaceSpec& surface, const psi::FizeauParams& fizeau,
+                          std::uint64_t seed);
+
 class TwinCamera final : public Camera {
  public:
   //! sensor: exposure_s and bit_depth are replaced by configure()'s settings. Throws
