@@ -49,7 +49,8 @@ class Camera {
   virtual void configure(const CameraSettings& settings) = 0;
   virtual void start() = 0;
   //! Starts one exposure at loop time loop_time_s. False (and message() says why) when the
-  //! camera cannot take it now: not started, or still reading out the previous frame.
+  //! camera cannot take it now: not started, still reading out the previous frame, or (the twin)
+  //! every buffer holds a frame not yet polled. A refused trigger takes no frame id.
   virtual bool trigger(double loop_time_s) noexcept = 0;
   virtual FrameStatus poll(Frame& frame) noexcept = 0;
   virtual FrameStatus wait(Frame& frame, double timeout_s) = 0;
@@ -64,7 +65,9 @@ class Camera {
   virtual std::string name() const = 0;
   //! The settings in force after configure() (the device's own values where it rounded them).
   virtual const CameraSettings& settings() const = 0;
-  //! The last error or refusal, for messages ("" when none).
+  //! The last error or refusal, for messages ("" when none): after trigger() returned false,
+  //! why; after poll()/wait() returned kLost or kError, what happened to that frame. Not
+  //! real-time safe; call it from the thread that got the refusal or the status.
   virtual std::string message() const = 0;
   //! Frames reported kLost since start().
   virtual std::uint64_t lost_frames() const noexcept = 0;
