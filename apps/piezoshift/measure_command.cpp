@@ -24,12 +24,14 @@
 #include "physics_budget.hpp"
 #include "piezoshift/camera/camera.hpp"
 #include "piezoshift/camera/camera_config.hpp"
+#include "piezoshift/camera/instrument_config.hpp"
 #include "piezoshift/camera/make_camera.hpp"
+#include "piezoshift/camera/twin_camera.hpp"
 #include "piezoshift/core/input_error.hpp"
 #include "piezoshift/instrument/measurement.hpp"
 #include "piezoshift/instrument/sequence.hpp"
-#include "piezoshift/plant/random.hpp"
 #include "piezoshift/psi/analysis.hpp"
+#include "piezoshift/plant/random.hpp"
 #include "piezoshift/psi/fizeau_simulation.hpp"
 #include "piezoshift/rig/validity.hpp"
 #include "piezoshift/runtime/control_loop.hpp"
@@ -110,23 +112,18 @@ LoopStackOptions stack_options(const MeasureOptions& o) {
   return so;
 }
 
-// The twin camera's scene: the --surface on a pupil of 0.47 of the frame's side (as `psi
-// simulate` draws it), rendered with the Fizeau's optics.
+// The twin camera's scene: the --surface on a pupil of 0.47 of the frame's side, drawn as
+// `psi simulate` draws it for the same spec and seed, rendered with the Fizeau's optics.
 camera::TwinScene twin_scene(const MeasureOptions& o, const camera::CameraConfig& cc,
                              double wavelength_nm) {
-  camera::TwinScene scene;
-  scene.fizeau.width_px = cc.settings.width_px;
-  scene.fizeau.height_px = cc.settings.height_px;
-  scene.fizeau.pupil_radius_px = 0.47 * std::min(cc.settings.width_px, cc.settings.height_px);
-  scene.fizeau.wavelength_nm = wavelength_nm;
-  scene.mask =
-      psi::disk_mask(scene.fizeau.width_px, scene.fizeau.height_px, scene.fizeau.pupil_radius_px);
+  psi::FizeauParams fizeau;
+  fizeau.width_px = cc.settings.width_px;
+  fizeau.height_px = cc.settings.height_px;
+  fizeau.pupil_radius_px = 0.47 * std::min(cc.settings.width_px, cc.settings.height_px);
+  fizeau.wavelength_nm = wavelength_nm;
   const psi::SurfaceSpec spec =
       o.surface.empty() ? psi::SurfaceSpec{} : psi::parse_surface_spec(o.surface);
-  plant::Rng rng(o.seed ^ 0x5u);
-  scene.surface_nm = psi::make_surface_nm(spec, scene.mask, rng);
-  scene.seed = o.seed;
-  return scene;
+  return camera::make_twin_scene(spec, fizeau, o.seed);
 }
 
 // Everything a measurement needs before the loop starts, checked in this order so that bad input
@@ -176,6 +173,31 @@ psi::Mask measurement_mask(const MeasureOptions& o, const MeasureSetup& s,
     return s.scene->mask;
   const std::vector<psi::Map> first = instrument::frame_maps({r.frames.front()});
   return load_mask(o.mask, first.front());
+}
+
+// The twin camera's floor: the same frames (same noise draws, frame by frame) rendered with an
+// ideal stage, exactly at the commanded steps and still during the exposure, analysed the same
+// way. measured^2 - ideal^2 is what the stage added (as `psi simulate` splits it).
+double ideal_error_rms_nm(const MeasureSetup& s, const psi::AnalysisOptions& ao) {
+  const camera::TwinScene& scene = *s.scene;
+  const psi::CameraParams sensor = camera::sensor_params(s.config.camera);
+  const double gain = std::pow(10.0, s.config.camera.settings.gain_dB / 20.0);
+  const double top = std::ldexp(1.0, sensor.bit_depth) - 1.0;
+  const std::size_t n = s.params.steps_rad.size();
+  std::vector<psi::Map> frames;
+  for (std::size_t k = 0; k < n; ++k) {
+    const double piston_nm =
+        s.params.steps_rad[k] * s.params.wavelength_nm / (4.0 * std::numbers::pi);
+    const psi::PoseSample still{0.0, piston_nm, 0.0, 0.0};
+    plant::Rng rng(camera::frame_seed(scene.seed, k));
+    psi::Map f = psi::render_frame(scene.surface_nm, scene.mask, scene.fizeau, sensor,
+                                   std::span<const psi::PoseSample>(&still, 1), rng);
+    for (double& v : f.v)
+      v = std::min(top, std::round(v * gain));
+    frames.push_back(std::move(f));
+  }
+  const psi::Analysis a = psi::analyze_frames(frames, scene.mask, ao);
+  return psi::surface_error_rms_nm(a.surface_nm, scene.surface_nm, a.valid);
 }
 
 struct Outcome {
@@ -267,9 +289,12 @@ int measure(const MeasureOptions& o) {
                     .mask = &mask,
                     .truth_nm = s.scene ? &s.scene->surface_nm : nullptr,
                     .error_rms_nm = std::nullopt,
+                    .ideal_error_rms_nm = std::nullopt,
                     .bit_depth = camera::bit_depth(s.config.camera.settings.format)};
-  if (s.scene)
+  if (s.scene) {
     rec.error_rms_nm = psi::surface_error_rms_nm(a.surface_nm, s.scene->surface_nm, a.valid);
+    rec.ideal_error_rms_nm = ideal_error_rms_nm(s, ao);
+  }
   if (!a.converged) {
     if (o.json)
       fmt::print("{}\n", measure_json(rec).dump(2));

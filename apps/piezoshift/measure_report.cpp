@@ -23,6 +23,14 @@ using Json = nlohmann::json;
 
 namespace {
 
+io::Panel panel(std::string title, std::string x_label, std::string y_label) {
+  io::Panel p;
+  p.title = std::move(title);
+  p.x_label = std::move(x_label);
+  p.y_label = std::move(y_label);
+  return p;
+}
+
 Json number_or_null(double v) {
   return std::isfinite(v) ? Json(v) : Json(nullptr);
 }
@@ -103,16 +111,19 @@ io::Figure zernike_figure(const instrument::MeasurementAnalysis& a) {
   f.width_px = 1000;
   f.height_px = 500;
   f.svg = true;
-  io::Panel p{.title = "Zernike coefficients of the measured surface (piston and tilt removed)",
-              .x_label = "Noll index j",
-              .y_label = "coefficient, RMS [nm]"};
+  io::Panel p = panel("Zernike coefficients of the measured surface (piston and tilt removed)",
+                      "Noll index j", "coefficient, RMS [nm]");
   std::vector<double> j, c, w;
   for (std::size_t k = 3; k < a.zernike_nm.size(); ++k) {
     j.push_back(static_cast<double>(k + 1));
     c.push_back(a.zernike_nm[k]);
     w.push_back(0.7);
   }
-  io::Series bars{.title = "", .style = io::SeriesStyle::kBoxes, .x = j, .y = c, .w = w};
+  io::Series bars;
+  bars.style = io::SeriesStyle::kBoxes;
+  bars.x = j;
+  bars.y = c;
+  bars.w = w;
   p.series.push_back(bars);
   p.key = "off";
   f.panels.push_back(p);
@@ -128,11 +139,10 @@ io::Figure steps_figure(const MeasureRecord& r) {
   f.width_px = 900;
   f.height_px = 800;
   f.svg = true;
-  io::Panel top{.title = "Phase steps, average 1", .x_label = "frame", .y_label = "step [rad]"};
-  io::Panel bottom{.title = a.true_steps_rad.empty() ? "recovered - commanded"
-                                                     : "recovered from the fringes - true",
-                   .x_label = "frame",
-                   .y_label = "difference [mrad]"};
+  io::Panel top = panel("Phase steps, average 1", "frame", "step [rad]");
+  io::Panel bottom = panel(
+      a.true_steps_rad.empty() ? "recovered - commanded" : "recovered from the fringes - true",
+      "frame", "difference [mrad]");
   std::vector<double> k, diff;
   const std::vector<double>& rec = a.recovered_steps_rad.front();
   const std::vector<double>& ref =
@@ -159,8 +169,7 @@ io::Figure stage_figure(const MeasureRecord& r) {
   f.width_px = 900;
   f.height_px = 500;
   f.svg = true;
-  io::Panel p{
-      .title = "The stage during each exposure", .x_label = "exposure", .y_label = "error [nm]"};
+  io::Panel p = panel("The stage during each exposure", "exposure", "error [nm]");
   std::vector<double> k, gauge, truth;
   for (std::size_t i = 0; i < r.sequence->exposures.size(); ++i) {
     const instrument::ExposureRecord& e = r.sequence->exposures[i];
@@ -197,6 +206,11 @@ std::string report_markdown(const MeasureRecord& r) {
       s.wall_time_s, s.floor_s, s.floor_s > 0 ? s.wall_time_s / s.floor_s : 0.0, s.overruns);
   if (r.error_rms_nm)
     md += fmt::format("| measured - true surface, RMS | {:.3f} nm |\n", *r.error_rms_nm);
+  if (r.ideal_error_rms_nm)
+    md += fmt::format(
+        "| the same frames from an ideal stage (camera and algorithm floor, one average) | "
+        "{:.3f} nm |\n",
+        *r.ideal_error_rms_nm);
   md +=
       "\n![surface](surface_nm.png)\n\n![Zernike](zernike.png)\n\n![steps](steps.png)\n\n"
       "![stage](stage.png)\n";
@@ -243,6 +257,8 @@ Json measure_json(const MeasureRecord& r) {
          {"valid_pixels", a.figures.pixels},
          {"zernike_nm", a.zernike_nm},
          {"error_rms_nm", r.error_rms_nm ? Json(*r.error_rms_nm) : Json(nullptr)},
+         {"ideal_error_rms_nm",
+          r.ideal_error_rms_nm ? Json(*r.ideal_error_rms_nm) : Json(nullptr)},
          {"timing",
           {{"wall_time_s", s.wall_time_s},
            {"floor_s", s.floor_s},

@@ -25,6 +25,8 @@ struct MeasureRecord {
   const psi::Mask* mask = nullptr;
   const psi::Map* truth_nm = nullptr;  //!< the twin camera's surface, else nullptr
   std::optional<double> error_rms_nm;  //!< measured - truth, piston and tilt removed
+  //! The same frames from an ideal stage (the camera's and the algorithm's floor, one average).
+  std::optional<double> ideal_error_rms_nm;
   int bit_depth = 12;
 };
 

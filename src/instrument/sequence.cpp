@@ -196,8 +196,13 @@ class Runner {
   bool expose(ExposureRecord& rec) {
     const auto n = std::max(1L, std::lround(camera_.settings().exposure_s / period_s_));
     std::array<double, 3> sum{};
-    double piston_sum = 0.0, tip_sum = 0.0, tilt_sum = 0.0;
-    double lo = pose().piston_nm, hi = lo;
+    // The mean pose over the exposure as the camera integrates it: the trajectory is piecewise
+    // linear between the ticks' poses, so the trapezoid rule, the first and last poses halved.
+    const camera::PlatePose first = pose();
+    double piston_sum = 0.5 * first.piston_nm, tip_sum = 0.5 * first.theta_x_urad,
+           tilt_sum = 0.5 * first.theta_y_urad;
+    double lo = first.piston_nm, hi = lo;
+    camera::PlatePose last = first;
     for (long k = 0; k < n; ++k) {
       if (!tick())
         return false;
@@ -211,6 +216,7 @@ class Runner {
       piston_sum += q.piston_nm;
       tip_sum += q.theta_x_urad;
       tilt_sum += q.theta_y_urad;
+      last = q;
       lo = std::min(lo, q.piston_nm);
       hi = std::max(hi, q.piston_nm);
     }
@@ -220,6 +226,9 @@ class Runner {
     rec.exposure_end_s = now_s();
     rec.has_truth = twin_ != nullptr;
     if (rec.has_truth) {
+      piston_sum -= 0.5 * last.piston_nm;
+      tip_sum -= 0.5 * last.theta_x_urad;
+      tilt_sum -= 0.5 * last.theta_y_urad;
       rec.truth_piston_nm = piston_sum / dn;
       rec.truth_blur_nm = hi - lo;
       rec.truth_tip_urad = tip_sum / dn;
