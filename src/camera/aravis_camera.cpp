@@ -172,6 +172,9 @@ class AravisCamera final : public Camera {
   void set_enum(const char* feature, const std::string& value);
   // start() / stop()
   void allocate_rings();
+  bool is_loopback_gv() const;
+  void open_stream();
+  void warm_up_stream();
   void release_stream() noexcept;
   void trigger_thread_main();
   // stream thread
@@ -509,11 +512,7 @@ void AravisCamera::start() {
     arv_fake_camera_set_trigger_frequency(
         arv_fake_device_get_fake_camera(ARV_FAKE_DEVICE(arv_camera_get_device(camera_))), 1000.0);
   allocate_rings();  // before the stream exists: its thread may call back at once
-  stream_ = arv_camera_create_stream(camera_, &AravisCamera::stream_callback, this, error.out());
-  if (stream_ == nullptr)
-    refuse("stream", "cannot create it (" + error.text() + ")");
-  arv_stream_get_statistics(stream_, nullptr, &failures_seen_, &underruns_seen_);
-  stream_live_.store(true, std::memory_order_release);
+  open_stream();
   buffers_.clear();
   for (int i = 0; i < settings_.buffer_count; ++i) {
     ArvBuffer* buffer = arv_buffer_new_allocate(buffer_bytes_);
@@ -534,6 +533,65 @@ void AravisCamera::start() {
     refuse("AcquisitionStart", "cannot start (" + why + ")");
   }
   set_message("");
+}
+
+void AravisCamera::open_stream() {
+  const bool loopback = is_loopback_gv();
+  if (loopback) {
+    // Run as root (CAP_NET_RAW), Aravis receives GigE Vision through a packet socket, which sees
+    // none of a loopback camera's packets (arv-fake-gv-camera-0.8 on 127.0.0.1): a UDP socket.
+    // Loopback's MTU is 64 KiB: 8 KiB packets, fewer to lose.
+    arv_camera_gv_set_stream_options(camera_, ARV_GV_STREAM_OPTION_PACKET_SOCKET_DISABLED);
+    arv_camera_gv_set_packet_size(camera_, 8192, nullptr);
+  } else if (arv_camera_is_gv_device(camera_)) {
+    // The largest packet the path carries (jumbo frames where the NIC has them), found by
+    // Aravis's test packets; the device's own size when the test fails.
+    arv_camera_gv_auto_packet_size(camera_, nullptr);
+  }
+  Error error;
+  stream_ = arv_camera_create_stream(camera_, &AravisCamera::stream_callback, this, error.out());
+  if (stream_ == nullptr)
+    refuse("stream", "cannot create it (" + error.text() + ")");
+  if (ARV_IS_GV_STREAM(stream_)) {
+    // A GigE Vision frame arrives as a burst of packets, which overflowed the system's default
+    // receive buffer (rmem_default, 208 KiB here) within a 128 KiB Mono16 frame on loopback.
+    // Room for several frames (the kernel caps it at net.core.rmem_max).
+    const auto bytes = std::clamp<std::size_t>(8 * buffer_bytes_, 1u << 20, 64u << 20);
+    g_object_set(stream_, "socket-buffer", ARV_GV_STREAM_SOCKET_BUFFER_FIXED, "socket-buffer-size",
+                 static_cast<int>(bytes), nullptr);
+  }
+  if (loopback && settings_.trigger == TriggerSource::kSoftware)
+    warm_up_stream();
+  arv_stream_get_statistics(stream_, nullptr, &failures_seen_, &underruns_seen_);
+  stream_live_.store(true, std::memory_order_release);
+}
+
+void AravisCamera::warm_up_stream() {
+  // The GigE Vision stream applies its receive buffer size only once a frame's first packet is
+  // in; on loopback the rest of that first frame is already queued, and lost its last packets
+  // about one start in three. One frame taken here, before stream_live_, and dropped.
+  arv_stream_push_buffer(stream_, arv_buffer_new_allocate(buffer_bytes_));  // the stream's
+  Error error;
+  arv_camera_start_acquisition(camera_, error.out());
+  if (!error)
+    arv_camera_software_trigger(camera_, error.out());
+  if (!error) {
+    // Left in the stream's queue if it does not come: then it is one more buffer of the pool.
+    if (ArvBuffer* done = arv_stream_timeout_pop_buffer(stream_, 1'000'000); done != nullptr)
+      g_object_unref(done);
+  }
+  arv_camera_stop_acquisition(camera_, nullptr);
+}
+
+bool AravisCamera::is_loopback_gv() const {
+  ArvDevice* device = arv_camera_get_device(camera_);
+  if (!ARV_IS_GV_DEVICE(device))
+    return false;
+  GSocketAddress* address = arv_gv_device_get_device_address(ARV_GV_DEVICE(device));
+  if (!G_IS_INET_SOCKET_ADDRESS(address))
+    return false;
+  GInetAddress* ip = g_inet_socket_address_get_address(G_INET_SOCKET_ADDRESS(address));
+  return ip != nullptr && g_inet_address_get_is_loopback(ip);
 }
 
 void AravisCamera::trigger_thread_main() {

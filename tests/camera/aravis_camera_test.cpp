@@ -322,6 +322,7 @@ TEST(AravisFakeGvCamera, HundredFramesOverLoopbackNoneLost) {
   camera->start();
   Frame frame;
   std::uint64_t first_id = 0;
+  std::int64_t last_device_ns = 0;
   for (int i = 0; i < 100; ++i) {
     // The fake GV camera looks at its TriggerSoftware register 25 times a second and latches
     // one trigger: one trigger per frame, the next once the frame is in.
@@ -329,6 +330,9 @@ TEST(AravisFakeGvCamera, HundredFramesOverLoopbackNoneLost) {
     if (i == 0)
       first_id = frame.frame_id;
     ASSERT_EQ(frame.frame_id, first_id + i);
+    ASSERT_EQ(frame.trigger_time_s, 0.01 * i);
+    ASSERT_GT(frame.device_timestamp_ns, last_device_ns);  // the leader's, one per frame
+    last_device_ns = frame.device_timestamp_ns;
     ASSERT_EQ(frame.width_px, 256);
     ASSERT_EQ(frame.height_px, 256);
     ASSERT_EQ(frame.format, PixelFormat::kMono16);
