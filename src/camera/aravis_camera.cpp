@@ -761,6 +761,8 @@ std::uint64_t AravisCamera::missing_before(std::uint64_t device_id) noexcept {
     last_frame_id_ = device_id;
     return 0;
   }
+  if (device_id == 0)  // no id (a GigE Vision buffer whose leader was lost): the next one
+    device_id = last_device_id_ == kGvBlockIdMax ? 1 : last_device_id_ + 1;
   std::uint64_t advance = 0;
   if (device_id > last_device_id_)
     advance = device_id - last_device_id_;

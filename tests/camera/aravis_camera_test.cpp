@@ -167,6 +167,37 @@ TEST(AravisFakeCamera, TriggerBeforeStartIsRefusedAndStopIsSafeTwice) {
   EXPECT_EQ(camera->poll(frame), FrameStatus::kNone);
 }
 
+TEST(AravisFakeCamera, ALineTriggerTakesFramesWithoutTrigger) {
+  SKIP_WITHOUT_ARAVIS();
+  // The in-process fake camera stands for a line pulsed at its trigger frequency (25 Hz).
+  auto camera = make_aravis_camera("Fake_1");
+  CameraSettings s = fake_settings(PixelFormat::kMono8);
+  s.trigger = TriggerSource::kLine;
+  camera->configure(s);
+  camera->start();
+  Frame frame;
+  std::uint64_t first_id = 0;
+  for (int i = 0; i < 3; ++i) {
+    ASSERT_EQ(camera->wait(frame, 1.0), FrameStatus::kOk) << camera->message();
+    if (i == 0)
+      first_id = frame.frame_id;
+    EXPECT_EQ(frame.frame_id, first_id + i);
+    EXPECT_TRUE(std::isnan(frame.trigger_time_s));  // no trigger() recorded for it
+  }
+  EXPECT_EQ(camera->lost_frames(), 0u);
+}
+
+TEST(AravisFakeCamera, RefusesALineTheDeviceDoesNotHave) {
+  SKIP_WITHOUT_ARAVIS();
+  auto camera = make_aravis_camera("Fake_1@Line1");
+  EXPECT_EQ(camera->name(), "aravis:Fake_1@Line1");
+  CameraSettings s = fake_settings(PixelFormat::kMono8);
+  s.trigger = TriggerSource::kLine;
+  EXPECT_TRUE(has(refusal(*camera, s),
+                  "aravis:Fake_1@Line1: TriggerSource: Line1 is not offered "
+                  "by the device (it offers Line0, Software)"));
+}
+
 TEST(AravisFakeCamera, AFullRingReportsEachLostFrameWithItsId) {
   SKIP_WITHOUT_ARAVIS();
   auto camera = make_aravis_camera("Fake_1");
