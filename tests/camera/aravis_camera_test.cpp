@@ -1,10 +1,5 @@
-// aravis:ID against Aravis's simulated cameras: the in-process fake camera (Fake_1) and
-// arv-fake-gv-camera-0.8 on loopback. No test needs a real camera.
-#include <signal.h>
-#include <spawn.h>
-#include <sys/wait.h>
-#include <unistd.h>
-
+// aravis:ID against Aravis's in-process fake camera (Fake_1); the GigE Vision path is
+// aravis_gv_camera_test.cpp. No test needs a real camera.
 #include <cmath>
 #include <string>
 #include <thread>
@@ -13,8 +8,6 @@
 #include "piezoshift/camera/aravis_camera.hpp"
 #include "piezoshift/camera/aravis_fake_fill.hpp"
 #include "piezoshift/core/input_error.hpp"
-
-extern char** environ;
 
 namespace piezoshift::camera {
 namespace {
@@ -285,95 +278,6 @@ TEST(AravisFakeCamera, AFakeFillNeedsTheFakeCameraConfigured) {
   } catch (const core::InputError& e) {
     EXPECT_TRUE(has(e.what(), "aravis:Fake_1: fake fill: needs the in-process fake camera"));
   }
-}
-
-// ---------------------------------------------------------------------------------------------
-// The GigE Vision path: arv-fake-gv-camera-0.8 as a child process on loopback.
-
-#ifdef PIEZOSHIFT_ARV_FAKE_GV_CAMERA
-//! The child, killed and reaped whatever the test's outcome.
-class FakeGvCamera {
- public:
-  //! Retries while another fake GV camera (another test run on this machine) holds 127.0.0.1's
-  //! GVCP port 3956: the child then exits at once with "Failed to start camera".
-  explicit FakeGvCamera(const std::string& serial) {
-    const auto give_up = std::chrono::steady_clock::now() + std::chrono::seconds(10);
-    while (std::chrono::steady_clock::now() < give_up) {
-      std::vector<std::string> args = {PIEZOSHIFT_ARV_FAKE_GV_CAMERA, "-i", "127.0.0.1", "-s",
-                                       serial};
-      std::vector<char*> argv;
-      for (auto& a : args)
-        argv.push_back(a.data());
-      argv.push_back(nullptr);
-      if (posix_spawn(&pid_, argv[0], nullptr, nullptr, argv.data(), environ) != 0) {
-        pid_ = -1;
-        return;
-      }
-      std::this_thread::sleep_for(std::chrono::milliseconds(500));
-      int status = 0;
-      if (waitpid(pid_, &status, WNOHANG) == 0)
-        return;  // still running: it holds the port
-      pid_ = -1;
-      std::this_thread::sleep_for(std::chrono::milliseconds(500));
-    }
-  }
-  FakeGvCamera(const FakeGvCamera&) = delete;
-  FakeGvCamera& operator=(const FakeGvCamera&) = delete;
-  ~FakeGvCamera() {
-    if (pid_ <= 0)
-      return;
-    kill(pid_, SIGTERM);
-    for (int i = 0; i < 50; ++i) {
-      int status = 0;
-      if (waitpid(pid_, &status, WNOHANG) == pid_)
-        return;
-      std::this_thread::sleep_for(std::chrono::milliseconds(20));
-    }
-    kill(pid_, SIGKILL);
-    waitpid(pid_, nullptr, 0);
-  }
-  bool running() const { return pid_ > 0; }
-
- private:
-  pid_t pid_ = -1;
-};
-#endif
-
-TEST(AravisFakeGvCamera, HundredFramesOverLoopbackNoneLost) {
-  SKIP_WITHOUT_ARAVIS();
-#ifndef PIEZOSHIFT_ARV_FAKE_GV_CAMERA
-  GTEST_SKIP() << "arv-fake-gv-camera-0.8 (aravis-tools) was not found at build time";
-#else
-  const std::string serial = "PZ" + std::to_string(getpid());
-  FakeGvCamera child(serial);
-  ASSERT_TRUE(child.running()) << "arv-fake-gv-camera-0.8 did not stay up on 127.0.0.1";
-  auto camera = make_aravis_camera("Aravis-Fake-" + serial);
-  CameraSettings s = fake_settings(PixelFormat::kMono16);
-  camera->configure(s);
-  camera->start();
-  Frame frame;
-  std::uint64_t first_id = 0;
-  std::int64_t last_device_ns = 0;
-  for (int i = 0; i < 100; ++i) {
-    // The fake GV camera looks at its TriggerSoftware register 25 times a second and latches
-    // one trigger: one trigger per frame, the next once the frame is in.
-    ASSERT_EQ(take(*camera, 0.01 * i, frame), FrameStatus::kOk) << i << ": " << camera->message();
-    if (i == 0)
-      first_id = frame.frame_id;
-    ASSERT_EQ(frame.frame_id, first_id + i);
-    ASSERT_EQ(frame.trigger_time_s, 0.01 * i);
-    ASSERT_GT(frame.device_timestamp_ns, last_device_ns);  // the leader's, one per frame
-    last_device_ns = frame.device_timestamp_ns;
-    ASSERT_EQ(frame.width_px, 256);
-    ASSERT_EQ(frame.height_px, 256);
-    ASSERT_EQ(frame.format, PixelFormat::kMono16);
-    ASSERT_EQ(frame.counts.size(), 256u * 256u);
-    ASSERT_EQ(frame.counts[1000], fake_ramp(PixelFormat::kMono16, 1000 % 256, 1000 / 256,
-                                            (frame.frame_id - 1) % 65535 + 1));
-  }
-  EXPECT_EQ(camera->lost_frames(), 0u);
-  camera->stop();
-#endif
 }
 
 }  // namespace
