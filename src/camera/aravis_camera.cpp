@@ -183,7 +183,7 @@ class AravisCamera final : public Camera {
                                  ArvPixelFormat format);
   void on_buffer_done() noexcept;
   void check_buffer(ArvBuffer* buffer) noexcept;
-  std::uint64_t missing_before(std::uint64_t device_id) noexcept;
+  std::uint64_t missing_before(std::uint64_t device_id, bool trusted) noexcept;
   void publish_frame(ArvBuffer* buffer, std::uint64_t frame_id) noexcept;
   void publish_lost(std::uint64_t frame_id, const char* reason) noexcept;
   void publish(const FrameEvent& event) noexcept;
@@ -754,20 +754,33 @@ void AravisCamera::recycle(ArvBuffer* buffer) noexcept {
   }
 }
 
-std::uint64_t AravisCamera::missing_before(std::uint64_t device_id) noexcept {
+std::uint64_t AravisCamera::missing_before(std::uint64_t device_id, bool trusted) noexcept {
+  // A failed buffer can carry the id of the frame it held before: Aravis sets the id from the
+  // leader, which may be the packet that was lost (seen with arv-fake-gv-camera-0.8 -r). It
+  // counts as the next frame; the next good frame's id tells what else is missing. The pool's
+  // buffers are new at start(), so before the first frame a failed buffer's id is either its
+  // own or 0 (unknown: the loss is reported with id 0).
+  if (!trusted && (have_last_id_ || device_id == 0)) {
+    if (have_last_id_) {
+      last_device_id_ = last_device_id_ == kGvBlockIdMax ? 1 : last_device_id_ + 1;
+      ++last_frame_id_;
+    }
+    return 0;
+  }
   if (!have_last_id_) {
     have_last_id_ = true;
     last_device_id_ = device_id;
     last_frame_id_ = device_id;
     return 0;
   }
-  if (device_id == 0)  // no id (a GigE Vision buffer whose leader was lost): the next one
-    device_id = last_device_id_ == kGvBlockIdMax ? 1 : last_device_id_ + 1;
   std::uint64_t advance = 0;
-  if (device_id > last_device_id_)
+  if (device_id > last_device_id_) {
     advance = device_id - last_device_id_;
-  else if (last_device_id_ <= kGvBlockIdMax && device_id >= 1)
+  } else if (last_device_id_ <= kGvBlockIdMax && device_id >= 1 &&
+             kGvBlockIdMax - last_device_id_ + device_id < kGvBlockIdMax / 2) {
     advance = (kGvBlockIdMax - last_device_id_) + device_id;  // wrapped, skipping 0
+  }
+  // Otherwise the device counts from the start again: nothing known to be missing.
   last_device_id_ = device_id;
   last_frame_id_ += std::max<std::uint64_t>(advance, 1);
   return advance > 1 ? advance - 1 : 0;
@@ -776,7 +789,8 @@ std::uint64_t AravisCamera::missing_before(std::uint64_t device_id) noexcept {
 void AravisCamera::check_buffer(ArvBuffer* buffer) noexcept {
   const ArvBufferStatus status = arv_buffer_get_status(buffer);
   const std::uint64_t previous_frame_id = last_frame_id_;
-  const std::uint64_t missing = missing_before(arv_buffer_get_frame_id(buffer));
+  const std::uint64_t missing =
+      missing_before(arv_buffer_get_frame_id(buffer), status == ARV_BUFFER_STATUS_SUCCESS);
   // A gap may already have been reported from the stream's counters (below): not twice.
   const std::uint64_t credited = std::min(missing, counter_only_lost_);
   counter_only_lost_ -= credited;
