@@ -1,8 +1,10 @@
 // aravis:ID over GigE Vision: Aravis's arv-fake-gv-camera-0.8 (Debian's aravis-tools) started by
 // the test as a child on 127.0.0.1 and opened through Aravis's discovery, like a camera on the
 // network. Integration tier: a child process and loopback sockets (docs/testing.md).
+#include <fcntl.h>
 #include <signal.h>
 #include <spawn.h>
+#include <sys/file.h>
 #include <sys/wait.h>
 #include <unistd.h>
 
@@ -19,53 +21,61 @@ namespace piezoshift::camera {
 namespace {
 
 #ifdef PIEZOSHIFT_ARV_FAKE_GV_CAMERA
-//! The child, killed and reaped whatever the test's outcome.
+//! The child, killed and reaped whatever the test's outcome. One at a time on this machine:
+//! two fake GV cameras both bind 127.0.0.1's GVCP port 3956 and then answer each other's
+//! controller (a PixelFormat write timed out when ctest -j2 ran two), so the child runs under an
+//! exclusive lock on a file in /tmp, shared by every test run and worktree here.
 class FakeGvCamera {
  public:
-  //! Retries while another fake GV camera (another test run on this machine) holds 127.0.0.1's
-  //! GVCP port 3956: the child then exits at once with "Failed to start camera".
   //! lost_per_thousand: the packets it drops on purpose (its -r), 0 for none.
   explicit FakeGvCamera(const std::string& serial, int lost_per_thousand = 0) {
-    const auto give_up = std::chrono::steady_clock::now() + std::chrono::seconds(10);
-    while (std::chrono::steady_clock::now() < give_up) {
-      std::vector<std::string> args = {
-          PIEZOSHIFT_ARV_FAKE_GV_CAMERA,    "-i", "127.0.0.1", "-s", serial, "-r",
-          std::to_string(lost_per_thousand)};
-      std::vector<char*> argv;
-      for (auto& a : args)
-        argv.push_back(a.data());
-      argv.push_back(nullptr);
-      if (posix_spawn(&pid_, argv[0], nullptr, nullptr, argv.data(), environ) != 0) {
-        pid_ = -1;
-        return;
-      }
-      std::this_thread::sleep_for(std::chrono::milliseconds(500));
-      int status = 0;
-      if (waitpid(pid_, &status, WNOHANG) == 0)
-        return;  // still running: it holds the port
-      pid_ = -1;
-      std::this_thread::sleep_for(std::chrono::milliseconds(500));
+    lock_fd_ = open("/tmp/piezoshift-arv-fake-gv-camera.lock", O_CREAT | O_RDWR | O_CLOEXEC, 0666);
+    const auto give_up = std::chrono::steady_clock::now() + std::chrono::seconds(60);
+    while (lock_fd_ >= 0 && flock(lock_fd_, LOCK_EX | LOCK_NB) != 0) {
+      if (std::chrono::steady_clock::now() > give_up)
+        return;  // running() is false: the test says so
+      std::this_thread::sleep_for(std::chrono::milliseconds(100));
     }
+    std::vector<std::string> args = {
+        PIEZOSHIFT_ARV_FAKE_GV_CAMERA,    "-i", "127.0.0.1", "-s", serial, "-r",
+        std::to_string(lost_per_thousand)};
+    std::vector<char*> argv;
+    for (auto& a : args)
+      argv.push_back(a.data());
+    argv.push_back(nullptr);
+    if (posix_spawn(&pid_, argv[0], nullptr, nullptr, argv.data(), environ) != 0) {
+      pid_ = -1;
+      return;
+    }
+    // It exits at once ("Failed to start camera") when it cannot listen on 127.0.0.1.
+    std::this_thread::sleep_for(std::chrono::milliseconds(300));
+    if (waitpid(pid_, nullptr, WNOHANG) != 0)
+      pid_ = -1;
   }
   FakeGvCamera(const FakeGvCamera&) = delete;
   FakeGvCamera& operator=(const FakeGvCamera&) = delete;
   ~FakeGvCamera() {
+    stop_child();
+    if (lock_fd_ >= 0)
+      close(lock_fd_);  // releases the lock, after the child is gone
+  }
+  bool running() const { return pid_ > 0; }
+
+ private:
+  void stop_child() {
     if (pid_ <= 0)
       return;
     kill(pid_, SIGTERM);
     for (int i = 0; i < 50; ++i) {
-      int status = 0;
-      if (waitpid(pid_, &status, WNOHANG) == pid_)
+      if (waitpid(pid_, nullptr, WNOHANG) == pid_)
         return;
       std::this_thread::sleep_for(std::chrono::milliseconds(20));
     }
     kill(pid_, SIGKILL);
     waitpid(pid_, nullptr, 0);
   }
-  bool running() const { return pid_ > 0; }
-
- private:
   pid_t pid_ = -1;
+  int lock_fd_ = -1;
 };
 #endif
 
@@ -89,7 +99,8 @@ TEST(AravisFakeGvCamera, HundredFramesOverLoopbackNoneLost) {
 #else
   const std::string serial = "PZ" + std::to_string(getpid());
   FakeGvCamera child(serial);
-  ASSERT_TRUE(child.running()) << "arv-fake-gv-camera-0.8 did not stay up on 127.0.0.1";
+  ASSERT_TRUE(child.running())
+      << "arv-fake-gv-camera-0.8 did not stay up on 127.0.0.1 (or its lock was held for 60 s)";
   auto camera = make_aravis_camera("Aravis-Fake-" + serial);
   camera->configure(gv_settings());
   camera->start();
@@ -130,7 +141,8 @@ TEST(AravisFakeGvCamera, DroppedPacketsAreLostFramesWithTheirIdsNeverSkipped) {
   // frame in three misses a packet (19 packets of 8 KiB a frame).
   const std::string serial = "PL" + std::to_string(getpid());
   FakeGvCamera child(serial, 20);
-  ASSERT_TRUE(child.running()) << "arv-fake-gv-camera-0.8 did not stay up on 127.0.0.1";
+  ASSERT_TRUE(child.running())
+      << "arv-fake-gv-camera-0.8 did not stay up on 127.0.0.1 (or its lock was held for 60 s)";
   auto camera = make_aravis_camera("Aravis-Fake-" + serial);
   camera->configure(gv_settings());
   camera->start();
