@@ -507,10 +507,12 @@ void AravisCamera::start() {
                               std::to_string(image_bytes_) + " bytes of one image " + error.text());
   // The in-process fake camera ignores TriggerMode: its stream fills any queued buffer at its
   // trigger frequency. Queuing one buffer per trigger makes it behave like a triggered camera.
+  // Otherwise (line trigger) it stands for a line pulsed at Aravis's default 25 Hz.
   gated_ = is_fake_ && settings_.trigger == TriggerSource::kSoftware;
-  if (gated_)
+  if (is_fake_)
     arv_fake_camera_set_trigger_frequency(
-        arv_fake_device_get_fake_camera(ARV_FAKE_DEVICE(arv_camera_get_device(camera_))), 1000.0);
+        arv_fake_device_get_fake_camera(ARV_FAKE_DEVICE(arv_camera_get_device(camera_))),
+        gated_ ? 1000.0 : 25.0);
   allocate_rings();  // before the stream exists: its thread may call back at once
   open_stream();
   buffers_.clear();
