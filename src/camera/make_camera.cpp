@@ -4,7 +4,7 @@
 
 #include <fmt/core.h>
 
-#include "piezoshift/camera/aravis_factory.hpp"
+#include "piezoshift/camera/aravis_camera.hpp"
 #include "piezoshift/camera/files_camera.hpp"
 #include "piezoshift/core/input_error.hpp"
 

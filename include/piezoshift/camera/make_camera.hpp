@@ -4,7 +4,7 @@
 //   "twin"        TwinCamera of the scene (the Fizeau simulation; a measurement on the twin
 //                 supplies the surface, mask, optics and seed) with config's sensor model
 //   "files:DIR"   FilesCamera replaying DIR's PNG files
-//   "aravis:ID"   make_aravis_camera(ID) (aravis_factory.hpp), refused where it is not built in
+//   "aravis:ID"   make_aravis_camera(ID) (aravis_camera.hpp), refused where it is not built in
 //
 // Anything else is core::InputError naming the spec and the choices. The camera returned has had
 // configure(config.settings) (so a size, pixel format or file it cannot take is refused here);
