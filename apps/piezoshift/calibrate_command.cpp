@@ -348,6 +348,8 @@ int run_improved(const Options& o, const config::ProjectConfig& config) {
   // The records stages 4 and 5 fitted, in the formats `fit improved` reads (docs/files.md),
   // each replaced atomically and before the calibration file: its presence implies them whole.
   const std::filesystem::path folder = std::filesystem::path(o.out).parent_path();
+  if (!folder.empty())
+    std::filesystem::create_directories(folder);
   const std::string excitation_file = (folder / "excitation.csv").string();
   const std::string mode_file = (folder / "mode_step.csv").string();
   write_improved_records(ic, excitation_file, mode_file);

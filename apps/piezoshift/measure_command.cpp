@@ -22,16 +22,18 @@
 #include "loop_stack.hpp"
 #include "measure_report.hpp"
 #include "physics_budget.hpp"
+#include "piezoshift/camera/aravis_camera.hpp"
 #include "piezoshift/camera/camera.hpp"
 #include "piezoshift/camera/camera_config.hpp"
 #include "piezoshift/camera/instrument_config.hpp"
 #include "piezoshift/camera/make_camera.hpp"
 #include "piezoshift/camera/twin_camera.hpp"
+#include "piezoshift/camera/twin_fed_camera.hpp"
 #include "piezoshift/core/input_error.hpp"
 #include "piezoshift/instrument/measurement.hpp"
 #include "piezoshift/instrument/sequence.hpp"
-#include "piezoshift/psi/analysis.hpp"
 #include "piezoshift/plant/random.hpp"
+#include "piezoshift/psi/analysis.hpp"
 #include "piezoshift/psi/fizeau_simulation.hpp"
 #include "piezoshift/rig/validity.hpp"
 #include "piezoshift/runtime/control_loop.hpp"
@@ -137,6 +139,11 @@ struct MeasureSetup {
   LoopCalibration calibration;
 };
 
+// Aravis's in-process fake camera on the twin: shown the twin's fringes (twin_fed_camera.hpp).
+bool fed_by_twin(const MeasureOptions& o) {
+  return o.camera.starts_with("aravis:Fake") && o.daq == "sim";
+}
+
 void check_options(const MeasureOptions& o) {
   check_loop_rate(o.rate_Hz);
   if (o.out.empty())
@@ -145,8 +152,9 @@ void check_options(const MeasureOptions& o) {
   if (o.camera == "twin" && o.daq != "sim")
     throw core::InputError(
         fmt::format("--camera twin renders the twin's plate: it needs --daq sim, not {}", o.daq));
-  if (o.camera != "twin" && !o.surface.empty())
-    throw core::InputError("--surface: the test surface of the twin camera only");
+  if (o.camera != "twin" && !fed_by_twin(o) && !o.surface.empty())
+    throw core::InputError(
+        "--surface: the test surface of the twin camera (or of aravis:Fake_1 on --daq sim)");
 }
 
 void check_travel(const MeasureSetup& s) {
@@ -161,8 +169,15 @@ void check_travel(const MeasureSetup& s) {
 }
 
 std::unique_ptr<camera::Camera> open_camera(const MeasureOptions& o, const MeasureSetup& s) {
-  std::unique_ptr<camera::Camera> cam =
-      camera::make_camera(o.camera, s.config.camera, s.scene ? &*s.scene : nullptr);
+  std::unique_ptr<camera::Camera> cam;
+  if (fed_by_twin(o)) {
+    cam = std::make_unique<camera::TwinFedCamera>(
+        std::make_unique<camera::TwinCamera>(*s.scene, camera::sensor_params(s.config.camera)),
+        camera::make_aravis_camera(o.camera.substr(7)));
+    cam->configure(s.config.camera.settings);
+  } else {
+    cam = camera::make_camera(o.camera, s.config.camera, s.scene ? &*s.scene : nullptr);
+  }
   cam->start();
   return cam;
 }
@@ -248,7 +263,7 @@ int measure(const MeasureOptions& o) {
   const double wavelength_nm = 632.8;
   s.algorithm = psi::parse_algorithm(o.algorithm);
   s.params = sequence_params(o, s.algorithm, wavelength_nm);
-  if (o.camera == "twin")
+  if (o.camera == "twin" || fed_by_twin(o))
     s.scene = twin_scene(o, s.config.camera, wavelength_nm);
   LoopStack stack(stack_options(o), s.config.installation.project);
   s.calibration = resolve_calibration(o.calibration, o.daq, s.config.installation.project, o.seed,
@@ -289,8 +304,7 @@ int measure(const MeasureOptions& o) {
                     .mask = &mask,
                     .truth_nm = s.scene ? &s.scene->surface_nm : nullptr,
                     .error_rms_nm = std::nullopt,
-                    .ideal_error_rms_nm = std::nullopt,
-                    .bit_depth = camera::bit_depth(s.config.camera.settings.format)};
+                    .ideal_error_rms_nm = std::nullopt};
   if (s.scene) {
     rec.error_rms_nm = psi::surface_error_rms_nm(a.surface_nm, s.scene->surface_nm, a.valid);
     rec.ideal_error_rms_nm = ideal_error_rms_nm(s, ao);

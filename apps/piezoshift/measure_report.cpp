@@ -91,17 +91,15 @@ void write_exposures_csv(const instrument::SequenceResult& s, const fs::path& pa
   csv.close();
 }
 
-// Frames as 16-bit PNG, the counts MSB-aligned (as `psi simulate` writes them), so that
-// `psi analyze` and `--camera files:DIR` read them back.
+// Frames as 16-bit PNG holding the camera's own counts (0 .. 2^bits - 1), so that `psi analyze`
+// and `--camera files:DIR` with the same pixel format read them back as they were taken.
 void write_frames(const MeasureRecord& r, const fs::path& dir) {
   fs::create_directories(dir);
-  const double msb = std::ldexp(1.0, 16 - r.bit_depth);
   const std::size_t n = r.params->steps_rad.size();
   for (std::size_t i = 0; i < r.sequence->frames.size(); ++i) {
     const camera::Frame& f = r.sequence->frames[i];
     psi::Map m(f.width_px, f.height_px);
-    for (std::size_t p = 0; p < m.size(); ++p)
-      m.v[p] = f.counts[p] * msb;
+    std::copy(f.counts.begin(), f.counts.end(), m.v.begin());
     psi::write_png_gray16((dir / fmt::format("frame_a{}_{:02}.png", i / n + 1, i % n)).string(), m);
   }
 }
@@ -257,8 +255,7 @@ Json measure_json(const MeasureRecord& r) {
          {"valid_pixels", a.figures.pixels},
          {"zernike_nm", a.zernike_nm},
          {"error_rms_nm", r.error_rms_nm ? Json(*r.error_rms_nm) : Json(nullptr)},
-         {"ideal_error_rms_nm",
-          r.ideal_error_rms_nm ? Json(*r.ideal_error_rms_nm) : Json(nullptr)},
+         {"ideal_error_rms_nm", r.ideal_error_rms_nm ? Json(*r.ideal_error_rms_nm) : Json(nullptr)},
          {"timing",
           {{"wall_time_s", s.wall_time_s},
            {"floor_s", s.floor_s},

@@ -27,7 +27,6 @@ struct MeasureRecord {
   std::optional<double> error_rms_nm;  //!< measured - truth, piston and tilt removed
   //! The same frames from an ideal stage (the camera's and the algorithm's floor, one average).
   std::optional<double> ideal_error_rms_nm;
-  int bit_depth = 12;
 };
 
 //! The summary measure prints with --json and writes as measurement.json.
