@@ -30,9 +30,10 @@
 #include "piezoshift/camera/twin_camera.hpp"
 #include "piezoshift/camera/twin_fed_camera.hpp"
 #include "piezoshift/core/input_error.hpp"
+#include "piezoshift/instrument/acquisition.hpp"
 #include "piezoshift/instrument/measurement.hpp"
 #include "piezoshift/instrument/sequence.hpp"
-#include "piezoshift/plant/random.hpp"
+#include "piezoshift/instrument/twin_floor.hpp"
 #include "piezoshift/psi/analysis.hpp"
 #include "piezoshift/psi/fizeau_simulation.hpp"
 #include "piezoshift/rig/validity.hpp"
@@ -190,31 +191,6 @@ psi::Mask measurement_mask(const MeasureOptions& o, const MeasureSetup& s,
   return load_mask(o.mask, first.front());
 }
 
-// The twin camera's floor: the same frames (same noise draws, frame by frame) rendered with an
-// ideal stage, exactly at the commanded steps and still during the exposure, analysed the same
-// way. measured^2 - ideal^2 is what the stage added (as `psi simulate` splits it).
-double ideal_error_rms_nm(const MeasureSetup& s, const psi::AnalysisOptions& ao) {
-  const camera::TwinScene& scene = *s.scene;
-  const psi::CameraParams sensor = camera::sensor_params(s.config.camera);
-  const double gain = std::pow(10.0, s.config.camera.settings.gain_dB / 20.0);
-  const double top = std::ldexp(1.0, sensor.bit_depth) - 1.0;
-  const std::size_t n = s.params.steps_rad.size();
-  std::vector<psi::Map> frames;
-  for (std::size_t k = 0; k < n; ++k) {
-    const double piston_nm =
-        s.params.steps_rad[k] * s.params.wavelength_nm / (4.0 * std::numbers::pi);
-    const psi::PoseSample still{0.0, piston_nm, 0.0, 0.0};
-    plant::Rng rng(camera::frame_seed(scene.seed, k));
-    psi::Map f = psi::render_frame(scene.surface_nm, scene.mask, scene.fizeau, sensor,
-                                   std::span<const psi::PoseSample>(&still, 1), rng);
-    for (double& v : f.v)
-      v = std::min(top, std::round(v * gain));
-    frames.push_back(std::move(f));
-  }
-  const psi::Analysis a = psi::analyze_frames(frames, scene.mask, ao);
-  return psi::surface_error_rms_nm(a.surface_nm, scene.surface_nm, a.valid);
-}
-
 struct Outcome {
   instrument::SequenceResult sequence;
   std::string camera_name;
@@ -224,15 +200,11 @@ struct Outcome {
 
 // The loop, the camera and the sequence; the DAQ's outputs at 0 V whatever happens.
 Outcome acquire(const MeasureOptions& o, MeasureSetup& s, LoopStack& stack) {
-  runtime::LoopConfig lc;
-  lc.rate_Hz = o.rate_Hz;
-  lc.duration_s = std::numeric_limits<double>::infinity();
-  lc.stop_signal = &g_stop_signal;
-  lc.owner_drives = true;
-  const runtime::SafetyLimits limits =
-      loop_safety_limits(s.config.installation.safety, std::nullopt);
-  runtime::ControlLoop loop(lc, s.calibration.params, limits, stack.daq(), stack.clock(),
-                            runtime::SetpointProfile::step(0.0));
+  instrument::LoopSetup loop;
+  loop.controller = s.calibration.params;
+  loop.limits = loop_safety_limits(s.config.installation.safety, std::nullopt);
+  loop.rate_Hz = o.rate_Hz;
+  loop.stop_signal = &g_stop_signal;
   std::unique_ptr<camera::Camera> cam = open_camera(o, s);
   StopSignals signals;
   ProgressBar bar(1);
@@ -240,14 +212,8 @@ Outcome acquire(const MeasureOptions& o, MeasureSetup& s, LoopStack& stack) {
     request_realtime_or_warn(o.cpu);
   const plant::Twin* twin = stack.sim() != nullptr ? &stack.sim()->twin() : nullptr;
   Outcome out;
-  stack.daq().activate();
-  try {
-    out.sequence = instrument::run_sequence(loop, twin, *cam, s.params, bar.callback());
-  } catch (...) {
-    stack.daq().deactivate();
-    throw;
-  }
-  stack.daq().deactivate();
+  out.sequence = instrument::acquire_sequence(stack.daq(), stack.clock(), twin, *cam, loop,
+                                              s.params, bar.callback());
   cam->stop();
   out.camera_name = cam->name();
   out.daq_name = stack.name();
@@ -307,7 +273,8 @@ int measure(const MeasureOptions& o) {
                     .ideal_error_rms_nm = std::nullopt};
   if (s.scene) {
     rec.error_rms_nm = psi::surface_error_rms_nm(a.surface_nm, s.scene->surface_nm, a.valid);
-    rec.ideal_error_rms_nm = ideal_error_rms_nm(s, ao);
+    rec.ideal_error_rms_nm =
+        instrument::ideal_stage_error_rms_nm(*s.scene, s.config.camera, s.params, ao);
   }
   if (!a.converged) {
     if (o.json)
