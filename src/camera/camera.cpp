@@ -1,5 +1,9 @@
 #include "piezoshift/camera/camera.hpp"
 
+#include <algorithm>
+#include <chrono>
+#include <thread>
+
 namespace piezoshift::camera {
 
 const char* to_string(FrameStatus status) noexcept {
@@ -40,6 +44,19 @@ const char* to_string(PixelFormat format) noexcept {
       return "Mono16";
   }
   return "unknown";
+}
+
+FrameStatus poll_until(Camera& camera, Frame& frame, double timeout_s) {
+  const auto deadline = std::chrono::steady_clock::now() +
+                        std::chrono::duration_cast<std::chrono::steady_clock::duration>(
+                            std::chrono::duration<double>(std::max(0.0, timeout_s)));
+  for (;;) {
+    if (const FrameStatus s = camera.poll(frame); s != FrameStatus::kNone)
+      return s;
+    if (std::chrono::steady_clock::now() >= deadline)
+      return FrameStatus::kTimeout;
+    std::this_thread::sleep_for(std::chrono::microseconds(100));
+  }
 }
 
 }  // namespace piezoshift::camera

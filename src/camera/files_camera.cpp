@@ -148,16 +148,7 @@ FrameStatus FilesCamera::poll(Frame& frame) noexcept {
 }
 
 FrameStatus FilesCamera::wait(Frame& frame, double timeout_s) {
-  const auto deadline = std::chrono::steady_clock::now() +
-                        std::chrono::duration_cast<std::chrono::steady_clock::duration>(
-                            std::chrono::duration<double>(std::max(0.0, timeout_s)));
-  for (;;) {
-    if (const FrameStatus s = poll(frame); s != FrameStatus::kNone)
-      return s;
-    if (std::chrono::steady_clock::now() >= deadline)
-      return FrameStatus::kTimeout;
-    std::this_thread::sleep_for(std::chrono::microseconds(100));
-  }
+  return poll_until(*this, frame, timeout_s);
 }
 
 std::string FilesCamera::message() const {

@@ -1,9 +1,7 @@
 #include "piezoshift/camera/twin_fed_camera.hpp"
 
 #include <algorithm>
-#include <chrono>
 #include <stdexcept>
-#include <thread>
 
 #include "piezoshift/camera/aravis_fake_fill.hpp"
 
@@ -78,14 +76,7 @@ FrameStatus TwinFedCamera::poll(Frame& frame) noexcept {
 }
 
 FrameStatus TwinFedCamera::wait(Frame& frame, double timeout_s) {
-  const auto end = std::chrono::steady_clock::now() + std::chrono::duration<double>(timeout_s);
-  while (std::chrono::steady_clock::now() < end) {
-    const FrameStatus s = poll(frame);
-    if (s != FrameStatus::kNone)
-      return s;
-    std::this_thread::sleep_for(std::chrono::microseconds(200));
-  }
-  return FrameStatus::kTimeout;
+  return poll_until(*this, frame, timeout_s);
 }
 
 void TwinFedCamera::stop() noexcept {

@@ -73,4 +73,8 @@ class Camera {
   virtual std::uint64_t lost_frames() const noexcept = 0;
 };
 
+//! wait() for a camera whose frames come to poll(): polls every 100 us until a frame (or a
+//! failure) arrives or timeout_s has passed (kTimeout).
+FrameStatus poll_until(Camera& camera, Frame& frame, double timeout_s);
+
 }  // namespace piezoshift::camera
