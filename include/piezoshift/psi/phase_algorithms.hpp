@@ -48,6 +48,13 @@
 // (a_k, b_k, piston_k, tip_k, tilt_k) per frame (in the spirit of Xu et al. 2008, Opt. Lett.
 // 33(4):405, for tilt-shift errors). For the plate of geometry.hpp, tip_k = (4 pi / lambda)
 // theta_x R and tilt_k = -(4 pi / lambda) theta_y R at pupil radius R.
+// It runs from three starts (plain AIA's steps; a grid of planes, solved linearly for piston,
+// against AIA's phase and against the least-squares phase at the commanded steps) and keeps the
+// one that settles with the smallest residual.
+//
+// Both AIAs check their own result (docs/psi.md, "Fits that check themselves"): settled, steps
+// within step_tolerance_rad of the commanded ones, planes within max_tilt_rad, and the frames'
+// residual from the model at their noise; otherwise converged = false with the reason.
 #include <complex>
 #include <cstdint>
 #include <limits>
