@@ -187,8 +187,16 @@ psi::Mask measurement_mask(const MeasureOptions& o, const MeasureSetup& s,
                            const instrument::SequenceResult& r) {
   if (s.scene)
     return s.scene->mask;
-  const std::vector<psi::Map> first = instrument::frame_maps({r.frames.front()});
-  return load_mask(o.mask, first.front());
+  const std::size_t n = s.params.steps_rad.size();
+  const std::vector<psi::Map> frames = instrument::frame_maps(
+      std::vector<camera::Frame>(r.frames.begin(), r.frames.begin() + static_cast<long>(n)));
+  if (!o.mask.empty())
+    return choose_pupil(o.mask, frames, "measure").mask;  // the user's file: bad input if wrong
+  try {
+    return choose_pupil("", frames, "measure").mask;
+  } catch (const core::InputError& e) {  // frames without a pupil: a measurement that failed
+    throw rig::ProcedureFailed(e.what());
+  }
 }
 
 struct Outcome {

@@ -26,6 +26,7 @@
 #include "piezoshift/psi/frame_set.hpp"
 #include "piezoshift/psi/npy.hpp"
 #include "piezoshift/psi/png_image.hpp"
+#include "piezoshift/psi/pupil_detection.hpp"
 #include "piezoshift/psi/simulation.hpp"
 #include "piezoshift/psi/step_calibration.hpp"
 #include "piezoshift/psi/zernike.hpp"
@@ -70,9 +71,19 @@ psi::Analysis run_analysis(const std::vector<psi::Map>& frames, const psi::Mask&
   }
 }
 
+// The iterative fits' own check (aia, tilt-aia): why not converged, and the frames' residual
+// from the fitted model and its white part, each over the median modulation.
+void add_fit_check(Json& j, const psi::PhaseResult& r) {
+  if (!std::isfinite(r.residual_rms))
+    return;
+  j["reason"] = r.reason;
+  j["residual_rms"] = r.residual_rms;
+  j["noise_rms"] = r.noise_rms;
+}
+
 // Writes surface_nm.npy and surface_nm.png into out; returns the JSON of the analysis.
 Json write_analysis(const psi::Analysis& a, psi::Algorithm alg, double wavelength_nm,
-                    const std::string& out) {
+                    const std::string& out, const Json& pupil = nullptr) {
   fs::create_directories(out);
   psi::write_npy((fs::path(out) / "surface_nm.npy").string(), a.surface_nm);
   double lo = 0.0, hi = 0.0;
@@ -90,6 +101,9 @@ Json write_analysis(const psi::Analysis& a, psi::Algorithm alg, double wavelengt
          {"valid_pixels", a.figures.pixels},      {"surface_rms_nm", a.figures.rms},
          {"surface_pv_nm", a.figures.pv},         {"surface_pvr_nm", a.figures.pvr},
          {"colour_scale_nm", {lo, hi}},           {"zernike_nm", a.zernike_nm}};
+  add_fit_check(j, a.phase);
+  if (!pupil.is_null())
+    j["pupil"] = pupil;
   if (!a.phase.shifts.empty()) {
     const psi::FrameShiftColumns c = psi::shift_columns(a.phase.shifts);
     j["piston_rad"] = c.piston_rad;
@@ -121,7 +135,6 @@ void print_analysis(const psi::Analysis& a, psi::Algorithm alg, const std::strin
 int run_analyze(const PsiOptions& o) {
   check_wavelength(o.wavelength_nm);
   const std::vector<psi::Map> frames = psi::read_frame_set(o.frames);
-  const psi::Mask mask = load_mask(o.mask, frames[0]);
   const psi::Algorithm alg = choose_algorithm(o.algorithm, frames.size());
   check_count(alg, frames.size());
   psi::AnalysisOptions ao;
@@ -134,8 +147,21 @@ int run_analyze(const PsiOptions& o) {
       throw core::InputError(fmt::format("--steps-rad: {} values for {} frames",
                                          ao.phase.steps_rad.size(), frames.size()));
   }
-  const psi::Analysis a = run_analysis(frames, mask, ao);
-  const Json j = write_analysis(a, alg, o.wavelength_nm, o.out);
+  const PupilChoice pupil = choose_pupil(o.mask, frames, "psi");
+  const psi::Analysis a = run_analysis(frames, pupil.mask, ao);
+  if (!a.phase.converged) {  // not a surface: nothing written, exit 4
+    if (o.json) {
+      Json j{{"algorithm", psi::algorithm_name(alg)},
+             {"steps_rad", a.phase.steps_rad},
+             {"iterations", a.phase.iterations},
+             {"converged", false}};
+      add_fit_check(j, a.phase);
+      j["pupil"] = pupil.json;
+      fmt::print("{}\n", j.dump(2));
+    }
+    throw rig::ProcedureFailed(fmt::format("psi analyze: {}", a.phase.reason));
+  }
+  const Json j = write_analysis(a, alg, o.wavelength_nm, o.out, pupil.json);
   if (o.json)
     fmt::print("{}\n", j.dump(2));
   else
@@ -146,8 +172,8 @@ int run_analyze(const PsiOptions& o) {
 // The steps a frame set made, recovered by AIA, tilt-aia or Carre. Frames without fringes are
 // refused as `psi analyze` refuses them (exit 2); a recovery that did not converge, or a gain
 // that is not finite and positive, is not a calibration (exit 4, no file written).
-psi::StepCalibration recover_steps(const PsiOptions& o, std::span<const psi::Map> frames) {
-  const psi::Mask mask = load_mask(o.mask, frames[0]);
+psi::StepCalibration recover_steps(const PsiOptions& o, std::span<const psi::Map> frames,
+                                   const psi::Mask& mask) {
   const psi::Algorithm alg =
       o.algorithm.empty() ? psi::Algorithm::kAia : psi::parse_algorithm(o.algorithm);
   if (alg != psi::Algorithm::kAia && alg != psi::Algorithm::kTiltAia &&
@@ -170,10 +196,12 @@ psi::StepCalibration recover_steps(const PsiOptions& o, std::span<const psi::Map
   c.algorithm = std::string(psi::algorithm_name(alg));
   c.iterations = r.iterations;
   c.converged = r.converged;
+  c.reason = r.reason;
   if (const std::string problem = psi::step_calibration_problem(c); !problem.empty()) {
     if (o.json)
       fmt::print("{}\n", Json{{"algorithm", c.algorithm},
                               {"iterations", c.iterations},
+                              {"steps_rad", c.steps_rad},
                               {"converged", false},
                               {"reason", problem}}
                              .dump(2));
@@ -191,7 +219,8 @@ int run_calibrate(const PsiOptions& o) {
         o.nominal_step_rad, psi::kMinNominalStepRad, std::numbers::pi - psi::kMaxNominalStepRad,
         psi::kMinNominalStepRad, psi::kMaxNominalStepRad));
   const std::vector<psi::Map> frames = psi::read_frame_set(o.frames);
-  const psi::StepCalibration c = recover_steps(o, frames);
+  const PupilChoice pupil = choose_pupil(o.mask, frames, "psi calibrate");
+  const psi::StepCalibration c = recover_steps(o, frames, pupil.mask);
   if (const fs::path parent = fs::path(o.out).parent_path(); !parent.empty())
     fs::create_directories(parent);
   io::write_file_atomically(o.out, psi::format_step_calibration_toml(c));
@@ -208,6 +237,8 @@ int run_calibrate(const PsiOptions& o) {
                  {"rms_step_error_rad", c.rms_step_error_rad},
                  {"iterations", c.iterations},
                  {"converged", c.converged},
+                 {"reason", ""},
+                 {"pupil", pupil.json},
                  {"calibration", o.out}};
     fmt::print("{}\n", j.dump(2));
   } else {

@@ -8,6 +8,7 @@
 
 #include "piezoshift/core/input_error.hpp"
 #include "piezoshift/psi/png_image.hpp"
+#include "piezoshift/psi/pupil_detection.hpp"
 
 namespace piezoshift::app {
 
@@ -29,14 +30,36 @@ std::vector<double> parse_list(const std::string& text, const std::string& optio
   return v;
 }
 
-psi::Mask load_mask(const std::string& path, const psi::Map& frame) {
-  if (path.empty())
-    return psi::Mask(frame.width, frame.height, 1);
-  psi::Mask m = psi::read_mask_png(path);
-  if (m.width != frame.width || m.height != frame.height)
-    throw core::InputError(fmt::format("{}: mask is {} x {} pixels, the frames {} x {}", path,
-                                       m.width, m.height, frame.width, frame.height));
-  return m;
+// The pupil: the mask file given, else found from the frames' fringe modulation
+// (pupil_detection.hpp), with what the JSON reports of it. who prefixes a refusal.
+PupilChoice choose_pupil(const std::string& path, std::span<const psi::Map> frames,
+                         const std::string& who) {
+  const psi::Map& frame = frames.front();
+  PupilChoice c;
+  if (!path.empty()) {
+    c.mask = psi::read_mask_png(path);
+    if (c.mask.width != frame.width || c.mask.height != frame.height)
+      throw core::InputError(fmt::format("{}: mask is {} x {} pixels, the frames {} x {}", path,
+                                         c.mask.width, c.mask.height, frame.width, frame.height));
+    c.json = {{"source", "mask"}, {"file", path}};
+  } else {
+    psi::DetectedPupil d;
+    try {
+      d = psi::pupil_from_modulation(frames);
+    } catch (const std::invalid_argument& e) {
+      throw core::InputError(fmt::format("{}: {}", who, e.what()));
+    }
+    c.mask = std::move(d.mask);
+    c.json = {
+        {"source", "modulation"}, {"modulation_max", d.modulation_max}, {"threshold", d.threshold}};
+  }
+  c.json["pixels"] = c.mask.count();
+  if (c.mask.count() > 0) {
+    const psi::Pupil p = psi::pupil_of(c.mask);
+    c.json["centre_px"] = {p.cx, p.cy};
+    c.json["radius_px"] = p.radius_px;
+  }
+  return c;
 }
 
 psi::Algorithm choose_algorithm(const std::string& name, std::size_t frames) {

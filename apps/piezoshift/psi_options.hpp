@@ -3,7 +3,10 @@
 // mask, the algorithm and its frame count, the wavelength.
 #include <cstddef>
 #include <string>
+#include <span>
 #include <vector>
+
+#include <nlohmann/json.hpp>
 
 #include "piezoshift/psi/grid.hpp"
 #include "piezoshift/psi/phase_algorithms.hpp"
@@ -12,8 +15,15 @@ namespace piezoshift::app {
 
 //! "0,1.5,3.1" as numbers; InputError naming option and the item that is not one.
 std::vector<double> parse_list(const std::string& text, const std::string& option);
-//! The mask PNG at path, of the frame's size; every pixel when path is empty.
-psi::Mask load_mask(const std::string& path, const psi::Map& frame);
+//! The pupil: the mask PNG at path (of the frames' size), else found from the frames' fringe
+//! modulation (psi/pupil_detection.hpp; InputError prefixed by who when it cannot be), with what
+//! the JSON reports of it.
+struct PupilChoice {
+  psi::Mask mask;
+  nlohmann::ordered_json json;
+};
+PupilChoice choose_pupil(const std::string& path, std::span<const psi::Map> frames,
+                         const std::string& who);
 //! The named algorithm, or the one made for that many frames (lsq for other counts).
 psi::Algorithm choose_algorithm(const std::string& name, std::size_t frames);
 //! InputError when the algorithm needs another frame count.

@@ -1,18 +1,22 @@
 // Python bindings of the psi module (docs/psi.md): frames, masks and maps as numpy arrays.
 //   frames: (N, H, W) float array (any numeric dtype is converted); mask: (H, W), nonzero inside
-//   (None: the whole frame). Maps come back as (H, W) float64 arrays with NaN outside the mask.
+//   (None: psi_analyze finds the pupil from the fringe modulation; the others take the whole
+//   frame). Maps come back as (H, W) float64 arrays with NaN outside the mask.
 // Results are dicts with the JSON names of `piezoshift psi analyze`.
 #include <pybind11/numpy.h>
 #include <pybind11/pybind11.h>
 #include <pybind11/stl.h>
 
+#include <stdexcept>
 #include <string>
+#include <utility>
 #include <vector>
 
 #include "bindings.hpp"
 #include "piezoshift/config/project_config.hpp"
 #include "piezoshift/core/input_error.hpp"
 #include "piezoshift/psi/analysis.hpp"
+#include "piezoshift/psi/pupil_detection.hpp"
 #include "piezoshift/psi/simulation.hpp"
 #include "piezoshift/psi/unwrap.hpp"
 #include "piezoshift/psi/zernike.hpp"
@@ -65,14 +69,44 @@ psi::Mask mask_from(const py::object& o, int w, int h) {
   return mask;
 }
 
+// The pupil analysed: the mask given, else the one found from the frames' fringe modulation
+// (pupil_detection.hpp), as `psi analyze` does without --mask.
+std::pair<psi::Mask, py::dict> pupil_from(const py::object& o,
+                                          const std::vector<psi::Map>& frames) {
+  py::dict d;
+  psi::Mask mask;
+  if (o.is_none()) {
+    try {
+      mask = psi::pupil_from_modulation(frames).mask;
+    } catch (const std::invalid_argument& e) {
+      throw piezoshift::core::InputError(std::string("psi: ") + e.what());
+    }
+    d["source"] = "modulation";
+  } else {
+    mask = mask_from(o, frames[0].width, frames[0].height);
+    d["source"] = "mask";
+  }
+  d["pixels"] = mask.count();
+  psi::Map m(mask.width, mask.height);
+  for (std::size_t q = 0; q < m.size(); ++q)
+    m.v[q] = mask.v[q];
+  d["mask"] = to_numpy(m);
+  return {std::move(mask), d};
+}
+
+// A fit that did not converge (aia, tilt-aia) returns no surface: surface_nm and phase_rad are
+// None, reason says why.
 py::dict analysis_dict(const psi::Analysis& a, psi::Algorithm alg) {
   py::dict d;
   d["algorithm"] = std::string(psi::algorithm_name(alg));
-  d["surface_nm"] = to_numpy(a.surface_nm);
-  d["phase_rad"] = to_numpy(a.phase.phase_rad);
+  d["converged"] = a.phase.converged;
+  d["reason"] = a.phase.reason;
+  d["residual_rms"] = a.phase.residual_rms;
+  d["noise_rms"] = a.phase.noise_rms;
+  d["surface_nm"] = a.phase.converged ? py::object(to_numpy(a.surface_nm)) : py::none();
+  d["phase_rad"] = a.phase.converged ? py::object(to_numpy(a.phase.phase_rad)) : py::none();
   d["steps_rad"] = a.phase.steps_rad;
   d["iterations"] = a.phase.iterations;
-  d["converged"] = a.phase.converged;
   d["surface_rms_nm"] = a.figures.rms;
   d["surface_pv_nm"] = a.figures.pv;
   d["surface_pvr_nm"] = a.figures.pvr;
@@ -105,7 +139,7 @@ void bind_psi(py::module_& m) {
       [](const In& frames_in, const py::object& mask_in, const std::string& algorithm,
          const std::vector<double>& steps_rad, double wavelength_nm, bool remove_power) {
         const std::vector<psi::Map> frames = frames_from(frames_in);
-        const psi::Mask mask = mask_from(mask_in, frames[0].width, frames[0].height);
+        const auto [mask, pupil] = pupil_from(mask_in, frames);
         psi::AnalysisOptions o;
         o.phase.algorithm = psi::parse_algorithm(algorithm);
         const int need = psi::required_frames(o.phase.algorithm);
@@ -115,12 +149,15 @@ void bind_psi(py::module_& m) {
         o.phase.steps_rad = steps_rad;
         o.wavelength_nm = wavelength_nm;
         o.removal = remove_power ? psi::Removal::kTiltAndPower : psi::Removal::kTilt;
-        return analysis_dict(analyze(frames, mask, o), o.phase.algorithm);
+        py::dict d = analysis_dict(analyze(frames, mask, o), o.phase.algorithm);
+        d["pupil"] = pupil;
+        return d;
       },
       py::arg("frames"), py::arg("mask") = py::none(), py::arg("algorithm") = "hariharan5",
       py::arg("steps_rad") = std::vector<double>{}, py::arg("wavelength_nm") = 632.8,
       py::arg("remove_power") = false,
-      "Frames (N, H, W) to a surface map [nm] and its figures (docs/psi.md)");
+      "Frames (N, H, W) to a surface map [nm] and its figures (docs/psi.md); mask None: the "
+      "pupil found from the fringe modulation");
 
   m.def(
       "psi_simulate",

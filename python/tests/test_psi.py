@@ -39,8 +39,40 @@ def test_aia_and_tilt_aia_return_steps_and_planes():
     steps = [0.0, 1.4, 3.2, 4.6, 6.4]
     r = ps.psi_analyze(frames_of(phi, steps), None, algorithm="aia")
     assert np.allclose(r["steps_rad"], steps, atol=1e-6)
+    assert r["converged"] and r["reason"] == ""
+    # fringes over the whole frame: the pupil found from their modulation is the whole frame
+    assert r["pupil"]["source"] == "modulation" and r["pupil"]["pixels"] == n * n
     t = ps.psi_analyze(frames_of(phi, steps), None, algorithm="tilt-aia")
     assert len(t["tip_rad"]) == 5 and len(t["piston_rad"]) == 5
+    assert t["converged"]
+    # the residual is the model's rounding: no noise here
+    assert t["residual_rms"] < 1e-6
+
+
+def test_a_fit_that_does_not_converge_returns_no_surface():
+    n = 64
+    y, x = np.mgrid[0:n, 0:n]
+    phi = 0.3 * x + 0.2 * y
+    # steps 1.5 rad beyond the commanded k pi/2 (issue 28): found, and refused
+    steps = [0.0] + [k * math.pi / 2 + 1.5 for k in range(1, 5)]
+    r = ps.psi_analyze(frames_of(phi, steps), None, algorithm="aia")
+    assert not r["converged"]
+    assert "from the commanded" in r["reason"]
+    assert r["surface_nm"] is None and r["phase_rad"] is None
+
+
+def test_pupil_found_from_the_modulation():
+    n = 80
+    y, x = np.mgrid[0:n, 0:n]
+    disk = (x - 39.5)**2 + (y - 39.5)**2 <= 30**2
+    phi = 0.4 * x
+    frames = np.stack([1.0 + np.where(disk, 0.8 * np.cos(phi + k * math.pi / 2), 0.0)
+                       for k in range(5)])
+    r = ps.psi_analyze(frames, None, algorithm="hariharan5")
+    assert r["pupil"]["pixels"] == disk.sum()
+    assert np.array_equal(r["pupil"]["mask"] != 0, disk)
+    with pytest.raises(ps.InputError, match="too few pixels with fringe modulation"):
+        ps.psi_analyze(np.ones((5, 16, 16)), None, algorithm="aia")
 
 
 def test_bad_input_raises_input_error():

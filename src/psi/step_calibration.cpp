@@ -58,6 +58,8 @@ StepCalibration calibrate_steps(std::span<const double> steps, double s, double 
 }
 
 std::string step_calibration_problem(const StepCalibration& c) {
+  if (!c.converged && !c.reason.empty())
+    return c.reason;
   if (!c.converged)
     return fmt::format("{} did not converge in {} iterations", c.algorithm, c.iterations);
   for (std::size_t k = 0; k < c.steps_rad.size(); ++k)

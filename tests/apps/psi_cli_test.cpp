@@ -134,5 +134,62 @@ TEST_F(PsiCliTest, FrameCountDegenerateFramesAndNominalStepAreRefused) {
   EXPECT_FALSE(std::filesystem::exists(path("a")));
 }
 
+// Issue 28: without --mask the whole frame was the pupil, and AIA's steps came out 0.47 rad off
+// (PVr 305 nm instead of 258 at 256 px). The pupil is now found from the fringe modulation: here
+// it is exactly simulate's mask, so steps, PVr and the calibration's gain match the masked run
+// to rounding (tolerances 1e-6 rad, 1e-6 nm, 1e-9).
+TEST_F(PsiCliTest, WithoutAMaskThePupilIsFoundFromTheModulation) {
+  const std::string sim = simulate();
+  const auto analyze = [&](const std::string& mask, const std::string& out) {
+    const testing::CliResult r = run("psi analyze" + frames(sim, 5) + mask +
+                                     " --algorithm aia --out '" + path(out) + "' --json");
+    EXPECT_EQ(r.status, 0) << r.err;
+    return nlohmann::json::parse(r.out);
+  };
+  const auto masked = analyze(" --mask '" + sim + "/mask.png'", "masked");
+  const auto found = analyze("", "found");
+  EXPECT_EQ(found["pupil"]["source"], "modulation");
+  EXPECT_EQ(masked["pupil"]["source"], "mask");
+  EXPECT_EQ(found["pupil"]["pixels"], masked["pupil"]["pixels"]);
+  EXPECT_TRUE(found["converged"].get<bool>());
+  for (std::size_t k = 0; k < 5; ++k)
+    EXPECT_NEAR(found["steps_rad"][k].get<double>(), masked["steps_rad"][k].get<double>(), 1e-6)
+        << k;
+  EXPECT_NEAR(found["steps_rad"][1].get<double>(), std::numbers::pi / 2, 0.05);
+  EXPECT_NEAR(found["surface_pvr_nm"].get<double>(), masked["surface_pvr_nm"].get<double>(), 1e-6);
+  const testing::CliResult c =
+      run("psi calibrate" + frames(sim, 5) + " --out '" + path("cal.toml") + "' --json");
+  ASSERT_EQ(c.status, 0) << c.err;
+  const testing::CliResult cm = run("psi calibrate" + frames(sim, 5) + " --mask '" + sim +
+                                    "/mask.png' --out '" + path("calm.toml") + "' --json");
+  ASSERT_EQ(cm.status, 0) << cm.err;
+  EXPECT_NEAR(nlohmann::json::parse(c.out)["step_gain"].get<double>(),
+              nlohmann::json::parse(cm.out)["step_gain"].get<double>(), 1e-9);
+}
+
+// A fit that does not check out is not a surface: frames given out of order (0, 2, 1, 3, 4) have
+// steps pi/2 from the commanded ones; analyze and calibrate exit 4 with the reason, write nothing.
+TEST_F(PsiCliTest, AFitThatDoesNotConvergeExitsFourAndWritesNothing) {
+  const std::string sim = simulate();
+  const auto f = [&](int k) { return " '" + sim + "/frame_0" + std::to_string(k) + ".png'"; };
+  const std::string shuffled = f(0) + f(2) + f(1) + f(3) + f(4);
+  const testing::CliResult r =
+      run("psi analyze" + shuffled + " --algorithm aia --out '" + path("a") + "' --json");
+  EXPECT_EQ(r.status, 4) << r.err;
+  const auto j = nlohmann::json::parse(r.out);
+  EXPECT_FALSE(j["converged"].get<bool>());
+  EXPECT_NE(j["reason"].get<std::string>().find("from the commanded"), std::string::npos)
+      << j["reason"];
+  EXPECT_NE(r.err.find("piezoshift: not valid: psi analyze: aia: step"), std::string::npos)
+      << r.err;
+  EXPECT_FALSE(std::filesystem::exists(path("a")));
+  const testing::CliResult c = run("psi calibrate" + shuffled + " --algorithm tilt-aia --out '" +
+                                   path("c.toml") + "' --json");
+  EXPECT_EQ(c.status, 4) << c.err;
+  EXPECT_FALSE(nlohmann::json::parse(c.out)["converged"].get<bool>());
+  EXPECT_NE(c.err.find("psi calibrate: tilt-aia:"), std::string::npos) << c.err;
+  EXPECT_FALSE(std::filesystem::exists(path("c.toml")));
+}
+
 }  // namespace
 }  // namespace piezoshift

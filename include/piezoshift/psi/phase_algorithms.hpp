@@ -48,8 +48,16 @@
 // (a_k, b_k, piston_k, tip_k, tilt_k) per frame (in the spirit of Xu et al. 2008, Opt. Lett.
 // 33(4):405, for tilt-shift errors). For the plate of geometry.hpp, tip_k = (4 pi / lambda)
 // theta_x R and tilt_k = -(4 pi / lambda) theta_y R at pupil radius R.
+// It runs from three starts (plain AIA's steps; a grid of planes, solved linearly for piston,
+// against AIA's phase and against the least-squares phase at the commanded steps) and keeps the
+// one that settles with the smallest residual.
+//
+// Both AIAs check their own result (docs/psi.md, "Fits that check themselves"): settled, steps
+// within step_tolerance_rad of the commanded ones, planes within max_tilt_rad, and the frames'
+// residual from the model at their noise; otherwise converged = false with the reason.
 #include <complex>
 #include <cstdint>
+#include <limits>
 #include <span>
 #include <string>
 #include <string_view>
@@ -104,6 +112,16 @@ struct PhaseOptions {
   int max_iterations = 200;      //!< aia, tilt-aia
   double tolerance_rad = 1e-6;   //!< aia, tilt-aia: stop when no step changes more
   double min_modulation = 1e-9;  //!< pixels with a smaller B estimate are left NaN
+  // aia, tilt-aia check their own fit (docs/psi.md, "Fits that check themselves"):
+  //! a recovered step further than this from the commanded one (steps_rad, else k pi/2, both
+  //! referred to frame 0) is a wrong solution: twice the +-0.25 rad the fits are shown to reach
+  double step_tolerance_rad = 0.5;
+  //! tilt-aia: a shift plane (relative to frame 0's) steeper than this at the pupil edge [rad]
+  //! is outside the range the starts cover (each frame's tilt up to 1 rad there, so 2 between two)
+  double max_tilt_rad = 2.5;
+  //! the frames' residual from the fitted model, beyond its white noise, as a fraction of the
+  //! median modulation: more is a wrong basin or frames the model does not describe
+  double max_misfit = 0.02;
 };
 
 //! One frame's phase shift over the pupil: piston + tip y + tilt x [rad] (tilt-aware methods).
@@ -126,7 +144,14 @@ struct PhaseResult {
   std::vector<double> steps_rad;   //!< delta_k used or recovered (piston at the pupil centre)
   std::vector<FrameShift> shifts;  //!< tilt-aia only
   int iterations = 0;              //!< aia, tilt-aia
+  //! aia, tilt-aia: the iteration settled AND the fit passed its checks (steps near the
+  //! commanded ones, planes within range, residual at the noise); the other algorithms: true
   bool converged = true;
+  std::string reason;  //!< why not converged, "" when converged
+  //! aia, tilt-aia: RMS of the frames' residual from the fitted model, and its white part (from
+  //! adjacent-pixel differences), each over the pupil's median modulation; NaN for the others
+  double residual_rms = std::numeric_limits<double>::quiet_NaN();
+  double noise_rms = std::numeric_limits<double>::quiet_NaN();
 };
 
 //! Wrapped phase from frames (same size as the mask, at least 3). Throws std::invalid_argument

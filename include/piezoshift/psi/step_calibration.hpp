@@ -35,6 +35,7 @@ struct StepCalibration {
   double rms_step_error_rad = 0.0;  //!< RMS of delta_k - s k
   int iterations = 0;
   bool converged = true;
+  std::string reason;  //!< the fit's own why-not (PhaseResult::reason), "" when it converged
 };
 
 //! std::invalid_argument for fewer than 3 steps or a nominal step outside
@@ -43,8 +44,9 @@ StepCalibration calibrate_steps(std::span<const double> steps_rad, double nomina
                                 double wavelength_nm);
 
 //! Why c is not a calibration, "" when it is: the iteration that recovered the steps did not
-//! converge, or a step or the step gain is not finite, or the gain is not positive (the steps
-//! did not advance). A failure is a failure, never a number: such a c is not written.
+//! converge (c.reason when the fit gave one), or a step or the step gain is not finite, or the gain
+//! is not positive (the steps did not advance). A failure is a failure, never a number: such a c is
+//! not written.
 std::string step_calibration_problem(const StepCalibration& c);
 
 std::string format_step_calibration_toml(const StepCalibration& c);
