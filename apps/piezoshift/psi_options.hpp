@@ -2,8 +2,8 @@
 // The options `psi analyze`, `psi calibrate` and `measure` share: lists of numbers, the pupil's
 // mask, the algorithm and its frame count, the wavelength.
 #include <cstddef>
-#include <string>
 #include <span>
+#include <string>
 #include <vector>
 
 #include <nlohmann/json.hpp>
