@@ -8,6 +8,7 @@
 
 #include <atomic>
 #include <chrono>
+#include <limits>
 #include <string>
 #include <thread>
 #include <vector>
@@ -179,6 +180,9 @@ TEST(HttpBind, ANonLoopbackAddressNeedsAToken) {
 TEST_F(Http, OneClientTooManyGets503) {
   HttpServerOptions o;
   o.max_clients = 2;
+  // The refusal itself: no slot kept from streams, no room made (poll_server_test.cpp has those).
+  o.reserved_for_requests = 0;
+  o.evict_idle_when_full_s = std::numeric_limits<double>::infinity();
   start(o);
   HttpConnection a(server_->port());
   HttpConnection b(server_->port());
