@@ -9,6 +9,9 @@
 //
 // Exit status: 0 stopped by SIGINT/SIGTERM or --duration-s; 2 bad input (including an address
 // that cannot be bound or a DAQ device that cannot be opened); 1 internal error.
+#include <sys/resource.h>
+#include <unistd.h>
+
 #include <cmath>
 #include <cstdint>
 #include <cstdio>
@@ -218,7 +221,13 @@ class Network {
   void start() {
     line_thread_ = std::thread([this] { serve_until_stopped(*server_, line_error_); });
     if (http_)
-      http_thread_ = std::thread([this] { serve_until_stopped(*http_, http_error_); });
+      http_thread_ = std::thread([this] {
+        // The dashboard yields to the GCS clients when both want the CPU they share (nice 5:
+        // scripts/serve-latency's POST flood, p99 7.3-13.8 ms -> 4.3-8.2 ms). Best effort.
+        if (::setpriority(PRIO_PROCESS, static_cast<id_t>(::gettid()), 5) != 0) {
+        }
+        serve_until_stopped(*http_, http_error_);
+      });
   }
   // Stops and joins both servers, then rethrows the first failure of either.
   void stop() {
