@@ -186,7 +186,12 @@ void HttpServer::on_round() {
     Client& c = client(polled);
     if (c.closing() || c.stream || now - c.accepted <= timeout)
       return;
-    if (!c.answered) {
+    if (c.deferred) {  // its handler took too long: given up, and the peer told so
+      c.deferred = false;
+      handler_.abandon(c.id());
+      respond(c, HttpResponse::text(503, "the answer was not ready within the request timeout"));
+      core_->flush(c);
+    } else if (!c.answered) {
       respond(c, HttpResponse::text(408, "request not complete within the timeout"));
       core_->flush(c);
     }
@@ -197,7 +202,14 @@ void HttpServer::on_round() {
 bool HttpServer::wants_input(const PollClient& polled) const {
   // A stream's peer sends nothing; still read, for its hang-up (EOF).
   const Client& c = HttpServer::client(polled);
-  return !c.answered || c.stream;
+  return !c.answered || c.stream || c.deferred;  // a deferred one: for a reset
+}
+
+void HttpServer::on_end_of_input(PollClient& polled) {
+  // A peer may shut down its sending side once its request is sent: its deferred answer is still
+  // made and sent (a peer that has gone fails the send, and the connection is closed then).
+  if (!client(polled).deferred)
+    PollProtocol::on_end_of_input(polled);
 }
 
 bool HttpServer::has_work(const PollClient& polled) const {

@@ -190,6 +190,24 @@ TEST(PollServerFairness, LineFloodDelaysAnotherClientByAtMostTwoRoundsOfLines) {
   EXPECT_GE(handler.echoes_beside_the_flood, 1);
 }
 
+// The turn's time budget (1 ms by default) ends a turn after the line that crosses it: with a
+// budget of 1 ns every turn is that one line, however cheap, so the count, not a clock, shows it.
+TEST(PollServerFairness, LineTurnEndsOnceItsTimeIsSpent) {
+  LineCounting handler;
+  LineServerLimits limits;
+  limits.turn_budget_s = 1e-9;
+  LineServer server(ListenAddress{"127.0.0.1", 0, false}, limits, handler);
+  {
+    Running running(server);
+    const Flooder flooder(server.port(), "", "F\n");
+    ASSERT_TRUE(eventually([&] { return handler.flood_lines.load() > 100; }));
+    GcsClient other("127.0.0.1", server.port());
+    EXPECT_EQ(other.query("ECHO 1"), "1\n");
+  }
+  EXPECT_EQ(handler.most_flood_in_one_round, 1);
+  EXPECT_LE(handler.most_flood_before_an_echo, 2);
+}
+
 TEST(PollServerSlowReader, LineReaderWhoseQueueExceedsTheBoundIsEvicted) {
   LineCounting handler;
   LineServerLimits limits;

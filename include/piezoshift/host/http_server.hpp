@@ -21,7 +21,8 @@
 //              ordinary requests always find a slot; one more stream gets 503
 //   later      a handler may answer HttpResponse::later() and give the response in parts: the
 //              server calls resume() once a round (serving every other client in between) until
-//              it returns one, or abandon() when the connection ends first
+//              it returns one, or abandon() when the connection ends first (reset, or the request
+//              timeout, which answers 503)
 //   room       with max_clients connected, a new connection takes the place of the one silent
 //              longest (a stream: the one opened first) if silent for evict_idle_when_full_s
 //              (poll_server.hpp); otherwise it gets 503
@@ -152,6 +153,7 @@ class HttpServer : private PollProtocol {
   bool wants_input(const PollClient& client) const override;
   bool has_work(const PollClient& client) const override;
   void on_input(PollClient& client, std::string_view bytes) override;
+  void on_end_of_input(PollClient& client) override;
   //! Resumes a deferred request.
   void serve(PollClient& client) override;
   void on_disconnect(PollClient& client) override;
