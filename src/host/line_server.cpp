@@ -147,7 +147,7 @@ void LineServer::serve(PollClient& polled) {
   std::string_view data = c.unread;
   std::size_t handled = 0;
   const auto answer = [&](std::string&& bytes) { core_->queue(c, bytes); };
-  // The clock is read after each line only: cheap lines stop at kLinesPerTurn first.
+  // The first line always runs; before each further one the clock is read.
   const auto turn_end = std::chrono::steady_clock::now() +
                         std::chrono::duration_cast<std::chrono::steady_clock::duration>(
                             std::chrono::duration<double>(std::min(limits_.turn_budget_s, 1e6)));
