@@ -25,6 +25,9 @@ void calibration_input(std::string_view data);
 //! A GCS session: the input split at LF into lines fed to host::GcsInterpreter on the twin's
 //! stage model, with a stand-in loop thread that applies every command and answers with samples.
 void gcs_input(std::string_view data);
+//! The texts of a figure (file name, titles, labels; fields at NUL) through io::check_output_path
+//! and io::write_plot_files: none may reach gnuplot's command stream (plot_entry.cpp).
+void plot_input(std::string_view data);
 //! A command line, one argument per input line, parsed by the program's own CLI11 app; only
 //! `design` without --search and --config runs (the others parse and validate their options).
 void command_line_input(std::string_view data);

@@ -3,6 +3,7 @@
 #include <atomic>
 #include <chrono>
 #include <cstdint>
+#include <stdexcept>
 #include <string>
 #include <thread>
 
@@ -80,6 +81,28 @@ class StandInLoop {
   std::thread thread_;  // last: starts once the members above exist
 };
 
+// Issue 27: an answer's size is bounded before it is made, whatever the arguments (a DRR? of every
+// table, HLP?, the 64 items a query may name, values of 300 digits): all its parts together at
+// most GcsInterpreter::kMaxAnswerBytes, each part at most kMaxPartBytes beyond what the line
+// itself holds (SPA? echoes its items). The rest of a pending answer is taken as LineServer does.
+void check_answer(host::GcsInterpreter& gcs, host::ClientId client, std::string_view line,
+                  std::string answer) {
+  using host::GcsInterpreter;
+  std::size_t whole = 0;
+  for (;;) {
+    if (answer.size() > GcsInterpreter::kMaxPartBytes + line.size())
+      throw std::logic_error("gcs: a part of " + std::to_string(answer.size()) +
+                             " bytes answers the line " + std::string(line.substr(0, 80)));
+    whole += answer.size();
+    if (!gcs.answer_pending(client))
+      break;
+    answer = gcs.more_answer(client);
+  }
+  if (whole > GcsInterpreter::kMaxAnswerBytes)
+    throw std::logic_error("gcs: an answer of " + std::to_string(whole) + " bytes to the line " +
+                           std::string(line.substr(0, 80)));
+}
+
 }  // namespace
 
 void gcs_input(std::string_view data) {
@@ -108,7 +131,7 @@ void gcs_input(std::string_view data) {
     if (line.size() > kMaxLineBytes)
       gcs.on_overlong_line(kClient);
     else
-      gcs.on_line(kClient, line);
+      check_answer(gcs, kClient, line, gcs.on_line(kClient, line));
     gcs.on_poll();
     data.remove_prefix(lf + 1);
   }

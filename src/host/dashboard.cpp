@@ -10,6 +10,7 @@
 #include <nlohmann/json.hpp>
 
 #include "piezoshift/host/gcs_client.hpp"
+#include "piezoshift/host/line_server.hpp"
 #include "piezoshift/runtime/safety_supervisor.hpp"
 
 namespace piezoshift::host {
@@ -342,7 +343,7 @@ HttpResponse Dashboard::command(const HttpRequest& request) {
   if (list.empty() || list.size() > options_.max_commands)
     return HttpResponse::text(
         400, fmt::format("commands: 1 to {} GCS lines per request", options_.max_commands));
-  std::vector<std::string> lines;
+  Job job;
   for (const nlohmann::json& item : list) {
     if (!item.is_string())
       return HttpResponse::text(400, "commands: every item must be a string");
@@ -353,31 +354,109 @@ HttpResponse Dashboard::command(const HttpRequest& request) {
     for (const char c : line)
       if (static_cast<unsigned char>(c) < 0x20 && c != '\t')
         return HttpResponse::text(400, "a GCS line must not hold control characters");
-    lines.push_back(line);
+    job.lines.push_back(line);
   }
+  jobs_[request.client] = std::move(job);
+  return HttpResponse::deferred();  // run a turn at a time: resume()
+}
 
-  nlohmann::json result;
-  result["answers"] = nlohmann::json::array();
-  result["ok"] = true;
-  {
-    const std::lock_guard lock(mutex_);
+void Dashboard::run_turn(Job& job) {
+  const auto turn_end = std::chrono::steady_clock::now() +
+                        std::chrono::duration_cast<std::chrono::steady_clock::duration>(
+                            std::chrono::duration<double>(std::min(options_.turn_budget_s, 1e6)));
+  std::size_t handled = 0;
+  std::size_t turn_bytes = 0;
+  const LineServerLimits line_limits;
+  const std::lock_guard lock(mutex_);
+  if (!job.started) {
     // Errors queued before this request (a fault's -1024) are not this request's.
     for (int i = 0; i < 32 && gcs_.on_line(kSession, "ERR?") != "0\n"; ++i) {
     }
-    for (const std::string& line : lines) {
-      std::string answer = gcs_.on_line(kSession, line);
-      const int code = std::stoi(gcs_.on_line(kSession, "ERR?"));
-      result["answers"].push_back(answer);
-      if (code != 0) {
-        result["ok"] = false;
-        result["error"] = {
-            {"code", code}, {"text", describe(static_cast<GcsError>(code))}, {"command", line}};
-        break;
-      }
+    job.started = true;
+  }
+  // A GCS client's turn (line_server.hpp): lines (or parts of a long answer), answer bytes and
+  // time, whichever ends first; the line that crosses is finished.
+  while (!job.done && (job.in_answer || job.next < job.lines.size()) &&
+         (handled == 0 || (handled < LineServer::kLinesPerTurn &&
+                           turn_bytes < line_limits.output_high_water_bytes &&
+                           std::chrono::steady_clock::now() < turn_end))) {
+    ++handled;
+    const std::string part =
+        job.in_answer ? gcs_.more_answer(kSession) : gcs_.on_line(kSession, job.lines[job.next++]);
+    turn_bytes += part.size();
+    job.answer_bytes += part.size();
+    if (job.answer_bytes > options_.max_answer_bytes) {
+      job.done = true;
+      job.failed_line = job.lines[job.next - 1];
+      gcs_.on_line(kSession, "");  // drops the rest of the answer
+      break;
+    }
+    job.partial += part;
+    job.in_answer = gcs_.answer_pending(kSession);
+    if (job.in_answer)
+      continue;
+    const int code = std::stoi(gcs_.on_line(kSession, "ERR?"));
+    job.answers.push_back(std::move(job.partial));
+    job.partial.clear();
+    if (code != 0) {
+      job.done = true;
+      job.code = code;
+      job.failed_line = job.lines[job.next - 1];
     }
   }
-  // A refused GCS command: 422 with its GCS error number and text, so that curl -f fails too.
-  return HttpResponse::json(result["ok"].get<bool>() ? 200 : 422, result.dump());
+  job.done = job.done || (!job.in_answer && job.next == job.lines.size());
+}
+
+HttpResponse Dashboard::job_response(const Job& job) const {
+  nlohmann::json result;
+  result["answers"] = job.answers;
+  result["ok"] = job.failed_line.empty();
+  int status = 200;
+  if (job.code != 0) {
+    // A refused GCS command: 422 with its GCS error number and text, so that curl -f fails too.
+    status = 422;
+    result["error"] = {{"code", job.code},
+                       {"text", describe(static_cast<GcsError>(job.code))},
+                       {"command", job.failed_line}};
+  } else if (!job.failed_line.empty()) {
+    status = 413;
+    result["error"] = {
+        {"text", fmt::format("the answers of one request exceed {} bytes: ask for less (e.g. "
+                             "DRR? in parts); the lines before this one were applied",
+                             options_.max_answer_bytes)},
+        {"command", job.failed_line}};
+  }
+  return HttpResponse::json(status, result.dump());
+}
+
+HttpResponse Dashboard::resume(std::uint64_t client) {
+  const auto it = jobs_.find(client);
+  if (it == jobs_.end())
+    return HttpResponse::text(500, "no command list for this connection");
+  if (running_job_ != 0 && running_job_ != client)
+    return HttpResponse::deferred();  // another POST's lines run first
+  running_job_ = client;
+  Job& job = it->second;
+  run_turn(job);
+  if (!job.done)
+    return HttpResponse::deferred();
+  HttpResponse response = job_response(job);
+  jobs_.erase(it);
+  running_job_ = 0;
+  return response;
+}
+
+void Dashboard::abandon(std::uint64_t client) {
+  const auto it = jobs_.find(client);
+  if (it == jobs_.end())
+    return;
+  if (it->second.in_answer) {
+    const std::lock_guard lock(mutex_);
+    gcs_.on_line(kSession, "");  // drops the rest of the answer
+  }
+  jobs_.erase(it);
+  if (running_job_ == client)
+    running_job_ = 0;
 }
 
 }  // namespace piezoshift::host

@@ -1,8 +1,9 @@
 #include "piezoshift/host/data_recorder.hpp"
 
-#include <fmt/format.h>
-
+#include <algorithm>
 #include <iterator>
+
+#include <fmt/format.h>
 
 namespace piezoshift::host {
 
@@ -163,7 +164,18 @@ GcsError DataRecorder::choose(const std::vector<int>& tables, std::vector<int>& 
 
 GcsError DataRecorder::read(long long start, long long count, const std::vector<int>& tables,
                             double servo_cycle_s, std::string& answer) const {
+  Reading reading;
+  const GcsError e = start_read(start, count, tables, servo_cycle_s, answer, reading);
+  while (reading.pending())
+    continue_read(reading, answer, kValuesPerPart);
+  return e;
+}
+
+GcsError DataRecorder::start_read(long long start, long long count, const std::vector<int>& tables,
+                                  double servo_cycle_s, std::string& answer,
+                                  Reading& reading) const {
   answer.clear();
+  reading = Reading{};
   std::vector<int> chosen;
   if (const GcsError e = choose(tables, chosen); e != GcsError::kNone)
     return e;
@@ -192,20 +204,34 @@ GcsError DataRecorder::read(long long start, long long count, const std::vector<
     header.push_back(
         fmt::format("# NAME{} = {}", c, name(tables_[static_cast<std::size_t>(chosen[c] - 1)])));
   header.push_back("# END_HEADER");
-  answer.reserve(kHeaderBytes + rows * chosen.size() * kValueBytes);
   for (std::size_t l = 0; l < header.size(); ++l)
     answer += header[l] + (l + 1 < header.size() || rows > 0 ? " \n" : "\n");
+  reading.columns = chosen.size();
+  reading.values.reserve(rows * chosen.size());
   const auto first = static_cast<std::size_t>(start - 1);
-  for (std::size_t r = first; r < first + rows; ++r) {
-    for (std::size_t c = 0; c < chosen.size(); ++c) {
+  for (std::size_t r = first; r < first + rows; ++r)
+    for (const int t : chosen)
+      reading.values.push_back(rows_[r][static_cast<std::size_t>(t - 1)]);
+  return GcsError::kNone;
+}
+
+void DataRecorder::continue_read(Reading& reading, std::string& answer, std::size_t max_values) {
+  if (!reading.pending() || reading.columns == 0)
+    return;
+  const std::size_t rows = std::max<std::size_t>(1, max_values / reading.columns);
+  const std::size_t end = std::min(reading.values.size(), reading.next + rows * reading.columns);
+  answer.reserve(answer.size() + (end - reading.next) * kValueBytes);
+  for (std::size_t i = reading.next; i < end; i += reading.columns) {
+    for (std::size_t c = 0; c < reading.columns; ++c) {
       if (c > 0)
         answer += ' ';
-      fmt::format_to(std::back_inserter(answer), "{:.9g}",
-                     rows_[r][static_cast<std::size_t>(chosen[c] - 1)]);
+      fmt::format_to(std::back_inserter(answer), "{:.9g}", reading.values[i + c]);
     }
-    answer += r + 1 < first + rows ? " \n" : "\n";
+    answer += i + reading.columns < reading.values.size() ? " \n" : "\n";
   }
-  return GcsError::kNone;
+  reading.next = end;
+  if (!reading.pending())
+    reading = Reading{};  // the memory back
 }
 
 }  // namespace piezoshift::host

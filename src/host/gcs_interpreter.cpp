@@ -113,6 +113,8 @@ GcsError parse_axes(const std::vector<std::string_view>& args, std::vector<std::
     out = {0, 1, 2};
     return GcsError::kNone;
   }
+  if (args.size() > GcsInterpreter::kMaxQueryItems)
+    return GcsError::kParamCount;
   for (std::string_view a : args) {
     const int axis = axis_of(a);
     if (axis < 0)
@@ -130,6 +132,8 @@ GcsError parse_ids(const std::vector<std::string_view>& args, int max, std::vect
       out.push_back(i);
     return GcsError::kNone;
   }
+  if (args.size() > GcsInterpreter::kMaxQueryItems)
+    return GcsError::kParamCount;
   for (std::string_view a : args) {
     long long v = 0;
     if (!parse_integer(a, v))
@@ -325,16 +329,30 @@ std::string GcsInterpreter::on_overlong_line(ClientId client) {
   return {};
 }
 
+bool GcsInterpreter::answer_pending(ClientId client) const {
+  const auto it = sessions_.find(client);
+  return it != sessions_.end() && it->second.reading.pending();
+}
+
+std::string GcsInterpreter::more_answer(ClientId client) {
+  std::string part;
+  DataRecorder::continue_read(sessions_[client].reading, part, DataRecorder::kValuesPerPart);
+  stats_.answer_bytes += part.size();
+  return part;
+}
+
 std::string GcsInterpreter::on_line(ClientId client, std::string_view line) {
   drain();
   ++stats_.lines;
   Session& session = sessions_[client];
+  session.reading = {};  // an answer not taken whole is dropped
   std::vector<std::string_view> tokens = split(line);
   if (tokens.empty())
     return {};
   const std::string_view name = tokens.front();
   tokens.erase(tokens.begin());
   std::string answer = execute(session, name, tokens);
+  stats_.answer_bytes += answer.size();
   trigger_.line_done(name, sequence_);
   // A query that failed answers one empty line: a client reading up to the answer's last LF
   // never waits in vain, and finds the reason with ERR? (PIPython does so after every query).
@@ -881,11 +899,13 @@ std::string GcsInterpreter::recorder_read(Session& s, const Args& args) {
     }
   }
   std::string answer;
-  if (const GcsError e = recorder_.read(start, count, tables, servo_cycle_s_, answer);
+  if (const GcsError e =
+          recorder_.start_read(start, count, tables, servo_cycle_s_, answer, s.reading);
       e != GcsError::kNone) {
     fail(s, e);
     return {};
   }
+  DataRecorder::continue_read(s.reading, answer, DataRecorder::kValuesPerPart);
   return answer;
 }
 
@@ -939,7 +959,7 @@ std::string GcsInterpreter::parameters(Session& s, const Args& args) {
       lines.push_back(fmt::format("1 0x{:08X}={}", p.id, value(p.id)));
     return framed(lines);
   }
-  if (args.size() % 2 != 0) {
+  if (args.size() % 2 != 0 || args.size() > 2 * kMaxQueryItems) {
     fail(s, GcsError::kParamCount);
     return {};
   }
@@ -999,7 +1019,7 @@ std::string GcsInterpreter::wave_query(Session& s, const Args& args) {
       line(t);
     return framed(lines);
   }
-  if (args.size() % 2 != 0) {
+  if (args.size() % 2 != 0 || args.size() > 2 * kMaxQueryItems) {
     fail(s, GcsError::kParamCount);
     return {};
   }

@@ -40,6 +40,16 @@ HttpResponse HttpResponse::json(int status, std::string body) {
   return r;
 }
 
+HttpResponse HttpResponse::deferred() {
+  HttpResponse r;
+  r.later = true;
+  return r;
+}
+
+HttpResponse HttpHandler::resume(std::uint64_t) {
+  return HttpResponse::text(500, "this handler does not answer in parts");
+}
+
 const char* http_reason(int status) noexcept {
   switch (status) {
     case 200:
@@ -82,6 +92,7 @@ struct HttpServer::Client : PollClient {
   std::chrono::steady_clock::time_point accepted = std::chrono::steady_clock::now();
   bool answered = false;  // a response is queued: closed once it is sent (unless a stream)
   bool stream = false;
+  bool deferred = false;  // the handler answers in parts (resume())
 };
 
 HttpServer::Client& HttpServer::client(PollClient& c) noexcept {
@@ -99,7 +110,8 @@ HttpServer::HttpServer(const HttpServerOptions& options, HttpHandler& handler)
     throw core::InputError(fmt::format("HTTP server on {}: {}", where, what));
   };
   if (options.max_clients < 1 || options.max_request_bytes < 256 || options.max_body_bytes < 1 ||
-      !(options.request_timeout_s > 0.0) || options.max_pending_output_bytes < 1)
+      !(options.request_timeout_s > 0.0) || options.max_pending_output_bytes < 1 ||
+      !(options.evict_idle_when_full_s >= 0.0))
     fail("invalid limits");
   const Ipv4Host ip = parse_ipv4_host(options.host, "HTTP server", where);
   if (!ip.loopback && options.token.empty())
@@ -115,6 +127,7 @@ HttpServer::HttpServer(const HttpServerOptions& options, HttpHandler& handler)
   // on_round() bounds every other connection.
   core.send_timeout_s = std::numeric_limits<double>::infinity();
   core.idle_timeout_s = std::numeric_limits<double>::infinity();
+  core.evict_idle_when_full_s = options.evict_idle_when_full_s;
   core_ = std::make_unique<PollServer>(ip, options.port, "HTTP server", where, core,
                                        static_cast<PollProtocol&>(*this));
   for (const std::string& h : {std::string("127.0.0.1"), std::string("localhost"), ip.numeric})
@@ -143,6 +156,8 @@ HttpServerStats HttpServer::stats() const {
   s.broadcast_bytes = stats_.broadcast_bytes.load(r);
   s.accept_failures = c.accept_failures;
   s.refused_max_clients = c.refused_max_clients;
+  s.refused_streams = stats_.refused_streams.load(r);
+  s.evicted_for_room = c.evicted_for_room;
   s.bytes_in = c.bytes_in;
   s.bytes_out = c.bytes_out;
   return s;
@@ -171,7 +186,12 @@ void HttpServer::on_round() {
     Client& c = client(polled);
     if (c.closing() || c.stream || now - c.accepted <= timeout)
       return;
-    if (!c.answered) {
+    if (c.deferred) {  // its handler took too long: given up, and the peer told so
+      c.deferred = false;
+      handler_.abandon(c.id());
+      respond(c, HttpResponse::text(503, "the answer was not ready within the request timeout"));
+      core_->flush(c);
+    } else if (!c.answered) {
       respond(c, HttpResponse::text(408, "request not complete within the timeout"));
       core_->flush(c);
     }
@@ -182,7 +202,42 @@ void HttpServer::on_round() {
 bool HttpServer::wants_input(const PollClient& polled) const {
   // A stream's peer sends nothing; still read, for its hang-up (EOF).
   const Client& c = HttpServer::client(polled);
-  return !c.answered || c.stream;
+  return !c.answered || c.stream || c.deferred;  // a deferred one: for a reset
+}
+
+void HttpServer::on_end_of_input(PollClient& polled) {
+  // A peer may shut down its sending side once its request is sent: its deferred answer is still
+  // made and sent (a peer that has gone fails the send, and the connection is closed then).
+  if (!client(polled).deferred)
+    PollProtocol::on_end_of_input(polled);
+}
+
+bool HttpServer::has_work(const PollClient& polled) const {
+  return HttpServer::client(polled).deferred;
+}
+
+void HttpServer::serve(PollClient& polled) {
+  Client& c = client(polled);
+  if (!c.deferred)
+    return;
+  HttpResponse response;
+  try {
+    response = handler_.resume(c.id());
+  } catch (const std::exception& e) {
+    response = HttpResponse::text(500, e.what());
+  }
+  if (response.later)
+    return;
+  c.deferred = false;
+  respond(c, response);
+}
+
+void HttpServer::on_disconnect(PollClient& polled) {
+  Client& c = client(polled);
+  if (c.deferred) {
+    c.deferred = false;
+    handler_.abandon(c.id());
+  }
 }
 
 void HttpServer::on_input(PollClient& polled, std::string_view bytes) {
@@ -214,11 +269,17 @@ void HttpServer::try_answer(Client& c) {
       break;
   }
   c.input.clear();
+  request.client = c.id();
   HttpResponse response;
   try {
     response = answer(request);
   } catch (const std::exception& e) {
     response = HttpResponse::text(500, e.what());
+  }
+  if (response.later) {
+    c.answered = true;  // nothing more is read; resume() answers it
+    c.deferred = true;
+    return;
   }
   respond(c, response);
 }
@@ -269,7 +330,18 @@ std::string HttpServer::format(const HttpResponse& r) {
   return head + r.body;
 }
 
-void HttpServer::respond(Client& c, const HttpResponse& r) {
+void HttpServer::respond(Client& c, const HttpResponse& response) {
+  const std::size_t max_streams = options_.max_clients > options_.reserved_for_requests
+                                      ? options_.max_clients - options_.reserved_for_requests
+                                      : 1;
+  if (response.stream && response.status == 200 && stream_count() >= max_streams) {
+    stats_.refused_streams.fetch_add(1, std::memory_order_relaxed);
+    respond(c, HttpResponse::text(503, fmt::format("too many event streams (at most {}; the "
+                                                   "other slots are kept for requests)",
+                                                   max_streams)));
+    return;
+  }
+  const HttpResponse& r = response;
   c.answered = true;
   core_->queue(c, format(r));
   if (r.stream && r.status == 200) {

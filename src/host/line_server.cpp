@@ -1,5 +1,7 @@
 #include "piezoshift/host/line_server.hpp"
 
+#include <algorithm>
+#include <chrono>
 #include <stdexcept>
 #include <utility>
 
@@ -33,6 +35,8 @@ void check_limits(const LineServerLimits& limits, const std::string& where) {
     fail("idle_timeout_s must be > 0 (+inf: no timeout)");
   if (!(limits.send_timeout_s > 0.0))
     fail("send_timeout_s must be > 0 (+inf: no timeout)");
+  if (!(limits.turn_budget_s > 0.0))
+    fail("turn_budget_s must be > 0 (+inf: lines and bytes alone bound a turn)");
 }
 
 }  // namespace
@@ -63,6 +67,7 @@ LineServer::LineServer(const ListenAddress& address, const LineServerLimits& lim
   core.max_pending_output_bytes = limits.max_pending_output_bytes;
   core.send_timeout_s = limits.send_timeout_s;
   core.idle_timeout_s = limits.idle_timeout_s;
+  core.evict_idle_when_full_s = limits.evict_idle_when_full_s;
   core_ = std::make_unique<PollServer>(ip, address.port, "TCP server", where, core,
                                        static_cast<PollProtocol&>(*this));
 }
@@ -86,6 +91,8 @@ LineServerStats LineServer::stats() const {
   s.refused_max_clients = c.refused_max_clients;
   s.disconnected_slow = c.evicted_slow;
   s.disconnected_idle = c.evicted_idle;
+  s.evicted_for_room = c.evicted_for_room;
+  s.rounds = c.rounds;
   s.overlong_lines = overlong_lines_.load(std::memory_order_relaxed);
   s.bytes_in = c.bytes_in;
   s.bytes_out = c.bytes_out;
@@ -114,7 +121,7 @@ bool LineServer::wants_input(const PollClient& c) const {
 }
 
 bool LineServer::has_work(const PollClient& c) const {
-  return !client(c).unread.empty() && !throttled(c);
+  return (!client(c).unread.empty() || handler_.answer_pending(c.id())) && !throttled(c);
 }
 
 void LineServer::on_input(PollClient& c, std::string_view bytes) {
@@ -129,18 +136,32 @@ void LineServer::on_end_of_input(PollClient& c) {
 }
 
 void LineServer::finish_if_done(Client& c) {
-  if (c.input_ended() && c.unread.empty())
+  if (c.input_ended() && c.unread.empty() && !handler_.answer_pending(c.id()))
     core_->finish(c);
 }
 
 void LineServer::serve(PollClient& polled) {
   Client& c = client(polled);
-  if (c.unread.empty() || throttled(c))
+  if ((c.unread.empty() && !handler_.answer_pending(c.id())) || throttled(c))
     return;
   std::string_view data = c.unread;
   std::size_t handled = 0;
   const auto answer = [&](std::string&& bytes) { core_->queue(c, bytes); };
-  while (!data.empty() && !c.closing() && handled < kLinesPerTurn && !throttled(c)) {
+  // The first line always runs; before each further one the clock is read.
+  const auto turn_end = std::chrono::steady_clock::now() +
+                        std::chrono::duration_cast<std::chrono::steady_clock::duration>(
+                            std::chrono::duration<double>(std::min(limits_.turn_budget_s, 1e6)));
+  const auto within_turn = [&] {
+    return handled == 0 || std::chrono::steady_clock::now() < turn_end;
+  };
+  while (!c.closing() && handled < kLinesPerTurn && !throttled(c) && within_turn()) {
+    if (handler_.answer_pending(c.id())) {
+      ++handled;
+      answer(handler_.more_answer(c.id()));
+      continue;
+    }
+    if (data.empty())
+      break;
     const std::size_t lf = data.find('\n');
     if (c.discarding) {  // the rest of an overlong line, already reported
       if (lf == std::string_view::npos) {

@@ -7,6 +7,7 @@
 #include <cerrno>
 #include <cmath>
 #include <cstring>
+#include <limits>
 #include <stdexcept>
 #include <utility>
 
@@ -37,6 +38,8 @@ const PollServerLimits& checked(const PollServerLimits& limits, const std::strin
     fail("idle_timeout_s must be > 0 (+inf: no timeout)");
   if (!(limits.send_timeout_s > 0.0))
     fail("send_timeout_s must be > 0 (+inf: no timeout)");
+  if (!(limits.evict_idle_when_full_s >= 0.0))
+    fail("evict_idle_when_full_s must be >= 0 (+inf: never)");
   return limits;
 }
 
@@ -74,6 +77,8 @@ PollServerStats PollServer::stats() const {
   s.refused_max_clients = stats_.refused_max_clients.load(r);
   s.evicted_slow = stats_.evicted_slow.load(r);
   s.evicted_idle = stats_.evicted_idle.load(r);
+  s.evicted_for_room = stats_.evicted_for_room.load(r);
+  s.rounds = stats_.rounds.load(r);
   s.bytes_in = stats_.bytes_in.load(r);
   s.bytes_out = stats_.bytes_out.load(r);
   s.accept_failures = listener_.accept_failures();
@@ -101,6 +106,7 @@ void PollServer::run(const std::atomic<int>* stop_flag, int poll_interval_ms) {
       // Accept after closing, so that a slot freed in this round is available at once.
       if (fds_[1].revents & POLLIN)
         accept_clients();
+      stats_.rounds.fetch_add(1, std::memory_order_relaxed);
     }
   } catch (...) {
     close_all_clients();
@@ -153,6 +159,8 @@ void PollServer::accept_clients() {
     const int fd = listener_.accept_client();
     if (fd < 0)
       return;
+    if (clients_.size() >= limits_.max_clients && make_room())
+      close_marked_clients();
     if (clients_.size() >= limits_.max_clients) {
       // Accept and close rather than leave it in the backlog: the peer learns at once.
       stats_.refused_max_clients.fetch_add(1, std::memory_order_relaxed);
@@ -173,6 +181,28 @@ void PollServer::accept_clients() {
     stats_.accepted.fetch_add(1, std::memory_order_relaxed);
     protocol_.on_connect(*clients_.back());
   }
+}
+
+bool PollServer::make_room() {
+  if (!(limits_.evict_idle_when_full_s < std::numeric_limits<double>::infinity()))
+    return false;
+  const auto min_idle = std::chrono::duration_cast<Clock::duration>(
+      std::chrono::duration<double>(limits_.evict_idle_when_full_s));
+  const auto now = Clock::now();
+  PollClient* idlest = nullptr;
+  for (auto& c : clients_) {
+    // Only a client waiting for its peer: one whose input ended, or whose input the protocol does
+    // not want (an answer on its way, a throttled reader), is busy by our side's doing.
+    if (c->closing() || c->input_ended_ || !protocol_.wants_input(*c) ||
+        now - c->last_input_ < min_idle)
+      continue;
+    if (idlest == nullptr || c->last_input_ < idlest->last_input_)
+      idlest = c.get();  // ties: the older connection, met first
+  }
+  if (idlest == nullptr)
+    return false;
+  idlest->close_ = PollClient::Close::kRoom;
+  return true;
 }
 
 void PollServer::read_from(PollClient& c) {
@@ -282,6 +312,8 @@ void PollServer::close_marked_clients() {
       stats_.evicted_slow.fetch_add(1, std::memory_order_relaxed);
     if (c->close_ == PollClient::Close::kIdle)
       stats_.evicted_idle.fetch_add(1, std::memory_order_relaxed);
+    if (c->close_ == PollClient::Close::kRoom)
+      stats_.evicted_for_room.fetch_add(1, std::memory_order_relaxed);
     close_fd(c->fd_);
     closed.push_back(std::move(c));
   }

@@ -36,6 +36,16 @@ std::string one_line(std::string_view s) {
   return out;
 }
 
+// Text at the end of a comment line: on one line, and not ending in a backslash, which gnuplot
+// reads as a line continuation that would take the next line into the comment (the fuzz target
+// `plot` found a title ending in one).
+std::string comment_end(std::string_view s) {
+  std::string out = one_line(s);
+  if (!out.empty() && out.back() == '\\')
+    out += ' ';
+  return out;
+}
+
 // gnuplot single-quoted string: '' stands for one quote, and nothing else is special in it
 // (a backslash is a backslash); on one line.
 std::string gp_quote(std::string_view s) {
@@ -317,7 +327,7 @@ PlotFiles write_plot_files(const Figure& figure, const fs::path& stem_in) {
       "# Redraw after editing: run `gnuplot {}.gp` in this folder.\n"
       "datafile = {}\n"
       "set encoding utf8\n",
-      figure.title.empty() ? "" : ": ", one_line(figure.title), one_line(name),
+      figure.title.empty() ? "" : ": ", comment_end(figure.title), one_line(name),
       gp_quote(name + ".dat"));
   const std::string size = fmt::format("size {},{}", figure.width_px, figure.height_px);
   if (figure.png) {

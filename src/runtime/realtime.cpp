@@ -58,4 +58,17 @@ RealtimeReport request_realtime(const RealtimeRequest& request) {
   return report;
 }
 
+bool keep_off_cpu(std::thread& thread, int cpu) {
+  if (cpu < 0 || cpu >= CPU_SETSIZE || !thread.joinable())
+    return false;
+  cpu_set_t set;
+  CPU_ZERO(&set);
+  if (::pthread_getaffinity_np(thread.native_handle(), sizeof(set), &set) != 0)
+    return false;
+  CPU_CLR(cpu, &set);
+  if (CPU_COUNT(&set) == 0)
+    return false;
+  return ::pthread_setaffinity_np(thread.native_handle(), sizeof(set), &set) == 0;
+}
+
 }  // namespace piezoshift::runtime

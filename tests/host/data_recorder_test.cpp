@@ -2,6 +2,7 @@
 // restart trigger, and DRR?'s header-then-columns text parsed back.
 #include <gtest/gtest.h>
 
+#include <algorithm>
 #include <cmath>
 #include <cstdlib>
 #include <limits>
@@ -363,6 +364,31 @@ TEST(DataRecorderTest, OffTableIsSkippedByDefaultRead) {
   EXPECT_EQ(p.header.at("NAME0"), "Current position of axis Z (um)");
   ASSERT_EQ(p.rows.size(), 2u);
   EXPECT_NEAR(p.rows[1].at(0), input_at(1).position[0], 1e-8);
+}
+
+// A DRR? made a part at a time (issue 27: the server answers other clients between the parts)
+// is read()'s answer byte for byte, each part whole rows of at most max_values values.
+TEST(DataRecorderTest, PartsJoinedAreTheWholeRead) {
+  DataRecorder r;
+  ASSERT_EQ(r.configure(3, "1", 7), GcsError::kNone);
+  for (int k = 0; k < 1000; ++k)
+    r.record(input_at(k));
+  std::string whole;
+  ASSERT_EQ(r.read(3, 990, {}, 1e-3, whole), GcsError::kNone);
+  std::string joined;
+  DataRecorder::Reading reading;
+  ASSERT_EQ(r.start_read(3, 990, {}, 1e-3, joined, reading), GcsError::kNone);
+  int parts = 0;
+  while (reading.pending()) {
+    std::string part;
+    DataRecorder::continue_read(reading, part, 100);  // 33 rows of 3 columns
+    EXPECT_EQ(std::count(part.begin(), part.end(), '\n'), parts < 30 ? 33 : 0) << parts;
+    joined += part;
+    ++parts;
+  }
+  EXPECT_EQ(parts, 30);  // 990 rows
+  EXPECT_EQ(joined, whole);
+  EXPECT_EQ(whole.back(), '\n');
 }
 
 }  // namespace

@@ -8,6 +8,8 @@
 
 #include <atomic>
 #include <chrono>
+#include <limits>
+#include <map>
 #include <string>
 #include <thread>
 #include <vector>
@@ -179,6 +181,9 @@ TEST(HttpBind, ANonLoopbackAddressNeedsAToken) {
 TEST_F(Http, OneClientTooManyGets503) {
   HttpServerOptions o;
   o.max_clients = 2;
+  // The refusal itself: no slot kept from streams, no room made (poll_server_test.cpp has those).
+  o.reserved_for_requests = 0;
+  o.evict_idle_when_full_s = std::numeric_limits<double>::infinity();
   start(o);
   HttpConnection a(server_->port());
   HttpConnection b(server_->port());
@@ -252,3 +257,60 @@ TEST_F(Http, OutOfDescriptorsItPausesAcceptingAndServesTheClientsItHas) {
 }
 
 }  // namespace
+
+namespace {
+
+// "/later" is answered after `parts` calls of resume(), one per round; the others at once.
+class LaterHandler : public HttpHandler {
+ public:
+  HttpResponse on_request(const HttpRequest& r) override {
+    if (r.path != "/later")
+      return HttpResponse::text(200, "now");
+    remaining[r.client] = parts;
+    return HttpResponse::deferred();
+  }
+  HttpResponse resume(std::uint64_t client) override {
+    ++resumes;
+    if (--remaining[client] > 0)
+      return HttpResponse::deferred();
+    remaining.erase(client);
+    return HttpResponse::text(200, "later");
+  }
+  void abandon(std::uint64_t client) override {
+    remaining.erase(client);
+    ++abandoned;
+  }
+  int parts = 5;
+  std::map<std::uint64_t, int> remaining;  // run() thread only
+  std::atomic<int> resumes{0};
+  std::atomic<int> abandoned{0};
+};
+
+}  // namespace
+
+// A handler that answers in parts (a dashboard POST's GCS lines): resume() once per round until
+// it answers, another request answered meanwhile; one not ready within the request timeout is
+// abandoned and answered 503.
+TEST(HttpLater, ADeferredRequestIsResumedUntilAnsweredOrGivenUpAtTheTimeout) {
+  LaterHandler handler;
+  HttpServerOptions options;
+  options.request_timeout_s = 0.5;
+  HttpServer server(options, handler);
+  std::thread thread([&] { server.run(nullptr, 2); });
+  const std::string host = "Host: 127.0.0.1:" + std::to_string(server.port()) + "\r\n";
+  const std::string later = http_exchange(server.port(), "GET /later HTTP/1.1\r\n" + host + "\r\n");
+  EXPECT_EQ(http_status(later), 200);
+  EXPECT_EQ(http_body(later), "later\n");
+  EXPECT_EQ(handler.resumes.load(), 5);
+
+  handler.parts = 1000000;  // never done: the request timeout gives it up
+  HttpConnection c(server.port());
+  c.send("GET /later HTTP/1.1\r\n" + host + "\r\n");
+  // Another client is answered while it is resumed.
+  EXPECT_EQ(http_body(http_exchange(server.port(), "GET / HTTP/1.1\r\n" + host + "\r\n")), "now\n");
+  EXPECT_EQ(http_status(c.read_all(10.0)), 503);
+  server.stop();
+  thread.join();
+  EXPECT_EQ(handler.abandoned.load(), 1);
+  EXPECT_TRUE(handler.remaining.empty());
+}

@@ -13,6 +13,7 @@
 #include <chrono>
 #include <exception>
 #include <functional>
+#include <limits>
 #include <memory>
 #include <mutex>
 #include <set>
@@ -251,6 +252,8 @@ TEST(LineServerLimits, ConnectionBeyondMaxClientsIsClosedAtOnce) {
   TestHandler handler;
   LineServerLimits limits;
   limits.max_clients = 2;
+  // The refusal itself: no silent client gives way (poll_server_test.cpp has that rule).
+  limits.evict_idle_when_full_s = std::numeric_limits<double>::infinity();
   ServerThread server(handler, limits);
   auto first = server.connect();
   auto second = server.connect();

@@ -8,6 +8,10 @@
 //   slow       a reader that never reads is evicted once its send queue exceeds its bound (and
 //              counted), while another client keeps being answered.
 //   refusal    a connection beyond max_clients is refused and counted on both.
+//   room       with the table full, a newcomer takes the place of the client silent longest
+//              (issue 27: eight silent GCS clients locked everyone out for the 600 s idle
+//              timeout); event streams leave slots for requests (sixteen streams made every
+//              other dashboard request a 503).
 // Descriptor exhaustion (the accept back-off) is pinned for both in line_server_test.cpp and
 // http_server_test.cpp (OutOfDescriptorsItPausesAcceptingAndServesTheClientsItHas).
 #include <fcntl.h>
@@ -23,9 +27,11 @@
 #include <cstdint>
 #include <functional>
 #include <limits>
+#include <memory>
 #include <string>
 #include <string_view>
 #include <thread>
+#include <vector>
 
 #include "../support/http_client.hpp"
 #include "piezoshift/host/gcs_client.hpp"
@@ -184,6 +190,24 @@ TEST(PollServerFairness, LineFloodDelaysAnotherClientByAtMostTwoRoundsOfLines) {
   EXPECT_GE(handler.echoes_beside_the_flood, 1);
 }
 
+// The turn's time budget (1 ms by default) ends a turn after the line that crosses it: with a
+// budget of 1 ns every turn is that one line, however cheap, so the count, not a clock, shows it.
+TEST(PollServerFairness, LineTurnEndsOnceItsTimeIsSpent) {
+  LineCounting handler;
+  LineServerLimits limits;
+  limits.turn_budget_s = 1e-9;
+  LineServer server(ListenAddress{"127.0.0.1", 0, false}, limits, handler);
+  {
+    Running running(server);
+    const Flooder flooder(server.port(), "", "F\n");
+    ASSERT_TRUE(eventually([&] { return handler.flood_lines.load() > 100; }));
+    GcsClient other("127.0.0.1", server.port());
+    EXPECT_EQ(other.query("ECHO 1"), "1\n");
+  }
+  EXPECT_EQ(handler.most_flood_in_one_round, 1);
+  EXPECT_LE(handler.most_flood_before_an_echo, 2);
+}
+
 TEST(PollServerSlowReader, LineReaderWhoseQueueExceedsTheBoundIsEvicted) {
   LineCounting handler;
   LineServerLimits limits;
@@ -215,6 +239,7 @@ TEST(PollServerRefusal, LineConnectionBeyondMaxClientsIsCounted) {
   LineCounting handler;
   LineServerLimits limits;
   limits.max_clients = 1;
+  limits.evict_idle_when_full_s = std::numeric_limits<double>::infinity();  // the refusal alone
   LineServer server(ListenAddress{"127.0.0.1", 0, false}, limits, handler);
   Running running(server);
   GcsClient first("127.0.0.1", server.port());
@@ -223,6 +248,49 @@ TEST(PollServerRefusal, LineConnectionBeyondMaxClientsIsCounted) {
   EXPECT_TRUE(second.wait_closed(10.0));
   EXPECT_EQ(server.stats().refused_max_clients, 1u);
   EXPECT_EQ(server.stats().accepted, 1u);
+}
+
+// Issue 27: eight GCS clients that connect and say nothing held every slot until the idle
+// timeout. Now a ninth takes the place of the one silent longest, the first.
+TEST(PollServerRoom, LineSilentClientsGiveWayToANewcomer) {
+  LineCounting handler;
+  LineServerLimits limits;              // max_clients 8
+  limits.evict_idle_when_full_s = 0.0;  // silent at all is enough (default: 1 s of silence)
+  LineServer server(ListenAddress{"127.0.0.1", 0, false}, limits, handler);
+  Running running(server);
+  std::vector<std::unique_ptr<GcsClient>> silent;
+  for (std::size_t i = 0; i < limits.max_clients; ++i) {
+    silent.push_back(std::make_unique<GcsClient>("127.0.0.1", server.port()));
+    // One at a time, so that the first is the one silent longest.
+    ASSERT_TRUE(eventually([&] { return server.client_count() == i + 1; }));
+  }
+  GcsClient ninth("127.0.0.1", server.port());
+  EXPECT_EQ(ninth.query("ECHO 9"), "9\n");
+  EXPECT_TRUE(silent.front()->wait_closed(10.0));
+  EXPECT_EQ(server.stats().evicted_for_room, 1u);
+  EXPECT_EQ(server.stats().refused_max_clients, 0u);
+  EXPECT_EQ(server.client_count(), limits.max_clients);
+  // The others kept their places.
+  for (std::size_t i = 1; i < silent.size(); ++i)
+    EXPECT_EQ(silent[i]->query("ECHO " + std::to_string(i)), std::to_string(i) + "\n");
+}
+
+// A client that spoke more recently than evict_idle_when_full_s keeps its place: the newcomer
+// is refused as before.
+TEST(PollServerRoom, LineRecentlyActiveClientKeepsItsPlace) {
+  LineCounting handler;
+  LineServerLimits limits;
+  limits.max_clients = 1;
+  limits.evict_idle_when_full_s = 3600.0;
+  LineServer server(ListenAddress{"127.0.0.1", 0, false}, limits, handler);
+  Running running(server);
+  GcsClient first("127.0.0.1", server.port());
+  EXPECT_EQ(first.query("ECHO 1"), "1\n");
+  GcsClient second("127.0.0.1", server.port());
+  EXPECT_TRUE(second.wait_closed(10.0));
+  EXPECT_EQ(first.query("ECHO 2"), "2\n");
+  EXPECT_EQ(server.stats().evicted_for_room, 0u);
+  EXPECT_EQ(server.stats().refused_max_clients, 1u);
 }
 
 // ---- HttpServer ----
@@ -338,6 +406,7 @@ TEST(PollServerRefusal, HttpConnectionBeyondMaxClientsGets503AndIsCounted) {
   HttpCounting handler;
   HttpServerOptions options;
   options.max_clients = 1;
+  options.evict_idle_when_full_s = std::numeric_limits<double>::infinity();  // the refusal alone
   HttpServer server(options, handler);
   Running running(server);
   HttpConnection stream(server.port());
@@ -346,6 +415,64 @@ TEST(PollServerRefusal, HttpConnectionBeyondMaxClientsGets503AndIsCounted) {
   ASSERT_TRUE(eventually([&] { return handler.streams.load() == 1; }));
   EXPECT_EQ(http_status(testing::http_exchange(server.port(), get_root(server.port()))), 503);
   EXPECT_EQ(server.stats().refused_max_clients, 1u);
+}
+
+// Opens one event stream; its status (200, or 503 when streams have no slot left).
+int open_stream(HttpConnection& c, std::uint16_t port) {
+  c.send("GET /stream HTTP/1.1\r\nHost: 127.0.0.1:" + std::to_string(port) + "\r\n\r\n");
+  std::string got;
+  for (int i = 0; i < 100 && got.find("\r\n\r\n") == std::string::npos; ++i)
+    if (!c.read_some(got, 0.1))
+      break;
+  return http_status(got);
+}
+
+// Issue 27: sixteen event streams, which never time out, made every other request a 503. Streams
+// may take all but reserved_for_requests (2) of the 16 slots; a GET is answered beside them.
+TEST(PollServerRoom, HttpStreamsLeaveSlotsForRequests) {
+  HttpCounting handler;
+  HttpServerOptions options;  // 16 clients, 2 reserved for requests
+  options.evict_idle_when_full_s = std::numeric_limits<double>::infinity();  // the reserve alone
+  HttpServer server(options, handler);
+  Running running(server);
+  std::vector<std::unique_ptr<HttpConnection>> streams;
+  int opened = 0;
+  int refused = 0;
+  for (std::size_t i = 0; i < options.max_clients; ++i) {
+    streams.push_back(std::make_unique<HttpConnection>(server.port()));
+    const int status = open_stream(*streams.back(), server.port());
+    opened += status == 200 ? 1 : 0;
+    refused += status == 503 ? 1 : 0;
+  }
+  EXPECT_EQ(opened, 14);
+  EXPECT_EQ(refused, 2);
+  EXPECT_EQ(http_status(testing::http_exchange(server.port(), get_root(server.port()))), 200);
+  EXPECT_EQ(server.stats().refused_streams, 2u);
+  EXPECT_EQ(server.stats().refused_max_clients, 0u);
+}
+
+// With no slot kept for requests, a full table of streams gives the longest-open one's place to
+// a newcomer (EventSource reconnects by itself, after its retry).
+TEST(PollServerRoom, HttpOldestStreamGivesWayWhenTheTableIsFull) {
+  HttpCounting handler;
+  HttpServerOptions options;
+  options.reserved_for_requests = 0;
+  options.evict_idle_when_full_s = 0.0;
+  HttpServer server(options, handler);
+  Running running(server);
+  std::vector<std::unique_ptr<HttpConnection>> streams;
+  for (std::size_t i = 0; i < options.max_clients; ++i) {
+    streams.push_back(std::make_unique<HttpConnection>(server.port()));
+    ASSERT_EQ(open_stream(*streams.back(), server.port()), 200);
+  }
+  ASSERT_TRUE(eventually([&] { return handler.streams.load() == options.max_clients; }));
+  EXPECT_EQ(http_status(testing::http_exchange(server.port(), get_root(server.port()))), 200);
+  EXPECT_EQ(server.stats().evicted_for_room, 1u);
+  std::string rest;
+  bool open = true;
+  for (int i = 0; i < 100 && open; ++i)
+    open = streams.front()->read_some(rest, 0.1);
+  EXPECT_FALSE(open) << "the first stream was not the one closed";
 }
 
 }  // namespace

@@ -17,13 +17,21 @@
 //   controls  POST /api/command {"commands": ["SVO Z 1 U 1 V 1", "MOV Z 5"]}: each line goes
 //             through GcsInterpreter::on_line on the dashboard's own GCS session, then ERR?; the
 //             first error stops the list and is answered with its GCS number and text. So every
-//             limit and error of GCS applies unchanged.
+//             limit and error of GCS applies unchanged. The lines run in turns, as a GCS
+//             client's do (HttpResponse::deferred(), resume()): one turn holds the mutex for at
+//             most LineServer::kLinesPerTurn lines, stops once its answers reach 16 KiB or it
+//             has taken turn_budget_s (the line that crosses is finished), and the next turn is
+//             the next round's, so a GCS client waits for at most one turn of a POST. The
+//             answers of one POST are at most max_answer_bytes (beyond: 413, the lines before
+//             it applied)
 // The mutex is the one the GCS thread holds around the interpreter (LockedLineHandler); the HTTP
-// thread holds it only to copy samples out and to run command lines, never across I/O.
+// thread holds it only to copy samples out and to run one turn of command lines, never across
+// I/O.
 #include <atomic>
 #include <cstddef>
 #include <cstdint>
 #include <deque>
+#include <map>
 #include <mutex>
 #include <string>
 #include <string_view>
@@ -42,6 +50,10 @@ struct DashboardOptions {
   double timing_window_s = 10.0;       //!< wake-latency percentiles over this span
   std::size_t max_commands = 32;       //!< per POST
   std::size_t max_command_bytes = 256;
+  //! A POST's answers in all; a line whose answer crosses it ends the request with 413.
+  std::size_t max_answer_bytes = std::size_t{2} << 20;
+  //! One turn of a POST's lines stops once it has taken this long [s] (LineServerLimits').
+  double turn_budget_s = 1e-3;
   std::string daq_name = "sim";
 };
 
@@ -69,6 +81,9 @@ class Dashboard final : public HttpHandler, public SampleObserver {
   //! HTTP thread.
   HttpResponse on_request(const HttpRequest& request) override;
   void on_poll(HttpServer& server) override;
+  //! One turn of a POST's command lines.
+  HttpResponse resume(std::uint64_t client) override;
+  void abandon(std::uint64_t client) override;
 
   //! Any thread.
   void set_realtime(const DashboardRealtime& rt) noexcept;
@@ -95,7 +110,24 @@ class Dashboard final : public HttpHandler, public SampleObserver {
     std::int8_t fault_channel = -1;
   };
 
+  //! A POST's lines, run a turn at a time (resume()).
+  struct Job {
+    std::vector<std::string> lines;
+    std::size_t next = 0;  //!< the first line not run yet
+    bool started = false;  //!< errors queued before the request have been taken
+    std::size_t answer_bytes = 0;
+    std::string partial;     //!< the answer of lines[next - 1] so far
+    bool in_answer = false;  //!< its answer has parts to come (GcsInterpreter::answer_pending)
+    std::vector<std::string> answers;
+    bool done = false;
+    int code = 0;             //!< the GCS error that stopped it (0: none)
+    std::string failed_line;  //!< the line that stopped it (an error, or answers too large)
+  };
   HttpResponse command(const HttpRequest& request);
+  //! Runs lines of the job within one turn's budget, under the mutex.
+  void run_turn(Job& job);
+  //! The response of a finished job.
+  HttpResponse job_response(const Job& job) const;
   std::string status_json();
   std::string samples_json(const std::vector<Row>& rows) const;
   //! Under the mutex: a query on the dashboard's session, its answer lines.
@@ -110,6 +142,11 @@ class Dashboard final : public HttpHandler, public SampleObserver {
   // Filled by on_sample (under mutex_), emptied by on_poll.
   std::vector<Row> pending_;
   std::uint64_t pending_dropped_ = 0;
+
+  // HTTP thread only: the POSTs being run, by HttpRequest::client.
+  std::map<std::uint64_t, Job> jobs_;
+  //! The job whose lines run (one at a time: they share the dashboard's session); 0: none.
+  std::uint64_t running_job_ = 0;
 
   // HTTP thread only.
   std::uint64_t next_update_ns_ = 0;

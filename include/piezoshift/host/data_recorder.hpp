@@ -16,7 +16,10 @@
 //               DRT's trigger says (record_trigger.hpp; by default on every motion command);
 //               it stops when kPoints are held.
 //   DRR?        GCS's data form: "# KEY = value" header lines ending with "# END_HEADER", then one
-//               line per point, columns separated by a space (SEPARATOR = 32).
+//               line per point, columns separated by a space (SEPARATOR = 32). Made a part at a
+//               time (start_read, continue_read: kValuesPerPart values, ~0.7 ms of formatting;
+//               the whole of kMaxAnswerBytes took 11 ms of CPU), so that the server answers the
+//               other clients between the parts; the values are copied when the read starts.
 // Not thread-safe: the server's one network thread owns it.
 #include <array>
 #include <cstddef>
@@ -50,6 +53,17 @@ class DataRecorder {
   static constexpr std::size_t kHeaderBytes = 1024;
   static constexpr std::size_t kMaxAnswerBytes =
       kHeaderBytes + kPoints * static_cast<std::size_t>(kTables) * kValueBytes;
+  //! Values formatted per part of a DRR? answer (whole rows, at least one).
+  static constexpr std::size_t kValuesPerPart = 4096;
+
+  //! A DRR? answer under way: the values it reads, copied when it started (at most kTables x
+  //! kPoints doubles, 512 KiB), and how far it has got.
+  struct Reading {
+    std::vector<double> values;  //!< row after row, `columns` values each
+    std::size_t columns = 0;
+    std::size_t next = 0;  //!< the first value not in the answer yet
+    bool pending() const noexcept { return next < values.size(); }
+  };
 
   DataRecorder();
 
@@ -74,6 +88,12 @@ class DataRecorder {
   //! answer is at most kMaxAnswerBytes.
   GcsError read(long long start, long long count, const std::vector<int>& tables,
                 double servo_cycle_s, std::string& answer) const;
+  //! read() a part at a time: answer := the header, reading := the values to answer. Then
+  //! continue_read() until !reading.pending(); the parts joined are read()'s answer.
+  GcsError start_read(long long start, long long count, const std::vector<int>& tables,
+                      double servo_cycle_s, std::string& answer, Reading& reading) const;
+  //! Appends the next rows of reading, at most max(max_values, one row) values, to answer.
+  static void continue_read(Reading& reading, std::string& answer, std::size_t max_values);
 
  private:
   struct Table {

@@ -62,10 +62,21 @@ struct GcsStats {
   std::uint64_t lines = 0;           //!< command lines handled
   std::uint64_t errors = 0;          //!< GCS errors queued
   std::uint64_t faults = 0;          //!< supervisor faults seen
+  std::uint64_t answer_bytes = 0;    //!< answers made to command lines (parts included)
 };
 
 class GcsInterpreter final : public LineHandler {
  public:
+  //! Axes, channels, tables or parameters one query names at most (`POS? Z Z ...`; more: error
+  //! 24): an answer grows with its list, so the list is bounded, not only the line.
+  static constexpr std::size_t kMaxQueryItems = 64;
+  //! Every answer to one line, its parts joined, is at most this (the largest DRR?); a part
+  //! (what one turn makes) at most kMaxPartBytes or, for the answers that echo an argument
+  //! (SPA? items), the line's length and kMaxPartBytes.
+  static constexpr std::size_t kMaxAnswerBytes = DataRecorder::kMaxAnswerBytes;
+  static constexpr std::size_t kMaxPartBytes =
+      DataRecorder::kHeaderBytes + DataRecorder::kValuesPerPart * DataRecorder::kValueBytes;
+
   GcsInterpreter(const StageModel& model, runtime::HostLink& link, double servo_cycle_s,
                  const GcsOptions& options);
 
@@ -76,6 +87,10 @@ class GcsInterpreter final : public LineHandler {
   bool is_immediate(char byte) const override;
   std::string on_immediate(ClientId client, char byte) override;
   void on_poll() override { drain(); }
+  //! A DRR? answer is made a part at a time (DataRecorder::kValuesPerPart values): on_line()
+  //! answers the header and the first part, more_answer() the next; a new line drops the rest.
+  bool answer_pending(ClientId client) const override;
+  std::string more_answer(ClientId client) override;
 
   //! Takes every sample the loop has pushed (also done before each command).
   void drain();
@@ -92,6 +107,7 @@ class GcsInterpreter final : public LineHandler {
   using Args = std::vector<std::string_view>;
   struct Session {
     std::deque<GcsError> errors;
+    DataRecorder::Reading reading;  //!< the rest of a DRR? answer
   };
   //! Returns the answer (empty for set commands) or fails the session.
   using Handler = std::string (GcsInterpreter::*)(Session&, const Args&);

@@ -3,6 +3,7 @@
 // "METHOD target HTTP/1.x" (LF or CRLF line ends), headers, a body only with Content-Length
 // (no chunked uploads: nothing here needs them).
 #include <cstddef>
+#include <cstdint>
 #include <map>
 #include <string>
 #include <string_view>
@@ -15,6 +16,8 @@ struct HttpRequest {
   std::map<std::string, std::string> query;    //!< decoded ?key=value pairs
   std::map<std::string, std::string> headers;  //!< names in lower case
   std::string body;
+  //! The connection (its poll server's ClientId), set by the server: HttpResponse::later().
+  std::uint64_t client = 0;
   std::string header(const std::string& lower_name) const;
 };
 

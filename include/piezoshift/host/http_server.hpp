@@ -16,7 +16,18 @@
 //              a POST must be application/json (a cross-site form cannot send that) from no Origin
 //              or this server's own (403)
 //   streams    a handler may answer with a stream (Server-Sent Events): the connection stays
-//              open and receives every broadcast() until it closes or reads too slowly
+//              open and receives every broadcast() until it closes or reads too slowly. Streams
+//              take at most max_clients - reserved_for_requests slots (at least one), so
+//              ordinary requests always find a slot; one more stream gets 503
+//   later      a handler may answer HttpResponse::later() and give the response in parts: the
+//              server calls resume() once a round (serving every other client in between) until
+//              it returns one, or abandon() when the connection ends first (reset, or the request
+//              timeout, which answers 503)
+//   room       with max_clients connected, a new connection takes the place of the one silent
+//              longest (a stream: the one opened first) if silent for evict_idle_when_full_s
+//              (poll_server.hpp); otherwise it gets 503
+//   memory     per client: max_request_bytes + max_body_bytes of request, max_pending_output_bytes
+//              of queued answer and events (the handler's own state aside)
 //   poll       it runs on the shared poll server (poll_server.hpp), as the GCS LineServer does: one
 //              thread, the accept back-off, at most kReadChunkBytes read from a client per round,
 //              bounded send queues with slow-reader eviction
@@ -47,6 +58,11 @@ struct HttpServerOptions {
   std::size_t max_body_bytes = 16384;    //!< POST bodies
   double request_timeout_s = 10.0;       //!< for a request to arrive and its answer to be taken
   std::size_t max_pending_output_bytes = std::size_t{4} << 20;  //!< per client
+  //! Slots event streams cannot take (they get 503), so that requests always find one.
+  std::size_t reserved_for_requests = 2;
+  //! A full table's newcomer takes the place of the client silent longest if silent this long
+  //! [s] (PollServerLimits::evict_idle_when_full_s); 0: always, +inf: never.
+  double evict_idle_when_full_s = 1.0;
 };
 
 struct HttpResponse {
@@ -56,9 +72,13 @@ struct HttpResponse {
   //! Keep the connection open as a text/event-stream that receives HttpServer::broadcast();
   //! body is sent first (e.g. a first event).
   bool stream = false;
+  //! Not answered yet: the server calls HttpHandler::resume() every round until it answers.
+  bool later = false;
 
   static HttpResponse text(int status, std::string body);
   static HttpResponse json(int status, std::string body);
+  //! See `later` above.
+  static HttpResponse deferred();
 };
 
 //! "OK", "Not Found", ... for the codes this server uses.
@@ -73,6 +93,12 @@ class HttpHandler {
   virtual HttpResponse on_request(const HttpRequest& request) = 0;
   //! Every turn of run(), at least every poll interval: where a handler broadcasts.
   virtual void on_poll(HttpServer&) {}
+  //! For a request answered HttpResponse::deferred(): called once per round (poll() does not
+  //! sleep meanwhile) with the request's HttpRequest::client until it returns a response that is
+  //! not deferred; it should do a bounded part of the work each time.
+  virtual HttpResponse resume(std::uint64_t client);
+  //! The connection of a deferred request ended (closed, timed out) before its response.
+  virtual void abandon(std::uint64_t) {}
 };
 
 struct HttpServerStats {
@@ -83,6 +109,8 @@ struct HttpServerStats {
   std::uint64_t dropped_slow = 0;         //!< readers beyond max_pending_output_bytes
   std::uint64_t broadcast_bytes = 0;      //!< bytes queued by broadcast(), all streams
   std::uint64_t refused_max_clients = 0;  //!< 503 and closed: max_clients already connected
+  std::uint64_t refused_streams = 0;      //!< 503: the streams' share of the slots was taken
+  std::uint64_t evicted_for_room = 0;     //!< silent longest when a newcomer found the table full
   std::uint64_t bytes_in = 0;             //!< received from all clients
   std::uint64_t bytes_out = 0;            //!< sent (taken by the kernel) to all clients
   //! accept() failed for lack of descriptors or memory; each pauses accepting for 100 ms
@@ -123,7 +151,12 @@ class HttpServer : private PollProtocol {
   //! Broadcasts (the handler's on_poll) and the request timeout.
   void on_round() override;
   bool wants_input(const PollClient& client) const override;
+  bool has_work(const PollClient& client) const override;
   void on_input(PollClient& client, std::string_view bytes) override;
+  void on_end_of_input(PollClient& client) override;
+  //! Resumes a deferred request.
+  void serve(PollClient& client) override;
+  void on_disconnect(PollClient& client) override;
   //! Parses the client's input when a whole request is there; answers it (or an error).
   void try_answer(Client& c);
   HttpResponse answer(const HttpRequest& request);
@@ -137,7 +170,7 @@ class HttpServer : private PollProtocol {
   std::unique_ptr<PollServer> core_;
   struct AtomicStats {
     std::atomic<std::uint64_t> requests{0}, refused{0}, unauthorised{0}, streams_opened{0},
-        broadcast_bytes{0};
+        broadcast_bytes{0}, refused_streams{0};
   } stats_;
 };
 

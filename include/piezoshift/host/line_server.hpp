@@ -5,14 +5,22 @@
 //
 // It runs on the shared poll server (poll_server.hpp: listener, accept back-off, client table,
 // fair reads, bounded send queues, slow and idle eviction); what it adds per round and client:
-//   handle the client's complete lines in the chunk read this round, at most kLinesPerTurn and
-//   none once its queued output reaches output_high_water_bytes: split at LF ->
+//   handle the client's complete lines in the chunk read this round, at most kLinesPerTurn, none
+//   once its queued output reaches output_high_water_bytes, none once its lines have taken
+//   turn_budget_s of this round: split at LF ->
 //   handler.on_line() -> queue the answer (a byte for which handler.is_immediate() holds, where a
-//   line would start: handler.on_immediate() at once, no LF needed)
-// Nothing blocks on one client, and no client's work delays another's by more than one answer:
+//   line would start: handler.on_immediate() at once, no LF needed); an answer the handler makes
+//   in parts (answer_pending()) takes a line's place in the turn for each part, and the client's
+//   next line waits for its last part
+// Nothing blocks on one client, and no client's work delays another's by more than one turn:
 // a round reads at most kReadChunkBytes of each client and handles a bounded number of its
-// lines, and a client that does not read its answers is throttled (its further lines wait, in
-// its own socket, until it reads) and, if it reads nothing for send_timeout_s, disconnected.
+// lines (at most turn_budget_s of them, plus the one line that crosses it: the costliest GCS
+// line is a DRR? of DataRecorder::kMaxAnswerBytes), and a client that does not read its answers
+// is throttled (its further lines wait, in its own socket, until it reads) and, if it reads
+// nothing for send_timeout_s, disconnected. With max_clients connected, a new client takes the
+// place of the one silent longest (at least evict_idle_when_full_s; poll_server.hpp).
+// Memory per client: kReadChunkBytes unread + max_line_bytes + 1 of a partial line +
+// max_pending_output_bytes queued + one answer (at most DataRecorder::kMaxAnswerBytes).
 // Not real-time code (heap, exceptions); it talks to the loop through its handler.
 #include <atomic>
 #include <chrono>
@@ -55,6 +63,13 @@ struct LineServerLimits {
   double send_timeout_s = 10.0;
   //! A client from which no byte arrives for this long [s] is disconnected; +inf: never.
   double idle_timeout_s = 600.0;
+  //! With max_clients connected, a new connection takes the place of the client silent longest
+  //! when it has been silent at least this long [s]; 0: always, +inf: never (the newcomer is
+  //! refused).
+  double evict_idle_when_full_s = 1.0;
+  //! One client's lines handled in one round stop once they have taken this long [s] (the line
+  //! that crosses it is finished): other clients are served in between.
+  double turn_budget_s = 1e-3;
 };
 
 //! What the protocol implements (the GCS interpreter). Called from the run() thread only.
@@ -78,6 +93,12 @@ class LineHandler {
   virtual std::string on_immediate(ClientId, char) { return {}; }
   //! Every turn of the loop, before input is handled: at least every poll interval.
   virtual void on_poll() {}
+  //! True while the answer to the client's last line is not whole (a long DRR?): the server
+  //! asks for the rest with more_answer(), a part per line of a turn's budget, before it hands
+  //! the client's next line to on_line(), so other clients are served between the parts.
+  virtual bool answer_pending(ClientId) const { return false; }
+  //! The next part of the pending answer.
+  virtual std::string more_answer(ClientId) { return {}; }
 };
 
 //! Counters since construction.
@@ -87,6 +108,8 @@ struct LineServerStats {
   //! output beyond max_pending_output_bytes, or none of it taken for send_timeout_s
   std::uint64_t disconnected_slow = 0;
   std::uint64_t disconnected_idle = 0;  //!< nothing received for idle_timeout_s
+  std::uint64_t evicted_for_room = 0;   //!< silent longest when a new client found the table full
+  std::uint64_t rounds = 0;             //!< poll rounds served (a clock for the tests)
   std::uint64_t overlong_lines = 0;     //!< lines longer than max_line_bytes
   std::uint64_t bytes_in = 0;           //!< received from all clients
   std::uint64_t bytes_out = 0;          //!< sent (accepted by the kernel) to all clients

@@ -42,6 +42,14 @@ class LockedLineHandler final : public LineHandler {
     const std::lock_guard lock(mutex_);
     inner_.on_poll();
   }
+  bool answer_pending(ClientId id) const override {
+    const std::lock_guard lock(mutex_);
+    return inner_.answer_pending(id);
+  }
+  std::string more_answer(ClientId id) override {
+    const std::lock_guard lock(mutex_);
+    return inner_.more_answer(id);
+  }
 
  private:
   LineHandler& inner_;

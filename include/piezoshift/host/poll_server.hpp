@@ -12,14 +12,19 @@
 //                    input()); protocol.serve(); send() what is queued (MSG_NOSIGNAL)
 //   evict idle clients (no byte received for idle_timeout_s while input is wanted) and slow ones
 //   (none of their queue taken for send_timeout_s); close the marked ones -> on_disconnect()
-//   accept() new connections: beyond max_clients, protocol.refusal() is sent best effort and the
-//        connection closed (counted)
+//   accept() new connections: beyond max_clients, the client idle longest (no byte received for
+//        the longest time, at least evict_idle_when_full_s, its input wanted) is closed to make
+//        room (counted); when none is that idle, protocol.refusal() is sent best effort to the
+//        newcomer and it is closed (counted)
 // Fairness: a round reads at most read_budget_bytes from each client and then serves every
 // client, so a client that floods delays another's answer by at most two budgets of its bytes
 // (the rest of the round in which the other's bytes arrive, and the round that reads them), not
 // by all it sent. Output: each client has its own queue, bounded by max_pending_output_bytes;
 // queue() beyond the bound sends at once, and a client whose socket still takes too little is
-// evicted as slow while the others are served. Not real-time code (heap, exceptions).
+// evicted as slow while the others are served. Room: silent connections cannot lock the others
+// out; a client that sent something within evict_idle_when_full_s keeps its place. Memory per
+// client: read_budget_bytes (the protocol's own buffers aside) + max_pending_output_bytes + one
+// answer. Not real-time code (heap, exceptions).
 #include <poll.h>
 
 #include <atomic>
@@ -50,6 +55,9 @@ struct PollServerLimits {
   double send_timeout_s = 10.0;
   //! No byte received for this long [s] while input is wanted evicts as idle; +inf: never.
   double idle_timeout_s = 600.0;
+  //! With max_clients connected, a new connection closes the client idle longest if it has been
+  //! idle (no byte received, input wanted) at least this long [s]; 0: always, +inf: never.
+  double evict_idle_when_full_s = 1.0;
 };
 
 //! Counters since construction.
@@ -58,6 +66,8 @@ struct PollServerStats {
   std::uint64_t refused_max_clients = 0;  //!< closed at once: max_clients already connected
   std::uint64_t evicted_slow = 0;         //!< queue beyond its bound, or not taken in time
   std::uint64_t evicted_idle = 0;         //!< nothing received for idle_timeout_s
+  std::uint64_t evicted_for_room = 0;     //!< idle longest when the table was full
+  std::uint64_t rounds = 0;               //!< rounds of run() (a clock for the tests)
   std::uint64_t bytes_in = 0;             //!< received from all clients
   std::uint64_t bytes_out = 0;            //!< sent (taken by the kernel) to all clients
   //! accept() failed for lack of descriptors or memory; each pauses accepting for 100 ms
@@ -87,7 +97,7 @@ class PollClient {
   bool finishing_ = false;  // close once output_ is sent
   Clock::time_point last_input_;
   Clock::time_point last_output_;  // output queued on an empty queue, or taken by the socket
-  enum class Close { kNo, kNow, kSlow, kIdle } close_ = Close::kNo;
+  enum class Close { kNo, kNow, kSlow, kIdle, kRoom } close_ = Close::kNo;
 };
 
 class PollServer;
@@ -164,6 +174,8 @@ class PollServer {
  private:
   void serve_round(int poll_interval_ms);
   void accept_clients();
+  //! With the table full: marks the client idle longest for closing if it may go; true if one was.
+  bool make_room();
   void read_from(PollClient& client);
   void evict_stale_clients();
   void close_marked_clients();
@@ -183,7 +195,7 @@ class PollServer {
   // Atomic so that stats() may be read from any thread while run() serves.
   struct AtomicStats {
     std::atomic<std::uint64_t> accepted{0}, refused_max_clients{0}, evicted_slow{0},
-        evicted_idle{0}, bytes_in{0}, bytes_out{0};
+        evicted_idle{0}, evicted_for_room{0}, rounds{0}, bytes_in{0}, bytes_out{0};
   } stats_;
 };
 

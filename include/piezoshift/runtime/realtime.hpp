@@ -7,6 +7,7 @@
 // Each request may be refused (no CAP_SYS_NICE / RLIMIT_RTPRIO / RLIMIT_MEMLOCK, a container):
 // the report says which and why, the caller says so once and runs on.
 #include <string>
+#include <thread>
 #include <vector>
 
 namespace piezoshift::runtime {
@@ -27,5 +28,10 @@ struct RealtimeReport {
 
 //! Set-up; never throws for a refusal (it is reported).
 RealtimeReport request_realtime(const RealtimeRequest& request);
+
+//! Takes `cpu` out of a normal thread's CPUs (the loop's, RealtimeReport::cpu), so that the
+//! thread's work never competes with the loop for it, granted SCHED_FIFO or not. False (nothing
+//! changed) when the thread has no other CPU or the kernel refuses.
+bool keep_off_cpu(std::thread& thread, int cpu);
 
 }  // namespace piezoshift::runtime
