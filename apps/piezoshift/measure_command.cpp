@@ -301,9 +301,7 @@ int measure(const MeasureOptions& o) {
         a.figures.pv,
         rec.error_rms_nm ? fmt::format(", measured - true {:.3f} nm RMS", *rec.error_rms_nm)
                          : std::string(),
-        a.true_steps_rad.empty() ? std::string("(no truth)")
-                                 : fmt::format("{:.2f} mrad", a.step_error_max_mrad),
-        r.wall_time_s, r.floor_s, r.overruns, o.out);
+        a.step_error_text(), r.wall_time_s, r.floor_s, r.overruns, o.out);
   }
   return 0;
 }

@@ -129,29 +129,38 @@ io::Figure zernike_figure(const instrument::MeasurementAnalysis& a) {
 }
 
 // The steps as commanded, as recovered from the fringes (AIA) and, on the twin, as made; below,
-// recovered minus true (or minus commanded without truth) in mrad.
+// recovered minus true (or minus commanded without truth) in mrad. Without recovered steps (AIA
+// did not converge) the title says why and the lower panel shows true - commanded.
 io::Figure steps_figure(const MeasureRecord& r) {
   const instrument::MeasurementAnalysis& a = *r.analysis;
+  const std::vector<double>& commanded = r.params->steps_rad;
+  const std::vector<double>& rec = a.recovered_steps_rad.front();
+  const bool truth = !a.true_steps_rad.empty();
+  const std::vector<double>& lhs =
+      rec.empty() ? (truth ? a.true_steps_rad.front() : commanded) : rec;
+  const std::vector<double>& rhs = rec.empty() || !truth ? commanded : a.true_steps_rad.front();
   io::Figure f;
   f.rows = 2;
   f.width_px = 900;
   f.height_px = 800;
   f.svg = true;
-  io::Panel top = panel("Phase steps, average 1", "frame", "step [rad]");
-  io::Panel bottom = panel(
-      a.true_steps_rad.empty() ? "recovered - commanded" : "recovered from the fringes - true",
-      "frame", "difference [mrad]");
+  io::Panel top =
+      panel(rec.empty() ? "Phase steps, average 1 (not recovered: " + a.steps_reason + ")"
+                        : "Phase steps, average 1",
+            "frame", "step [rad]");
+  io::Panel bottom =
+      panel(rec.empty() ? (truth ? "true - commanded" : "(no recovered steps)")
+                        : (truth ? "recovered from the fringes - true" : "recovered - commanded"),
+            "frame", "difference [mrad]");
   std::vector<double> k, diff;
-  const std::vector<double>& rec = a.recovered_steps_rad.front();
-  const std::vector<double>& ref =
-      a.true_steps_rad.empty() ? r.params->steps_rad : a.true_steps_rad.front();
-  for (std::size_t i = 0; i < rec.size(); ++i) {
+  for (std::size_t i = 0; i < commanded.size(); ++i) {
     k.push_back(static_cast<double>(i));
-    diff.push_back(1000.0 * (rec[i] - ref[i]));
+    diff.push_back(1000.0 * (lhs[i] - rhs[i]));
   }
-  top.series.push_back(io::line_series("commanded", k, r.params->steps_rad));
-  top.series.push_back(io::point_series("recovered (AIA)", k, rec));
-  if (!a.true_steps_rad.empty())
+  top.series.push_back(io::line_series("commanded", k, commanded));
+  if (!rec.empty())
+    top.series.push_back(io::point_series("recovered (AIA)", k, rec));
+  if (truth)
     top.series.push_back(io::point_series("true (twin)", k, a.true_steps_rad.front()));
   top.key = "top left";
   bottom.series.push_back(io::point_series("", k, diff));
@@ -198,10 +207,8 @@ std::string report_markdown(const MeasureRecord& r) {
       "| loop overruns | {} |\n",
       r.camera, r.daq, r.rate_Hz, r.real_time ? "real-time" : "simulated", r.algorithm,
       r.params->steps_rad.size(), r.params->averages, r.calibration_source, a.figures.rms,
-      a.figures.pv, a.figures.pvr, a.figures.pixels,
-      a.true_steps_rad.empty() ? std::string("(no truth)")
-                               : fmt::format("{:.2f} mrad", a.step_error_max_mrad),
-      s.wall_time_s, s.floor_s, s.floor_s > 0 ? s.wall_time_s / s.floor_s : 0.0, s.overruns);
+      a.figures.pv, a.figures.pvr, a.figures.pixels, a.step_error_text(), s.wall_time_s, s.floor_s,
+      s.floor_s > 0 ? s.wall_time_s / s.floor_s : 0.0, s.overruns);
   if (r.error_rms_nm)
     md += fmt::format("| measured - true surface, RMS | {:.3f} nm |\n", *r.error_rms_nm);
   if (r.ideal_error_rms_nm)
@@ -245,8 +252,8 @@ Json measure_json(const MeasureRecord& r) {
          {"commanded_steps_rad", r.params->steps_rad},
          {"recovered_steps_rad", a.recovered_steps_rad},
          {"true_steps_rad", a.true_steps_rad.empty() ? Json(nullptr) : Json(a.true_steps_rad)},
-         {"step_error_max_mrad",
-          a.true_steps_rad.empty() ? Json(nullptr) : Json(a.step_error_max_mrad)},
+         {"step_error_max_mrad", a.has_step_error() ? Json(a.step_error_max_mrad) : Json(nullptr)},
+         {"steps_reason", a.steps_reason.empty() ? Json(nullptr) : Json(a.steps_reason)},
          {"converged", a.converged},
          {"reason", a.reason.empty() ? Json(nullptr) : Json(a.reason)},
          {"surface_rms_nm", a.figures.rms},

@@ -23,6 +23,20 @@ std::vector<psi::Map> frame_maps(const std::vector<camera::Frame>& frames) {
   return maps;
 }
 
+bool MeasurementAnalysis::has_step_error() const {
+  return !true_steps_rad.empty() &&
+         std::any_of(recovered_steps_rad.begin(), recovered_steps_rad.end(),
+                     [](const std::vector<double>& s) { return !s.empty(); });
+}
+
+std::string MeasurementAnalysis::step_error_text() const {
+  if (true_steps_rad.empty())
+    return "(no truth)";
+  if (!has_step_error())
+    return "(not recovered: " + steps_reason + ")";
+  return fmt::format("{:.2f} mrad", step_error_max_mrad);
+}
+
 namespace {
 
 // The steps the frames show, by AIA started from the commanded ones.
@@ -74,25 +88,27 @@ MeasurementAnalysis analyze_measurement(const SequenceResult& sequence,
     const std::span<const ExposureRecord> exposures(
         sequence.exposures.data() + static_cast<std::size_t>(a) * n, n);
     analyses.push_back(psi::analyze_frames(frames, mask, options));
-    if (!analyses.back().phase.converged && m.converged) {
+    const psi::PhaseResult& fit = analyses.back().phase;
+    if (!fit.converged && m.converged) {
       m.converged = false;
-      m.reason = fmt::format("average {}: the {} fit did not converge", a + 1,
-                             psi::algorithm_name(options.phase.algorithm));
+      m.reason = fmt::format("average {}: {}", a + 1,
+                             fit.reason.empty() ? "the fit did not converge" : fit.reason);
     }
     m.average_figures.push_back(analyses.back().figures);
+    if (!exposures.empty() && exposures[0].has_truth)
+      m.true_steps_rad.push_back(true_steps(exposures, params.wavelength_nm));
     const psi::PhaseResult steps = recover_steps(frames, mask, params.steps_rad);
-    if (!steps.converged && m.converged) {
-      m.converged = false;
-      m.reason = fmt::format("average {}: AIA did not converge on the steps", a + 1);
+    if (!steps.converged) {
+      if (m.steps_reason.empty())
+        m.steps_reason = fmt::format("average {}: {}", a + 1, steps.reason);
+      m.recovered_steps_rad.emplace_back();
+      continue;
     }
     m.recovered_steps_rad.push_back(steps.steps_rad);
-    if (!exposures.empty() && exposures[0].has_truth) {
-      m.true_steps_rad.push_back(true_steps(exposures, params.wavelength_nm));
-      for (std::size_t k = 0; k < n; ++k)
-        m.step_error_max_mrad =
-            std::max(m.step_error_max_mrad,
-                     1000.0 * std::fabs(steps.steps_rad[k] - m.true_steps_rad.back()[k]));
-    }
+    for (std::size_t k = 0; !m.true_steps_rad.empty() && k < n; ++k)
+      m.step_error_max_mrad =
+          std::max(m.step_error_max_mrad,
+                   1000.0 * std::fabs(steps.steps_rad[k] - m.true_steps_rad.back()[k]));
   }
   average_into(m, analyses);
   m.figures = psi::surface_figures(m.surface_nm, m.valid);

@@ -20,13 +20,20 @@ struct MeasurementAnalysis {
   std::vector<double> zernike_nm;  //!< Noll j = 1.., of surface_nm
   std::vector<psi::SurfaceFigures> average_figures;
   //! Per average, per frame: steps recovered from the fringes (AIA), and on the twin the true
-  //! ones; step_error_max_mrad is the largest |recovered - true| (0 without truth).
+  //! ones; step_error_max_mrad is the largest |recovered - true| (0 without truth). An average
+  //! whose AIA did not converge has no recovered steps (empty) and steps_reason says why: the
+  //! steps are a check on the stage, the surface does not depend on them.
   std::vector<std::vector<double>> recovered_steps_rad;
   std::vector<std::vector<double>> true_steps_rad;
   double step_error_max_mrad = 0.0;
-  //! Whether every iterative fit (the algorithm's and the steps' AIA) converged.
+  std::string steps_reason;  //!< "" when every average's steps were recovered
+  //! The worst step error as text: "0.77 mrad", or why there is none (no truth, not recovered).
+  std::string step_error_text() const;
+  //! Some average's steps were recovered and the truth is known.
+  bool has_step_error() const;
+  //! Whether the analysis' own fit converged on every average (aia, tilt-aia: psi's checks).
   bool converged = true;
-  std::string reason;  //!< the first fit that did not converge, and why
+  std::string reason;  //!< the first average whose fit did not converge, and why
 };
 
 //! The frames as counts, one Map each.
