@@ -11,6 +11,7 @@
 #include "piezoshift/io/csv_writer.hpp"
 #include "piezoshift/io/plot.hpp"
 #include "piezoshift/psi/png_image.hpp"
+#include "piezoshift/psi/zernike_figure.hpp"
 
 namespace piezoshift::reproduction {
 namespace {
@@ -26,29 +27,6 @@ std::pair<double, double> finite_range(const psi::Map& m) {
       hi = std::max(hi, v);
     }
   return std::isfinite(lo) ? std::pair{lo, hi} : std::pair{0.0, 0.0};
-}
-
-// Noll j >= 4: piston and tilt are removed before the fit, so they carry nothing.
-io::Figure zernike_figure(const PhaseMeasurement& m) {
-  io::Figure f;
-  f.width_px = 900;
-  f.height_px = 450;
-  io::Panel p;
-  p.title = "Zernike coefficients of the measured surface (piston and tilt removed)";
-  p.x_label = "Noll index j";
-  p.y_label = "coefficient, RMS [nm]";
-  p.key = "off";
-  io::Series bars;
-  bars.style = io::SeriesStyle::kBoxes;
-  for (std::size_t k = 3; k < m.analysis.zernike_nm.size(); ++k) {
-    bars.x.push_back(static_cast<double>(k + 1));
-    bars.y.push_back(m.analysis.zernike_nm[k]);
-    bars.w.push_back(0.7);
-  }
-  p.series.push_back(std::move(bars));
-  p.markers.push_back({.vertical = false, .at = 0.0, .label = ""});
-  f.panels.push_back(std::move(p));
-  return f;
 }
 
 std::string surface_caption(const PhaseMeasurement& m) {
@@ -86,7 +64,8 @@ void write_measurement_files(const PhaseMeasurement& m, const fs::path& dir, Rep
   psi::write_false_colour_png((dir / "measurement_surface_nm.png").string(), m.analysis.surface_nm,
                               lo, hi);
   files.figures.push_back(dir / "measurement_surface_nm.png");
-  files.figures.push_back(*io::render(zernike_figure(m), dir / "measurement_zernike").png);
+  files.figures.push_back(
+      *io::render(psi::zernike_figure(m.analysis.zernike_nm), dir / "measurement_zernike").png);
   io::CsvWriter w(
       (dir / "measurement_exposures.csv").string(),
       {"frame", "commanded_step_rad", "recovered_step_rad", "true_step_rad", "settle_s",
