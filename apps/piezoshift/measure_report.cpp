@@ -15,6 +15,7 @@
 #include "piezoshift/io/plot.hpp"
 #include "piezoshift/psi/npy.hpp"
 #include "piezoshift/psi/png_image.hpp"
+#include "piezoshift/psi/zernike_figure.hpp"
 
 namespace piezoshift::app {
 
@@ -105,26 +106,8 @@ void write_frames(const MeasureRecord& r, const fs::path& dir) {
 }
 
 io::Figure zernike_figure(const instrument::MeasurementAnalysis& a) {
-  io::Figure f;
-  f.width_px = 1000;
-  f.height_px = 500;
+  io::Figure f = psi::zernike_figure(a.zernike_nm);
   f.svg = true;
-  io::Panel p = panel("Zernike coefficients of the measured surface (piston and tilt removed)",
-                      "Noll index j", "coefficient, RMS [nm]");
-  std::vector<double> j, c, w;
-  for (std::size_t k = 3; k < a.zernike_nm.size(); ++k) {
-    j.push_back(static_cast<double>(k + 1));
-    c.push_back(a.zernike_nm[k]);
-    w.push_back(0.7);
-  }
-  io::Series bars;
-  bars.style = io::SeriesStyle::kBoxes;
-  bars.x = j;
-  bars.y = c;
-  bars.w = w;
-  p.series.push_back(bars);
-  p.key = "off";
-  f.panels.push_back(p);
   return f;
 }
 

@@ -98,6 +98,13 @@ int run(const Options& o) {
                   t.oracle.repeat_5um.metrics.repeatability_nm,
                   t.oracle.repeat_10um.metrics.repeatability_nm),
       "-");
+  const reproduction::PhaseMeasurement& m = t.measurement;
+  row("measurement", m.validity,
+      fmt::format("{} on the twin camera: {:.2f} nm RMS, {:.3f} nm from the truth (floor "
+                  "{:.3f}), steps within {:.1f} mrad",
+                  m.algorithm, m.analysis.figures.rms, m.error_rms_nm, m.ideal_error_rms_nm,
+                  m.analysis.step_error_max_mrad),
+      "-");
   fmt::print("report: {}\n        {}\n", files.markdown.string(), files.html.string());
   if (status != 0) {
     fmt::print(stderr, "piezoshift: reproduce: not valid (exit status 4):\n");

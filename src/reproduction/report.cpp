@@ -15,6 +15,7 @@
 #include "piezoshift/io/csv_writer.hpp"
 #include "piezoshift/io/plot.hpp"
 #include "piezoshift/reproduction/document.hpp"
+#include "piezoshift/reproduction/measurement_report.hpp"
 #include "piezoshift/reproduction/summary.hpp"
 
 namespace piezoshift::reproduction {
@@ -496,6 +497,7 @@ ReportFiles write_report(const ReproductionResult& r, const fs::path& dir,
   ReportFiles files;
   write_data(r, dir, files);
   const bool any_loop = write_figures(r, dir, files);
+  write_measurement_files(r.measurement, dir, files);
 
   Document doc;
   introduction(doc, r, config_label);
@@ -503,6 +505,7 @@ ReportFiles write_report(const ReproductionResult& r, const fs::path& dir,
   linearity_section(doc, r);
   phase_step_section(doc, r);
   inner_loop_section(doc, r, any_loop);
+  measurement_section(doc, r.measurement);
   calibration_section(doc, r);
   figures_and_files_section(doc, files);
 

@@ -180,6 +180,13 @@ std::vector<std::string> ExperimentSet::invalid_reasons() const {
   return out;
 }
 
+std::vector<std::string> ReproductionResult::invalid_reasons() const {
+  std::vector<std::string> out = ExperimentSet::invalid_reasons();
+  if (!measurement.validity.valid)
+    out.push_back("measurement: " + measurement.validity.reason);
+  return out;
+}
+
 ReproductionResult reproduce(const config::ProjectConfig& config, const ReproduceOptions& options,
                              const rig::Progress& progress) {
   const auto start = std::chrono::steady_clock::now();
@@ -201,13 +208,16 @@ ReproductionResult reproduce(const config::ProjectConfig& config, const Reproduc
   r.linearity_without_cubic =
       experiments::run_linearity(config, r.oracle_controller, seed + 30, s.linearity, progress);
   r.inner_loop = analyze_inner_loop(config, r.calibration.controller, seed);
+  r.measurement =
+      run_phase_measurement(config, r.calibration.controller, seed + kMeasurementSeedOffset);
   // The oracle: the same loop, gains and A, fed the plate's truth; nothing left for p to correct.
   r.oracle = run_experiment_set(config, r.oracle_controller, seed,
                                 with_feedback(s, rig::Feedback::kOracle), progress);
-  r.simulated_time_s =
-      r.calibration.pid.simulated_time_s + r.calibration.matrix.simulated_time_s +
-      r.calibration.polynomial.simulated_time_s + r.experiments_simulated_time_s() +
-      r.linearity_without_cubic.simulated_time_s + r.oracle.experiments_simulated_time_s();
+  r.simulated_time_s = r.calibration.pid.simulated_time_s + r.calibration.matrix.simulated_time_s +
+                       r.calibration.polynomial.simulated_time_s +
+                       r.experiments_simulated_time_s() +
+                       r.linearity_without_cubic.simulated_time_s +
+                       r.oracle.experiments_simulated_time_s() + r.measurement.simulated_time_s;
   r.wall_time_s = std::chrono::duration<double>(std::chrono::steady_clock::now() - start).count();
   return r;
 }

@@ -83,6 +83,32 @@ void set_json(nlohmann::json& j, const std::string& prefix, const ExperimentSet&
                             {"phase_step", validity(e.phase_step.validity)}};
 }
 
+// The phase-shifting measurement, keys prefixed measurement_; its numbers only when valid.
+void measurement_json(nlohmann::json& j, const PhaseMeasurement& m) {
+  j["validity"]["measurement"] = {{"valid", m.validity.valid}, {"reason", m.validity.reason}};
+  j["measurement_valid"] = m.validity.valid;
+  j["measurement_algorithm"] = m.algorithm;
+  j["measurement_seed"] = m.scene.seed;
+  j["measurement_commanded_steps_rad"] = m.params.steps_rad;
+  nlohmann::json settle = nlohmann::json::array();
+  for (const instrument::ExposureRecord& e : m.sequence.exposures)
+    settle.push_back(e.settled_time_s - e.move_time_s);
+  j["measurement_settle_s"] = settle;
+  j["measurement_simulated_time_s"] = m.simulated_time_s;
+  if (!m.validity.valid)
+    return;
+  const psi::SurfaceFigures& f = m.analysis.figures;
+  j["measurement_surface_rms_nm"] = f.rms;
+  j["measurement_surface_pv_nm"] = f.pv;
+  j["measurement_surface_pvr_nm"] = f.pvr;
+  j["measurement_error_rms_nm"] = m.error_rms_nm;
+  j["measurement_ideal_error_rms_nm"] = m.ideal_error_rms_nm;
+  j["measurement_recovered_steps_rad"] = m.analysis.recovered_steps_rad.front();
+  j["measurement_true_steps_rad"] = m.analysis.true_steps_rad.front();
+  j["measurement_step_error_max_mrad"] = m.analysis.step_error_max_mrad;
+  j["measurement_zernike_nm"] = m.analysis.zernike_nm;
+}
+
 }  // namespace
 
 nlohmann::json summary_json(const ReproductionResult& r) {
@@ -93,6 +119,10 @@ nlohmann::json summary_json(const ReproductionResult& r) {
   j["pid"] = r.options.pid == calibration::PidChoice::kPaper ? "paper" : "search";
   set_json(j, "", r);
   set_json(j, "oracle_", r.oracle);
+  // reproduce's own validity: Table 4 and the measurement (set_json's is the set's).
+  j["valid"] = r.valid();
+  j["invalid_reasons"] = r.invalid_reasons();
+  measurement_json(j, r.measurement);
   const auto& raw = r.linearity_without_cubic;
   j["linearity_without_cubic_zero_end_pct"] = raw.metrics.linearity_zero_end_pct;
   j["linearity_without_cubic_best_fit_pct"] = raw.metrics.linearity_best_fit_pct;

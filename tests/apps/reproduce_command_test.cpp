@@ -25,6 +25,20 @@ TEST_F(ReproduceCommand, QuickRunWritesTheReportAndPrintsTheSummary) {
   ASSERT_EQ(a.status, 0) << a.err;
   EXPECT_NEAR(nlohmann::json::parse(a.out)["repeatability_nm"].get<double>(),
               j["repeatability_5um_nm"].get<double>(), 1e-3);
+  // The report's measurement is `measure`'s: the calibration it wrote and the measurement's seed
+  // (seed + 100) take it again, number for number (issue 28).
+  ASSERT_TRUE(j["measurement_valid"].get<bool>());
+  EXPECT_EQ(j["measurement_seed"], 102);
+  const testing::CliResult m =
+      run("measure --camera twin --free-run --seed 102 --json "
+          "--calibration '" +
+          out + "/calibration.toml' --out '" + path("measurement") + "'");
+  ASSERT_EQ(m.status, 0) << m.err;
+  const auto mj = nlohmann::json::parse(m.out);
+  EXPECT_EQ(mj["error_rms_nm"].get<double>(), j["measurement_error_rms_nm"].get<double>());
+  EXPECT_EQ(mj["surface_rms_nm"].get<double>(), j["measurement_surface_rms_nm"].get<double>());
+  EXPECT_EQ(mj["recovered_steps_rad"][0], j["measurement_recovered_steps_rad"]);
+  EXPECT_LT(j["measurement_error_rms_nm"].get<double>(), 1.0);
 }
 
 TEST_F(ReproduceCommand, CalibrateWritesAFileThatRunLoads) {

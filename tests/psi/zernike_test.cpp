@@ -7,6 +7,7 @@
 
 #include "piezoshift/plant/random.hpp"
 #include "piezoshift/psi/surface_metrics.hpp"
+#include "piezoshift/psi/zernike_figure.hpp"
 
 namespace piezoshift::psi {
 namespace {
@@ -80,6 +81,20 @@ TEST(ZernikeTest, PvrOfAPureZernikeSurfaceIsItsPv) {
   for (const double c4 : fit_zernike(r, mask, 4))
     EXPECT_NEAR(c4, 0.0, 1e-9);
   EXPECT_NEAR(fit_zernike(r, mask, 11)[10], 3.0, 1e-9);
+}
+
+// The chart `measure` and `reproduce` draw: one bar per coefficient from Z4 on, at its Noll index.
+TEST(ZernikeTest, TheChartHasABarPerCoefficientFromDefocusOn) {
+  const std::vector<double> c{0.5, 2.0, -3.0, 40.0, 25.0, -15.0};
+  const io::Figure f = zernike_figure(c);
+  ASSERT_EQ(f.panels.size(), 1u);
+  ASSERT_EQ(f.panels[0].series.size(), 1u);
+  const io::Series& bars = f.panels[0].series[0];
+  EXPECT_EQ(bars.style, io::SeriesStyle::kBoxes);
+  EXPECT_EQ(bars.x, (std::vector<double>{4.0, 5.0, 6.0}));
+  EXPECT_EQ(bars.y, (std::vector<double>{40.0, 25.0, -15.0}));
+  EXPECT_EQ(bars.w.size(), 3u);
+  EXPECT_EQ(f.panels[0].x_label, "Noll index j");
 }
 
 }  // namespace

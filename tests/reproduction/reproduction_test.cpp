@@ -5,8 +5,13 @@
 
 #include <filesystem>
 #include <fstream>
+#include <numbers>
+
+#include <fmt/core.h>
 
 #include "piezoshift/io/plot.hpp"
+#include "piezoshift/reproduction/document.hpp"
+#include "piezoshift/reproduction/measurement_report.hpp"
 #include "piezoshift/reproduction/report.hpp"
 #include "piezoshift/reproduction/reproduction.hpp"
 #include "piezoshift/reproduction/reproduction_cost.hpp"
@@ -118,6 +123,56 @@ TEST(Reproduction, IdentifiedMatrixIsThePapersAndCalibrationIsDeterministic) {
   EXPECT_GT(r.simulated_time_s, 1000.0);
 }
 
+// Issue 28's done-when: `make demo` shows a measurement. Hariharan's 5 frames of the twin camera
+// through `measure`'s library path with the controller seed 1's quick run calibrated.
+TEST(Reproduction, ThePhaseShiftingMeasurementRecoversTheSurfaceAndTheSteps) {
+  const ReproductionResult& r = quick_run();
+  const PhaseMeasurement& m = r.measurement;
+  ASSERT_TRUE(m.validity.valid) << m.validity.reason;
+  EXPECT_TRUE(r.valid());
+  EXPECT_EQ(m.scene.seed, 1U + kMeasurementSeedOffset);  // a session of its own
+  ASSERT_EQ(m.sequence.frames.size(), 5U);
+  ASSERT_EQ(m.sequence.exposures.size(), 5U);
+  // The error is the camera's noise and the stage's: below 1 nm, and not zero (noise-free frames
+  // would mean the camera's noise never reached the analysis).
+  EXPECT_LT(m.error_rms_nm, 1.0);
+  EXPECT_GT(m.error_rms_nm, 0.0);
+  EXPECT_GT(m.ideal_error_rms_nm, 0.0);
+  EXPECT_LT(m.ideal_error_rms_nm, 1.0);
+  // The steps the fringes show, against the plate's true mean piston over each exposure.
+  EXPECT_LT(m.analysis.step_error_max_mrad, 20.0);
+  ASSERT_EQ(m.analysis.true_steps_rad.size(), 1U);
+  for (std::size_t k = 0; k < 5; ++k) {
+    EXPECT_NEAR(m.analysis.true_steps_rad[0][k], k * std::numbers::pi / 2.0, 0.2) << k;
+    const instrument::ExposureRecord& e = m.sequence.exposures[k];
+    EXPECT_GT(e.settled_time_s - e.move_time_s, 0.0) << k;
+    EXPECT_LT(e.settled_time_s - e.move_time_s, m.params.on_target.timeout_s) << k;
+  }
+  // The default test surface: Z4 = 40 nm of the 256 px pupil's surface comes back.
+  ASSERT_GE(m.analysis.zernike_nm.size(), 4U);
+  EXPECT_NEAR(m.analysis.zernike_nm[3], 40.0, 1.0);
+  EXPECT_GT(m.simulated_time_s, 0.2);
+  EXPECT_LT(m.simulated_time_s, 1.0);
+}
+
+// A measurement that is not valid marks reproduce's validity and its section, never a number.
+TEST(Reproduction, AMeasurementThatIsNotValidIsAFailureWithItsReason) {
+  ReproductionResult r = quick_run();
+  r.measurement.validity.fail("camera twin lost frame 2");
+  EXPECT_FALSE(r.valid());
+  ASSERT_FALSE(r.invalid_reasons().empty());
+  EXPECT_EQ(r.invalid_reasons().back(), "measurement: camera twin lost frame 2");
+  const nlohmann::json j = summary_json(r);
+  EXPECT_FALSE(j["valid"].get<bool>());
+  EXPECT_FALSE(j["measurement_valid"].get<bool>());
+  EXPECT_FALSE(j.contains("measurement_error_rms_nm"));
+  Document doc;
+  measurement_section(doc, r.measurement);
+  const std::string md = to_markdown(doc.blocks);
+  EXPECT_NE(md.find("NOT VALID: camera twin lost frame 2"), std::string::npos) << md;
+  EXPECT_EQ(md.find("measured - true"), std::string::npos) << md;
+}
+
 TEST(Reproduction, SummaryHasTheIssuesKeys) {
   const nlohmann::json j = summary_json(quick_run());
   for (const char* key :
@@ -129,6 +184,13 @@ TEST(Reproduction, SummaryHasTheIssuesKeys) {
         "pid_margins_10kHz_phase_margin_deg"}) {
     EXPECT_TRUE(j.contains(key)) << key;
   }
+  EXPECT_TRUE(j["valid"].get<bool>());
+  EXPECT_TRUE(j["measurement_valid"].get<bool>());
+  EXPECT_DOUBLE_EQ(j["measurement_error_rms_nm"].get<double>(),
+                   quick_run().measurement.error_rms_nm);
+  EXPECT_DOUBLE_EQ(j["measurement_step_error_max_mrad"].get<double>(),
+                   quick_run().measurement.analysis.step_error_max_mrad);
+  EXPECT_EQ(j["measurement_settle_s"].size(), 5U);
   EXPECT_EQ(j["identified_A"].size(), 3U);
   EXPECT_EQ(j["fitted_p"].size(), 4U);
   EXPECT_DOUBLE_EQ(j["repeatability_5um_nm"].get<double>(),
@@ -141,7 +203,8 @@ TEST(Reproduction, ReportHasTable4FiguresAndData) {
   const auto dir = std::filesystem::temp_directory_path() / "piezoshift_report_test";
   std::filesystem::remove_all(dir);
   const ReportFiles files = write_report(quick_run(), dir, "built-in defaults");
-  ASSERT_EQ(files.figures.size(), 5U);  // Figures 10 to 12, the phase step, the Bode plot
+  // Figures 10 to 12, the phase step, the Bode plot, the measurement's surface and Zernike chart
+  ASSERT_EQ(files.figures.size(), 7U);
   for (const auto& f : files.figures)
     EXPECT_GT(std::filesystem::file_size(f), 5000U) << f;
   std::ifstream md(files.markdown);
@@ -152,6 +215,19 @@ TEST(Reproduction, ReportHasTable4FiguresAndData) {
   EXPECT_NE(text.find("![Figure 10"), std::string::npos);
   EXPECT_NE(text.find("![Phase step](phase_step.png)"), std::string::npos);
   EXPECT_NE(text.find("| hold jitter, 1 ms exposure means (rms) |"), std::string::npos);
+  EXPECT_NE(text.find("## A phase-shifting measurement"), std::string::npos);
+  EXPECT_NE(text.find("](measurement_surface_nm.png)"), std::string::npos);
+  EXPECT_NE(text.find("](measurement_zernike.png)"), std::string::npos);
+  EXPECT_NE(text.find(fmt::format("| measured - true surface, RMS | {:.3f} nm |",
+                                  quick_run().measurement.error_rms_nm)),
+            std::string::npos);
+  EXPECT_NE(text.find("`piezoshift measure`"), std::string::npos);
+  std::ifstream html_file(dir / "report.html");
+  const std::string html((std::istreambuf_iterator<char>(html_file)),
+                         std::istreambuf_iterator<char>());
+  EXPECT_NE(html.find("<h2>A phase-shifting measurement</h2>"), std::string::npos);
+  EXPECT_NE(html.find("src=\"measurement_surface_nm.png\""), std::string::npos);
+  EXPECT_TRUE(std::filesystem::exists(dir / "measurement_exposures.csv"));
   EXPECT_TRUE(std::filesystem::exists(dir / "report.html"));
   EXPECT_TRUE(std::filesystem::exists(dir / "calibration.toml"));
   EXPECT_TRUE(std::filesystem::exists(dir / "linearity.csv"));

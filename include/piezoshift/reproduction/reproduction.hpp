@@ -12,6 +12,8 @@
 //   phase step (lambda/8)   seed + 80   (beyond the paper: experiments/phase_step.hpp)
 //   inner loop identified   seed + 90 at the DAQ's rate, seed + 91 at 10 kHz, with the margins
 //                           of the calibrated PID on it (calibration/loop_identification.hpp)
+//   a measurement           seed + 100  (Hariharan's 5 frames on the twin camera, through
+//                           `measure`'s library path: phase_measurement.hpp)
 // all with the calibrated controller (the paper's structure: PID, A, p), through the loop `run`
 // and `serve` ship (rig/bench.hpp), supervisor included. Then the same experiments, same
 // seeds, with the oracle (runtime/oracle_backend.hpp): the same loop fed the plate's true point
@@ -20,7 +22,8 @@
 // configuration, seed and schedule give the same numbers bit for bit.
 //
 // valid() is false when any Table 4 experiment of the paper's controller is not valid
-// (rig/validity.hpp); `reproduce` then exits with kExitInvalidExperiment.
+// (rig/validity.hpp) or the measurement is not (a sequence that failed, a fit that did not
+// converge); `reproduce` then exits with kExitInvalidExperiment.
 //
 // Schedules: the full one is the paper's (230 moves per target, 10 s per linearity level, the
 // full PID grid); the quick one keeps every step but shortens the calibration, the travel search
@@ -34,6 +37,7 @@
 #include "piezoshift/config/project_config.hpp"
 #include "piezoshift/experiments/paper_experiments.hpp"
 #include "piezoshift/experiments/phase_step.hpp"
+#include "piezoshift/reproduction/phase_measurement.hpp"
 
 namespace piezoshift::reproduction {
 
@@ -137,10 +141,14 @@ struct ReproductionResult : ExperimentSet {
   //! The calibrated PID's loop at the DAQ's rate (the paper's 1 kHz) and at 10 kHz (the same
   //! gains re-expressed per sample, the twin's DAQ at 0.1 ms) unless that is the DAQ's rate.
   std::vector<InnerLoopAnalysis> inner_loop;
+  //! A phase-shifting measurement with the calibrated controller (seed + 100).
+  PhaseMeasurement measurement;
   double simulated_time_s = 0.0;  //!< twin time over every stage and experiment
   double wall_time_s = 0.0;
 
-  bool valid() const { return table4_valid(); }
+  bool valid() const { return table4_valid() && measurement.validity.valid; }
+  //! ExperimentSet's reasons, then the measurement's ("measurement: ...").
+  std::vector<std::string> invalid_reasons() const;
 };
 
 ReproductionResult reproduce(const config::ProjectConfig& config, const ReproduceOptions& options,

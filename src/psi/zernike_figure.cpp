@@ -1,0 +1,26 @@
+#include "piezoshift/psi/zernike_figure.hpp"
+
+namespace piezoshift::psi {
+
+io::Figure zernike_figure(std::span<const double> zernike_nm) {
+  io::Figure f;
+  f.width_px = 1000;
+  f.height_px = 500;
+  io::Panel p;
+  p.title = "Zernike coefficients of the measured surface (piston and tilt removed)";
+  p.x_label = "Noll index j";
+  p.y_label = "coefficient, RMS [nm]";
+  p.key = "off";
+  io::Series bars;
+  bars.style = io::SeriesStyle::kBoxes;
+  for (std::size_t k = 3; k < zernike_nm.size(); ++k) {
+    bars.x.push_back(static_cast<double>(k + 1));
+    bars.y.push_back(zernike_nm[k]);
+    bars.w.push_back(0.7);
+  }
+  p.series.push_back(std::move(bars));
+  f.panels.push_back(std::move(p));
+  return f;
+}
+
+}  // namespace piezoshift::psi
