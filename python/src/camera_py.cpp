@@ -9,6 +9,7 @@
 #include <pybind11/stl.h>
 
 #include <memory>
+#include <optional>
 #include <string>
 
 #include "bindings.hpp"
@@ -27,6 +28,8 @@ namespace piezoshift::python {
 namespace {
 
 namespace cam = ps::camera;
+
+constexpr double kWavelength_nm = 632.8;  // measure's: HeNe
 
 void bind_camera_enums(py::module_& m) {
   py::enum_<cam::PixelFormat>(m, "PixelFormat")
@@ -110,7 +113,7 @@ void bind_twin_scene(py::module_& m) {
             surface.empty() ? ps::psi::SurfaceSpec{} : ps::psi::parse_surface_spec(surface);
         const cam::CameraConfig cc = config.value_or(cam::CameraConfig{});
         return cam::make_twin_scene(
-            spec, fizeau.value_or(cam::measurement_optics(cc.settings, 632.8)), seed);
+            spec, fizeau.value_or(cam::measurement_optics(cc.settings, kWavelength_nm)), seed);
       },
       py::arg("surface") = "", py::arg("config") = py::none(), py::arg("seed") = 1,
       py::arg("fizeau") = py::none(),

@@ -1,6 +1,8 @@
 """Cameras and measurements from Python (docs/python.md): measure() on the twin, the twin camera
 driven by hand, and the refusals of bad cameras."""
 import math
+import struct
+import zlib
 
 import numpy as np
 import pytest
@@ -62,6 +64,36 @@ def test_a_sequence_that_cannot_settle_raises_procedure_failed(tmp_path):
     assert isinstance(e.value, RuntimeError)
     assert e.value.result["valid"] is False
     assert e.value.result["frames"] == []  # never a silently short sequence
+
+
+def write_png_gray16(path, counts):
+    """A 16-bit grayscale PNG of a (H, W) uint16 array (the format `measure` writes frames in)."""
+    h, w = counts.shape
+    rows = b"".join(b"\0" + counts[y].astype(">u2").tobytes() for y in range(h))
+
+    def chunk(kind, data):
+        return (struct.pack(">I", len(data)) + kind + data
+                + struct.pack(">I", zlib.crc32(kind + data) & 0xFFFFFFFF))
+
+    header = struct.pack(">IIBBBBB", w, h, 16, 0, 0, 0, 0)  # 16-bit, grayscale
+    path.write_bytes(b"\x89PNG\r\n\x1a\n" + chunk(b"IHDR", header)
+                     + chunk(b"IDAT", zlib.compress(rows)) + chunk(b"IEND", b""))
+
+
+def test_frames_replayed_through_files_give_the_same_surface(tmp_path):
+    config = small_camera_toml(tmp_path)
+    twin = ps.measure(config=config)
+    frames = tmp_path / "frames"
+    frames.mkdir()
+    for k, counts in enumerate(twin["frames"]):
+        write_png_gray16(frames / f"frame_{k:03}.png", counts)
+    replay = ps.measure(config=config, camera=f"files:{frames}", mask=twin["mask"])
+    assert replay["camera"] == f"files:{frames}"
+    assert replay["truth_nm"] is None and replay["error_rms_nm"] is None
+    np.testing.assert_array_equal(replay["frames"][3], twin["frames"][3])
+    np.testing.assert_allclose(replay["surface_nm"], twin["surface_nm"], rtol=0, atol=1e-9)
+    with pytest.raises(ps.InputError, match="mask: expected a \\(96, 96\\) array"):
+        ps.measure(config=config, camera=f"files:{frames}", mask=np.ones((3, 3)))
 
 
 def test_bad_cameras_are_refused_by_name(tmp_path):
