@@ -119,14 +119,10 @@ LoopStackOptions stack_options(const MeasureOptions& o) {
 // `psi simulate` draws it for the same spec and seed, rendered with the Fizeau's optics.
 camera::TwinScene twin_scene(const MeasureOptions& o, const camera::CameraConfig& cc,
                              double wavelength_nm) {
-  psi::FizeauParams fizeau;
-  fizeau.width_px = cc.settings.width_px;
-  fizeau.height_px = cc.settings.height_px;
-  fizeau.pupil_radius_px = 0.47 * std::min(cc.settings.width_px, cc.settings.height_px);
-  fizeau.wavelength_nm = wavelength_nm;
   const psi::SurfaceSpec spec =
       o.surface.empty() ? psi::SurfaceSpec{} : psi::parse_surface_spec(o.surface);
-  return camera::make_twin_scene(spec, fizeau, o.seed);
+  return camera::make_twin_scene(spec, camera::measurement_optics(cc.settings, wavelength_nm),
+                                 o.seed);
 }
 
 // Everything a measurement needs before the loop starts, checked in this order so that bad input

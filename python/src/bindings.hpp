@@ -9,7 +9,8 @@ namespace piezoshift::python {
 
 namespace py = pybind11;
 
-void bind_errors(py::module_& m);        // errors_py.cpp: InputError, FitError, MetricsError
+void bind_errors(py::module_& m);        // errors_py.cpp: InputError, FitError, MetricsError,
+                                         // ProcedureFailed
 void bind_psi(py::module_& m);           // psi_py.cpp
 void bind_control(py::module_& m);       // control_py.cpp
 void bind_design(py::module_& m);        // design_py.cpp
@@ -19,5 +20,7 @@ void bind_twin(py::module_& m);          // plant_py.cpp: after ProjectConfig, w
 void bind_experiments(py::module_& m);   // experiments_py.cpp
 void bind_calibration(py::module_& m);   // calibration_py.cpp
 void bind_reproduction(py::module_& m);  // reproduction_py.cpp
+void bind_camera(py::module_& m);        // camera_py.cpp
+void bind_instrument(py::module_& m);    // instrument_py.cpp: after the controller and cameras
 
 }  // namespace piezoshift::python

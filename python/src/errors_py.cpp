@@ -1,7 +1,9 @@
 // Bindings of the errors bad input raises, with the C++ message: core::InputError becomes
 // piezoshift.InputError, a ValueError so that `except ValueError` catches bad input too;
 // calibration::FitError and experiments::MetricsError become FitError and MetricsError, both
-// InputErrors. std::invalid_argument is pybind11's own ValueError.
+// InputErrors. rig::ProcedureFailed (a procedure or measurement that is not valid: the CLI's exit
+// status 4) becomes ProcedureFailed, a RuntimeError. std::invalid_argument is pybind11's own
+// ValueError.
 #include <pybind11/pybind11.h>
 
 #include <exception>
@@ -10,6 +12,7 @@
 #include "piezoshift/calibration/fit_error.hpp"
 #include "piezoshift/core/input_error.hpp"
 #include "piezoshift/experiments/metrics_error.hpp"
+#include "piezoshift/rig/validity.hpp"
 
 namespace piezoshift::python {
 
@@ -19,6 +22,8 @@ void bind_errors(py::module_& m) {
   static py::exception<ps::calibration::FitError> fit_error(m, "FitError", input_error.ptr());
   static py::exception<ps::experiments::MetricsError> metrics_error(m, "MetricsError",
                                                                     input_error.ptr());
+  static py::exception<ps::rig::ProcedureFailed> procedure_failed(m, "ProcedureFailed",
+                                                                  PyExc_RuntimeError);
   py::register_exception_translator([](std::exception_ptr p) {
     try {
       if (p)
@@ -29,6 +34,8 @@ void bind_errors(py::module_& m) {
       metrics_error(e.what());
     } catch (const ps::core::InputError& e) {
       input_error(e.what());
+    } catch (const ps::rig::ProcedureFailed& e) {
+      procedure_failed(e.what());
     }
   });
 }

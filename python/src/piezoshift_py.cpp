@@ -3,7 +3,8 @@
 // Value structs become Python classes with the same field names (nested structs are returned by
 // reference, so cfg.design.hinge.thickness_m = ... edits in place). Three-channel values (Vec3)
 // and 3x3 matrices come back as numpy copies and are set by assigning a whole value; time series
-// (std::vector<double>) come back as 1-D numpy arrays. The real-time runtime is not bound.
+// (std::vector<double>) come back as 1-D numpy arrays; images (frames, maps) as 2-D arrays. The
+// real-time runtime is not bound, but measure() runs it on the twin's simulated clock.
 // Each library module's bindings are in a file of its own (bindings.hpp); this one only calls
 // them, in an order that registers every type before a signature names it.
 #include <pybind11/pybind11.h>
@@ -23,4 +24,6 @@ PYBIND11_MODULE(_piezoshift, m) {
   bind::bind_experiments(m);
   bind::bind_calibration(m);
   bind::bind_reproduction(m);
+  bind::bind_camera(m);
+  bind::bind_instrument(m);
 }

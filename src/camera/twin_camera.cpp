@@ -78,6 +78,15 @@ TwinScene make_twin_scene(const psi::SurfaceSpec& surface, const psi::FizeauPara
   return s;
 }
 
+psi::FizeauParams measurement_optics(const CameraSettings& settings, double wavelength_nm) {
+  psi::FizeauParams fizeau;
+  fizeau.width_px = settings.width_px;
+  fizeau.height_px = settings.height_px;
+  fizeau.pupil_radius_px = 0.47 * std::min(settings.width_px, settings.height_px);
+  fizeau.wavelength_nm = wavelength_nm;
+  return fizeau;
+}
+
 TwinCamera::TwinCamera(TwinScene scene, const psi::CameraParams& sensor)
     : scene_(std::move(scene)), sensor_(sensor) {
   const psi::FizeauParams& f = scene_.fizeau;

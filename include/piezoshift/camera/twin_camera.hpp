@@ -60,6 +60,10 @@ struct TwinScene {
 TwinScene make_twin_scene(const psi::SurfaceSpec& surface, const psi::FizeauParams& fizeau,
                           std::uint64_t seed);
 
+//! The optics a measurement renders a camera's frames with: the frame's size, a pupil of 0.47 of
+//! its shorter side (`psi simulate`'s proportion), wavelength_nm; the rest psi's defaults.
+psi::FizeauParams measurement_optics(const CameraSettings& settings, double wavelength_nm);
+
 class TwinCamera final : public Camera {
  public:
   //! sensor: exposure_s and bit_depth are replaced by configure()'s settings. Throws

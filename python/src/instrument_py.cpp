@@ -1,0 +1,411 @@
+// Python binding of the instrument module (docs/python.md, "Cameras and measurements"): measure()
+// takes one phase-shifting measurement on the twin as `piezoshift measure --daq sim --free-run`
+// does (the shipping loop in owner mode on a simulated clock, the camera exposing once the stage
+// has settled, then the analysis) and returns its result as a dict with the JSON names of
+// `measure --json`, plus the maps and frames as numpy arrays. A measurement that is not valid or
+// whose fits did not converge raises ProcedureFailed (the CLI's exit status 4), the partial
+// result in its `result` attribute.
+#include <pybind11/numpy.h>
+#include <pybind11/pybind11.h>
+#include <pybind11/stl.h>
+
+#include <cmath>
+#include <memory>
+#include <numbers>
+#include <optional>
+#include <string>
+#include <variant>
+#include <vector>
+
+#include "bindings.hpp"
+#include "images.hpp"
+#include "piezoshift/calibration/calibration_file.hpp"
+#include "piezoshift/calibration/calibration_procedure.hpp"
+#include "piezoshift/calibration/controller_ranges.hpp"
+#include "piezoshift/camera/aravis_camera.hpp"
+#include "piezoshift/camera/instrument_config.hpp"
+#include "piezoshift/camera/make_camera.hpp"
+#include "piezoshift/camera/twin_camera.hpp"
+#include "piezoshift/camera/twin_fed_camera.hpp"
+#include "piezoshift/control/parameter_check.hpp"
+#include "piezoshift/core/input_error.hpp"
+#include "piezoshift/instrument/acquisition.hpp"
+#include "piezoshift/instrument/measurement.hpp"
+#include "piezoshift/instrument/twin_floor.hpp"
+#include "piezoshift/rig/validity.hpp"
+#include "piezoshift/runtime/loop_clock.hpp"
+#include "piezoshift/runtime/sim_backend.hpp"
+#include "values.hpp"
+
+namespace piezoshift::python {
+
+namespace {
+
+namespace cam = ps::camera;
+namespace ins = ps::instrument;
+namespace psi = ps::psi;
+
+constexpr double kWavelength_nm = 632.8;  // the CLI's: HeNe
+
+struct MeasureArgs {
+  std::optional<std::string> config;
+  std::variant<std::monostate, std::string, ps::control::SemiClosedLoopParams> calibration;
+  std::string camera = "twin";
+  std::string algorithm = "hariharan5";
+  std::vector<double> steps_rad;
+  int averages = 1;
+  std::string surface;
+  std::uint64_t seed = 1;
+  double rate_Hz = 1000.0;
+  double base_um = 5.0;
+  psi::OnTarget on_target{};
+  double frame_timeout_s = 2.0;
+  py::object mask;
+};
+
+// Aravis's in-process fake camera shown the twin's fringes, as `measure --daq sim` does.
+bool fed_by_twin(const std::string& spec) {
+  return spec.starts_with("aravis:Fake");
+}
+
+// The commanded steps (steps_rad, or k times the algorithm's nominal step), checked as the CLI
+// checks them.
+ins::SequenceParams sequence_params(const MeasureArgs& a, psi::Algorithm alg) {
+  ins::SequenceParams p;
+  const bool free_steps = alg == psi::Algorithm::kLeastSquares || alg == psi::Algorithm::kAia ||
+                          alg == psi::Algorithm::kTiltAia;
+  if (!a.steps_rad.empty() && !free_steps)
+    throw ps::core::InputError("steps_rad: " + std::string(psi::algorithm_name(alg)) +
+                               " has fixed steps; unequal steps need lsq, aia or tilt-aia");
+  p.steps_rad = a.steps_rad;
+  const int need = psi::required_frames(alg);
+  if (p.steps_rad.empty()) {
+    for (int k = 0; k < (need > 0 ? need : 5); ++k)
+      p.steps_rad.push_back(k * psi::nominal_step_rad(alg));
+  }
+  if (need > 0 && static_cast<std::size_t>(need) != p.steps_rad.size())
+    throw ps::core::InputError("algorithm " + std::string(psi::algorithm_name(alg)) + " needs " +
+                               std::to_string(need) + " frames, " +
+                               std::to_string(p.steps_rad.size()) + " given");
+  p.wavelength_nm = kWavelength_nm;
+  p.base_um = a.base_um;
+  p.on_target = a.on_target;
+  p.averages = a.averages;
+  p.frame_timeout_s = a.frame_timeout_s;
+  if (const std::string why = ins::sequence_problem(p); !why.empty())
+    throw ps::core::InputError("measure: " + why);
+  return p;
+}
+
+struct Calibration {
+  ps::control::SemiClosedLoopParams params;
+  std::optional<double> travel_z_max_um;
+  std::string source;
+};
+
+// A file or a controller, checked at the loop's rate; none: the twin calibrated first with the
+// paper's procedure and gains, as `measure` on the twin does without --calibration.
+Calibration resolve(const MeasureArgs& a, const ps::config::ProjectConfig& config) {
+  Calibration c;
+  const double ts = 1.0 / a.rate_Hz;
+  if (const auto* path = std::get_if<std::string>(&a.calibration)) {
+    c.params = ps::calibration::load_calibration_file(*path, &c.travel_z_max_um);
+    c.source = *path;
+  } else if (const auto* p = std::get_if<ps::control::SemiClosedLoopParams>(&a.calibration)) {
+    c.params = *p;
+    c.source = "a controller from Python";
+  } else {
+    const ps::calibration::CalibrationWithTravel ct = ps::calibration::calibrate_with_travel(
+        config, a.seed, ps::calibration::CalibrationOptions::paper_gains_only());
+    c.params = ct.calibration.controller;
+    c.travel_z_max_um = ct.travel.single_move_um;
+    c.source =
+        "the twin's own calibration (paper's procedure, seed " + std::to_string(a.seed) + ")";
+    return c;
+  }
+  // The loop's own rule first (an improved controller runs at its design rate only), then the
+  // gains rescaled to the loop's rate, as `measure --calibration` checks a file.
+  ps::control::SemiClosedLoopParams at_loop = c.params;
+  at_loop.sample_time_s = ts;
+  if (ps::control::params_problem(at_loop, ts) == ps::control::ParamsProblem::kImprovedRate)
+    throw ps::core::InputError(c.source + ": [improved] sample_time_s = " +
+                               std::to_string(c.params.improved.sample_time_s) +
+                               " s, but the loop runs at " + std::to_string(a.rate_Hz) +
+                               " Hz: calibrate the improved controller at the loop's rate");
+  if (const std::string why = ps::calibration::controller_problem(c.params, ts); !why.empty())
+    throw ps::core::InputError(c.source + " at the loop's " + std::to_string(a.rate_Hz) +
+                               " Hz: " + why);
+  return c;
+}
+
+void check_args(const MeasureArgs& a) {
+  if (!(a.rate_Hz >= 1000.0 && a.rate_Hz <= 10000.0))
+    throw ps::core::InputError("rate_Hz " + std::to_string(a.rate_Hz) + ": must be in 1000..10000");
+  if (a.averages < 1 || a.averages > 100)
+    throw ps::core::InputError("averages " + std::to_string(a.averages) + ": must be in 1..100");
+  if (a.camera != "twin" && !fed_by_twin(a.camera) && !a.surface.empty())
+    throw ps::core::InputError(
+        "surface: the test surface of the twin camera (or of aravis:Fake_1)");
+  if ((a.camera == "twin" || fed_by_twin(a.camera)) && !a.mask.is_none())
+    throw ps::core::InputError("mask: the twin camera's pupil is its scene's; give none");
+}
+
+void check_travel(const ins::SequenceParams& p, const Calibration& c) {
+  double top_nm = 0.0;
+  for (double step : p.steps_rad)
+    top_nm = std::max(top_nm, step * p.wavelength_nm / (4.0 * std::numbers::pi));
+  const double top_um = p.base_um + top_nm * 1e-3;
+  if (c.travel_z_max_um && top_um > *c.travel_z_max_um)
+    throw ps::core::InputError("base_um " + std::to_string(p.base_um) + ": the sequence reaches " +
+                               std::to_string(top_um) + " um, beyond the calibrated travel " +
+                               std::to_string(*c.travel_z_max_um) + " um (" + c.source + ")");
+}
+
+std::unique_ptr<cam::Camera> open_camera(const MeasureArgs& a, const cam::CameraConfig& cc,
+                                         const cam::TwinScene* scene) {
+  std::unique_ptr<cam::Camera> c;
+  if (fed_by_twin(a.camera)) {
+    c = std::make_unique<cam::TwinFedCamera>(
+        std::make_unique<cam::TwinCamera>(*scene, cam::sensor_params(cc)),
+        cam::make_aravis_camera(a.camera.substr(7)));
+    c->configure(cc.settings);
+  } else {
+    c = cam::make_camera(a.camera, cc, scene);
+  }
+  c->start();
+  return c;
+}
+
+py::list exposures_list(const ins::SequenceResult& s) {
+  py::list out;
+  for (const ins::ExposureRecord& e : s.exposures) {
+    py::dict d;
+    d["average"] = e.average + 1;
+    d["frame"] = e.frame;
+    d["frame_id"] = e.frame_id;
+    d["commanded_step_rad"] = e.commanded_step_rad;
+    d["commanded_piston_nm"] = e.commanded_piston_nm;
+    d["move_time_s"] = e.move_time_s;
+    d["settle_s"] = e.settled_time_s - e.move_time_s;
+    d["trigger_time_s"] = e.trigger_time_s;
+    d["exposure_end_s"] = e.exposure_end_s;
+    d["gauge_error_mean_nm"] = e.gauge_error_mean_nm;
+    d["gauge_error_max_nm"] = e.gauge_error_max_nm;
+    d["arrival_wall_s"] = e.arrival_wall_s;
+    if (e.has_truth) {
+      d["truth_piston_nm"] = e.truth_piston_nm;
+      d["truth_blur_nm"] = e.truth_blur_nm;
+      d["truth_tip_urad"] = e.truth_tip_urad;
+      d["truth_tilt_urad"] = e.truth_tilt_urad;
+    }
+    out.append(d);
+  }
+  return out;
+}
+
+py::object number_or_none(std::optional<double> v) {
+  return v ? py::object(py::float_(*v)) : py::object(py::none());
+}
+
+// The acquisition's part of the result: frames, exposures, timing, validity.
+py::dict sequence_dict(const ins::SequenceResult& s, const ins::SequenceParams& p,
+                       const std::string& camera_name, const Calibration& c, psi::Algorithm alg) {
+  py::dict d;
+  d["camera"] = camera_name;
+  d["daq"] = "sim";
+  d["clock"] = "free-run";
+  d["calibration"] = c.source;
+  d["algorithm"] = std::string(psi::algorithm_name(alg));
+  d["wavelength_nm"] = p.wavelength_nm;
+  d["averages"] = p.averages;
+  d["commanded_steps_rad"] = p.steps_rad;
+  d["valid"] = s.validity.valid;
+  d["valid_reason"] =
+      s.validity.reason.empty() ? py::object(py::none()) : py::object(py::str(s.validity.reason));
+  py::list frames;
+  for (const cam::Frame& f : s.frames)
+    frames.append(counts_to_numpy(f));
+  d["frames"] = frames;
+  d["exposures"] = exposures_list(s);
+  py::dict t;
+  t["wall_time_s"] = s.wall_time_s;
+  t["floor_s"] = s.floor_s;
+  t["ratio_to_floor"] =
+      s.floor_s > 0.0 ? py::object(py::float_(s.wall_time_s / s.floor_s)) : py::object(py::none());
+  t["loop_time_s"] = s.loop_time_s;
+  t["ticks"] = s.ticks;
+  t["overruns"] = s.overruns;
+  d["timing"] = t;
+  return d;
+}
+
+void add_analysis(py::dict& d, const ins::MeasurementAnalysis& a) {
+  d["surface_nm"] = map_to_numpy(a.surface_nm);
+  d["valid_pixels_mask"] = mask_to_numpy(a.valid);
+  d["recovered_steps_rad"] = a.recovered_steps_rad;
+  d["true_steps_rad"] =
+      a.true_steps_rad.empty() ? py::object(py::none()) : py::object(py::cast(a.true_steps_rad));
+  d["step_error_max_mrad"] = a.true_steps_rad.empty()
+                                 ? py::object(py::none())
+                                 : py::object(py::float_(a.step_error_max_mrad));
+  d["converged"] = a.converged;
+  d["reason"] = a.reason.empty() ? py::object(py::none()) : py::object(py::str(a.reason));
+  d["surface_rms_nm"] = a.figures.rms;
+  d["surface_pv_nm"] = a.figures.pv;
+  d["surface_pvr_nm"] = a.figures.pvr;
+  d["valid_pixels"] = a.figures.pixels;
+  d["zernike_nm"] = a.zernike_nm;
+  py::list averages;
+  for (const psi::SurfaceFigures& f : a.average_figures) {
+    py::dict af;
+    af["rms_nm"] = f.rms;
+    af["pv_nm"] = f.pv;
+    af["pvr_nm"] = f.pvr;
+    averages.append(af);
+  }
+  d["average_figures"] = averages;
+}
+
+// Raises piezoshift.ProcedureFailed with the partial result attached.
+[[noreturn]] void fail(const std::string& why, const py::dict& partial) {
+  const py::object type = py::module_::import("piezoshift._piezoshift").attr("ProcedureFailed");
+  py::object error = type(why);
+  error.attr("result") = partial;
+  PyErr_SetObject(type.ptr(), error.ptr());
+  throw py::error_already_set();
+}
+
+struct Setup {
+  cam::InstrumentConfig config;
+  psi::Algorithm algorithm = psi::Algorithm::kHariharan5;
+  ins::SequenceParams params;
+  std::optional<cam::TwinScene> scene;
+  Calibration calibration;
+};
+
+// Everything before the loop starts, in the CLI's order so that bad input is named first.
+Setup prepare(const MeasureArgs& a) {
+  check_args(a);
+  Setup s;
+  if (a.config)
+    s.config = cam::load_instrument_config(*a.config);
+  s.algorithm = psi::parse_algorithm(a.algorithm);
+  s.params = sequence_params(a, s.algorithm);
+  if (a.camera == "twin" || fed_by_twin(a.camera)) {
+    const psi::SurfaceSpec spec =
+        a.surface.empty() ? psi::SurfaceSpec{} : psi::parse_surface_spec(a.surface);
+    s.scene = cam::make_twin_scene(
+        spec, cam::measurement_optics(s.config.camera.settings, kWavelength_nm), a.seed);
+  }
+  return s;
+}
+
+py::dict measure(const MeasureArgs& a) {
+  Setup s = prepare(a);
+  const ps::config::ProjectConfig& project = s.config.installation.project;
+  ps::runtime::SimOptions so;
+  so.design = project.design;
+  so.twin = project.twin;
+  so.seed = a.seed;
+  so.rate_Hz = a.rate_Hz;
+  if (a.config)
+    so.source = *a.config;
+  ps::runtime::SimBackend sim(so);
+  sim.configure();
+  ps::runtime::SimulatedClock clock;
+  ins::SequenceResult r;
+  std::string camera_name;
+  {
+    py::gil_scoped_release release;
+    s.calibration = resolve(a, project);
+    check_travel(s.params, s.calibration);
+    std::unique_ptr<cam::Camera> camera =
+        open_camera(a, s.config.camera, s.scene ? &*s.scene : nullptr);
+    ins::LoopSetup loop;
+    loop.controller = s.calibration.params;
+    loop.limits = s.config.installation.safety;
+    loop.rate_Hz = a.rate_Hz;
+    r = ins::acquire_sequence(sim, clock, &sim.twin(), *camera, loop, s.params);
+    camera->stop();
+    camera_name = camera->name();
+  }
+  py::dict d = sequence_dict(r, s.params, camera_name, s.calibration, s.algorithm);
+  if (!r.validity.valid)
+    fail("measure: " + r.validity.reason, d);
+  const psi::Mask mask =
+      s.scene
+          ? s.scene->mask
+          : (a.mask.is_none() ? psi::Mask(r.frames.front().width_px, r.frames.front().height_px, 1)
+                              : mask_from_numpy(a.mask, r.frames.front().width_px,
+                                                r.frames.front().height_px, "mask"));
+  psi::AnalysisOptions ao;
+  ao.phase.algorithm = s.algorithm;
+  ao.phase.steps_rad = s.params.steps_rad;
+  ao.wavelength_nm = kWavelength_nm;
+  ins::MeasurementAnalysis an;
+  std::optional<double> error_rms_nm, ideal_rms_nm;
+  try {
+    py::gil_scoped_release release;
+    an = ins::analyze_measurement(r, s.params, mask, ao);
+    if (s.scene) {
+      error_rms_nm = psi::surface_error_rms_nm(an.surface_nm, s.scene->surface_nm, an.valid);
+      ideal_rms_nm = ins::ideal_stage_error_rms_nm(*s.scene, s.config.camera, s.params, ao);
+    }
+  } catch (const std::invalid_argument& e) {
+    fail(std::string("measure: the frames carry no phase: ") + e.what(), d);
+  }
+  add_analysis(d, an);
+  d["truth_nm"] = s.scene ? py::object(map_to_numpy(s.scene->surface_nm)) : py::object(py::none());
+  d["mask"] = mask_to_numpy(mask);
+  d["error_rms_nm"] = number_or_none(error_rms_nm);
+  d["ideal_error_rms_nm"] = number_or_none(ideal_rms_nm);
+  if (!an.converged)
+    fail("measure: " + an.reason, d);
+  return d;
+}
+
+}  // namespace
+
+void bind_instrument(py::module_& m) {
+  const ins::SequenceParams defaults;
+  m.def(
+      "measure",
+      [](const py::object& config, const py::object& calibration, const std::string& camera,
+         const std::string& algorithm, const std::vector<double>& steps_rad, int averages,
+         const std::string& surface, std::uint64_t seed, double rate_Hz, double base_um,
+         double settle_band_nm, double settle_hold_s, double settle_timeout_s,
+         double frame_timeout_s, const py::object& mask) {
+        MeasureArgs a;
+        if (!config.is_none())
+          a.config = py::str(config).cast<std::string>();  // str or os.PathLike
+        if (py::isinstance<ps::control::SemiClosedLoopParams>(calibration))
+          a.calibration = calibration.cast<ps::control::SemiClosedLoopParams>();
+        else if (!calibration.is_none())
+          a.calibration = py::str(calibration).cast<std::string>();
+        a.camera = camera;
+        a.algorithm = algorithm;
+        a.steps_rad = steps_rad;
+        a.averages = averages;
+        a.surface = surface;
+        a.seed = seed;
+        a.rate_Hz = rate_Hz;
+        a.base_um = base_um;
+        a.on_target = {settle_band_nm, settle_hold_s, settle_timeout_s};
+        a.frame_timeout_s = frame_timeout_s;
+        a.mask = mask;
+        return measure(a);
+      },
+      py::arg("config") = py::none(), py::arg("calibration") = py::none(),
+      py::arg("camera") = "twin", py::arg("algorithm") = "hariharan5",
+      py::arg("steps_rad") = std::vector<double>{}, py::arg("averages") = 1,
+      py::arg("surface") = "", py::arg("seed") = 1, py::arg("rate_Hz") = 1000.0,
+      py::arg("base_um") = defaults.base_um, py::arg("settle_band_nm") = defaults.on_target.band_nm,
+      py::arg("settle_hold_s") = defaults.on_target.hold_s,
+      py::arg("settle_timeout_s") = defaults.on_target.timeout_s,
+      py::arg("frame_timeout_s") = defaults.frame_timeout_s, py::arg("mask") = py::none(),
+      "One phase-shifting measurement on the twin (free-running simulated clock), as "
+      "`piezoshift measure --daq sim --free-run` takes it; a dict with the names of "
+      "`measure --json`, maps and frames as numpy arrays (docs/python.md)");
+}
+
+}  // namespace piezoshift::python

@@ -1,0 +1,165 @@
+"""Cameras and measurements from Python (docs/python.md): measure() on the twin, the twin camera
+driven by hand, and the refusals of bad cameras."""
+import math
+import struct
+import zlib
+
+import numpy as np
+import pytest
+
+import piezoshift as ps
+
+
+def small_camera_toml(tmp_path, pixel_format="Mono12"):
+    path = tmp_path / "camera.toml"
+    path.write_text("[camera]\nwidth_px = 96\nheight_px = 96\n"
+                    f'pixel_format = "{pixel_format}"\n')
+    return str(path)
+
+
+def small_camera_config(pixel_format=ps.PixelFormat.MONO12):
+    cc = ps.CameraConfig()
+    cc.settings.width_px = cc.settings.height_px = 96
+    cc.settings.format = pixel_format
+    return cc
+
+
+def test_measure_on_the_twin_recovers_the_surface(tmp_path):
+    r = ps.measure(config=small_camera_toml(tmp_path), surface="Z4=40,Z5=25,rough=0.5", seed=2)
+    assert r["camera"] == "twin" and r["algorithm"] == "hariharan5"
+    assert r["valid"] and r["converged"]
+    frames = r["frames"]
+    assert len(frames) == 5
+    assert all(f.shape == (96, 96) and f.dtype == np.uint16 for f in frames)
+    assert max(int(f.max()) for f in frames) <= 4095  # Mono12 counts
+    assert len(r["exposures"]) == 5
+    assert [e["frame_id"] for e in r["exposures"]] == [0, 1, 2, 3, 4]
+    assert r["exposures"][2]["commanded_piston_nm"] == pytest.approx(632.8 / 4)
+    # The measured surface against the twin's truth, piston and tilt removed (psi's measure).
+    s, truth, mask = r["surface_nm"], r["truth_nm"], r["mask"]
+    assert s.shape == truth.shape == mask.shape == (96, 96)
+    assert np.isnan(s[0, 0]) and np.isnan(truth[0, 0]) and not mask[0, 0]
+    assert r["error_rms_nm"] < 1.0
+    assert r["ideal_error_rms_nm"] <= r["error_rms_nm"] * 1.5
+    # 40 nm RMS of defocus and 25 of astigmatism: the surface's RMS is theirs.
+    assert r["surface_rms_nm"] == pytest.approx(math.hypot(40.0, 25.0), rel=0.05)
+    assert r["zernike_nm"][3] == pytest.approx(40.0, abs=1.0)
+    # The steps recovered from the fringes against the stage's true ones.
+    assert r["step_error_max_mrad"] < 5.0
+    assert len(r["recovered_steps_rad"][0]) == 5
+    assert r["timing"]["floor_s"] > 0 and r["timing"]["overruns"] == 0
+
+
+def test_measure_is_deterministic_for_a_seed(tmp_path):
+    config = small_camera_toml(tmp_path)
+    a = ps.measure(config=config, seed=3)
+    b = ps.measure(config=config, seed=3)
+    np.testing.assert_array_equal(a["frames"][4], b["frames"][4])
+    assert a["error_rms_nm"] == b["error_rms_nm"]
+
+
+def test_a_sequence_that_cannot_settle_raises_procedure_failed(tmp_path):
+    with pytest.raises(ps.ProcedureFailed, match="did not settle") as e:
+        ps.measure(config=small_camera_toml(tmp_path), settle_band_nm=1e-6, settle_timeout_s=0.05)
+    assert isinstance(e.value, RuntimeError)
+    assert e.value.result["valid"] is False
+    assert e.value.result["frames"] == []  # never a silently short sequence
+
+
+def write_png_gray16(path, counts):
+    """A 16-bit grayscale PNG of a (H, W) uint16 array (the format `measure` writes frames in)."""
+    h, w = counts.shape
+    rows = b"".join(b"\0" + counts[y].astype(">u2").tobytes() for y in range(h))
+
+    def chunk(kind, data):
+        return (struct.pack(">I", len(data)) + kind + data
+                + struct.pack(">I", zlib.crc32(kind + data) & 0xFFFFFFFF))
+
+    header = struct.pack(">IIBBBBB", w, h, 16, 0, 0, 0, 0)  # 16-bit, grayscale
+    path.write_bytes(b"\x89PNG\r\n\x1a\n" + chunk(b"IHDR", header)
+                     + chunk(b"IDAT", zlib.compress(rows)) + chunk(b"IEND", b""))
+
+
+def test_frames_replayed_through_files_give_the_same_surface(tmp_path):
+    config = small_camera_toml(tmp_path)
+    twin = ps.measure(config=config)
+    frames = tmp_path / "frames"
+    frames.mkdir()
+    for k, counts in enumerate(twin["frames"]):
+        write_png_gray16(frames / f"frame_{k:03}.png", counts)
+    replay = ps.measure(config=config, camera=f"files:{frames}", mask=twin["mask"])
+    assert replay["camera"] == f"files:{frames}"
+    assert replay["truth_nm"] is None and replay["error_rms_nm"] is None
+    np.testing.assert_array_equal(replay["frames"][3], twin["frames"][3])
+    np.testing.assert_allclose(replay["surface_nm"], twin["surface_nm"], rtol=0, atol=1e-9)
+    with pytest.raises(ps.InputError, match="mask: expected a \\(96, 96\\) array"):
+        ps.measure(config=config, camera=f"files:{frames}", mask=np.ones((3, 3)))
+
+
+def test_bad_cameras_are_refused_by_name(tmp_path):
+    with pytest.raises(ps.InputError, match="'webcam:0': not a camera"):
+        ps.measure(config=small_camera_toml(tmp_path), camera="webcam:0")
+    with pytest.raises(ps.InputError, match="no simulated interferometer"):
+        ps.make_camera("twin", small_camera_config())  # no scene to render
+    with pytest.raises(ps.InputError, match="files:/nonexistent"):
+        ps.make_camera("files:/nonexistent")
+
+
+@pytest.mark.skipif(not ps.aravis_available(), reason="built without Aravis")
+def test_the_fake_aravis_camera_refuses_mono12_and_sees_the_twin_in_mono16(tmp_path):
+    with pytest.raises(ps.InputError, match="Mono12"):
+        ps.make_camera("aravis:Fake_1", small_camera_config(ps.PixelFormat.MONO12))
+    with pytest.raises(ps.InputError, match="Mono12"):
+        ps.measure(config=small_camera_toml(tmp_path), camera="aravis:Fake_1")
+    config = small_camera_toml(tmp_path, "Mono16")
+    fake = ps.measure(config=config, camera="aravis:Fake_1")
+    twin = ps.measure(config=config)
+    assert fake["camera"] == "aravis:Fake_1"
+    assert fake["frames"][0].dtype == np.uint16
+    diff = fake["surface_nm"] - twin["surface_nm"]
+    assert np.sqrt(np.nanmean(diff**2)) < 0.1
+
+
+def test_the_twin_camera_driven_by_hand():
+    cc = small_camera_config()
+    scene = ps.make_twin_scene("Z4=40", config=cc, seed=5)
+    assert scene.surface_nm.shape == scene.mask.shape == (96, 96)
+    assert scene.mask.dtype == bool and np.isnan(scene.surface_nm[~scene.mask]).all()
+    cam = ps.make_camera("twin", cc, scene)
+    assert cam.name == "twin" and cam.settings.width_px == 96
+    cam.start()
+    frames = []
+    t = 0.0
+    for piston_nm in (0.0, 632.8 / 8):  # a quarter wave of phase apart
+        assert cam.trigger(t)
+        assert not cam.trigger(t)  # still exposing, then reading out
+        assert "readout" in cam.message or "exposure" in cam.message
+        cam.observe_plate(ps.PlatePose(time_s=t, piston_nm=piston_nm))
+        cam.observe_plate(ps.PlatePose(time_s=t + cc.settings.exposure_s, piston_nm=piston_nm))
+        status, frame = cam.wait(2.0)
+        assert status == ps.FrameStatus.OK, cam.message
+        frames.append(frame)
+        t += cc.settings.exposure_s + cc.settings.readout_s
+    status, frame = cam.poll()
+    assert status == ps.FrameStatus.NONE and frame is None
+    cam.stop()
+    assert [f.frame_id for f in frames] == [0, 1]
+    first = frames[0].counts
+    assert first.shape == (96, 96) and first.dtype == np.uint16
+    assert frames[0].format == ps.PixelFormat.MONO12 and first.max() <= 4095
+    assert frames[1].trigger_time_s == pytest.approx(0.001 + cc.settings.readout_s)
+    # The fringes moved: a quarter wave changes the pupil's pixels far beyond the noise.
+    inside = scene.mask
+    moved = np.abs(first[inside].astype(float) - frames[1].counts[inside].astype(float))
+    assert moved.mean() > 100
+    assert cam.lost_frames == 0
+
+
+def test_the_docs_example_runs():
+    """docs/python.md's fenced Python example of "Cameras and measurements", run as written."""
+    from conftest import SOURCE_DIR
+    text = (SOURCE_DIR / "docs" / "python.md").read_text()
+    section = text.split("### Cameras and measurements", 1)[1].split("\n## ", 1)[0]
+    blocks = section.split("```python\n")[1:]
+    assert len(blocks) == 1
+    exec(compile(blocks[0].split("```", 1)[0], "docs/python.md", "exec"), {})
