@@ -54,52 +54,22 @@ nlohmann::json safety_json(const runtime::SafetyLimits& limits) {
 LoopCalibration resolve_calibration(const std::string& path, const std::string& daq,
                                     const config::ProjectConfig& config, std::uint64_t seed,
                                     double loop_sample_time_s, double max_physics_steps) {
-  LoopCalibration c;
-  if (!path.empty()) {
-    c.params = calibration::load_calibration_file(path, &c.travel_z_max_um, &c.travel_z_min_um);
-    // The loop's own rule (control::params_problem, which the loop applies again when it takes
-    // the set), checked here so that the refusal names the file.
-    control::SemiClosedLoopParams at_loop = c.params;
-    at_loop.sample_time_s = loop_sample_time_s;
-    const double t = c.params.improved.sample_time_s;
-    if (control::params_problem(at_loop, loop_sample_time_s) ==
-        control::ParamsProblem::kImprovedRate)
-      throw core::InputError(fmt::format(
-          "{}: [improved] sample_time_s = {} s, but the loop runs at {} s ({} Hz): calibrate the "
-          "improved controller at the loop's rate",
-          path, t, loop_sample_time_s, 1.0 / loop_sample_time_s));
-    // The file was checked at its own rate; the gains are rescaled to the loop's, where they
-    // must be stable too (calibration/controller_ranges.hpp).
-    if (const std::string why = calibration::controller_problem(c.params, loop_sample_time_s);
-        !why.empty())
-      throw core::InputError(
-          fmt::format("{} at the loop's {} Hz: {}", path, 1.0 / loop_sample_time_s, why));
-    c.source = path;
-    return c;
-  }
+  if (!path.empty())
+    return calibration::load_loop_calibration(path, loop_sample_time_s);
   if (daq != "sim") {
     fmt::print(stderr,
                "piezoshift: warning: no --calibration: running with the paper's gains, A and p "
                "(Section 4), which describe the paper's stage, not this one\n");
+    LoopCalibration c;
     c.source = "the paper's values (Section 4)";
     return c;
   }
-  const calibration::CalibrationOptions startup =
-      calibration::CalibrationOptions::paper_gains_only();
-  check_procedure_cost("the start-up calibration of the twin (no --calibration)",
-                       calibration::calibration_cost(startup, config.twin.daq.sample_time_s),
-                       config.twin, max_physics_steps);
+  check_physics_budget(max_physics_steps);
   fmt::print(stderr,
              "piezoshift: no --calibration: calibrating the twin first (the paper's procedure "
              "and gains, seed {})\n",
              seed);
-  const calibration::CalibrationWithTravel ct =
-      calibration::calibrate_with_travel(config, seed, startup);
-  c.params = ct.calibration.controller;
-  c.travel_z_max_um = ct.travel.single_move_um;
-  c.travel_z_min_um = ct.travel.single_move_min_um;
-  c.source = fmt::format("the twin's own calibration (paper's procedure, seed {})", seed);
-  return c;
+  return calibration::startup_calibration(config, seed, max_physics_steps);
 }
 
 struct StopSignals::Saved {

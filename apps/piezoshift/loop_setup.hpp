@@ -11,6 +11,7 @@
 
 #include <nlohmann/json.hpp>
 
+#include "piezoshift/calibration/loop_calibration.hpp"
 #include "piezoshift/config/project_config.hpp"
 #include "piezoshift/control/semi_closed_loop.hpp"
 #include "piezoshift/plant/simulation_cost.hpp"
@@ -35,12 +36,7 @@ runtime::SafetyLimits loop_safety_limits(const runtime::SafetyLimits& installati
 nlohmann::json safety_json(const runtime::SafetyLimits& limits);
 
 //! The controller a loop runs with, and where it came from.
-struct LoopCalibration {
-  control::SemiClosedLoopParams params;
-  std::optional<double> travel_z_max_um;  //!< the travel one move reaches, when known
-  std::optional<double> travel_z_min_um;  //!< the lowest Z a move from the top reaches
-  std::string source;                     //!< the file, or how it was obtained
-};
+using calibration::LoopCalibration;
 
 //! --calibration FILE when given. Otherwise, on the twin (--daq sim), the paper's calibration
 //! procedure with the paper's gains run on that twin first (one line on stderr says so: a few

@@ -22,13 +22,11 @@
 #include "loop_stack.hpp"
 #include "measure_report.hpp"
 #include "physics_budget.hpp"
-#include "piezoshift/camera/aravis_camera.hpp"
 #include "piezoshift/camera/camera.hpp"
 #include "piezoshift/camera/camera_config.hpp"
 #include "piezoshift/camera/instrument_config.hpp"
 #include "piezoshift/camera/make_camera.hpp"
 #include "piezoshift/camera/twin_camera.hpp"
-#include "piezoshift/camera/twin_fed_camera.hpp"
 #include "piezoshift/core/input_error.hpp"
 #include "piezoshift/instrument/acquisition.hpp"
 #include "piezoshift/instrument/measurement.hpp"
@@ -71,30 +69,12 @@ struct MeasureOptions {
   bool json = false;
 };
 
-// The commanded steps: --steps-rad, or k times the algorithm's nominal step.
-std::vector<double> commanded_steps(const MeasureOptions& o, psi::Algorithm alg) {
-  if (!o.steps_rad.empty()) {
-    std::vector<double> steps = parse_list(o.steps_rad, "--steps-rad");
-    const bool free_steps = alg == psi::Algorithm::kLeastSquares || alg == psi::Algorithm::kAia ||
-                            alg == psi::Algorithm::kTiltAia;
-    if (!free_steps)
-      throw core::InputError(
-          fmt::format("--steps-rad: {} has fixed steps; unequal steps need lsq, aia or tilt-aia",
-                      psi::algorithm_name(alg)));
-    return steps;
-  }
-  const int n = psi::required_frames(alg) > 0 ? psi::required_frames(alg) : 5;
-  std::vector<double> steps;
-  for (int k = 0; k < n; ++k)
-    steps.push_back(k * psi::nominal_step_rad(alg));
-  return steps;
-}
-
 instrument::SequenceParams sequence_params(const MeasureOptions& o, psi::Algorithm alg,
                                            double wavelength_nm) {
   instrument::SequenceParams p;
-  p.steps_rad = commanded_steps(o, alg);
-  check_count(alg, p.steps_rad.size());
+  p.steps_rad = instrument::commanded_steps(
+      alg, o.steps_rad.empty() ? std::vector<double>{} : parse_list(o.steps_rad, "--steps-rad"),
+      "--steps-rad");
   p.wavelength_nm = wavelength_nm;
   p.base_um = o.base_um;
   p.on_target = o.on_target;
@@ -155,26 +135,15 @@ void check_options(const MeasureOptions& o) {
 }
 
 void check_travel(const MeasureSetup& s) {
-  double top_nm = 0.0;
-  for (double step : s.params.steps_rad)
-    top_nm = std::max(top_nm, step * s.params.wavelength_nm / (4.0 * std::numbers::pi));
-  const double top_um = s.params.base_um + top_nm * 1e-3;
-  if (s.calibration.travel_z_max_um && top_um > *s.calibration.travel_z_max_um)
-    throw core::InputError(fmt::format(
-        "--base-um {}: the sequence reaches {:.4f} um, beyond the calibrated travel {} um ({})",
-        s.params.base_um, top_um, *s.calibration.travel_z_max_um, s.calibration.source));
+  if (const std::string why =
+          instrument::travel_problem(s.params, s.calibration.travel_z_max_um, s.calibration.source);
+      !why.empty())
+    throw core::InputError("--base-um: " + why);
 }
 
 std::unique_ptr<camera::Camera> open_camera(const MeasureOptions& o, const MeasureSetup& s) {
-  std::unique_ptr<camera::Camera> cam;
-  if (fed_by_twin(o)) {
-    cam = std::make_unique<camera::TwinFedCamera>(
-        std::make_unique<camera::TwinCamera>(*s.scene, camera::sensor_params(s.config.camera)),
-        camera::make_aravis_camera(o.camera.substr(7)));
-    cam->configure(s.config.camera.settings);
-  } else {
-    cam = camera::make_camera(o.camera, s.config.camera, s.scene ? &*s.scene : nullptr);
-  }
+  std::unique_ptr<camera::Camera> cam =
+      camera::make_camera(o.camera, s.config.camera, s.scene ? &*s.scene : nullptr);
   cam->start();
   return cam;
 }

@@ -19,19 +19,16 @@
 
 #include "bindings.hpp"
 #include "images.hpp"
-#include "piezoshift/calibration/calibration_file.hpp"
-#include "piezoshift/calibration/calibration_procedure.hpp"
-#include "piezoshift/calibration/controller_ranges.hpp"
-#include "piezoshift/camera/aravis_camera.hpp"
+#include "piezoshift/calibration/loop_calibration.hpp"
 #include "piezoshift/camera/instrument_config.hpp"
 #include "piezoshift/camera/make_camera.hpp"
 #include "piezoshift/camera/twin_camera.hpp"
-#include "piezoshift/camera/twin_fed_camera.hpp"
-#include "piezoshift/control/parameter_check.hpp"
 #include "piezoshift/core/input_error.hpp"
 #include "piezoshift/instrument/acquisition.hpp"
 #include "piezoshift/instrument/measurement.hpp"
 #include "piezoshift/instrument/twin_floor.hpp"
+#include "piezoshift/plant/simulation_cost.hpp"
+#include "piezoshift/psi/pupil_detection.hpp"
 #include "piezoshift/rig/validity.hpp"
 #include "piezoshift/runtime/loop_clock.hpp"
 #include "piezoshift/runtime/sim_backend.hpp"
@@ -68,25 +65,10 @@ bool fed_by_twin(const std::string& spec) {
   return spec.starts_with("aravis:Fake");
 }
 
-// The commanded steps (steps_rad, or k times the algorithm's nominal step), checked as the CLI
-// checks them.
+// The commanded steps and the sequence, checked as the CLI checks them.
 ins::SequenceParams sequence_params(const MeasureArgs& a, psi::Algorithm alg) {
   ins::SequenceParams p;
-  const bool free_steps = alg == psi::Algorithm::kLeastSquares || alg == psi::Algorithm::kAia ||
-                          alg == psi::Algorithm::kTiltAia;
-  if (!a.steps_rad.empty() && !free_steps)
-    throw ps::core::InputError("steps_rad: " + std::string(psi::algorithm_name(alg)) +
-                               " has fixed steps; unequal steps need lsq, aia or tilt-aia");
-  p.steps_rad = a.steps_rad;
-  const int need = psi::required_frames(alg);
-  if (p.steps_rad.empty()) {
-    for (int k = 0; k < (need > 0 ? need : 5); ++k)
-      p.steps_rad.push_back(k * psi::nominal_step_rad(alg));
-  }
-  if (need > 0 && static_cast<std::size_t>(need) != p.steps_rad.size())
-    throw ps::core::InputError("algorithm " + std::string(psi::algorithm_name(alg)) + " needs " +
-                               std::to_string(need) + " frames, " +
-                               std::to_string(p.steps_rad.size()) + " given");
+  p.steps_rad = ins::commanded_steps(alg, a.steps_rad, "steps_rad");
   p.wavelength_nm = kWavelength_nm;
   p.base_um = a.base_um;
   p.on_target = a.on_target;
@@ -97,45 +79,23 @@ ins::SequenceParams sequence_params(const MeasureArgs& a, psi::Algorithm alg) {
   return p;
 }
 
-struct Calibration {
-  ps::control::SemiClosedLoopParams params;
-  std::optional<double> travel_z_max_um;
-  std::string source;
-};
+using ps::calibration::LoopCalibration;
 
 // A file or a controller, checked at the loop's rate; none: the twin calibrated first with the
 // paper's procedure and gains, as `measure` on the twin does without --calibration.
-Calibration resolve(const MeasureArgs& a, const ps::config::ProjectConfig& config) {
-  Calibration c;
+LoopCalibration resolve(const MeasureArgs& a, const ps::config::ProjectConfig& config) {
   const double ts = 1.0 / a.rate_Hz;
-  if (const auto* path = std::get_if<std::string>(&a.calibration)) {
-    c.params = ps::calibration::load_calibration_file(*path, &c.travel_z_max_um);
-    c.source = *path;
-  } else if (const auto* p = std::get_if<ps::control::SemiClosedLoopParams>(&a.calibration)) {
+  if (const auto* path = std::get_if<std::string>(&a.calibration))
+    return ps::calibration::load_loop_calibration(*path, ts);
+  if (const auto* p = std::get_if<ps::control::SemiClosedLoopParams>(&a.calibration)) {
+    LoopCalibration c;
     c.params = *p;
     c.source = "a controller from Python";
-  } else {
-    const ps::calibration::CalibrationWithTravel ct = ps::calibration::calibrate_with_travel(
-        config, a.seed, ps::calibration::CalibrationOptions::paper_gains_only());
-    c.params = ct.calibration.controller;
-    c.travel_z_max_um = ct.travel.single_move_um;
-    c.source =
-        "the twin's own calibration (paper's procedure, seed " + std::to_string(a.seed) + ")";
+    ps::calibration::check_at_loop_rate(c.params, ts, c.source);
     return c;
   }
-  // The loop's own rule first (an improved controller runs at its design rate only), then the
-  // gains rescaled to the loop's rate, as `measure --calibration` checks a file.
-  ps::control::SemiClosedLoopParams at_loop = c.params;
-  at_loop.sample_time_s = ts;
-  if (ps::control::params_problem(at_loop, ts) == ps::control::ParamsProblem::kImprovedRate)
-    throw ps::core::InputError(c.source + ": [improved] sample_time_s = " +
-                               std::to_string(c.params.improved.sample_time_s) +
-                               " s, but the loop runs at " + std::to_string(a.rate_Hz) +
-                               " Hz: calibrate the improved controller at the loop's rate");
-  if (const std::string why = ps::calibration::controller_problem(c.params, ts); !why.empty())
-    throw ps::core::InputError(c.source + " at the loop's " + std::to_string(a.rate_Hz) +
-                               " Hz: " + why);
-  return c;
+  return ps::calibration::startup_calibration(config, a.seed, ps::plant::kDefaultPhysicsStepBudget,
+                                              "a calibration file or controller");
 }
 
 void check_args(const MeasureArgs& a) {
@@ -150,28 +110,9 @@ void check_args(const MeasureArgs& a) {
     throw ps::core::InputError("mask: the twin camera's pupil is its scene's; give none");
 }
 
-void check_travel(const ins::SequenceParams& p, const Calibration& c) {
-  double top_nm = 0.0;
-  for (double step : p.steps_rad)
-    top_nm = std::max(top_nm, step * p.wavelength_nm / (4.0 * std::numbers::pi));
-  const double top_um = p.base_um + top_nm * 1e-3;
-  if (c.travel_z_max_um && top_um > *c.travel_z_max_um)
-    throw ps::core::InputError("base_um " + std::to_string(p.base_um) + ": the sequence reaches " +
-                               std::to_string(top_um) + " um, beyond the calibrated travel " +
-                               std::to_string(*c.travel_z_max_um) + " um (" + c.source + ")");
-}
-
 std::unique_ptr<cam::Camera> open_camera(const MeasureArgs& a, const cam::CameraConfig& cc,
                                          const cam::TwinScene* scene) {
-  std::unique_ptr<cam::Camera> c;
-  if (fed_by_twin(a.camera)) {
-    c = std::make_unique<cam::TwinFedCamera>(
-        std::make_unique<cam::TwinCamera>(*scene, cam::sensor_params(cc)),
-        cam::make_aravis_camera(a.camera.substr(7)));
-    c->configure(cc.settings);
-  } else {
-    c = cam::make_camera(a.camera, cc, scene);
-  }
+  std::unique_ptr<cam::Camera> c = cam::make_camera(a.camera, cc, scene);
   c->start();
   return c;
 }
@@ -209,7 +150,8 @@ py::object number_or_none(std::optional<double> v) {
 
 // The acquisition's part of the result: frames, exposures, timing, validity.
 py::dict sequence_dict(const ins::SequenceResult& s, const ins::SequenceParams& p,
-                       const std::string& camera_name, const Calibration& c, psi::Algorithm alg) {
+                       const std::string& camera_name, const LoopCalibration& c,
+                       psi::Algorithm alg) {
   py::dict d;
   d["camera"] = camera_name;
   d["daq"] = "sim";
@@ -280,7 +222,7 @@ struct Setup {
   psi::Algorithm algorithm = psi::Algorithm::kHariharan5;
   ins::SequenceParams params;
   std::optional<cam::TwinScene> scene;
-  Calibration calibration;
+  LoopCalibration calibration;
 };
 
 // Everything before the loop starts, in the CLI's order so that bad input is named first.
@@ -318,7 +260,10 @@ py::dict measure(const MeasureArgs& a) {
   {
     py::gil_scoped_release release;
     s.calibration = resolve(a, project);
-    check_travel(s.params, s.calibration);
+    if (const std::string why =
+            ins::travel_problem(s.params, s.calibration.travel_z_max_um, s.calibration.source);
+        !why.empty())
+      throw ps::core::InputError("measure: " + why);
     std::unique_ptr<cam::Camera> camera =
         open_camera(a, s.config.camera, s.scene ? &*s.scene : nullptr);
     ins::LoopSetup loop;
@@ -332,12 +277,20 @@ py::dict measure(const MeasureArgs& a) {
   py::dict d = sequence_dict(r, s.params, camera_name, s.calibration, s.algorithm);
   if (!r.validity.valid)
     fail("measure: " + r.validity.reason, d);
-  const psi::Mask mask =
-      s.scene
-          ? s.scene->mask
-          : (a.mask.is_none() ? psi::Mask(r.frames.front().width_px, r.frames.front().height_px, 1)
-                              : mask_from_numpy(a.mask, r.frames.front().width_px,
-                                                r.frames.front().height_px, "mask"));
+  psi::Mask mask;
+  if (s.scene) {
+    mask = s.scene->mask;
+  } else if (!a.mask.is_none()) {
+    mask = mask_from_numpy(a.mask, r.frames.front().width_px, r.frames.front().height_px, "mask");
+  } else {  // the pupil from the fringe modulation, as `measure` finds it without --mask
+    const std::vector<ps::camera::Frame> first(
+        r.frames.begin(), r.frames.begin() + static_cast<long>(s.params.steps_rad.size()));
+    try {
+      mask = psi::pupil_from_modulation(ins::frame_maps(first)).mask;
+    } catch (const std::invalid_argument& e) {
+      fail(std::string("measure: ") + e.what(), d);
+    }
+  }
   psi::AnalysisOptions ao;
   ao.phase.algorithm = s.algorithm;
   ao.phase.steps_rad = s.params.steps_rad;

@@ -6,6 +6,7 @@
 
 #include "piezoshift/camera/aravis_camera.hpp"
 #include "piezoshift/camera/files_camera.hpp"
+#include "piezoshift/camera/twin_fed_camera.hpp"
 #include "piezoshift/core/input_error.hpp"
 
 namespace piezoshift::camera {
@@ -26,6 +27,10 @@ std::unique_ptr<Camera> make_camera(std::string_view spec, const CameraConfig& c
     if (dir.empty())
       throw core::InputError("camera files:: no directory after 'files:'");
     camera = std::make_unique<FilesCamera>(std::string(dir));
+  } else if (spec.starts_with("aravis:Fake") && twin != nullptr) {
+    // Aravis's in-process fake camera on the twin: shown the twin's fringes.
+    camera = std::make_unique<TwinFedCamera>(std::make_unique<TwinCamera>(*twin, config.sensor),
+                                             make_aravis_camera(std::string(spec.substr(7))));
   } else if (spec.starts_with("aravis:")) {
     camera = make_aravis_camera(std::string(spec.substr(7)));
   } else {

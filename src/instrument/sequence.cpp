@@ -329,6 +329,39 @@ class Runner {
 
 }  // namespace
 
+std::vector<double> commanded_steps(psi::Algorithm a, const std::vector<double>& given,
+                                    std::string_view option) {
+  const bool free_steps = a == psi::Algorithm::kLeastSquares || a == psi::Algorithm::kAia ||
+                          a == psi::Algorithm::kTiltAia;
+  if (!given.empty() && !free_steps)
+    throw core::InputError(
+        fmt::format("{}: {} has fixed steps; unequal steps need lsq, aia or "
+                    "tilt-aia",
+                    option, psi::algorithm_name(a)));
+  const int need = psi::required_frames(a);
+  std::vector<double> steps = given;
+  for (int k = 0; given.empty() && k < (need > 0 ? need : 5); ++k)
+    steps.push_back(k * psi::nominal_step_rad(a));
+  if (need > 0 && static_cast<std::size_t>(need) != steps.size())
+    throw core::InputError(fmt::format("--algorithm {} needs {} frames, {} given",
+                                       psi::algorithm_name(a), need, steps.size()));
+  return steps;
+}
+
+std::string travel_problem(const SequenceParams& p, std::optional<double> travel_z_max_um,
+                           std::string_view calibration_source) {
+  double top_nm = 0.0;
+  for (double step : p.steps_rad)
+    top_nm = std::max(top_nm, step * p.wavelength_nm / (4.0 * std::numbers::pi));
+  const double top_um = p.base_um + top_nm * 1e-3;
+  if (!travel_z_max_um || top_um <= *travel_z_max_um)
+    return {};
+  return fmt::format(
+      "base {} um: the sequence reaches {:.4f} um, beyond the calibrated travel {} "
+      "um ({})",
+      p.base_um, top_um, *travel_z_max_um, calibration_source);
+}
+
 std::string sequence_problem(const SequenceParams& p) {
   const std::size_t n = p.steps_rad.size();
   if (n < 3 || n > 64)

@@ -224,5 +224,29 @@ TEST(SequenceTest, ParametersOutOfRangeAreRefusedNamingTheValue) {
   EXPECT_THROW(run_sequence(rig.loop, &rig.sim.twin(), cam, p), core::InputError);
 }
 
+TEST(SequenceTest, CommandedStepsFollowTheAlgorithmAndRefuseWhatItCannotTake) {
+  const std::vector<double> h5 = commanded_steps(psi::Algorithm::kHariharan5, {}, "--steps-rad");
+  ASSERT_EQ(h5.size(), 5u);
+  EXPECT_NEAR(h5[4], 2.0 * std::numbers::pi, 1e-12);
+  const std::vector<double> f13 = commanded_steps(psi::Algorithm::kFrame13, {}, "--steps-rad");
+  ASSERT_EQ(f13.size(), 13u);
+  EXPECT_NEAR(f13[1], std::numbers::pi / 4.0, 1e-12);  // the 13-frame's pi/4
+  EXPECT_EQ(commanded_steps(psi::Algorithm::kAia, {}, "x").size(), 5u);
+  EXPECT_EQ(commanded_steps(psi::Algorithm::kAia, {0.0, 1.4, 3.3, 4.6}, "x")[2], 3.3);
+  EXPECT_THROW(commanded_steps(psi::Algorithm::kHariharan5, {0.0, 1.0, 2.0}, "x"),
+               core::InputError);
+  EXPECT_THROW(commanded_steps(psi::Algorithm::kFourStep, {}, "x").at(4), std::out_of_range);
+}
+
+TEST(SequenceTest, TheSequencesTopIsHeldToTheCalibratedTravel) {
+  SequenceParams p = five_steps();
+  p.base_um = 11.0;  // the top frame is 2 pi: 316.4 nm above the base
+  EXPECT_EQ(travel_problem(p, std::nullopt, "none"), "");
+  EXPECT_EQ(travel_problem(p, 11.32, "cal.toml"), "");
+  const std::string why = travel_problem(p, 11.3, "cal.toml");
+  EXPECT_NE(why.find("11.3164 um"), std::string::npos) << why;
+  EXPECT_NE(why.find("cal.toml"), std::string::npos) << why;
+}
+
 }  // namespace
 }  // namespace piezoshift::instrument

@@ -22,10 +22,14 @@
 // valid = false and the first reason; the loop still ramps to 0 V. The wall-time floor is
 // frames x (settle + exposure + readout), with settle the hold time the criterion needs.
 #include <cstdint>
+#include <optional>
+#include <string>
+#include <string_view>
 #include <vector>
 
 #include "piezoshift/camera/camera.hpp"
 #include "piezoshift/plant/twin.hpp"
+#include "piezoshift/psi/phase_algorithms.hpp"
 #include "piezoshift/psi/stage.hpp"
 #include "piezoshift/rig/progress.hpp"
 #include "piezoshift/rig/validity.hpp"
@@ -42,6 +46,17 @@ struct SequenceParams {
   int averages = 1;               //!< measurements taken one after the other
   double frame_timeout_s = 2.0;   //!< after its exposure, for a frame to arrive
 };
+
+//! The commanded steps of a measurement with algorithm a: given, for lsq, aia and tilt-aia (the
+//! algorithms whose steps are free), else k times a's nominal step over its frame count (5 for
+//! the free ones). core::InputError naming option for steps a fixed-step algorithm cannot take,
+//! or a count the algorithm does not take.
+std::vector<double> commanded_steps(psi::Algorithm a, const std::vector<double>& given,
+                                    std::string_view option);
+
+//! "" when the sequence stays within the calibrated travel (when known), else why not.
+std::string travel_problem(const SequenceParams& p, std::optional<double> travel_z_max_um,
+                           std::string_view calibration_source);
 
 //! Why p cannot be run ("" when it can): 3 to 64 steps, finite, the first 0; wavelength, base,
 //! times and averages in range.
