@@ -1,6 +1,5 @@
 #include "piezoshift/reproduction/phase_measurement.hpp"
 
-#include <algorithm>
 #include <stdexcept>
 
 #include "piezoshift/instrument/acquisition.hpp"
@@ -19,20 +18,15 @@ constexpr psi::Algorithm kAlgorithm = psi::Algorithm::kHariharan5;
 // `measure`'s sequence for Hariharan's algorithm and its defaults: k pi/2, one average.
 instrument::SequenceParams sequence_params() {
   instrument::SequenceParams p;
-  for (int k = 0; k < psi::required_frames(kAlgorithm); ++k)
-    p.steps_rad.push_back(k * psi::nominal_step_rad(kAlgorithm));
+  p.steps_rad = instrument::commanded_steps(kAlgorithm, {}, "steps");
   p.wavelength_nm = kWavelength_nm;
   return p;
 }
 
-// `measure`'s twin scene (measure_command.cpp) for the default surface.
+// `measure`'s twin scene for the default surface.
 camera::TwinScene twin_scene(const camera::CameraConfig& cc, std::uint64_t seed) {
-  psi::FizeauParams fizeau;
-  fizeau.width_px = cc.settings.width_px;
-  fizeau.height_px = cc.settings.height_px;
-  fizeau.pupil_radius_px = 0.47 * std::min(cc.settings.width_px, cc.settings.height_px);
-  fizeau.wavelength_nm = kWavelength_nm;
-  return camera::make_twin_scene(psi::SurfaceSpec{}, fizeau, seed);
+  return camera::make_twin_scene(psi::SurfaceSpec{},
+                                 camera::measurement_optics(cc.settings, kWavelength_nm), seed);
 }
 
 }  // namespace
