@@ -62,17 +62,6 @@ Json exposures_json(const instrument::SequenceResult& s) {
   return a;
 }
 
-// Finite range of a map, for its colour scale.
-std::pair<double, double> finite_range(const psi::Map& m) {
-  double lo = INFINITY, hi = -INFINITY;
-  for (double v : m.v)
-    if (std::isfinite(v)) {
-      lo = std::min(lo, v);
-      hi = std::max(hi, v);
-    }
-  return std::isfinite(lo) ? std::pair{lo, hi} : std::pair{0.0, 0.0};
-}
-
 void write_exposures_csv(const instrument::SequenceResult& s, const fs::path& path) {
   io::CsvWriter csv(
       path.string(),
@@ -272,7 +261,7 @@ void write_measurement(const MeasureRecord& r, const std::string& out_name) {
     write_frames(r, tmp / "frames");
     psi::write_mask_png((tmp / "mask.png").string(), *r.mask);
     psi::write_npy((tmp / "surface_nm.npy").string(), r.analysis->surface_nm);
-    const auto [lo, hi] = finite_range(r.analysis->surface_nm);
+    const auto [lo, hi] = psi::finite_range(r.analysis->surface_nm);
     psi::write_false_colour_png((tmp / "surface_nm.png").string(), r.analysis->surface_nm, lo, hi);
     if (r.truth_nm != nullptr)
       psi::write_npy((tmp / "surface_truth_nm.npy").string(), *r.truth_nm);

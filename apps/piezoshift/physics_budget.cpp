@@ -22,11 +22,7 @@ void check_physics_budget(double budget) {
 void check_procedure_cost(std::string_view procedure, const rig::ProcedureCost& cost,
                           const plant::TwinParams& twin, double budget, double repeats) {
   check_physics_budget(budget);
-  const rig::CostEstimate e = rig::estimate_cost(cost, twin, repeats);
-  if (const std::string why =
-          rig::procedure_budget_problem(procedure, e, twin, budget, "--max-physics-steps");
-      !why.empty())
-    throw core::InputError(why);
+  rig::check_procedure_budget(procedure, cost, twin, budget, "--max-physics-steps", repeats);
 }
 
 }  // namespace piezoshift::app

@@ -86,14 +86,7 @@ Json write_analysis(const psi::Analysis& a, psi::Algorithm alg, double wavelengt
                     const std::string& out, const Json& pupil = nullptr) {
   fs::create_directories(out);
   psi::write_npy((fs::path(out) / "surface_nm.npy").string(), a.surface_nm);
-  double lo = 0.0, hi = 0.0;
-  bool first = true;
-  for (std::size_t p = 0; p < a.surface_nm.size(); ++p)
-    if (std::isfinite(a.surface_nm.v[p])) {
-      lo = first ? a.surface_nm.v[p] : std::min(lo, a.surface_nm.v[p]);
-      hi = first ? a.surface_nm.v[p] : std::max(hi, a.surface_nm.v[p]);
-      first = false;
-    }
+  const auto [lo, hi] = psi::finite_range(a.surface_nm);
   psi::write_false_colour_png((fs::path(out) / "surface_nm.png").string(), a.surface_nm, lo, hi);
   Json j{{"algorithm", psi::algorithm_name(alg)}, {"wavelength_nm", wavelength_nm},
          {"frames", a.phase.steps_rad.size()},    {"steps_rad", a.phase.steps_rad},

@@ -40,13 +40,9 @@ LoopCalibration load_loop_calibration(const std::string& path, double loop_sampl
 LoopCalibration startup_calibration(const config::ProjectConfig& config, std::uint64_t seed,
                                     double budget_physics_steps, const std::string& raise_option) {
   const CalibrationOptions startup = CalibrationOptions::paper_gains_only();
-  const rig::CostEstimate e =
-      rig::estimate_cost(calibration_cost(startup, config.twin.daq.sample_time_s), config.twin);
-  if (const std::string why = rig::procedure_budget_problem(
-          "the start-up calibration of the twin (no calibration given)", e, config.twin,
-          budget_physics_steps, raise_option);
-      !why.empty())
-    throw core::InputError(why);
+  rig::check_procedure_budget("the start-up calibration of the twin (no calibration given)",
+                              calibration_cost(startup, config.twin.daq.sample_time_s), config.twin,
+                              budget_physics_steps, raise_option);
   const CalibrationWithTravel ct = calibrate_with_travel(config, seed, startup);
   LoopCalibration c;
   c.params = ct.calibration.controller;

@@ -2,10 +2,21 @@
 
 #include <algorithm>
 #include <cmath>
+#include <limits>
 #include <numeric>
 #include <stdexcept>
 
 namespace piezoshift::psi {
+
+std::pair<double, double> finite_range(const Map& map) {
+  double lo = std::numeric_limits<double>::infinity(), hi = -lo;
+  for (double v : map.v)
+    if (std::isfinite(v)) {
+      lo = std::min(lo, v);
+      hi = std::max(hi, v);
+    }
+  return std::isfinite(lo) ? std::pair{lo, hi} : std::pair{0.0, 0.0};
+}
 
 std::size_t Mask::count() const {
   return static_cast<std::size_t>(std::count(v.begin(), v.end(), std::uint8_t{1}));

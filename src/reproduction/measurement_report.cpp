@@ -18,19 +18,8 @@ namespace {
 
 namespace fs = std::filesystem;
 
-// The finite range of a map: its colour scale.
-std::pair<double, double> finite_range(const psi::Map& m) {
-  double lo = INFINITY, hi = -INFINITY;
-  for (double v : m.v)
-    if (std::isfinite(v)) {
-      lo = std::min(lo, v);
-      hi = std::max(hi, v);
-    }
-  return std::isfinite(lo) ? std::pair{lo, hi} : std::pair{0.0, 0.0};
-}
-
 std::string surface_caption(const PhaseMeasurement& m) {
-  const auto [lo, hi] = finite_range(m.analysis.surface_nm);
+  const auto [lo, hi] = psi::finite_range(m.analysis.surface_nm);
   return fmt::format(
       "Measured surface [nm], piston and tilt removed: the scale bar runs from {:.1f} nm (blue, "
       "bottom) through white to {:.1f} nm (red, top), a tick every {:.1f} nm; gray: no value",
@@ -60,7 +49,7 @@ std::vector<std::vector<std::string>> steps_table(const PhaseMeasurement& m) {
 void write_measurement_files(const PhaseMeasurement& m, const fs::path& dir, ReportFiles& files) {
   if (!m.validity.valid)
     return;
-  const auto [lo, hi] = finite_range(m.analysis.surface_nm);
+  const auto [lo, hi] = psi::finite_range(m.analysis.surface_nm);
   psi::write_false_colour_png((dir / "measurement_surface_nm.png").string(), m.analysis.surface_nm,
                               lo, hi);
   files.figures.push_back(dir / "measurement_surface_nm.png");

@@ -4,6 +4,7 @@
 
 #include <fmt/core.h>
 
+#include "piezoshift/core/input_error.hpp"
 #include "piezoshift/plant/simulation_cost.hpp"
 
 namespace piezoshift::rig {
@@ -28,6 +29,16 @@ std::string procedure_budget_problem(std::string_view procedure, const CostEstim
       "change those settings, or raise the budget with {}",
       procedure, estimate.physics_steps, estimate.simulated_s, twin.interferometer.static_average_s,
       twin.physics_rate_Hz, twin.daq.sample_time_s, budget_physics_steps, raise_option);
+}
+
+void check_procedure_budget(std::string_view procedure, const ProcedureCost& cost,
+                            const plant::TwinParams& twin, double budget_physics_steps,
+                            std::string_view raise_option, double repeats) {
+  const CostEstimate e = estimate_cost(cost, twin, repeats);
+  if (const std::string why =
+          procedure_budget_problem(procedure, e, twin, budget_physics_steps, raise_option);
+      !why.empty())
+    throw core::InputError(why);
 }
 
 }  // namespace piezoshift::rig

@@ -9,6 +9,7 @@
 // the pupil is the unit disk for a circular mask.
 #include <cstddef>
 #include <cstdint>
+#include <utility>
 #include <vector>
 
 namespace piezoshift::psi {
@@ -48,6 +49,9 @@ struct Pupil {
   double x(int i) const { return (i - cx) / radius_px; }
   double y(int j) const { return (cy - j) / radius_px; }
 };
+
+//! The smallest and largest finite value of a map (its colour scale); {0, 0} when none is finite.
+std::pair<double, double> finite_range(const Map& map);
 
 //! The pupil of a mask. Throws std::invalid_argument for an empty mask.
 Pupil pupil_of(const Mask& mask);

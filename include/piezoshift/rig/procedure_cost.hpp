@@ -36,4 +36,10 @@ std::string procedure_budget_problem(std::string_view procedure, const CostEstim
                                      const plant::TwinParams& twin, double budget_physics_steps,
                                      std::string_view raise_option);
 
+//! core::InputError carrying procedure_budget_problem()'s message when repeats x cost is above
+//! budget_physics_steps on this twin; nothing otherwise.
+void check_procedure_budget(std::string_view procedure, const ProcedureCost& cost,
+                            const plant::TwinParams& twin, double budget_physics_steps,
+                            std::string_view raise_option, double repeats = 1.0);
+
 }  // namespace piezoshift::rig
