@@ -79,6 +79,8 @@ void add_fit_check(Json& j, const psi::PhaseResult& r) {
   j["reason"] = r.reason;
   j["residual_rms"] = r.residual_rms;
   j["noise_rms"] = r.noise_rms;
+  if (std::isfinite(r.step_conditioning))
+    j["step_conditioning"] = r.step_conditioning;
 }
 
 // Writes surface_nm.npy and surface_nm.png into out; returns the JSON of the analysis.

@@ -106,6 +106,7 @@ py::dict analysis_dict(const psi::Analysis& a, psi::Algorithm alg) {
   d["surface_nm"] = a.phase.converged ? py::object(to_numpy(a.surface_nm)) : py::none();
   d["phase_rad"] = a.phase.converged ? py::object(to_numpy(a.phase.phase_rad)) : py::none();
   d["steps_rad"] = a.phase.steps_rad;
+  d["step_conditioning"] = a.phase.step_conditioning;  // aia, else NaN
   d["iterations"] = a.phase.iterations;
   d["surface_rms_nm"] = a.figures.rms;
   d["surface_pv_nm"] = a.figures.pv;

@@ -40,6 +40,9 @@ def test_aia_and_tilt_aia_return_steps_and_planes():
     r = ps.psi_analyze(frames_of(phi, steps), None, algorithm="aia")
     assert np.allclose(r["steps_rad"], steps, atol=1e-6)
     assert r["converged"] and r["reason"] == ""
+    # 19 + 13 rad of phase over the frame: spread evenly over fringes, the conditioning is near
+    # its 0.5 (docs/psi.md); a flat phase would be 0
+    assert 0.45 < r["step_conditioning"] <= 0.5
     # fringes over the whole frame: the pupil found from their modulation is the whole frame
     assert r["pupil"]["source"] == "modulation" and r["pupil"]["pixels"] == n * n
     t = ps.psi_analyze(frames_of(phi, steps), None, algorithm="tilt-aia")

@@ -209,6 +209,19 @@ std::vector<double> commanded_steps(const PhaseOptions& o, std::size_t nf) {
   return o.steps_rad.size() == nf ? o.steps_rad : uniform_steps(static_cast<int>(nf), kPi / 2.0);
 }
 
+// PhaseResult::step_conditioning of a phase over the pupil's pixels.
+double step_conditioning(const std::vector<double>& phi) {
+  Eigen::Matrix3d m = Eigen::Matrix3d::Zero();
+  for (const double p : phi) {
+    const Eigen::Vector3d u(1.0, std::cos(p), std::sin(p));
+    m += u * u.transpose();
+  }
+  if (phi.empty())
+    return 0.0;
+  m /= static_cast<double>(phi.size());
+  return Eigen::SelfAdjointEigenSolver<Eigen::Matrix3d>(m, Eigen::EigenvaluesOnly).eigenvalues()(0);
+}
+
 void aia(std::span<const Map> frames, const std::vector<std::size_t>& pix, const PhaseOptions& o,
          PhaseResult& r, std::vector<double>& phi, std::vector<double>& b) {
   const std::size_t nf = frames.size();
@@ -229,6 +242,7 @@ void aia(std::span<const Map> frames, const std::vector<std::size_t>& pix, const
   }
   r.iterations = std::min(r.iterations, o.max_iterations);
   aia_pixels(frames, pix, steps, phi, b);
+  r.step_conditioning = step_conditioning(phi);
   const double d0 = steps[0];
   const double sign = normalise_steps(steps);
   for (double& x : phi)
@@ -514,11 +528,18 @@ void measure_residual(std::span<const Map> frames, const std::vector<std::size_t
 }
 
 // Why an iterative fit is not to be trusted, "" when it is (docs/psi.md, "Fits that check
-// themselves"): it did not settle; a step is further than step_tolerance_rad from the commanded
-// one; a plane is steeper than max_tilt_rad at the pupil edge; or the frames differ from the
-// fitted model by more than max_misfit of the modulation beyond their white noise.
+// themselves"): the phase spread too little to determine the steps (aia); it did not settle; a
+// step is further than step_tolerance_rad from the commanded one; a plane is steeper than
+// max_tilt_rad at the pupil edge; or the frames differ from the fitted model by more than
+// max_misfit of the modulation beyond their white noise.
 std::string fit_problem(Algorithm alg, const PhaseResult& r, const PhaseOptions& o,
                         std::size_t frames) {
+  if (!(r.step_conditioning >= o.min_step_conditioning) && std::isfinite(r.step_conditioning))
+    return fmt::format(
+        "{}: the phase spans too little of a fringe over the pupil to tell the steps from it "
+        "(conditioning {:.2g}, at least {:g}; 0.5 for a phase spread over a fringe or more): add "
+        "tilt fringes, or use an algorithm with fixed steps",
+        algorithm_name(alg), r.step_conditioning, o.min_step_conditioning);
   if (!r.converged)
     return fmt::format("{} did not converge in {} iterations", algorithm_name(alg), r.iterations);
   const std::vector<double> c = commanded_steps(o, frames);

@@ -246,6 +246,54 @@ TEST(PhaseAlgorithmsTest, AiaRecoversUnknownStepsFromFiveFrames) {
     EXPECT_NEAR(r.steps_rad[k], truth[k], 2e-3) << k;
 }
 
+// A defocus over a disk, phi = L (r^2 - 1/2): r^2 is uniform over the disk, so phi is uniform over
+// [-L/2, L/2] and AIA's step conditioning has a closed form, the least eigenvalue of
+//   [[1, s, 0], [s, (1 + sin L / L) / 2, 0], [0, 0, (1 - sin L / L) / 2]],  s = sin(L/2) / (L/2).
+// Below min_step_conditioning (a defocus spanning 2.5 rad: 0.027) the steps are refused, never
+// returned: on the twin such surfaces gave steps 0.3 to 0.6 rad off, most reported settled
+// (docs/psi.md). At 6 rad (0.47) they are recovered.
+double defocus_conditioning(double span_rad) {
+  const double s = std::sin(span_rad / 2.0) / (span_rad / 2.0);
+  const double q = std::sin(span_rad) / span_rad;
+  Eigen::Matrix3d m;
+  m << 1.0, s, 0.0, s, 0.5 * (1.0 + q), 0.0, 0.0, 0.0, 0.5 * (1.0 - q);
+  return Eigen::SelfAdjointEigenSolver<Eigen::Matrix3d>(m).eigenvalues()(0);
+}
+
+TEST(PhaseAlgorithmsTest, AiaRefusesStepsAPhaseSpreadTooLittleCannotDetermine) {
+  constexpr int n = 128;
+  const Mask mask = disk_mask(n, n, 0.5 * (n - 1));
+  const Pupil pupil = pupil_of(mask);
+  const std::vector<double> truth{0.0, 1.45, 3.20, 4.60, 6.35};
+  for (const double span : {2.5, 6.0}) {
+    Map phi(n, n, 0.0);
+    for (int j = 0; j < n; ++j)
+      for (int i = 0; i < n; ++i)
+        phi.at(i, j) = span * (pupil.x(i) * pupil.x(i) + pupil.y(j) * pupil.y(j) - 0.5);
+    std::vector<Map> f = frames_of(phi, truth);
+    plant::Rng rng(11);
+    for (Map& m : f)
+      for (double& v : m.v)
+        v += 0.01 * rng.normal();
+    const PhaseResult r = run(Algorithm::kAia, f, mask);
+    // It is computed from the phase AIA recovered: at 6 rad the closed form to 2 % (the disk's
+    // pixels); at 2.5 rad, where AIA's steps and so its phase are off, to 10 % (measured: 6 %).
+    EXPECT_NEAR(r.step_conditioning, defocus_conditioning(span),
+                (span < 4.0 ? 0.10 : 0.02) * defocus_conditioning(span))
+        << span;
+    if (span < 4.0) {
+      EXPECT_LT(defocus_conditioning(span), PhaseOptions{}.min_step_conditioning);
+      EXPECT_FALSE(r.converged);
+      EXPECT_NE(r.reason.find("spans too little of a fringe"), std::string::npos) << r.reason;
+    } else {
+      EXPECT_GT(defocus_conditioning(span), PhaseOptions{}.min_step_conditioning);
+      ASSERT_TRUE(r.converged) << r.reason;
+      for (std::size_t k = 0; k < truth.size(); ++k)
+        EXPECT_NEAR(r.steps_rad[k], truth[k], 2e-3) << k;
+    }
+  }
+}
+
 // Frames whose shift is a plane per frame over the unit-disk pupil.
 struct TiltCase {
   Map phi;
