@@ -1,6 +1,7 @@
 #include "loop_stack.hpp"
 
 #include <cmath>
+#include <optional>
 
 #include <fmt/core.h>
 
@@ -43,6 +44,12 @@ LoopStack::LoopStack(const LoopStackOptions& o, const config::ProjectConfig& con
   const bool comedi = is_comedi(o.daq);
   if (!comedi && o.daq != "sim")
     throw core::InputError(fmt::format("--daq '{}': expected sim or comedi:/dev/comediN", o.daq));
+  if (!comedi && !o.trigger_line.empty())
+    throw core::InputError(
+        "--trigger-line: a Comedi board's digital channel; the twin's trigger line is built in");
+  std::optional<runtime::ComediOptions::DigitalLine> trigger_line;
+  if (!o.trigger_line.empty())
+    trigger_line = runtime::parse_digital_line(o.trigger_line, "--trigger-line");
   if (comedi && !faults.empty())
     throw core::InputError("--fault needs --daq sim (faults are injected into the twin)");
   if (comedi && o.clock == StackClock::kFreeRun)
@@ -54,6 +61,7 @@ LoopStack::LoopStack(const LoopStackOptions& o, const config::ProjectConfig& con
     runtime::ComediOptions co;
     if (o.daq.size() > 7)
       co.device = o.daq.substr(7);
+    co.trigger_line = trigger_line;
     backend_ = std::make_unique<runtime::ComediBackend>(co);
   } else {
     runtime::SimOptions so;

@@ -2,8 +2,9 @@
 // The loop stack `run`, `serve` and `calibrate --daq` build one way (and `measure` next), from the
 // bottom up:
 //
-//   backend   --daq: the twin ("sim", at the loop's rate) or a Comedi board ("comedi[:DEVICE]"),
-//             configured here, so a device that cannot be opened is named before anything runs
+//   backend   --daq: the twin ("sim", at the loop's rate) or a Comedi board ("comedi[:DEVICE]",
+//             with --trigger-line its trigger output), configured here, so a device that cannot
+//             be opened is named before anything runs
 //   clock     real time (MonotonicClock), free-run (SimulatedClock: as fast as the CPU allows)
 //             or paced (PacedClock: the guided calibration's twin, paced by its rig)
 //   faults    --fault specs, injected between the loop and the twin (fault_injection.hpp)
@@ -36,6 +37,9 @@ struct LoopStackOptions {
   StackClock clock = StackClock::kRealTime;
   std::vector<std::string> faults;  //!< --fault specs (the twin only)
   std::string log;                  //!< --log CSV path ("" none)
+  //! --trigger-line SUBDEVICE/CHANNEL: the Comedi board's trigger output ("" none; the twin's
+  //! line is built in)
+  std::string trigger_line;
 };
 
 class LoopStack {

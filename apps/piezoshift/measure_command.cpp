@@ -64,6 +64,8 @@ struct MeasureOptions {
   double frame_timeout_s = 2.0;
   std::uint64_t seed = 1;
   bool free_run = false;
+  std::string trigger = "software";
+  std::string trigger_line;
   int cpu = -1;
   std::string out;
   bool json = false;
@@ -80,6 +82,8 @@ instrument::SequenceParams sequence_params(const MeasureOptions& o, psi::Algorit
   p.on_target = o.on_target;
   p.averages = o.averages;
   p.frame_timeout_s = o.frame_timeout_s;
+  p.trigger =
+      o.trigger == "line" ? instrument::TriggerMode::kLine : instrument::TriggerMode::kSoftware;
   if (const std::string why = instrument::sequence_problem(p); !why.empty())
     throw core::InputError("measure: " + why);
   return p;
@@ -92,6 +96,7 @@ LoopStackOptions stack_options(const MeasureOptions& o) {
   so.seed = o.seed;
   so.config_path = o.config;
   so.clock = o.free_run ? StackClock::kFreeRun : StackClock::kRealTime;
+  so.trigger_line = o.trigger_line;
   return so;
 }
 
@@ -121,8 +126,30 @@ bool fed_by_twin(const MeasureOptions& o) {
   return o.camera.starts_with("aravis:Fake") && o.daq == "sim";
 }
 
+// --trigger line needs a DAQ with a trigger output (the twin's, or a Comedi board's
+// --trigger-line) and a camera whose line it can reach.
+void check_trigger(const MeasureOptions& o) {
+  if (o.trigger != "software" && o.trigger != "line")
+    throw core::InputError(fmt::format("--trigger '{}': expected software or line", o.trigger));
+  if (o.trigger == "software" && !o.trigger_line.empty())
+    throw core::InputError("--trigger-line: the DAQ's trigger output is used by --trigger line");
+  if (o.trigger != "line")
+    return;
+  if (o.daq != "sim" && o.trigger_line.empty())
+    throw core::InputError(fmt::format(
+        "--trigger line: DAQ {} has no trigger line (give --trigger-line SUBDEVICE/CHANNEL, a "
+        "digital output of the board: 2/0 is the PCI-6229's P0.0)",
+        o.daq));
+  if (o.camera.starts_with("aravis:Fake"))
+    throw core::InputError(
+        fmt::format("--trigger line: camera {} has no line input (Aravis's fake camera "
+                    "free-runs at 25 Hz on a line trigger); use --trigger software",
+                    o.camera));
+}
+
 void check_options(const MeasureOptions& o) {
   check_loop_rate(o.rate_Hz);
+  check_trigger(o);
   if (o.out.empty())
     throw core::InputError("--out: a folder for the measurement is required");
   check_measure_out(o.out);
@@ -202,9 +229,13 @@ int measure(const MeasureOptions& o) {
   const double wavelength_nm = 632.8;
   s.algorithm = psi::parse_algorithm(o.algorithm);
   s.params = sequence_params(o, s.algorithm, wavelength_nm);
+  if (o.trigger == "line")
+    s.config.camera.settings.trigger = camera::TriggerSource::kLine;
   if (o.camera == "twin" || fed_by_twin(o))
     s.scene = twin_scene(o, s.config.camera, wavelength_nm);
   LoopStack stack(stack_options(o), s.config.installation.project);
+  if (s.params.trigger == instrument::TriggerMode::kLine && !stack.daq().has_trigger_line())
+    throw core::InputError(fmt::format("--trigger line: DAQ {} has no trigger line", stack.name()));
   s.calibration = resolve_calibration(o.calibration, o.daq, s.config.installation.project, o.seed,
                                       1.0 / o.rate_Hz, o.max_physics_steps);
   check_travel(s);
@@ -315,6 +346,12 @@ void add_measure_command(CLI::App& app, Action& action) {
   cmd->add_option("--seed", o->seed, "twin and camera noise seed")
       ->capture_default_str()
       ->check(whole_number(0, kAnyUnsigned));
+  cmd->add_option("--trigger", o->trigger,
+                  "software (camera.trigger() between ticks) or line (a pulse on the DAQ's "
+                  "trigger line written by the loop's tick; the camera's trigger source a line)")
+      ->capture_default_str();
+  cmd->add_option("--trigger-line", o->trigger_line,
+                  "comedi: the trigger output as SUBDEVICE/CHANNEL (2/0: the PCI-6229's P0.0)");
   cmd->add_flag("--free-run", o->free_run,
                 "sim only: simulated clock, as fast as possible (tests, benches)");
   cmd->add_option("--cpu", o->cpu, "CPU to pin the loop to (-1: the last one, -2: none)")

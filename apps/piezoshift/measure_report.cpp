@@ -214,6 +214,7 @@ Json measure_json(const MeasureRecord& r) {
   const instrument::SequenceResult& s = *r.sequence;
   Json j{{"camera", r.camera},
          {"daq", r.daq},
+         {"trigger", instrument::to_string(r.params->trigger)},
          {"rate_Hz", r.rate_Hz},
          {"clock", r.real_time ? "realtime" : "free-run"},
          {"calibration", r.calibration_source},

@@ -58,6 +58,7 @@ struct MeasureArgs {
   psi::OnTarget on_target{};
   double frame_timeout_s = 2.0;
   py::object mask;
+  std::string trigger = "software";
 };
 
 // Aravis's in-process fake camera shown the twin's fringes, as `measure --daq sim` does.
@@ -74,6 +75,7 @@ ins::SequenceParams sequence_params(const MeasureArgs& a, psi::Algorithm alg) {
   p.on_target = a.on_target;
   p.averages = a.averages;
   p.frame_timeout_s = a.frame_timeout_s;
+  p.trigger = a.trigger == "line" ? ins::TriggerMode::kLine : ins::TriggerMode::kSoftware;
   if (const std::string why = ins::sequence_problem(p); !why.empty())
     throw ps::core::InputError("measure: " + why);
   return p;
@@ -106,6 +108,12 @@ void check_args(const MeasureArgs& a) {
   if (a.camera != "twin" && !fed_by_twin(a.camera) && !a.surface.empty())
     throw ps::core::InputError(
         "surface: the test surface of the twin camera (or of aravis:Fake_1)");
+  if (a.trigger != "software" && a.trigger != "line")
+    throw ps::core::InputError("trigger '" + a.trigger + "': expected software or line");
+  if (a.trigger == "line" && fed_by_twin(a.camera))
+    throw ps::core::InputError("trigger: camera " + a.camera +
+                               " has no line input (Aravis's fake camera free-runs at 25 Hz "
+                               "on a line trigger); use software");
   if ((a.camera == "twin" || fed_by_twin(a.camera)) && !a.mask.is_none())
     throw ps::core::InputError("mask: the twin camera's pupil is its scene's; give none");
 }
@@ -155,6 +163,7 @@ py::dict sequence_dict(const ins::SequenceResult& s, const ins::SequenceParams& 
   py::dict d;
   d["camera"] = camera_name;
   d["daq"] = "sim";
+  d["trigger"] = ins::to_string(p.trigger);
   d["clock"] = "free-run";
   d["calibration"] = c.source;
   d["algorithm"] = std::string(psi::algorithm_name(alg));
@@ -233,6 +242,8 @@ Setup prepare(const MeasureArgs& a) {
     s.config = cam::load_instrument_config(*a.config);
   s.algorithm = psi::parse_algorithm(a.algorithm);
   s.params = sequence_params(a, s.algorithm);
+  if (a.trigger == "line")
+    s.config.camera.settings.trigger = cam::TriggerSource::kLine;
   if (a.camera == "twin" || fed_by_twin(a.camera)) {
     const psi::SurfaceSpec spec =
         a.surface.empty() ? psi::SurfaceSpec{} : psi::parse_surface_spec(a.surface);
@@ -327,7 +338,7 @@ void bind_instrument(py::module_& m) {
          const std::string& algorithm, const std::vector<double>& steps_rad, int averages,
          const std::string& surface, std::uint64_t seed, double rate_Hz, double base_um,
          double settle_band_nm, double settle_hold_s, double settle_timeout_s,
-         double frame_timeout_s, const py::object& mask) {
+         double frame_timeout_s, const py::object& mask, const std::string& trigger) {
         MeasureArgs a;
         if (!config.is_none())
           a.config = py::str(config).cast<std::string>();  // str or os.PathLike
@@ -346,6 +357,7 @@ void bind_instrument(py::module_& m) {
         a.on_target = {settle_band_nm, settle_hold_s, settle_timeout_s};
         a.frame_timeout_s = frame_timeout_s;
         a.mask = mask;
+        a.trigger = trigger;
         return measure(a);
       },
       py::arg("config") = py::none(), py::arg("calibration") = py::none(),
@@ -356,6 +368,7 @@ void bind_instrument(py::module_& m) {
       py::arg("settle_hold_s") = defaults.on_target.hold_s,
       py::arg("settle_timeout_s") = defaults.on_target.timeout_s,
       py::arg("frame_timeout_s") = defaults.frame_timeout_s, py::arg("mask") = py::none(),
+      py::arg("trigger") = "software",
       "One phase-shifting measurement on the twin (free-running simulated clock), as "
       "`piezoshift measure --daq sim --free-run` takes it; a dict with the names of "
       "`measure --json`, maps and frames as numpy arrays (docs/python.md)");

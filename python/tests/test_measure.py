@@ -58,6 +58,20 @@ def test_measure_is_deterministic_for_a_seed(tmp_path):
     assert a["error_rms_nm"] == b["error_rms_nm"]
 
 
+def test_line_trigger_gives_the_software_triggers_frames(tmp_path):
+    # The loop's pulse on the twin's trigger line starts each exposure at the tick the software
+    # trigger would start it (docs/measure.md, --trigger line): the same frames, the same times.
+    config = small_camera_toml(tmp_path)
+    sw = ps.measure(config=config, seed=3)
+    line = ps.measure(config=config, seed=3, trigger="line")
+    assert sw["trigger"] == "software" and line["trigger"] == "line"
+    np.testing.assert_array_equal(sw["frames"][4], line["frames"][4])
+    assert [e["trigger_time_s"] for e in line["exposures"]] == \
+        [e["trigger_time_s"] for e in sw["exposures"]]
+    with pytest.raises(ValueError, match="trigger 'sideways'"):
+        ps.measure(config=config, trigger="sideways")
+
+
 def test_a_sequence_that_cannot_settle_raises_procedure_failed(tmp_path):
     with pytest.raises(ps.ProcedureFailed, match="did not settle") as e:
         ps.measure(config=small_camera_toml(tmp_path), settle_band_nm=1e-6, settle_timeout_s=0.05)

@@ -121,10 +121,6 @@ void TwinCamera::configure(const CameraSettings& s) {
         fmt::format("twin camera: camera.width_px x height_px = {} x {}, but the simulated "
                     "interferometer's grid is {} x {}",
                     s.width_px, s.height_px, f.width_px, f.height_px));
-  if (s.trigger == TriggerSource::kLine)
-    throw core::InputError(
-        "twin camera: camera.trigger = line: the twin has no trigger line "
-        "(use software)");
   sensor_.exposure_s = s.exposure_s;
   sensor_.bit_depth = bit_depth(s.format);
   if (std::string p = psi::camera_problem(sensor_); !p.empty())

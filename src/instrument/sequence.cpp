@@ -88,6 +88,8 @@ class Runner {
       note_loop_end();
       return false;
     }
+    if (loop_.trigger_pulses() > edges_forwarded_)
+      forward_trigger_edge();
     camera_.observe_plate(pose());
     poll_frames();
     if (loop_.result().fault_detected) {
@@ -177,6 +179,8 @@ class Runner {
 
   // The camera refuses a trigger while it reads out the previous frame: tick until it takes one.
   bool trigger_when_ready(ExposureRecord& rec) {
+    if (p_.trigger == TriggerMode::kLine)
+      return arm_when_ready();
     const double t0 = now_s();
     while (!camera_.trigger(now_s())) {
       if (now_s() - t0 > p_.frame_timeout_s) {
@@ -190,6 +194,54 @@ class Runner {
     rec.trigger_time_s = now_s();
     camera_.observe_plate(pose());  // the exposure's first instant
     return true;
+  }
+
+  // A line-triggered camera cannot refuse an edge, so the pulse waits (as trigger() would be
+  // refused) until the camera's exposure and readout since the previous edge are over.
+  bool arm_when_ready() {
+    const camera::CameraSettings& cs = camera_.settings();
+    const double t0 = now_s();
+    while (edges_forwarded_ > 0 && now_s() < last_edge_s_ + cs.exposure_s + cs.readout_s - 1e-9) {
+      if (now_s() - t0 > p_.frame_timeout_s) {
+        fail(fmt::format("camera {} not ready for {} s", camera_.name(), p_.frame_timeout_s));
+        return false;
+      }
+      if (!tick())
+        return false;
+    }
+    if (!loop_.arm_trigger_pulse(p_.trigger_pulse_ticks)) {
+      fail(
+          fmt::format("the trigger line of DAQ {} took no pulse at {:.3f} s (the previous one "
+                      "still high?)",
+                      loop_.daq().name(), now_s()));
+      return false;
+    }
+    edge_pose_ = pose();  // the exposure's first instant: the state the raising tick starts from
+    return true;
+  }
+
+  // The rising edge the last tick put out, to the camera before that tick's pose, as a wire would
+  // carry it: the twin's from its backend's record of the line, else (hardware: the wire is a
+  // cable) the loop's report, which a line-triggered camera takes as its frame's time.
+  void forward_trigger_edge() {
+    runtime::TriggerEdge edge = loop_.last_trigger_edge();
+    runtime::TriggerEdge recorded{};
+    if (loop_.daq().take_trigger_edge(recorded))
+      edge = recorded;
+    edges_forwarded_ = loop_.trigger_pulses();
+    // On the records' and the poses' clock (ticks x T): the edge's scheduled time unless slots
+    // were skipped before it, when the scheduled time is later by them and a camera triggered
+    // at it would wait for poses the sequence labels earlier, past its exposure's last tick.
+    last_edge_s_ = static_cast<double>(edge.tick) * period_s_;
+    if (result_.exposures.empty())
+      return;
+    result_.exposures.back().trigger_time_s = last_edge_s_;
+    if (!camera_.trigger(last_edge_s_)) {
+      fail(fmt::format("camera {} took no trigger from the line's edge at {:.3f} s: {}",
+                       camera_.name(), last_edge_s_, camera_.message()));
+      return;
+    }
+    camera_.observe_plate(edge_pose_);
   }
 
   // Ticks through the exposure, the stage's state recorded tick by tick.
@@ -324,10 +376,18 @@ class Runner {
   Clock::time_point start_wall_ = Clock::now();
   double start_loop_s_ = 0.0;
   bool ended_ = false;
+  // TriggerMode::kLine: edges forwarded to the camera, the last one's time, the pose it starts.
+  std::uint64_t edges_forwarded_ = 0;
+  double last_edge_s_ = 0.0;
+  camera::PlatePose edge_pose_{};
   SequenceResult result_;
 };
 
 }  // namespace
+
+const char* to_string(TriggerMode mode) noexcept {
+  return mode == TriggerMode::kLine ? "line" : "software";
+}
 
 std::vector<double> commanded_steps(psi::Algorithm a, const std::vector<double>& given,
                                     std::string_view option) {
@@ -395,6 +455,9 @@ SequenceResult run_sequence(runtime::ControlLoop& loop, const plant::Twin* twin,
                             const rig::Progress& progress) {
   if (const std::string why = sequence_problem(params); !why.empty())
     throw core::InputError("measurement: " + why);
+  if (params.trigger == TriggerMode::kLine && !loop.daq().has_trigger_line())
+    throw core::InputError(
+        fmt::format("measurement: trigger line: DAQ {} has no trigger line", loop.daq().name()));
   return Runner(loop, twin, camera, params, progress).run();
 }
 

@@ -1,5 +1,6 @@
 #include "piezoshift/runtime/comedi_backend.hpp"
 
+#include <charconv>
 #include <cstdlib>
 
 #include <fmt/core.h>
@@ -11,6 +12,25 @@
 #endif
 
 namespace piezoshift::runtime {
+
+ComediOptions::DigitalLine parse_digital_line(std::string_view text, std::string_view option) {
+  const auto bad = [&] {
+    return core::InputError(fmt::format(
+        "{} '{}': expected SUBDEVICE/CHANNEL, two whole numbers (2/0: the PCI-6229's P0.0)", option,
+        text));
+  };
+  const std::size_t slash = text.find('/');
+  if (slash == std::string_view::npos)
+    throw bad();
+  const auto number = [&](std::string_view part) {
+    unsigned v = 0;
+    const auto [end, ec] = std::from_chars(part.data(), part.data() + part.size(), v);
+    if (part.empty() || ec != std::errc{} || end != part.data() + part.size() || v > 255)
+      throw bad();
+    return v;
+  };
+  return {number(text.substr(0, slash)), number(text.substr(slash + 1))};
+}
 
 #ifdef PIEZOSHIFT_HAVE_COMEDI
 
@@ -28,8 +48,11 @@ struct ComediBackend::Impl {
   std::array<lsampl_t, 3> ai_maxdata{};
   std::array<lsampl_t, 3> ao_maxdata{};
   std::array<double, 3> ai_lo{}, ai_hi{}, ao_lo{}, ao_hi{};
-  std::array<lsampl_t, 6> data{};  // [0..2] AO codes staged, [3..5] AI codes read
-  std::array<comedi_insn, 6> insns{};
+  // [0..2] AO codes staged, [3..5] AI codes read, [6] the trigger line's level staged
+  std::array<lsampl_t, 7> data{};
+  // The three AO writes, the trigger line's write (if any), then the three AI reads.
+  std::array<comedi_insn, 7> insns{};
+  unsigned n_writes = 3;
   comedi_insnlist list{};
   bool active = false;
 
@@ -132,16 +155,50 @@ void ComediBackend::configure() {
     w.data = &impl->data[i];
     w.subdev = ao_sub;
     w.chanspec = CR_PACK(ao_ch, ao_range, AREF_GROUND);
-    comedi_insn& rd = impl->insns[3 + i];
+    comedi_insn& rd = impl->insns[(options_.trigger_line ? 4 : 3) + i];
     rd.insn = INSN_READ;
     rd.n = 1;
     rd.data = &impl->data[3 + i];
     rd.subdev = ai_sub;
     rd.chanspec = CR_PACK(ai_ch, ai_range, AREF_DIFF);  // the PCI-6229's differential inputs
   }
-  impl->list.n_insns = 6;
+  if (options_.trigger_line)
+    configure_trigger_line(*impl);
+  impl->list.n_insns = impl->n_writes + 3;
   impl->list.insns = impl->insns.data();
   impl_ = std::move(impl);
+}
+
+void ComediBackend::configure_trigger_line(Impl& impl) {
+  const ComediOptions::DigitalLine line = *options_.trigger_line;
+  const std::string what =
+      fmt::format("{}: trigger line {}/{}", options_.device, line.subdevice, line.channel);
+  const int n_subdevices = comedi_get_n_subdevices(impl.dev);
+  if (n_subdevices < 0 || line.subdevice >= static_cast<unsigned>(n_subdevices))
+    throw core::InputError(fmt::format("{}: the device has {} subdevices", what, n_subdevices));
+  const int type = comedi_get_subdevice_type(impl.dev, line.subdevice);
+  if (type != COMEDI_SUBD_DIO && type != COMEDI_SUBD_DO)
+    throw core::InputError(
+        fmt::format("{}: subdevice {} is not a digital output (DIO or DO)", what, line.subdevice));
+  const int n = comedi_get_n_channels(impl.dev, line.subdevice);
+  if (n < 0 || line.channel >= static_cast<unsigned>(n))
+    throw core::InputError(fmt::format("{}: the subdevice has {} channels", what, n));
+  if (type == COMEDI_SUBD_DIO &&
+      comedi_dio_config(impl.dev, line.subdevice, line.channel, COMEDI_OUTPUT) < 0)
+    throw core::InputError(fmt::format("{}: cannot make it an output: {}", what, comedi_error()));
+  comedi_insn& w = impl.insns[3];
+  w.insn = INSN_WRITE;  // what comedi_dio_write issues, here in the tick's one insnlist
+  w.n = 1;
+  w.data = &impl.data[6];
+  w.subdev = line.subdevice;
+  w.chanspec = CR_PACK(line.channel, 0, 0);
+  impl.data[6] = 0;
+  impl.n_writes = 4;
+}
+
+void ComediBackend::stage_trigger_line(bool high) noexcept {
+  if (impl_)
+    impl_->data[6] = high ? 1 : 0;
 }
 
 void ComediBackend::activate() {
@@ -150,6 +207,7 @@ void ComediBackend::activate() {
   impl_->active = true;
   Vec3 ai{};
   write(CycleTime{}, Vec3{});
+  stage_trigger_line(false);
   if (read(CycleTime{}, ai) != DaqStatus::kOk) {
     impl_->active = false;
     throw core::InputError(fmt::format("{}: the first read/write transaction failed: {}",
@@ -161,7 +219,8 @@ void ComediBackend::deactivate() noexcept {
   if (!impl_ || !impl_->active)
     return;
   write(CycleTime{}, Vec3{});
-  comedi_insnlist zeros{3, impl_->insns.data()};  // the three writes only
+  stage_trigger_line(false);
+  comedi_insnlist zeros{impl_->n_writes, impl_->insns.data()};  // the writes only
   comedi_do_insnlist(impl_->dev, &zeros);
   impl_->active = false;
 }
@@ -169,7 +228,7 @@ void ComediBackend::deactivate() noexcept {
 DaqStatus ComediBackend::read(const CycleTime&, Vec3& ai_V) noexcept {
   if (!impl_ || !impl_->active)
     return DaqStatus::kInactive;
-  if (comedi_do_insnlist(impl_->dev, &impl_->list) != 6)
+  if (comedi_do_insnlist(impl_->dev, &impl_->list) != static_cast<int>(impl_->list.n_insns))
     return DaqStatus::kError;
   for (std::size_t i = 0; i < 3; ++i) {
     const lsampl_t code = impl_->data[3 + i];
@@ -229,6 +288,7 @@ void ComediBackend::activate() {
   configure();
 }
 void ComediBackend::deactivate() noexcept {}
+void ComediBackend::stage_trigger_line(bool) noexcept {}
 DaqStatus ComediBackend::read(const CycleTime&, Vec3&) noexcept {
   return DaqStatus::kInactive;
 }

@@ -86,6 +86,12 @@ void ControlLoop::start() noexcept {
   wave_ = WaveGenerator{};
   applied_sequence_ = 0;
   configure_problem_ = control::ParamsProblem::kNone;
+  if (trigger_high_)  // a pulse cut short by the previous run's end
+    daq_.stage_trigger_line(false);
+  trigger_armed_ = trigger_high_ = false;
+  trigger_ticks_left_ = 0;
+  trigger_pulses_ = 0;
+  trigger_edge_ = TriggerEdge{};
   if (config_.host == nullptr && !config_.owner_drives)
     cycle_.drive_points(profile_.at(0.0));
 }
@@ -102,6 +108,8 @@ bool ControlLoop::tick() noexcept {
     clear_latched_fault();
   apply_host_commands();
   choose_setpoint(ct);
+  if (trigger_armed_ || trigger_high_) [[unlikely]]
+    drive_trigger_line(ct);
 
   const CycleSample& cs = cycle_.step(daq_, ct, previous_overran_);
   const Vec3& zd = cs.zd_um;  // zero unless on Z_d: S is no Z_d
@@ -202,6 +210,33 @@ void ControlLoop::choose_setpoint(const CycleTime& t) noexcept {
   } else if (!config_.owner_drives) {
     cycle_.drive_points(profile_.at(static_cast<double>(t.since_start_ns) * 1e-9));
   }
+}
+
+bool ControlLoop::arm_trigger_pulse(std::uint32_t width_ticks) noexcept {
+  if (trigger_armed_ || trigger_high_ || width_ticks == 0 || width_ticks > kMaxTriggerPulseTicks ||
+      !daq_.has_trigger_line())
+    return false;
+  trigger_armed_ = true;
+  trigger_width_ticks_ = width_ticks;
+  return true;
+}
+
+// Staged before the tick's read(): the level goes out in this tick's transaction.
+void ControlLoop::drive_trigger_line(const CycleTime& t) noexcept {
+  if (trigger_armed_) {
+    trigger_armed_ = false;
+    trigger_high_ = true;
+    trigger_ticks_left_ = trigger_width_ticks_;
+    trigger_edge_ = TriggerEdge{t.tick, t.since_start_ns};
+    ++trigger_pulses_;
+    daq_.stage_trigger_line(true);
+  }
+  if (trigger_ticks_left_ == 0) {
+    trigger_high_ = false;
+    daq_.stage_trigger_line(false);
+    return;
+  }
+  --trigger_ticks_left_;
 }
 
 void ControlLoop::record_outputs(const CycleSample& cs, const Vec3& zd) noexcept {

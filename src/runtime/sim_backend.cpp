@@ -41,6 +41,9 @@ void SimBackend::activate() {
     throw core::InputError("sim: activate() before configure()");
   staged_ = Vec3{};
   twin_->write_ao(staged_);
+  line_staged_ = line_high_ = false;
+  for (TriggerEdge stale{}; wire_.try_pop(stale);) {  // a previous run's, never taken
+  }
   active_ = true;
 }
 
@@ -49,6 +52,7 @@ void SimBackend::deactivate() noexcept {
     return;
   staged_ = Vec3{};
   twin_->write_ao(staged_);
+  line_staged_ = line_high_ = false;
   active_ = false;
 }
 
@@ -67,6 +71,14 @@ DaqStatus SimBackend::read(const CycleTime& t, Vec3& ai_V) noexcept {
   ai_V = twin_->read_ai();
   last_ai_ = ai_V;
   twin_->write_ao(staged_);
+  if (line_staged_ != line_high_) {
+    line_high_ = line_staged_;
+    if (line_high_) {
+      ++edges_;
+      if (!wire_.try_push(TriggerEdge{t.tick, t.since_start_ns}))
+        ++edges_dropped_;
+    }
+  }
   return DaqStatus::kOk;
 }
 

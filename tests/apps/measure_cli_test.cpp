@@ -3,6 +3,10 @@
 // status with nothing half-written.
 #include <cmath>
 #include <filesystem>
+#include <fstream>
+#include <sstream>
+#include <string>
+#include <vector>
 
 #include <gtest/gtest.h>
 #include <nlohmann/json.hpp>
@@ -28,6 +32,26 @@ double rms_difference(const psi::Map& a, const psi::Map& b) {
       ++n;
     }
   return n ? std::sqrt(std::max(0.0, s2 / n - (s / n) * (s / n))) : INFINITY;
+}
+
+// The column of a CSV file with a header line, as numbers.
+std::vector<double> csv_column(const std::string& file, const std::string& name) {
+  std::ifstream in(file);
+  std::string line, cell;
+  std::getline(in, line);
+  std::istringstream header(line);
+  int column = -1;
+  for (int c = 0; std::getline(header, cell, ','); ++c)
+    if (cell == name)
+      column = c;
+  std::vector<double> values;
+  while (column >= 0 && std::getline(in, line)) {
+    std::istringstream row(line);
+    for (int c = 0; c <= column; ++c)
+      std::getline(row, cell, ',');
+    values.push_back(std::stod(cell));
+  }
+  return values;
 }
 
 class MeasureCli : public testing::CliTest {
@@ -132,6 +156,48 @@ TEST_F(MeasureCli, ImprovedControllerRecoversTheSurfaceAndTheSteps) {
   const Json& t = j["timing"];
   EXPECT_LE(t["loop_time_s"].get<double>(), 1.5 * t["floor_s"].get<double>());
   EXPECT_EQ(t["overruns"], 0);  // a simulated clock is never late
+}
+
+// Issue 28's line trigger: the loop's tick raises the twin's trigger line, whose recorded edge
+// triggers the twin camera. Both triggers start each exposure at the scheduled time of the tick
+// after the one the stage settled on (software: camera.trigger(ticks x T) between the ticks;
+// line: the next tick's edge), and the camera sees the same poses, so the same frames: measured,
+// byte-equal frames, 0 nm between the surfaces and 0 s between the trigger times; the tolerances
+// below are the doubles' rounding. A trigger one tick late would miss the times by 1 ms.
+TEST_F(MeasureCli, LineTriggerGivesTheSoftwareTriggersSurfaceOnTickBoundaries) {
+  const std::string cam = small_camera();
+  const Json sw = measure("--config '" + cam + "' --out '" + path("sw") + "'");
+  const Json line = measure("--config '" + cam + "' --trigger line --out '" + path("line") + "'");
+  EXPECT_EQ(sw["trigger"], "software");
+  EXPECT_EQ(line["trigger"], "line");
+  EXPECT_LT(rms_difference(psi::read_npy(path("sw") + "/surface_nm.npy"),
+                           psi::read_npy(path("line") + "/surface_nm.npy")),
+            1e-9);
+  EXPECT_NEAR(line["error_rms_nm"].get<double>(), sw["error_rms_nm"].get<double>(), 1e-9);
+  const std::vector<double> t_sw = csv_column(path("sw") + "/exposures.csv", "trigger_time_s");
+  const std::vector<double> t_line = csv_column(path("line") + "/exposures.csv", "trigger_time_s");
+  ASSERT_EQ(t_line.size(), 5u);
+  ASSERT_EQ(t_sw.size(), t_line.size());
+  for (std::size_t k = 0; k < t_line.size(); ++k) {
+    EXPECT_NEAR(t_line[k], t_sw[k], 1e-9) << "frame " << k;
+    // 1 kHz: a whole number of milliseconds (the CSV's 6 decimals hold them exactly).
+    EXPECT_NEAR(t_line[k] * 1000.0, std::round(t_line[k] * 1000.0), 1e-6) << t_line[k];
+    if (k > 0) {
+      EXPECT_GT(t_line[k], t_line[k - 1]);
+    }
+  }
+  EXPECT_GT(t_line[0], 0.2) << "after the initial settle";
+}
+
+TEST_F(MeasureCli, LineTriggerNeedsADaqWithATriggerLine) {
+  refused("--daq comedi:/dev/comedi9 --trigger line --out '" + path("c") + "'",
+          "--trigger line: DAQ comedi:/dev/comedi9 has no trigger line");
+  refused("--trigger sideways --out '" + path("s") + "'", "--trigger 'sideways'");
+  refused("--trigger-line 2/0 --trigger line --out '" + path("t") + "'", "--trigger-line");
+  refused("--camera files:nowhere --daq comedi --trigger line --trigger-line 2/x --out '" +
+              path("u") + "'",
+          "--trigger-line '2/x'");
+  EXPECT_FALSE(fs::exists(path("c")));
 }
 
 // Aravis's in-process fake camera shown the twin's fringes (Mono16: the fake has no Mono12): the

@@ -9,8 +9,10 @@
 // with G = f k_a / (f k_a + k_m) (f = 1, or the crack's stiffness factor) and a dead amplifier
 // giving x_cmd = 0. Not a model of anything more: the supervisor and loop tests need a plant
 // whose answers are known in closed form.
+#include <array>
 #include <atomic>
 #include <cmath>
+#include <cstdint>
 
 #include "piezoshift/runtime/daq_backend.hpp"
 #include "piezoshift/runtime/fault_injection.hpp"
@@ -44,6 +46,13 @@ class FakeBackend final : public DaqBackend, public PlantFaultHooks {
       ai_V[i] = x_um_[i] / 1.6;
     }
     applied_ = staged_;
+    if (line_staged_ && !line_high_ && rising_edges < static_cast<int>(rising_ticks.size()))
+      rising_ticks[static_cast<std::size_t>(rising_edges)] = t.tick;
+    if (line_staged_ && !line_high_)
+      ++rising_edges;
+    line_high_ = line_staged_;
+    if (line_high_)
+      ++high_ticks;
     ++reads;
     if (signal_flag != nullptr && t.tick == signal_tick)
       signal_flag->store(15);
@@ -59,6 +68,11 @@ class FakeBackend final : public DaqBackend, public PlantFaultHooks {
     return DaqStatus::kOk;
   }
   std::string name() const override { return "fake"; }
+  bool has_trigger_line() const noexcept override { return trigger_line; }
+  void stage_trigger_line(bool high) noexcept override {
+    line_staged_ = high;
+    ++line_stages;
+  }
   bool truth(Vec3& z_um, Vec3& interferometer_um) const noexcept override {
     z_um = x_um_;
     interferometer_um = x_um_;
@@ -97,11 +111,21 @@ class FakeBackend final : public DaqBackend, public PlantFaultHooks {
   int reads = 0;
   int deactivations = 0;
   Vec3 last_written{};
+  // The trigger line (when trigger_line): stage calls, reads that put it out high, rising edges
+  // (the first ticks of up to 8 of them).
+  bool trigger_line = false;
+  int line_stages = 0;
+  int high_ticks = 0;
+  int rising_edges = 0;
+  std::array<std::uint64_t, 8> rising_ticks{};
+  bool line_high() const { return line_high_; }
 
  private:
   Vec3 x_um_{};
   Vec3 applied_{};
   Vec3 staged_{};
+  bool line_staged_ = false;
+  bool line_high_ = false;
   std::array<bool, 3> dead_{};
   Vec3 stiffness_factor_{1.0, 1.0, 1.0};
 };

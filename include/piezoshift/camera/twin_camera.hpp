@@ -23,7 +23,9 @@
 // the three through lock-free rings (runtime/spsc_ring.hpp) as indices; a frame's counts are
 // swapped into the caller's Frame, so poll() copies no pixels and allocates nothing.
 // The noise of frame k depends on (seed, k) alone, so a seed gives the same frames whatever the
-// threads' timing. A hardware trigger line is refused at configure(): the twin has none.
+// threads' timing. TriggerSource::kLine is taken as well: the twin's line is the sim backend's
+// trigger wire (sim_backend.hpp), whose rising edges the measurement hands to trigger(t_edge), so
+// trigger() is the line's edge arriving; its rules above are the same.
 #include <atomic>
 #include <cstdint>
 #include <memory>
@@ -71,8 +73,8 @@ class TwinCamera final : public Camera {
   TwinCamera(TwinScene scene, const psi::CameraParams& sensor);
   ~TwinCamera() override;
 
-  //! Refuses (core::InputError naming the setting) a size other than the scene's, a trigger line
-  //! and any value outside camera_settings_problem()'s ranges. Allocates the buffers.
+  //! Refuses (core::InputError naming the setting) a size other than the scene's and any value
+  //! outside camera_settings_problem()'s ranges. Allocates the buffers.
   void configure(const CameraSettings& settings) override;
   //! Starts the worker; frame ids restart at 0.
   void start() override;

@@ -14,6 +14,13 @@
 //     tick until the camera can expose (its readout of the previous frame is over)
 //     camera.trigger(t); tick through the exposure, each tick's plate pose to the camera
 //       (observe_plate: the twin camera renders from it) and to the exposure's record
+//     (TriggerMode::kLine: instead of camera.trigger(t), the loop's trigger pulse is armed once
+//       the camera's exposure + readout since the previous edge are over; the exposure's first
+//       tick raises the DAQ's line at its scheduled time. The edge reaches the camera as
+//       camera.trigger(t_e), t_e = the edge's tick x T (the records' loop time), before that
+//       tick's pose: on the twin from the sim backend's record of its line (the wire), on
+//       hardware from the loop's report (a line-triggered camera stamps its frame with t_e).
+//       Same ticks, same poses, same times as kSoftware.)
 //   tick, holding the last position, until every frame has arrived (frame_timeout_s)
 //   the loop's controlled part ends; tick through its ramp to 0 V
 //
@@ -37,6 +44,12 @@
 
 namespace piezoshift::instrument {
 
+//! What starts each exposure: camera.trigger() from this thread, or the loop's pulse on the DAQ's
+//! trigger line (the camera's TriggerSource is then a line).
+enum class TriggerMode : std::uint8_t { kSoftware, kLine };
+//! "software", "line".
+const char* to_string(TriggerMode mode) noexcept;
+
 struct SequenceParams {
   std::vector<double> steps_rad;  //!< the phase steps of one measurement, steps_rad[0] = 0
   double wavelength_nm = 632.8;   //!< HeNe, the usual Fizeau source
@@ -45,6 +58,8 @@ struct SequenceParams {
   psi::OnTarget on_target{};      //!< the settle criterion (band, hold time, timeout)
   int averages = 1;               //!< measurements taken one after the other
   double frame_timeout_s = 2.0;   //!< after its exposure, for a frame to arrive
+  TriggerMode trigger = TriggerMode::kSoftware;
+  std::uint32_t trigger_pulse_ticks = 1;  //!< kLine: the pulse's width, 1 to 1000 ticks
 };
 
 //! The commanded steps of a measurement with algorithm a: given, for lsq, aia and tilt-aia (the
@@ -59,7 +74,7 @@ std::string travel_problem(const SequenceParams& p, std::optional<double> travel
                            std::string_view calibration_source);
 
 //! Why p cannot be run ("" when it can): 3 to 64 steps, finite, the first 0; wavelength, base,
-//! times and averages in range.
+//! times, averages and pulse width in range.
 std::string sequence_problem(const SequenceParams& p);
 
 //! One exposure: what was commanded, when, and where the stage was while the camera integrated.
@@ -70,7 +85,8 @@ struct ExposureRecord {
   double commanded_piston_nm = 0.0;  //!< relative to the base
   double move_time_s = 0.0;          //!< loop time of the move
   double settled_time_s = 0.0;       //!< loop time the criterion was met
-  double trigger_time_s = 0.0;       //!< loop time the exposure started
+  //! Loop time the exposure started (kLine: the edge's tick, on this clock: ticks x T).
+  double trigger_time_s = 0.0;
   double exposure_end_s = 0.0;
   //! The controller's estimate over the exposure: per channel the mean of S - feedback; the
   //! largest magnitude of the three, and the largest single-tick magnitude [nm].
@@ -99,7 +115,8 @@ struct SequenceResult {
 
 //! Runs the sequence (see the header). twin: the twin whose true plate pose feeds the camera and
 //! the records (nullptr on hardware). loop must be in owner mode and not started; the DAQ
-//! backend must be active. Throws core::InputError for parameters sequence_problem() refuses.
+//! backend must be active. Throws core::InputError for parameters sequence_problem() refuses, and
+//! for TriggerMode::kLine on a backend without a trigger line.
 SequenceResult run_sequence(runtime::ControlLoop& loop, const plant::Twin* twin,
                             camera::Camera& camera, const SequenceParams& params,
                             const rig::Progress& progress = {});

@@ -34,6 +34,14 @@
 // drive_actuators(), drive_open_loop() and try_configure(), called by the thread that calls
 // tick().
 //
+// Trigger pulse (owner mode, a backend with a trigger line: daq_backend.hpp): arm_trigger_pulse(N)
+// between ticks makes the next tick stage the line high before its read(), so the edge goes out
+// in that tick's transaction at its scheduled time; the line is held for N ticks and staged low
+// by the tick after them. The edge (tick, scheduled time) is reported by last_trigger_edge(). An
+// arm while a pulse is armed or high is refused (false), not queued: the next exposure's trigger
+// belongs after the camera's readout anyway, and a refusal keeps every pulse's edge the one its
+// arm asked for. Without a pulse armed or high the tick pays a test of two flags.
+//
 // start(), tick() and run() are real-time safe: everything they touch is allocated by the
 // constructor; the telemetry and host pushes are lock-free ring writes that drop (and count) on a
 // full ring.
@@ -129,6 +137,20 @@ class ControlLoop {
   //! Owner mode, between ticks: the controlled part ends at the next tick, as the duration would
   //! end it (the safe ramp to 0 V follows; tick() returns false once it is done).
   void finish() noexcept { finish_requested_ = true; }
+  //! Owner mode, between ticks: raise the DAQ's trigger line at the next tick and hold it high for
+  //! width_ticks ticks (see the header comment). False, nothing armed: no trigger line, width 0
+  //! or above kMaxTriggerPulseTicks, or a pulse already armed or high.
+  bool arm_trigger_pulse(std::uint32_t width_ticks = 1) noexcept;
+  //! The longest pulse: 1 s at 1 kHz (a camera needs a few us).
+  static constexpr std::uint32_t kMaxTriggerPulseTicks = 1000;
+  //! Rising edges raised since start(); the last one (valid when trigger_pulses() > 0).
+  std::uint64_t trigger_pulses() const noexcept { return trigger_pulses_; }
+  const TriggerEdge& last_trigger_edge() const noexcept { return trigger_edge_; }
+  //! The level the loop last staged on the trigger line.
+  bool trigger_line_high() const noexcept { return trigger_high_; }
+  //! The backend, for the owner thread between ticks (its trigger wire: take_trigger_edge()).
+  DaqBackend& daq() noexcept { return daq_; }
+
   //! Any thread: ask the loop to clear a latched fault at its next tick.
   void request_clear() noexcept { clear_requested_.store(true, std::memory_order_release); }
 
@@ -153,6 +175,7 @@ class ControlLoop {
   void apply_host_commands() noexcept;
   void apply(const HostCommand& command) noexcept;
   void choose_setpoint(const CycleTime& t) noexcept;
+  void drive_trigger_line(const CycleTime& t) noexcept;
   void record_outputs(const CycleSample& cs, const Vec3& zd) noexcept;
   void publish_status(const CycleSample& cs, const Vec3& zd, const CycleTime& t) noexcept;
   void push_telemetry(const CycleSample& cs, const Vec3& zd, const CycleTime& t,
@@ -192,6 +215,13 @@ class ControlLoop {
   WaveGenerator wave_;
   std::uint64_t applied_sequence_ = 0;
   control::ParamsProblem configure_problem_ = control::ParamsProblem::kNone;
+  // Owner mode: the trigger pulse (armed for the next tick; ticks still high after this one).
+  bool trigger_armed_ = false;
+  bool trigger_high_ = false;
+  std::uint32_t trigger_width_ticks_ = 1;
+  std::uint32_t trigger_ticks_left_ = 0;
+  std::uint64_t trigger_pulses_ = 0;
+  TriggerEdge trigger_edge_{};
 };
 
 }  // namespace piezoshift::runtime

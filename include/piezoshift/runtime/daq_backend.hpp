@@ -16,6 +16,12 @@
 //
 // read() and write() never throw and never allocate; they return a status. A non-kOk status is a
 // fault for the safety supervisor.
+//
+// Optional: a digital trigger output (a camera's hardware trigger; default: none). The loop stages
+// the line's level before the tick's read() only when it changes (control_loop.hpp's trigger
+// pulse); the level goes out in the same transaction as the staged AO, so a rising edge staged in
+// tick k happens at tick k's scheduled time, and the line keeps its level until staged again.
+// activate() and deactivate() leave it low.
 #include <cstdint>
 #include <string>
 
@@ -30,6 +36,12 @@ enum class DaqStatus : std::uint8_t {
   kError,     //!< the transaction failed (driver error); the AI values are not valid
   kClamped,   //!< write(): a value outside the output range was clamped before conversion
   kInactive,  //!< read()/write() outside activate()..deactivate()
+};
+
+//! A rising edge of the trigger line: the tick whose transaction raised it and its scheduled time.
+struct TriggerEdge {
+  std::uint64_t tick = 0;
+  std::int64_t since_start_ns = 0;
 };
 
 //! Where a tick is on the loop's time line.
@@ -61,6 +73,16 @@ class DaqBackend {
   //! Real-time safe. Ground truth at the measurement points P1..P3 (um), where the backend knows
   //! it (the twin: true displacement and the interferometer's reading). False on hardware.
   virtual bool truth(Vec3& /*z_um*/, Vec3& /*interferometer_um*/) const noexcept { return false; }
+
+  //! Set-up: the backend drives a digital trigger output (default: none).
+  virtual bool has_trigger_line() const noexcept { return false; }
+  //! Real-time safe. Stages the trigger line's level: it goes out at the start of the next read(),
+  //! with the staged AO, and holds until staged again. Ignored without a line.
+  virtual void stage_trigger_line(bool /*high*/) noexcept {}
+  //! Owner thread, lock-free: the oldest rising edge not yet taken, where the backend sees its own
+  //! line (the twin: its wire to the twin camera). False when there is none; always on hardware,
+  //! where the wire is a cable.
+  virtual bool take_trigger_edge(TriggerEdge& /*edge*/) noexcept { return false; }
 };
 
 }  // namespace piezoshift::runtime

@@ -100,6 +100,11 @@ class FaultInjectingBackend final : public DaqBackend {
   bool truth(Vec3& z_um, Vec3& interferometer_um) const noexcept override {
     return inner_.truth(z_um, interferometer_um);
   }
+  bool has_trigger_line() const noexcept override { return inner_.has_trigger_line(); }
+  void stage_trigger_line(bool high) noexcept override { inner_.stage_trigger_line(high); }
+  bool take_trigger_edge(TriggerEdge& edge) noexcept override {
+    return inner_.take_trigger_edge(edge);
+  }
 
   const std::vector<FaultSpec>& faults() const noexcept { return faults_; }
   //! The tick at which fault i started, or kNotYet.

@@ -41,6 +41,11 @@ class OracleBackend final : public DaqBackend {
   bool truth(Vec3& z_um, Vec3& interferometer_um) const noexcept override {
     return sim_.truth(z_um, interferometer_um);
   }
+  bool has_trigger_line() const noexcept override { return sim_.has_trigger_line(); }
+  void stage_trigger_line(bool high) noexcept override { sim_.stage_trigger_line(high); }
+  bool take_trigger_edge(TriggerEdge& edge) noexcept override {
+    return sim_.take_trigger_edge(edge);
+  }
 
  private:
   SimBackend& sim_;

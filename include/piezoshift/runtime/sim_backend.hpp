@@ -18,8 +18,13 @@
 // stiffness change re-discretizes the twin's mechanics: inject() is then not real-time safe,
 // which only fault-injection runs ever do.
 //
-// read()/write()/truth() are real-time safe; configure() builds the twin (allocates, throws
-// core::InputError for parameters that cannot make one).
+// The trigger line: the twin has one, a wire to the twin camera. read() puts the staged level out
+// with the AO and records each rising edge (its tick and scheduled time) in a fixed-size
+// lock-free ring (kWireEdges; an edge that finds it full is counted, not kept) that the owner
+// thread drains with take_trigger_edge() and hands to the camera's trigger(): the wire.
+//
+// read()/write()/truth()/stage_trigger_line() are real-time safe; configure() builds the twin
+// (allocates, throws core::InputError for parameters that cannot make one).
 #include <cstdint>
 #include <memory>
 #include <string>
@@ -29,6 +34,7 @@
 #include "piezoshift/plant/twin_params.hpp"
 #include "piezoshift/runtime/daq_backend.hpp"
 #include "piezoshift/runtime/fault_injection.hpp"
+#include "piezoshift/runtime/spsc_ring.hpp"
 
 namespace piezoshift::runtime {
 
@@ -58,6 +64,17 @@ class SimBackend final : public DaqBackend, public PlantFaultHooks {
   std::string name() const override { return "sim"; }
   bool truth(Vec3& z_um, Vec3& interferometer_um) const noexcept override;
 
+  bool has_trigger_line() const noexcept override { return true; }
+  void stage_trigger_line(bool high) noexcept override { line_staged_ = high; }
+  bool take_trigger_edge(TriggerEdge& edge) noexcept override { return wire_.try_pop(edge); }
+  //! Rising edges the wire can hold before the owner takes them.
+  static constexpr std::size_t kWireEdges = 64;
+  //! Rising edges put out since configure(), and those lost to a full wire.
+  std::uint64_t trigger_edges() const noexcept { return edges_; }
+  std::uint64_t trigger_edges_dropped() const noexcept { return edges_dropped_; }
+  //! The line's level as it went out at the last read().
+  bool trigger_line_high() const noexcept { return line_high_; }
+
   bool inject(FaultKind kind, std::size_t channel,
               const FaultInjectionParams& params) noexcept override;
 
@@ -72,6 +89,11 @@ class SimBackend final : public DaqBackend, public PlantFaultHooks {
   Vec3 staged_{};
   Vec3 last_ai_{};
   bool active_ = false;
+  bool line_staged_ = false;
+  bool line_high_ = false;
+  SpscRing<TriggerEdge> wire_{kWireEdges};
+  std::uint64_t edges_ = 0;
+  std::uint64_t edges_dropped_ = 0;
 };
 
 }  // namespace piezoshift::runtime
