@@ -267,14 +267,21 @@ void ServeCamera::preview(const std::vector<instrument::LoopSample>& batch) {
   const auto now_ns = static_cast<std::uint64_t>(now * 1e9);
   if (preview_pending_ || last_t_s_ < 0.0 || now_ns < next_preview_ns_)
     return;
-  next_preview_ns_ = now_ns + static_cast<std::uint64_t>(options_.preview_period_s * 1e9);
   if (camera_->trigger(last_t_s_)) {
+    next_preview_ns_ = now_ns + static_cast<std::uint64_t>(options_.preview_period_s * 1e9);
     preview_pending_ = true;
     pending_since_s_ = now;
-  } else {
+    refused_since_s_ = -1.0;
+    return;
+  }
+  // Refused: tried again with the next batch. Right after a measurement the camera still reads
+  // out its last frame (10 ms): only a refusal that lasts is news.
+  if (refused_since_s_ < 0.0)
+    refused_since_s_ = now;
+  if (now - refused_since_s_ > kPreviewTimeout_s) {
     const std::lock_guard lock(mutex_);
-    message_ =
-        fmt::format("camera {} took no live trigger: {}", camera_->name(), camera_->message());
+    message_ = fmt::format("camera {} has taken no live trigger for {} s: {}", camera_->name(),
+                           kPreviewTimeout_s, camera_->message());
   }
 }
 
@@ -340,6 +347,7 @@ void ServeCamera::publish_frame(const camera::Frame& f) {
       vis_px.at(x, y) = vis.tiles.at(x / kTilePx, y / kTilePx);
   std::string vis_png = psi::encode_false_colour_png(vis_px, 0.0, 1.0);
   const std::lock_guard lock(mutex_);
+  message_.clear();  // the camera works again
   frame_png_ = std::move(frame_png);
   visibility_png_ = std::move(vis_png);
   frame_json_ = j.dump();

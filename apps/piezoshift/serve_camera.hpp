@@ -114,6 +114,7 @@ class ServeCamera final : public host::DashboardPanel {
   bool preview_pending_ = false;
   double last_t_s_ = -1.0;
   double pending_since_s_ = 0.0;
+  double refused_since_s_ = -1.0;  //!< live triggers refused since (-1: the last was taken)
   std::uint64_t next_preview_ns_ = 0;
 };
 

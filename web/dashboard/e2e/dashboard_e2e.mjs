@@ -225,6 +225,7 @@ try {
 
   // The camera panel: a third server with the twin camera; the live frame shows, a measurement
   // started from the page shows its surface and figures.
+  const cameraStart = Date.now();
   await stopServe(server);
   server = await startServe(["--camera", "twin"]);
   gcsPort = server.gcs;
@@ -243,6 +244,7 @@ try {
   const fig = await page.textContent("#meas-fig");
   check(measured, `a measurement from the page shows its surface: PV / PVr / RMS ${fig}`);
   await page.screenshot({ path: join(artifacts, "dashboard-camera.png"), fullPage: true });
+  console.log(`     (camera panel: ${Date.now() - cameraStart} ms, the server's start-up included)`);
   console.log(`screenshots: ${join(artifacts, "dashboard.png")}, dashboard-fault.png, dashboard-camera.png`);
 } catch (e) {
   check(false, `unexpected: ${e.stack || e}`);
