@@ -107,6 +107,13 @@ void SampleSequence::feed(const LoopSample& s) {
   result_.overruns += s.overrun ? 1 : 0;
   camera_.observe_plate(relative(s));
   if (phase_ == Phase::kStart) {
+    // Its first move would switch the servo on, which clears a latched fault: that is the
+    // operator's to do, knowing why it latched.
+    if (s.faulted) {
+      fail(fmt::format("the safety supervisor has {} latched: clear it (SVO) before measuring",
+                       s.fault));
+      return;
+    }
     phase_t0_s_ = s.t_s;
     command(p_.base_um);
     return;

@@ -452,17 +452,23 @@ TEST_F(Dashboard, WithoutACameraTheCameraEndpointsAreRefusedSayingWhy) {
   EXPECT_EQ(stop(), 0);
 }
 
-// As measure: the twin camera renders the twin's plate, so a hardware DAQ is refused, exit 2.
-TEST(DashboardOptions, TheTwinCameraOnAHardwareDaqIsRefused) {
-  const std::string cmd = "'" + piezoshift::testing::cli_path() +
-                          "' serve --daq comedi:/dev/comedi0 --camera twin --port 0 "
-                          "--http-port 0 --duration-s 1 2>&1 >/dev/null";
-  FILE* pipe = ::popen(cmd.c_str(), "r");
-  ASSERT_NE(pipe, nullptr);
-  std::string err;
-  char buf[256];
-  while (std::fgets(buf, sizeof buf, pipe) != nullptr)
-    err += buf;
-  EXPECT_EQ(WEXITSTATUS(::pclose(pipe)), 2) << err;
-  EXPECT_NE(err.find("--camera twin"), std::string::npos) << err;
+// As measure: the twin camera renders the twin's plate, so a hardware DAQ is refused, exit 2; a
+// camera without the dashboard has nowhere to show, refused too.
+TEST(DashboardOptions, TheTwinCameraOnAHardwareDaqOrWithoutTheDashboardIsRefused) {
+  const std::pair<std::string, std::string> cases[] = {
+      {"--daq comedi:/dev/comedi0 --camera twin --http-port 0",
+       "--camera twin renders the twin's plate"},
+      {"--camera twin", "give --http-port"}};
+  for (const auto& [args, why] : cases) {
+    const std::string cmd = "'" + piezoshift::testing::cli_path() + "' serve --port 0 " + args +
+                            " --duration-s 1 2>&1 >/dev/null";
+    FILE* pipe = ::popen(cmd.c_str(), "r");
+    ASSERT_NE(pipe, nullptr);
+    std::string err;
+    char buf[256];
+    while (std::fgets(buf, sizeof buf, pipe) != nullptr)
+      err += buf;
+    EXPECT_EQ(WEXITSTATUS(::pclose(pipe)), 2) << args << ": " << err;
+    EXPECT_NE(err.find(why), std::string::npos) << err;
+  }
 }

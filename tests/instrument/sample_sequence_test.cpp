@@ -142,6 +142,27 @@ TEST(SampleSequenceTest, AStageThatDoesNotSettleIsAFailureNotAFrame) {
   EXPECT_TRUE(r.exposures.empty());
 }
 
+TEST(SampleSequenceTest, ALatchedFaultIsNotClearedByAMeasurement) {
+  ScriptedCamera cam;
+  cam.configure({});
+  SyntheticLoop loop;
+  int moves = 0;
+  SampleSequence seq(cam, five_steps(), kPeriod_s, [&](double z) {
+    ++moves;
+    return loop.move(z);
+  });
+  LoopSample s = loop.step();
+  s.faulted = true;
+  s.fault = "tracking";
+  seq.feed(s);
+  ASSERT_TRUE(seq.done());
+  const SequenceResult r = seq.take();
+  EXPECT_FALSE(r.validity.valid);
+  EXPECT_NE(r.validity.reason.find("tracking latched: clear it"), std::string::npos)
+      << r.validity.reason;
+  EXPECT_EQ(moves, 0);  // no SVO, no MOV sent
+}
+
 TEST(SettleWindowTest, SettledOnlyOnceTheWindowsMeanIsWithinTheBandOnEveryChannel) {
   psi::OnTarget c;
   c.band_nm = 2.0;

@@ -15,7 +15,8 @@
 //   every frame arrived within frame_timeout_s (wall) of the last exposure: done
 //
 // Every sample's plate pose, relative to the pose at the settled base, goes to the camera
-// (observe_plate; the twin camera renders from it). The sequence fails, with the first reason,
+// (observe_plate; the twin camera renders from it). It does not start on a latched fault (its
+// first move would clear it: the operator's to do). The sequence fails, with the first reason,
 // when a move is refused, the supervisor latches a fault, the servo goes off, the loop's Z_d
 // departs from what the sequence commanded (another client moved the stage, a wave generator, a
 // stop), a step does not settle, or a frame is lost or late. The stage stays where the last step
