@@ -152,6 +152,9 @@ ServeCamera::ServeCamera(std::unique_ptr<camera::Camera> camera,
       gcs_(gcs),
       gcs_mutex_(gcs_mutex),
       options_(std::move(options)) {
+  if (!options_.preview)
+    message_ = fmt::format("camera {}: recorded frames, for measurements only (no live view)",
+                           camera_->name());
   const std::lock_guard lock(gcs_mutex_);
   gcs_.on_connect(kSession);
 }
@@ -265,7 +268,7 @@ void ServeCamera::preview(const std::vector<instrument::LoopSample>& batch) {
                            kPreviewTimeout_s);
   }
   const auto now_ns = static_cast<std::uint64_t>(now * 1e9);
-  if (preview_pending_ || last_t_s_ < 0.0 || now_ns < next_preview_ns_)
+  if (!options_.preview || preview_pending_ || last_t_s_ < 0.0 || now_ns < next_preview_ns_)
     return;
   if (camera_->trigger(last_t_s_)) {
     next_preview_ns_ = now_ns + static_cast<std::uint64_t>(options_.preview_period_s * 1e9);
@@ -347,7 +350,8 @@ void ServeCamera::publish_frame(const camera::Frame& f) {
       vis_px.at(x, y) = vis.tiles.at(x / kTilePx, y / kTilePx);
   std::string vis_png = psi::encode_false_colour_png(vis_px, 0.0, 1.0);
   const std::lock_guard lock(mutex_);
-  message_.clear();  // the camera works again
+  if (options_.preview)
+    message_.clear();  // the camera works again
   frame_png_ = std::move(frame_png);
   visibility_png_ = std::move(vis_png);
   frame_json_ = j.dump();
@@ -394,6 +398,8 @@ void ServeCamera::begin_measurement() {
 void ServeCamera::finish_measurement() {
   instrument::SequenceResult r = running_->sequence.take();
   const Request& req = running_->request;
+  if (!options_.preview && !r.frames.empty())
+    publish_frame(r.frames.front());  // no live view: the measurement's first frame instead
   MeasurementOutcome out;
   if (r.validity.valid)
     out = analyse(r, req.algorithm, req.params, scene_, options_.mask, options_.wavelength_nm);
@@ -488,11 +494,12 @@ host::HttpResponse ServeCamera::on_request(const host::HttpRequest& request) {
     const std::lock_guard lock(mutex_);
     return host::HttpResponse::json(
         200, fmt::format(R"({{"camera":{},"width_px":{},"height_px":{},"bits":{},)"
-                         R"("exposure_s":{},"preview_period_s":{},"measuring":{},)"
+                         R"("exposure_s":{},"preview_period_s":{},"preview":{},"measuring":{},)"
                          R"("message":{},"samples_dropped":{},"frame":{}}})",
                          json(camera_->name()).dump(), cs.width_px, cs.height_px,
                          camera::bit_depth(cs.format), cs.exposure_s, options_.preview_period_s,
-                         measuring_, json(message_).dump(), incoming_dropped_, frame_json_));
+                         options_.preview, measuring_, json(message_).dump(), incoming_dropped_,
+                         frame_json_));
   }
   if (path == "/api/measure") {
     const std::lock_guard lock(mutex_);

@@ -41,6 +41,8 @@ namespace piezoshift::app {
 struct ServeCameraOptions {
   double period_s = 1e-3;          //!< the loop's
   double preview_period_s = 0.25;  //!< 4 live frames per second
+  //! false: no live frames (files:DIR, whose recorded frames are the measurements' own)
+  bool preview = true;
   double wavelength_nm = 632.8;
   std::string mask;  //!< the pupil as a PNG for cameras other than the twin ("" : from the frames)
   instrument::SequenceParams sequence;  //!< base, settle criterion, timeouts (steps per request)

@@ -196,6 +196,8 @@ CameraSetup open_camera(const ServeOptions& o, const camera::CameraConfig& cc,
         camera::measurement_optics(cc.settings, wavelength_nm), o.seed);
   c.camera = camera::make_camera(o.camera, cc, c.scene ? &*c.scene : nullptr);
   c.options.period_s = 1.0 / o.rate_Hz;
+  // A replay's frames are the measurements' own: a live view would use them up.
+  c.options.preview = !o.camera.starts_with("files:");
   c.options.wavelength_nm = wavelength_nm;
   c.options.mask = o.mask;
   c.options.travel_z_max_um = cal.travel_z_max_um;
