@@ -33,6 +33,8 @@
 #include "loop_stack.hpp"
 #include "physics_budget.hpp"
 #include "piezoshift/calibration/calibration_file.hpp"
+#include "piezoshift/camera/instrument_config.hpp"
+#include "piezoshift/camera/make_camera.hpp"
 #include "piezoshift/config/project_config.hpp"
 #include "piezoshift/core/input_error.hpp"
 #include "piezoshift/host/dashboard.hpp"
@@ -42,11 +44,13 @@
 #include "piezoshift/host/locked_line_handler.hpp"
 #include "piezoshift/host/stage_model.hpp"
 #include "piezoshift/io/input_file.hpp"
+#include "piezoshift/psi/fizeau_simulation.hpp"
 #include "piezoshift/runtime/control_loop.hpp"
 #include "piezoshift/runtime/csv_logger.hpp"
 #include "piezoshift/runtime/fault_injection.hpp"
 #include "piezoshift/runtime/loop_clock.hpp"
 #include "piezoshift/runtime/safety_ranges.hpp"
+#include "serve_camera.hpp"
 #include "whole_number.hpp"
 
 namespace piezoshift::app {
@@ -83,6 +87,17 @@ struct ServeOptions {
   std::string http_token;
   std::string http_token_file;
   int http_max_clients = 16;
+  std::string camera;  // "": none
+  std::string surface;
+  std::string mask;
+};
+
+// The camera of the dashboard's live view and measurements (serve_camera.hpp), opened before the
+// loop starts so that a camera that cannot be opened is named at once.
+struct CameraSetup {
+  std::unique_ptr<camera::Camera> camera;
+  std::optional<camera::TwinScene> scene;
+  ServeCameraOptions options;
 };
 
 void check(bool ok, const std::string& message) {
@@ -160,6 +175,34 @@ void check_serve_options(const ServeOptions& o) {
         fmt::format("--http-port {}: must be 0 to 65535", o.http_port));
   check(o.http_max_clients >= 1 && o.http_max_clients <= 256,
         fmt::format("--http-max-clients {}: must be 1 to 256", o.http_max_clients));
+  // As `measure` refuses them (measure_command.cpp).
+  check(o.camera != "twin" || o.daq == "sim",
+        fmt::format("--camera twin renders the twin's plate: it needs --daq sim, not {}", o.daq));
+  const bool fed_by_twin = o.camera.starts_with("aravis:Fake") && o.daq == "sim";
+  check(o.surface.empty() || o.camera == "twin" || fed_by_twin,
+        "--surface: the test surface of the twin camera (or of aravis:Fake_1 on --daq sim)");
+  check(o.mask.empty() || !o.camera.empty(), "--mask: the pupil of --camera's frames");
+  check(o.camera.empty() || o.http_port >= 0,
+        "--camera: the live view and the measurements are the dashboard's; give --http-port");
+}
+
+CameraSetup open_camera(const ServeOptions& o, const camera::CameraConfig& cc,
+                        const LoopCalibration& cal) {
+  CameraSetup c;
+  const double wavelength_nm = c.options.sequence.wavelength_nm;
+  if (o.camera == "twin" || (o.camera.starts_with("aravis:Fake") && o.daq == "sim"))
+    c.scene = camera::make_twin_scene(
+        o.surface.empty() ? psi::SurfaceSpec{} : psi::parse_surface_spec(o.surface),
+        camera::measurement_optics(cc.settings, wavelength_nm), o.seed);
+  c.camera = camera::make_camera(o.camera, cc, c.scene ? &*c.scene : nullptr);
+  c.options.period_s = 1.0 / o.rate_Hz;
+  // A replay's frames are the measurements' own: a live view would use them up.
+  c.options.preview = !o.camera.starts_with("files:");
+  c.options.wavelength_nm = wavelength_nm;
+  c.options.mask = o.mask;
+  c.options.travel_z_max_um = cal.travel_z_max_um;
+  c.options.calibration_source = cal.source;
+  return c;
 }
 
 LoopStackOptions stack_options(const ServeOptions& o) {
@@ -188,13 +231,19 @@ host::GcsOptions gcs_options(const ServeOptions& o, const std::string& daq_name)
 class Network {
  public:
   Network(const ServeOptions& o, const host::StageModel& model, runtime::HostLink& link,
-          double period_s, const std::string& daq_name, const std::string& token)
+          double period_s, const std::string& daq_name, const std::string& token,
+          CameraSetup camera)
       : gcs_(model, link, period_s, gcs_options(o, daq_name)), locked_gcs_(gcs_, gcs_mutex_) {
     if (o.http_port >= 0) {
       host::DashboardOptions dopts;
       dopts.loop_rate_Hz = o.rate_Hz;
       dopts.daq_name = daq_name;
       dashboard_ = std::make_unique<host::Dashboard>(gcs_, gcs_mutex_, dashboard_page(), dopts);
+      if (camera.camera) {
+        camera_ = std::make_unique<ServeCamera>(std::move(camera.camera), std::move(camera.scene),
+                                                gcs_, gcs_mutex_, std::move(camera.options));
+        dashboard_->set_panel(camera_.get());
+      }
       gcs_.set_sample_observer(dashboard_.get());
       host::HttpServerOptions hopts;
       hopts.host = o.http_bind;
@@ -221,6 +270,8 @@ class Network {
   // Starts the servers' threads: before the real-time request, so they stay normal threads. A
   // server that fails stops the loop through its ramp (g_stop_signal); stop() rethrows it.
   void start() {
+    if (camera_)
+      camera_->start();
     line_thread_ = std::thread([this] { serve_until_stopped(*server_, line_error_); });
     if (http_)
       http_thread_ = std::thread([this] {
@@ -241,6 +292,8 @@ class Network {
       if (http_thread_.joinable())
         http_thread_.join();
     }
+    if (camera_)
+      camera_->stop();  // after the threads that hand it samples and requests
   }
   void rethrow_failure() const {
     if (line_error_)
@@ -254,6 +307,8 @@ class Network {
     bool moved = runtime::keep_off_cpu(line_thread_, cpu);
     if (http_thread_.joinable())
       moved = runtime::keep_off_cpu(http_thread_, cpu) && moved;
+    if (camera_ && camera_->thread().joinable())
+      moved = runtime::keep_off_cpu(camera_->thread(), cpu) && moved;
     return moved;
   }
 
@@ -277,6 +332,7 @@ class Network {
   std::mutex gcs_mutex_;
   host::LockedLineHandler locked_gcs_;
   std::unique_ptr<host::Dashboard> dashboard_;
+  std::unique_ptr<ServeCamera> camera_;  // the dashboard's panel: destroyed before it
   std::unique_ptr<host::HttpServer> http_;
   std::unique_ptr<host::LineServer> server_;
   std::thread line_thread_, http_thread_;
@@ -341,9 +397,13 @@ void print_serve_summary(const ServeOptions& o, Network& net, const std::string&
 int serve(const ServeOptions& o) {
   check_serve_options(o);
   const std::string token = http_token(o);
-  const runtime::InstallationConfig installation =
-      o.config.empty() ? runtime::InstallationConfig{}
-                       : runtime::load_installation_config(o.config);
+  // With a camera the file may hold [camera] too (one file serves `measure` and `serve`).
+  camera::InstrumentConfig instrument;
+  if (!o.config.empty() && !o.camera.empty())
+    instrument = camera::load_instrument_config(o.config);
+  else if (!o.config.empty())
+    instrument.installation = runtime::load_installation_config(o.config);
+  const runtime::InstallationConfig& installation = instrument.installation;
   const config::ProjectConfig& config = installation.project;
   const runtime::SafetyLimits safety = loop_safety_limits(installation.safety, o.max_overruns);
   // The stack first: a bad --fault, --daq or device is named before the twin's calibration runs.
@@ -352,9 +412,20 @@ int serve(const ServeOptions& o) {
                                                   1.0 / o.rate_Hz, o.max_physics_steps);
   const host::StageModel model = make_stage_model(o, config, cal.params, cal, safety);
 
+  CameraSetup camera_setup;
+  if (!o.camera.empty())
+    camera_setup = open_camera(o, instrument.camera, cal);
+  const std::string camera_line =
+      camera_setup.camera
+          ? fmt::format("piezoshift serve: camera {} ({} x {} px) on the dashboard\n",
+                        camera_setup.camera->name(), camera_setup.camera->settings().width_px,
+                        camera_setup.camera->settings().height_px)
+          : std::string();
+
   runtime::HostLink link;
   const std::string daq_name = stack.daq().name();
-  Network net(o, model, link, static_cast<double>(stack.period_ns()) * 1e-9, daq_name, token);
+  Network net(o, model, link, static_cast<double>(stack.period_ns()) * 1e-9, daq_name, token,
+              std::move(camera_setup));
   runtime::LoopConfig lc;
   lc.rate_Hz = o.rate_Hz;
   lc.duration_s = o.duration_s;
@@ -372,6 +443,7 @@ int serve(const ServeOptions& o) {
                token.empty() ? "" : " (token required)");
   fmt::print("piezoshift serve: GCS 2.0 on {}:{}, loop at {:g} Hz on {}\n", o.bind,
              net.server().port(), o.rate_Hz, daq_name);
+  fmt::print("{}", camera_line);
   fmt::print("piezoshift serve: safety ({}): {}\n",
              o.config.empty() ? "built in" : o.config + " [safety]", runtime::describe(safety));
   std::fflush(stdout);
@@ -452,6 +524,12 @@ void add_serve_command(CLI::App& app, Action& action) {
                   "file whose first line is the access token");
   cmd->add_option("--http-max-clients", o->http_max_clients, "dashboard connections at once")
       ->capture_default_str();
+  cmd->add_option("--camera", o->camera,
+                  "twin, files:DIR or aravis:ID: the dashboard's live view and measurements "
+                  "(docs/dashboard.md; [camera] of --config)");
+  cmd->add_option("--surface", o->surface,
+                  "the twin camera's test surface, as `psi simulate` takes it (Z4=40,rough=0.5)");
+  cmd->add_option("--mask", o->mask, "the pupil as a PNG (cameras other than the twin)");
   cmd->add_flag("--json", o->json, "print the summary at exit as JSON");
   cmd->callback([&action, o] { action = [o] { return serve(*o); }; });
 }

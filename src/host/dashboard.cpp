@@ -136,6 +136,16 @@ void Dashboard::on_sample(const runtime::HostSample& s, const RecorderInput& d) 
   r.fault_reason = s.fault_reason;
   r.fault_channel = s.fault_channel;
   pending_.push_back(r);
+  if (panel_ != nullptr)
+    panel_->on_sample(s, d);
+}
+
+bool Dashboard::is_panel_path(std::string_view path) noexcept {
+  for (const std::string_view root :
+       {std::string_view("/api/camera"), std::string_view("/api/measure")})
+    if (path.starts_with(root) && (path.size() == root.size() || path[root.size()] == '/'))
+      return true;
+  return false;
 }
 
 std::vector<std::string> Dashboard::query(std::string_view line) {
@@ -192,6 +202,7 @@ void Dashboard::on_poll(HttpServer& server) {
   nlohmann::json st;
   st["t_s"] = last_.t_s;
   st["daq"] = options_.daq_name;
+  st["camera"] = panel_ != nullptr;
   st["loop_rate_Hz"] = options_.loop_rate_Hz;
   st["stream_rate_Hz"] = options_.loop_rate_Hz / static_cast<double>(stride_);
   const auto number = [](double v) { return std::isfinite(v) ? nlohmann::json(v) : nullptr; };
@@ -326,6 +337,14 @@ HttpResponse Dashboard::on_request(const HttpRequest& request) {
     if (request.method != "POST")
       return HttpResponse::text(405, "POST only");
     return command(request);
+  }
+  if (is_panel_path(request.path)) {
+    if (panel_ != nullptr)
+      return panel_->on_request(request);
+    return HttpResponse::text(
+        404, fmt::format("{}: serve runs without a camera; start it with --camera twin, "
+                         "files:DIR or aravis:ID for the live view and measurements",
+                         request.path));
   }
   return HttpResponse::text(404, fmt::format("no such page: {}", request.path));
 }

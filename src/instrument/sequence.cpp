@@ -10,6 +10,8 @@
 #include <fmt/core.h>
 
 #include "piezoshift/core/input_error.hpp"
+#include "piezoshift/instrument/exposure_accumulator.hpp"
+#include "piezoshift/instrument/settle_window.hpp"
 
 namespace piezoshift::instrument {
 
@@ -32,11 +34,10 @@ class Runner {
         p_(p),
         progress_(progress),
         period_s_(static_cast<double>(loop.period_ns()) * 1e-9),
-        total_(static_cast<std::size_t>(p.averages) * p.steps_rad.size()) {
+        total_(static_cast<std::size_t>(p.averages) * p.steps_rad.size()),
+        window_(p.on_target, period_s_) {
     result_.frames.reserve(total_);
     result_.exposures.reserve(total_);
-    const auto hold = std::max(1L, std::lround(p.on_target.hold_s / period_s_));
-    window_.resize(static_cast<std::size_t>(hold));
   }
 
   SequenceResult run() {
@@ -57,7 +58,7 @@ class Runner {
     }
     finish_loop();
     result_.floor_s = static_cast<double>(total_) *
-                      (static_cast<double>(window_.size()) * period_s_ +
+                      (static_cast<double>(window_.length()) * period_s_ +
                        camera_.settings().exposure_s + camera_.settings().readout_s);
     return std::move(result_);
   }
@@ -121,35 +122,28 @@ class Runner {
     return true;
   }
 
-  // Ticks until the windowed mean of S - feedback is within the band on every channel.
+  // S - feedback per channel [nm], the controller's own estimate of this tick.
+  std::array<double, 3> gauge_error_nm() const {
+    const control::ControllerOutput& out = loop_.last_cycle().controller;
+    std::array<double, 3> e{};
+    for (std::size_t i = 0; i < 3; ++i)
+      e[i] = 1000.0 * (out.target_um[i] - out.feedback_um[i]);
+    return e;
+  }
+
+  // Ticks until the settle criterion holds (settle_window.hpp).
   bool settle() {
     const double t0 = now_s();
-    std::size_t filled = 0, next = 0;
+    window_.reset();
     while (now_s() - t0 < p_.on_target.timeout_s) {
       if (!tick())
         return false;
-      const control::ControllerOutput& out = loop_.last_cycle().controller;
-      for (std::size_t i = 0; i < 3; ++i)
-        window_[next][i] = 1000.0 * (out.target_um[i] - out.feedback_um[i]);
-      next = (next + 1) % window_.size();
-      filled = std::min(filled + 1, window_.size());
-      if (filled == window_.size() && windowed_error_nm() <= p_.on_target.band_nm)
+      if (window_.add(gauge_error_nm()))
         return true;
     }
     fail(fmt::format("the stage did not settle within {} nm (mean over {} s) in {} s at {:.3f} s",
                      p_.on_target.band_nm, p_.on_target.hold_s, p_.on_target.timeout_s, now_s()));
     return false;
-  }
-
-  double windowed_error_nm() const {
-    double worst = 0.0;
-    for (std::size_t i = 0; i < 3; ++i) {
-      double sum = 0.0;
-      for (const auto& w : window_)
-        sum += w[i];
-      worst = std::max(worst, std::fabs(sum / static_cast<double>(window_.size())));
-    }
-    return worst;
   }
 
   void take_frame(int average, int frame) {
@@ -247,45 +241,14 @@ class Runner {
   // Ticks through the exposure, the stage's state recorded tick by tick.
   bool expose(ExposureRecord& rec) {
     const auto n = std::max(1L, std::lround(camera_.settings().exposure_s / period_s_));
-    std::array<double, 3> sum{};
-    // The mean pose over the exposure as the camera integrates it: the trajectory is piecewise
-    // linear between the ticks' poses, so the trapezoid rule, the first and last poses halved.
-    const camera::PlatePose first = pose();
-    double piston_sum = 0.5 * first.piston_nm, tip_sum = 0.5 * first.theta_x_urad,
-           tilt_sum = 0.5 * first.theta_y_urad;
-    double lo = first.piston_nm, hi = lo;
-    camera::PlatePose last = first;
+    ExposureAccumulator acc;
+    acc.begin(pose());
     for (long k = 0; k < n; ++k) {
       if (!tick())
         return false;
-      const control::ControllerOutput& out = loop_.last_cycle().controller;
-      for (std::size_t i = 0; i < 3; ++i) {
-        const double e = 1000.0 * (out.target_um[i] - out.feedback_um[i]);
-        sum[i] += e;
-        rec.gauge_error_max_nm = std::max(rec.gauge_error_max_nm, std::fabs(e));
-      }
-      const camera::PlatePose q = pose();
-      piston_sum += q.piston_nm;
-      tip_sum += q.theta_x_urad;
-      tilt_sum += q.theta_y_urad;
-      last = q;
-      lo = std::min(lo, q.piston_nm);
-      hi = std::max(hi, q.piston_nm);
+      acc.add(gauge_error_nm(), pose());
     }
-    const double dn = static_cast<double>(n);
-    for (double s : sum)
-      rec.gauge_error_mean_nm = std::max(rec.gauge_error_mean_nm, std::fabs(s / dn));
-    rec.exposure_end_s = now_s();
-    rec.has_truth = twin_ != nullptr;
-    if (rec.has_truth) {
-      piston_sum -= 0.5 * last.piston_nm;
-      tip_sum -= 0.5 * last.theta_x_urad;
-      tilt_sum -= 0.5 * last.theta_y_urad;
-      rec.truth_piston_nm = piston_sum / dn;
-      rec.truth_blur_nm = hi - lo;
-      rec.truth_tip_urad = tip_sum / dn;
-      rec.truth_tilt_urad = tilt_sum / dn;
-    }
+    acc.finish(rec, twin_ != nullptr, now_s());
     return true;
   }
 
@@ -301,24 +264,12 @@ class Runner {
   }
 
   bool accept(camera::FrameStatus s, camera::Frame& f) {
-    if (s == camera::FrameStatus::kLost) {
-      fail(fmt::format("camera {} lost frame {}", camera_.name(), f.frame_id));
+    if (const std::string why =
+            instrument::take_frame(s, f, camera_, seconds_since(start_wall_), result_);
+        !why.empty()) {
+      fail(why);
       return false;
     }
-    if (s != camera::FrameStatus::kOk) {
-      fail(fmt::format("camera {}: {} ({})", camera_.name(), camera::to_string(s),
-                       camera_.message()));
-      return false;
-    }
-    const std::size_t k = result_.frames.size();
-    if (k >= result_.exposures.size()) {
-      fail(fmt::format("camera {} delivered frame {} that no trigger asked for", camera_.name(),
-                       f.frame_id));
-      return false;
-    }
-    result_.exposures[k].frame_id = f.frame_id;
-    result_.exposures[k].arrival_wall_s = seconds_since(start_wall_);
-    result_.frames.push_back(std::move(f));
     return true;
   }
 
@@ -371,7 +322,7 @@ class Runner {
   const rig::Progress& progress_;
   double period_s_;
   std::size_t total_;
-  std::vector<std::array<double, 3>> window_;
+  SettleWindow window_;
   camera::PlatePose origin_{};
   Clock::time_point start_wall_ = Clock::now();
   double start_loop_s_ = 0.0;
@@ -384,6 +335,22 @@ class Runner {
 };
 
 }  // namespace
+
+std::string take_frame(camera::FrameStatus s, camera::Frame& f, const camera::Camera& camera,
+                       double arrival_wall_s, SequenceResult& result) {
+  if (s == camera::FrameStatus::kLost)
+    return fmt::format("camera {} lost frame {}", camera.name(), f.frame_id);
+  if (s != camera::FrameStatus::kOk)
+    return fmt::format("camera {}: {} ({})", camera.name(), camera::to_string(s), camera.message());
+  const std::size_t k = result.frames.size();
+  if (k >= result.exposures.size())
+    return fmt::format("camera {} delivered frame {} that no trigger asked for", camera.name(),
+                       f.frame_id);
+  result.exposures[k].frame_id = f.frame_id;
+  result.exposures[k].arrival_wall_s = arrival_wall_s;
+  result.frames.push_back(std::move(f));
+  return {};
+}
 
 const char* to_string(TriggerMode mode) noexcept {
   return mode == TriggerMode::kLine ? "line" : "software";

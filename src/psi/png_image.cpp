@@ -48,15 +48,16 @@ void write_to_memory(png_structp png, png_bytep in, png_size_t n) {
 }
 void flush_nothing(png_structp) {}
 
-// Writes rows (already in the PNG's byte order: 8-bit, or 16-bit big-endian) to path.
-void write_png(const std::string& path, int width, int height, int bit_depth, int color_type,
-               const std::vector<std::vector<png_byte>>& rows) {
+// Rows (already in the PNG's byte order: 8-bit, or 16-bit big-endian) as a PNG file's bytes;
+// what names it in messages.
+std::string encode_png(const std::string& what, int width, int height, int bit_depth,
+                       int color_type, const std::vector<std::vector<png_byte>>& rows) {
   std::string out;
   png_structp png = png_create_write_struct(PNG_LIBPNG_VER_STRING, nullptr, on_error, on_warning);
   png_infop info = png ? png_create_info_struct(png) : nullptr;
   if (!png || !info) {
     png_destroy_write_struct(&png, &info);
-    throw core::InputError(fmt::format("{}: libpng could not start", path));
+    throw core::InputError(fmt::format("{}: libpng could not start", what));
   }
   try {
     png_set_write_fn(png, &out, write_to_memory, flush_nothing);
@@ -69,10 +70,15 @@ void write_png(const std::string& path, int width, int height, int bit_depth, in
     png_write_end(png, nullptr);
   } catch (const PngFailure& e) {
     png_destroy_write_struct(&png, &info);
-    throw core::InputError(fmt::format("{}: {}", path, e.what()));
+    throw core::InputError(fmt::format("{}: {}", what, e.what()));
   }
   png_destroy_write_struct(&png, &info);
-  io::write_file_atomically(path, out);
+  return out;
+}
+
+void write_png(const std::string& path, int width, int height, int bit_depth, int color_type,
+               const std::vector<std::vector<png_byte>>& rows) {
+  io::write_file_atomically(path, encode_png(path, width, height, bit_depth, color_type, rows));
 }
 
 // Blue (lo) - white - red (hi).
@@ -136,7 +142,7 @@ GrayImage read_png_gray(const std::string& path) {
   return img;
 }
 
-void write_png_gray16(const std::string& path, const Map& counts) {
+std::string encode_png_gray16(const Map& counts) {
   std::vector<std::vector<png_byte>> rows(static_cast<std::size_t>(counts.height));
   for (int j = 0; j < counts.height; ++j) {
     auto& row = rows[static_cast<std::size_t>(j)];
@@ -149,7 +155,11 @@ void write_png_gray16(const std::string& path, const Map& counts) {
       row[2 * static_cast<std::size_t>(i) + 1] = static_cast<png_byte>(c & 0xff);
     }
   }
-  write_png(path, counts.width, counts.height, 16, PNG_COLOR_TYPE_GRAY, rows);
+  return encode_png("16-bit gray PNG", counts.width, counts.height, 16, PNG_COLOR_TYPE_GRAY, rows);
+}
+
+void write_png_gray16(const std::string& path, const Map& counts) {
+  io::write_file_atomically(path, encode_png_gray16(counts));
 }
 
 void write_mask_png(const std::string& path, const Mask& mask) {
@@ -171,7 +181,7 @@ Mask read_mask_png(const std::string& path) {
   return m;
 }
 
-void write_false_colour_png(const std::string& path, const Map& map, double lo, double hi) {
+std::string encode_false_colour_png(const Map& map, double lo, double hi) {
   const int bar = std::max(12, map.width / 16), gap = std::max(4, map.width / 64);
   const int w = map.width + gap + bar, h = map.height;
   const double span = hi > lo ? hi - lo : 1.0;
@@ -192,7 +202,11 @@ void write_false_colour_png(const std::string& path, const Map& map, double lo, 
     for (int i = map.width + gap; i < w; ++i)
       put(i, tick && i < map.width + gap + bar / 3 ? std::array<png_byte, 3>{0, 0, 0} : colour(t));
   }
-  write_png(path, w, h, 8, PNG_COLOR_TYPE_RGB, rows);
+  return encode_png("false-colour PNG", w, h, 8, PNG_COLOR_TYPE_RGB, rows);
+}
+
+void write_false_colour_png(const std::string& path, const Map& map, double lo, double hi) {
+  io::write_file_atomically(path, encode_false_colour_png(map, lo, hi));
 }
 
 }  // namespace piezoshift::psi

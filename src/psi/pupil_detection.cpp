@@ -88,6 +88,14 @@ double median(std::vector<double> v) {
 
 }  // namespace
 
+Map modulation_map(std::span<const Map> frames) {
+  if (frames.empty() || frames.front().size() == 0)
+    throw std::invalid_argument("modulation: no frames, or frames without pixels");
+  Map out(frames.front().width, frames.front().height);
+  out.v = temporal_std(frames);
+  return out;
+}
+
 DetectedPupil pupil_from_modulation(std::span<const Map> frames, const PupilDetection& d) {
   if (frames.empty() || frames.front().size() == 0)
     throw std::invalid_argument("pupil: no frames, or frames without pixels");

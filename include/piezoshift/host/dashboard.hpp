@@ -24,6 +24,10 @@
 //             the next round's, so a GCS client waits for at most one turn of a POST. The
 //             answers of one POST are at most max_answer_bytes (beyond: 413, the lines before
 //             it applied)
+//   panel     with `serve --camera`, the camera's live view and the measurement
+//             (dashboard_panel.hpp): the requests under /api/camera and /api/measure go to it,
+//             and every sample; without one they are refused with 404 and why. The status says
+//             whether there is one ("camera": true/false)
 // The mutex is the one the GCS thread holds around the interpreter (LockedLineHandler); the HTTP
 // thread holds it only to copy samples out and to run one turn of command lines, never across
 // I/O.
@@ -37,6 +41,7 @@
 #include <string_view>
 #include <vector>
 
+#include "piezoshift/host/dashboard_panel.hpp"
 #include "piezoshift/host/gcs_interpreter.hpp"
 #include "piezoshift/host/http_server.hpp"
 #include "piezoshift/host/sample_observer.hpp"
@@ -84,6 +89,12 @@ class Dashboard final : public HttpHandler, public SampleObserver {
   //! One turn of a POST's command lines.
   HttpResponse resume(std::uint64_t client) override;
   void abandon(std::uint64_t client) override;
+
+  //! Before the servers start: the panel of /api/camera and /api/measure (null: none). It must
+  //! outlive the dashboard's use of it.
+  void set_panel(DashboardPanel* panel) noexcept { panel_ = panel; }
+  //! The paths whose requests go to the panel: these and everything under them.
+  static bool is_panel_path(std::string_view path) noexcept;
 
   //! Any thread.
   void set_realtime(const DashboardRealtime& rt) noexcept;
@@ -137,6 +148,7 @@ class Dashboard final : public HttpHandler, public SampleObserver {
   std::mutex& mutex_;
   std::string page_;
   DashboardOptions options_;
+  DashboardPanel* panel_ = nullptr;
   std::size_t stride_ = 1;
 
   // Filled by on_sample (under mutex_), emptied by on_poll.

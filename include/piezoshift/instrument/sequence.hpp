@@ -113,6 +113,12 @@ struct SequenceResult {
   rig::Validity validity;
 };
 
+//! A frame polled from camera into result (the next exposure's frame_id and arrival_wall_s, the
+//! frame appended): "" when taken, else why the sequence fails (lost, an error, a frame no
+//! trigger asked for). Both drivers of a sequence use it (sample_sequence.hpp).
+std::string take_frame(camera::FrameStatus status, camera::Frame& frame,
+                       const camera::Camera& camera, double arrival_wall_s, SequenceResult& result);
+
 //! Runs the sequence (see the header). twin: the twin whose true plate pose feeds the camera and
 //! the records (nullptr on hardware). loop must be in owner mode and not started; the DAQ
 //! backend must be active. Throws core::InputError for parameters sequence_problem() refuses, and

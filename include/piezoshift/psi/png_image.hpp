@@ -8,6 +8,7 @@
 //   write_false_colour_png: a height map drawn with a blue-white-red scale, NaN as gray, and a
 //     scale bar (colour ramp with tick marks every quarter of the range) on the right; the range
 //     is printed by the caller (the PNG holds no text).
+//   encode_*: the same images as a PNG file's bytes, for a caller that sends them (the dashboard).
 // Set-up only; every error is core::InputError naming the file.
 #include <string>
 
@@ -24,9 +25,11 @@ struct GrayImage {
 
 GrayImage read_png_gray(const std::string& path);
 void write_png_gray16(const std::string& path, const Map& counts);
+std::string encode_png_gray16(const Map& counts);
 void write_mask_png(const std::string& path, const Mask& mask);
 Mask read_mask_png(const std::string& path);
 //! Writes the map with the colour scale spanning [lo, hi]; returns nothing, throws on I/O.
 void write_false_colour_png(const std::string& path, const Map& map, double lo, double hi);
+std::string encode_false_colour_png(const Map& map, double lo, double hi);
 
 }  // namespace piezoshift::psi

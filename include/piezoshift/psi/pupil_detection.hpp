@@ -42,4 +42,8 @@ struct DetectedPupil {
 
 DetectedPupil pupil_from_modulation(std::span<const Map> frames, const PupilDetection& d = {});
 
+//! m(pixel), the temporal standard deviation above [frame units], as a map of the frames' size.
+//! std::invalid_argument for no frames.
+Map modulation_map(std::span<const Map> frames);
+
 }  // namespace piezoshift::psi

@@ -3,7 +3,9 @@
 // headless Chromium through playwright-core (no browser is downloaded), and checks:
 //   the stream delivers every loop sample (gaps only where the loop skipped slots); a click on "Move absolute" to Z = 5 um shows in the scope's
 //   position trace and the readout within 2 s; GCS POS? (a second client) sees that move; a GCS
-//   MOV is seen on the page; the injected fault is shown with its reason; screenshots are kept.
+//   MOV is seen on the page; the injected fault is shown with its reason; with --camera twin (a
+//   third server) the live frame shows and a measurement started from the page shows its
+//   surface; screenshots are kept.
 //   node e2e/dashboard_e2e.mjs --cli PATH/piezoshift --artifacts DIR
 import { spawn } from "node:child_process";
 import { existsSync, mkdirSync, readFileSync } from "node:fs";
@@ -220,7 +222,30 @@ try {
   check(faulted, `fault shown: ${reason.replace(/\s+/g, " ").trim()}`);
   await page.waitForTimeout(300);
   await page.screenshot({ path: join(artifacts, "dashboard-fault.png") });
-  console.log(`screenshots: ${join(artifacts, "dashboard.png")}, dashboard-fault.png`);
+
+  // The camera panel: a third server with the twin camera; the live frame shows, a measurement
+  // started from the page shows its surface and figures.
+  const cameraStart = Date.now();
+  await stopServe(server);
+  server = await startServe(["--camera", "twin"]);
+  gcsPort = server.gcs;
+  await page.goto(server.url);
+  const live = await page.waitForFunction(() => window.piezoshift.frameShown() >= 0 &&
+    document.getElementById("cam-frame").naturalWidth === 256,
+  null, { timeout: 15000 }).then(() => true, () => false);
+  check(live, "camera panel: the twin's live frame (256 x 256 px) is shown");
+  await page.click("#btn-measure");
+  const measured = await page.waitForFunction(() => {
+    const m = window.piezoshift.measurement();
+    return m && !m.running && m.last && m.last.valid &&
+      document.getElementById("meas-surface").naturalWidth > 256 &&
+      document.getElementById("meas-fig").textContent.includes("nm");
+  }, null, { timeout: 20000 }).then(() => true, () => false);
+  const fig = await page.textContent("#meas-fig");
+  check(measured, `a measurement from the page shows its surface: PV / PVr / RMS ${fig}`);
+  await page.screenshot({ path: join(artifacts, "dashboard-camera.png"), fullPage: true });
+  console.log(`     (camera panel: ${Date.now() - cameraStart} ms, the server's start-up included)`);
+  console.log(`screenshots: ${join(artifacts, "dashboard.png")}, dashboard-fault.png, dashboard-camera.png`);
 } catch (e) {
   check(false, `unexpected: ${e.stack || e}`);
 } finally {

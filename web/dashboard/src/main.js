@@ -274,7 +274,97 @@ $("btn-csv").onclick = () => {
   URL.revokeObjectURL(a.href);
 };
 
+// ---- camera (serve --camera): the live frame, its fringe visibility, measurements
+const withToken = (url) => (token ? url + (url.includes("?") ? "&" : "?") + "token=" + encodeURIComponent(token) : url);
+function ticks(id, lo, hi, digits) {
+  // Five labels from hi (top) to lo (bottom): the PNGs' scale bar has its ticks at each quarter.
+  const el = $(id);
+  el.replaceChildren(...[1, 0.75, 0.5, 0.25, 0].map((q) => {
+    const d = document.createElement("div");
+    d.textContent = fmt(lo + q * (hi - lo), digits);
+    return d;
+  }));
+}
+async function getJson(url) {
+  const res = await fetch(withToken(url));
+  return res.ok ? res.json() : null;
+}
+let cameraOn = false;
+let shownFrame = -1;
+let shownMeasurement = -1;
+let measurement = null;
+async function pollCamera() {
+  if (!lastStatus || !lastStatus.camera) return;
+  if (!cameraOn) {
+    cameraOn = true;
+    $("camera-panel").classList.remove("hidden");
+    ticks("vis-ticks", 0, 1, 2);
+  }
+  const cam = await getJson("/api/camera").catch(() => null);
+  if (cam) {
+    $("cam-name").textContent = cam.camera;
+    $("cam-msg").textContent = cam.message || "";
+    const f = cam.frame;
+    if (f && f.id !== shownFrame) {
+      shownFrame = f.id;
+      $("cam-frame").src = withToken(`/api/camera/frame.png?n=${f.id}`);
+      $("cam-vis-map").src = withToken(`/api/camera/visibility.png?n=${f.id}`);
+      ticks("cam-ticks", 0, f.full_scale_counts, 0);
+      $("cam-id").textContent = `${f.id}, ${f.width_px} × ${f.height_px} px, ${f.bits} bit, t = ${fmt(f.trigger_time_s, 3)} s`;
+      $("cam-max").textContent = `${fmt(f.max_counts, 0)} / ${fmt(f.mean_counts, 0)} of ${fmt(f.full_scale_counts, 0)}`;
+      $("cam-sat").textContent = `${f.saturated_pixels} px (${fmt(100 * f.saturated_fraction, 2)} %)`;
+      $("cam-sat").className = f.saturated_pixels > 0 ? "bad" : "";
+      $("cam-vis").textContent = `${fmt(f.visibility.p90, 2)} / ${fmt(f.visibility.median, 2)}`;
+    }
+  }
+  measurement = await getJson("/api/measure").catch(() => null);
+  if (measurement) showMeasurement(measurement);
+}
+function showMeasurement(m) {
+  const l = m.last;
+  $("btn-measure").disabled = m.running;
+  if (m.running) $("meas-state").textContent = `measurement ${m.id} running: ${m.progress.frames} of ${m.progress.of || "…"} frames`;
+  if (!l || l.id === shownMeasurement || m.running) return;
+  shownMeasurement = l.id;
+  $("meas-state").textContent = l.valid
+    ? `measurement ${l.id}: valid (${l.algorithm}, ${l.frames} frames × ${l.averages})`
+    : `measurement ${l.id} FAILED: ${l.reason}`;
+  $("meas-state").className = l.valid ? "muted" : "bad";
+  const s = l.valid ? l.surface : null;
+  $("meas-fig").textContent = s ? `${fmt(s.pv_nm, 2)} / ${fmt(s.pvr_nm, 2)} / ${fmt(s.rms_nm, 3)} nm` : "—";
+  $("meas-err").textContent = s && l.error_rms_nm != null ? `${fmt(l.error_rms_nm, 3)} nm` : "—";
+  $("meas-steps").textContent = l.steps ? l.steps.worst_error : "—";
+  $("meas-rec").textContent = l.steps && l.steps.recovered_rad.length
+    ? l.steps.recovered_rad[0].map((v) => v.toFixed(3)).join(", ") : "—";
+  $("meas-time").textContent = `${fmt(l.wall_time_s, 3)} / ${fmt(l.floor_s, 3)} s`;
+  // A failed measurement shows its reason, never a surface.
+  if (s) {
+    $("meas-surface").src = withToken(`/api/measure/surface.png?n=${l.id}`);
+    ticks("surf-ticks", s.lo_nm, s.hi_nm, 1);
+  } else {
+    $("meas-surface").removeAttribute("src");
+    $("surf-ticks").replaceChildren();
+  }
+  if (l.modulation) {
+    $("meas-mod").src = withToken(`/api/measure/modulation.png?n=${l.id}`);
+    ticks("mod-ticks", l.modulation.lo, l.modulation.hi, 0);
+  } else {
+    $("meas-mod").removeAttribute("src");
+    $("mod-ticks").replaceChildren();
+  }
+}
+$("btn-measure").onclick = async () => {
+  const headers = { "Content-Type": "application/json" };
+  if (token) headers.Authorization = "Bearer " + token;
+  const body = { algorithm: $("meas-alg").value, averages: Math.round(num("meas-avg")) };
+  const res = await fetch("/api/measure", { method: "POST", headers, body: JSON.stringify(body) });
+  const text = await res.text();
+  log(res.ok ? `measure: ${body.algorithm} × ${body.averages} started` : `measure: HTTP ${res.status}, ${text.trim()}`, res.ok);
+};
+setInterval(pollCamera, 500);
+
 // For tests and the console: the charts and the last status.
-window.piezoshift = { charts, store, status: () => lastStatus, events: () => events };
+window.piezoshift = { charts, store, status: () => lastStatus, events: () => events,
+  measurement: () => measurement, frameShown: () => shownFrame };
 connect();
 requestAnimationFrame(frame);
