@@ -52,8 +52,12 @@ class StandInLoop {
             s.ao_V = c.ao_V;
             break;
           case HostCommand::Kind::kActuators:  // the guided calibration's, never the server's
-          case HostCommand::Kind::kConfigure:
             break;
+          case HostCommand::Kind::kConfigure: {  // SPA's set, taken as the loop takes it
+            control::SemiClosedLoopParams p{};
+            (void)link_.params.try_pop(p);
+            break;
+          }
           case HostCommand::Kind::kWave: {
             const auto bit = static_cast<std::uint8_t>(1u << c.wave.generator);
             if (c.wave.action == runtime::WaveCommand::Action::kStart) {

@@ -77,6 +77,7 @@ struct ServeOptions {
   double on_target_um = 0.01;
   double on_target_urad = 0.5;
   double settle_s = 0.01;
+  std::string idn;  //!< *IDN?'s answer; empty: host::default_identification
   std::optional<std::int64_t> max_overruns;  // absent: the installation's [safety]
   int cpu = -1;
   std::string log;
@@ -169,6 +170,8 @@ void check_serve_options(const ServeOptions& o) {
         fmt::format("--on-target-um {}: must be > 0", o.on_target_um));
   check(o.on_target_urad > 0.0 && std::isfinite(o.on_target_urad),
         fmt::format("--on-target-urad {}: must be > 0", o.on_target_urad));
+  check(o.idn.size() <= 200 && o.idn.find_first_of("\r\n") == std::string::npos,
+        "--idn: at most 200 characters, one line");
   check(o.settle_s >= 0.0 && o.settle_s <= 10.0,
         fmt::format("--settle-s {}: must be 0 to 10 s", o.settle_s));
   check(o.http_port >= -1 && o.http_port <= 65535,
@@ -221,8 +224,7 @@ host::GcsOptions gcs_options(const ServeOptions& o, const std::string& daq_name)
   g.on_target_tolerance_um = o.on_target_um;
   g.on_target_tolerance_urad = o.on_target_urad;
   g.settle_time_s = o.settle_s;
-  g.identification =
-      fmt::format("piezoshift, semi-closed-loop PZT phase shifter ({}), 0, 0.1.0", daq_name);
+  g.identification = o.idn.empty() ? host::default_identification(daq_name) : o.idn;
   return g;
 }
 
@@ -502,6 +504,7 @@ void add_serve_command(CLI::App& app, Action& action) {
       ->capture_default_str();
   cmd->add_option("--on-target-urad", o->on_target_urad, "ONT? tolerance of U and V (urad)")
       ->capture_default_str();
+  cmd->add_option("--idn", o->idn, "*IDN?'s answer (default: piezoshift's, naming E-727)");
   cmd->add_option("--settle-s", o->settle_s, "ONT? needs the tolerance held this long (s)")
       ->capture_default_str();
   cmd->add_option("--max-overruns", o->max_overruns,

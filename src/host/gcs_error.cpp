@@ -38,6 +38,12 @@ const char* describe(GcsError error) noexcept {
       return "Data record table does not exist";
     case GcsError::kNoRecordOption:
       return "Record source option does not exist";
+    case GcsError::kInvalidPassword:
+      return "Invalid password";
+    case GcsError::kParamProtection:
+      return "Protected Param: current Command Level (CCL) too low";
+    case GcsError::kReadOnlyParameter:
+      return "Parameter is read-only";
     case GcsError::kVoltageOutOfLimits:
       return "Voltage out of limits";
     case GcsError::kNotEnoughData:

@@ -59,22 +59,6 @@ bool parse_integer(std::string_view s, long long& value) {
   return r.ec == std::errc{} && r.ptr == end;
 }
 
-// The parameters SPA?/SEP? answer (all controller-wide: any item is accepted), as HPA? lists
-// them: id, PI's data type and description. The ids are PI's (PIPython's datarectools reads
-// 0x0E000200, 0x16000200 and 0x16000300 to size a recording).
-struct Parameter {
-  long long id;
-  const char* type;
-  const char* group;
-  const char* description;
-};
-constexpr Parameter kParameters[] = {
-    {0x0E000200, "FLOAT", "Controller", "Servo Update Time (s)"},
-    {0x16000200, "INT", "Data Recorder", "Data Recorder Max Points (all tables)"},
-    {0x16000300, "INT", "Data Recorder", "Data Recorder Chan Number"},
-    {0x13000004, "INT", "Wave Generator", "Max Wave Points (per table)"},
-};
-
 int axis_of(std::string_view s) {
   for (Axis a : kAxes)
     if (s == axis_name(a))
@@ -219,8 +203,11 @@ const GcsInterpreter::Command GcsInterpreter::kCommands[] = {
     {"CST?", "[{axis} ...]", "stage type of each axis", &GcsInterpreter::stage_types},
     {"PUN?", "[{axis} ...]", "position units", &GcsInterpreter::units},
     {"HLP?", "", "this list", &GcsInterpreter::help},
-    {"ERR?", "", "oldest queued error number (0: none), removed from the queue",
+    {"ERR?", "", "the last error number (0: none since the last ERR?), reset to 0",
      &GcsInterpreter::error_number},
+    {"CCL", "{level} [{password}]", "command level: 0, or 1 with the password advanced",
+     &GcsInterpreter::command_level},
+    {"CCL?", "", "command level", &GcsInterpreter::command_level_query},
     {"SVO", "{axis} {0|1} ...", "servo (semi-closed loop) off or on, all axes together",
      &GcsInterpreter::servo},
     {"SVO?", "[{axis} ...]", "servo state", &GcsInterpreter::servo_query},
@@ -231,6 +218,8 @@ const GcsInterpreter::Command GcsInterpreter::kCommands[] = {
     {"MOV?", "[{axis} ...]", "target position", &GcsInterpreter::target_query},
     {"POS?", "[{axis} ...]", "position from the strain gauges", &GcsInterpreter::position_query},
     {"ONT?", "[{axis} ...]", "on target", &GcsInterpreter::on_target_query},
+    {"OVF?", "[{axis} ...]", "overflow: a PID at its output limit (closed loop)",
+     &GcsInterpreter::overflow_query},
     {"STP", "", "stop: wave generators off, hold where the stage is (sets error 10)",
      &GcsInterpreter::stop},
     {"VEL", "{axis} {velocity} ...", "closed-loop velocity, stored (velocity control is off)",
@@ -239,6 +228,8 @@ const GcsInterpreter::Command GcsInterpreter::kCommands[] = {
     {"VCO?", "[{axis} ...]", "velocity control, 0", &GcsInterpreter::velocity_control_query},
     {"SPA?", "[{item} {parameter} ...]", "parameter values", &GcsInterpreter::parameters},
     {"SEP?", "[{item} {parameter} ...]", "parameter values, as SPA?", &GcsInterpreter::parameters},
+    {"SPA", "{item} {parameter} {value} ...", "set the P or I term (CCL 1), applied bumplessly",
+     &GcsInterpreter::set_parameters},
     {"HPA?", "", "parameter list", &GcsInterpreter::parameter_list},
     {"SVA", "{axis} {volts} ...", "open-loop value in amplifier volts (servo off)",
      &GcsInterpreter::open_loop},
@@ -306,12 +297,24 @@ GcsInterpreter::GcsInterpreter(const StageModel& model, runtime::HostLink& link,
       servo_cycle_s_(servo_cycle_s),
       options_(options),
       settle_samples_(static_cast<std::uint64_t>(
-          std::max(1.0, std::round(options.settle_time_s / servo_cycle_s)))) {
+          std::max(1.0, std::round(options.settle_time_s / servo_cycle_s)))),
+      servo_params_(model.params().controller, servo_cycle_s) {
   position_ = model_.pose_from_sgs(Vec3{});
+}
+
+std::string default_identification(const std::string& daq) {
+  return fmt::format(
+      "(c)2026 piezoshift, E-727 compatible semi-closed-loop PZT phase shifter{}, "
+      "0, 0.1.0",
+      daq.empty() ? std::string{} : fmt::format(" ({})", daq));
 }
 
 void GcsInterpreter::on_connect(ClientId client) {
   sessions_[client] = Session{};
+  // A PI controller keeps its error until ERR? reads it, whoever connects: a fault latched
+  // before this client came is its first error too.
+  if (faulted_)
+    sessions_[client].error = GcsError::kMotionError;
 }
 
 void GcsInterpreter::on_disconnect(ClientId client) {
@@ -320,8 +323,7 @@ void GcsInterpreter::on_disconnect(ClientId client) {
 
 void GcsInterpreter::fail(Session& session, GcsError error) {
   ++stats_.errors;
-  if (session.errors.size() < options_.error_queue_length)
-    session.errors.push_back(error);
+  session.error = error;  // PI keeps only the last error
 }
 
 std::string GcsInterpreter::on_overlong_line(ClientId client) {
@@ -479,6 +481,12 @@ void GcsInterpreter::take(const runtime::HostSample& s) {
     }
     faulted_ = faulted;
   }
+  // The loop refused SPA's set (configure_problem): the running set is the one before it.
+  if (configure_sequence_ != 0 && s.applied_sequence >= configure_sequence_) {
+    if (s.configure_problem != 0)
+      servo_params_.applied(before_configure_);
+    configure_sequence_ = 0;
+  }
 
   // A generator the loop reports stopped (its cycles done, WGO 0, servo off, a fault) leaves
   // its axis where the wave ended: that is the target from now on.
@@ -573,11 +581,8 @@ std::string GcsInterpreter::help(Session&, const Args&) {
 }
 
 std::string GcsInterpreter::error_number(Session& s, const Args&) {
-  int code = 0;
-  if (!s.errors.empty()) {
-    code = static_cast<int>(s.errors.front());
-    s.errors.pop_front();
-  }
+  const int code = static_cast<int>(s.error);
+  s.error = GcsError::kNone;
   return fmt::format("{}\n", code);
 }
 
@@ -631,7 +636,7 @@ std::string GcsInterpreter::velocity_control_query(Session& s, const Args& args)
 
 std::string GcsInterpreter::parameter_list(Session&, const Args&) {
   std::vector<std::string> lines;
-  for (const Parameter& p : kParameters)
+  for (const ServoParameter& p : ServoParameters::list())
     lines.push_back(
         fmt::format("0x{:08X}=\t0\t1\t{}\t{}\t{}", p.id, p.type, p.group, p.description));
   return framed(lines);
@@ -939,24 +944,10 @@ std::string GcsInterpreter::recorder_trigger(Session& s, const Args& args) {
 }
 
 std::string GcsInterpreter::parameters(Session& s, const Args& args) {
-  const auto value = [this](long long id) -> std::string {
-    switch (id) {
-      case 0x0E000200:
-        return fmt::format("{:.9g}", servo_cycle_s_);
-      case 0x16000200:
-        return fmt::format("{}", DataRecorder::kTables * DataRecorder::kPoints);
-      case 0x16000300:
-        return fmt::format("{}", DataRecorder::kTables);
-      case 0x13000004:
-        return fmt::format("{}", WaveTables::kPoints);
-      default:
-        return {};
-    }
-  };
   std::vector<std::string> lines;
   if (args.empty()) {
-    for (const Parameter& p : kParameters)
-      lines.push_back(fmt::format("1 0x{:08X}={}", p.id, value(p.id)));
+    for (const ServoParameter& p : ServoParameters::list())
+      lines.push_back(fmt::format("1 0x{:08X}={}", p.id, servo_params_.value(p.id)));
     return framed(lines);
   }
   if (args.size() % 2 != 0 || args.size() > 2 * kMaxQueryItems) {
@@ -969,7 +960,7 @@ std::string GcsInterpreter::parameters(Session& s, const Args& args) {
       fail(s, GcsError::kParamSyntax);
       return {};
     }
-    const std::string v = value(id);
+    const std::string v = servo_params_.value(id);
     if (v.empty()) {
       fail(s, GcsError::kUnknownParameter);
       return {};
@@ -977,6 +968,77 @@ std::string GcsInterpreter::parameters(Session& s, const Args& args) {
     lines.push_back(fmt::format("{} 0x{:08X}={}", args[i], id, v));
   }
   return framed(lines);
+}
+
+// SPA {item} {id} {value} ...: every write checked first (nothing changes when one fails), then
+// one parameter set to the loop through its one parameter path (kConfigure), applied between two
+// ticks and bumplessly (ControlCycle::try_configure).
+std::string GcsInterpreter::set_parameters(Session& s, const Args& args) {
+  if (args.empty() || args.size() % 3 != 0) {
+    fail(s, GcsError::kParamCount);
+    return {};
+  }
+  const control::SemiClosedLoopParams before = servo_params_.controller();
+  ServoParameters next = servo_params_;
+  for (std::size_t i = 0; i < args.size(); i += 3) {
+    long long id = 0;
+    double value = 0.0;
+    if (!parse_integer(args[i + 1], id)) {
+      fail(s, GcsError::kParamSyntax);
+      return {};
+    }
+    if (!parse_real(args[i + 2], value)) {
+      fail(s, GcsError::kInvalidReal);
+      return {};
+    }
+    control::SemiClosedLoopParams written{};
+    if (!accepted(s, next.write(id, value, s.command_level, written)))
+      return {};
+    next.applied(written);
+  }
+  if (!link_.params.try_push(next.controller())) {
+    fail(s, GcsError::kCommunication);
+    return {};
+  }
+  HostCommand c{};
+  c.kind = HostCommand::Kind::kConfigure;
+  if (!send(s, c))
+    return {};  // 52: the loop takes no commands (a full ring); its set waits in `params`
+  before_configure_ = before;
+  configure_sequence_ = sequence_;
+  servo_params_ = next;
+  return {};
+}
+
+std::string GcsInterpreter::command_level(Session& s, const Args& args) {
+  long long level = 0;
+  if (args.empty() || args.size() > 2 || !parse_integer(args[0], level)) {
+    fail(s, args.empty() || args.size() > 2 ? GcsError::kParamCount : GcsError::kParamSyntax);
+    return {};
+  }
+  if (level != 0 && level != 1) {
+    fail(s, GcsError::kParamOutOfRange);
+    return {};
+  }
+  if (level == 1 && (args.size() != 2 || args[1] != ServoParameters::kAdvancedPassword)) {
+    fail(s, GcsError::kInvalidPassword);
+    return {};
+  }
+  s.command_level = static_cast<int>(level);
+  return {};
+}
+
+std::string GcsInterpreter::command_level_query(Session& s, const Args&) {
+  return fmt::format("{}\n", s.command_level);
+}
+
+// One loop drives all three axes through all three channels, so a channel at its limit is an
+// overflow of every axis (as SVO switches them together).
+std::string GcsInterpreter::overflow_query(Session& s, const Args& args) {
+  std::string answer;
+  const bool overflow = have_sample_ && last_.closed_loop != 0 && last_.saturated_mask != 0;
+  const auto value = [overflow](std::size_t) { return overflow ? 1 : 0; };
+  return reply(s, axis_lines(args, value, answer), answer);
 }
 
 std::string GcsInterpreter::velocity(Session& s, const Args& args) {

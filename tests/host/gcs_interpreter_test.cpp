@@ -5,6 +5,8 @@
 #include <fmt/format.h>
 #include <gtest/gtest.h>
 
+#include <algorithm>
+#include <cctype>
 #include <cmath>
 #include <cstdint>
 #include <cstdlib>
@@ -178,7 +180,7 @@ TEST_F(GcsInterpreterTest, TheDocsListEveryCommandOfTheTableAndNoOther) {
   std::set<std::string> known;
   for (std::string_view name : GcsInterpreter::command_names())
     known.insert(std::string(name));
-  EXPECT_EQ(known.size(), 53u);  // 48 command lines and #5, #7, #8, #9, #24
+  EXPECT_EQ(known.size(), 57u);  // 52 command lines and #5, #7, #8, #9, #24
   for (const std::string& name : known)
     EXPECT_EQ(documented.count(name), 1u) << name << " is not in docs/gcs.md's command table";
   for (const std::string& name : documented)
@@ -197,10 +199,10 @@ TEST_F(GcsInterpreterTest, TheDocsListEveryCommandOfTheTableAndNoOther) {
 
 TEST_F(GcsInterpreterTest, UnknownCommandAnswersNothingAndQueues2) {
   EXPECT_EQ(cmd("FOO 1 2"), "");
+  EXPECT_EQ(err(), 2);
   EXPECT_EQ(cmd("mov Z 1"), "");  // GCS commands are upper case
   EXPECT_EQ(err(), 2);
-  EXPECT_EQ(err(), 2);
-  EXPECT_EQ(err(), 0);
+  EXPECT_EQ(err(), 0);  // ERR? resets it
   EXPECT_EQ(err(), 0);
 }
 
@@ -213,10 +215,10 @@ TEST_F(GcsInterpreterTest, BlankLinesAreIgnored) {
 
 TEST_F(GcsInterpreterTest, GarbageBytesAreAnUnknownCommand) {
   EXPECT_EQ(cmd(std::string_view("\0\xff\xfe", 3)), "");
+  EXPECT_EQ(err(), 2);
   EXPECT_EQ(cmd(std::string_view("MOV\0 Z 1", 8)), "");
+  EXPECT_EQ(err(), 2);
   EXPECT_EQ(cmd("\r"), "");
-  EXPECT_EQ(err(), 2);
-  EXPECT_EQ(err(), 2);
   EXPECT_EQ(err(), 2);
   EXPECT_EQ(err(), 0);
   EXPECT_TRUE(commands().empty());
@@ -348,8 +350,8 @@ TEST_F(GcsInterpreterTest, MoveErrors) {
   // Servo off: 5.
   feed(at({3.0, 0.0, 0.0}, 0, false));
   EXPECT_EQ(cmd("MOV Z 5"), "");
-  EXPECT_EQ(cmd("MVR Z 1"), "");
   EXPECT_EQ(err(), 5);
+  EXPECT_EQ(cmd("MVR Z 1"), "");
   EXPECT_EQ(err(), 5);
   EXPECT_TRUE(commands().empty());
 
@@ -494,46 +496,32 @@ TEST_F(GcsInterpreterTest, OverlongLineQueues3) {
   EXPECT_EQ(err(1), 0);
 }
 
-TEST_F(GcsInterpreterTest, ErrorQueuesArePerClientAndBounded) {
+// PI's ERR?: the last error that occurred, reset to 0 when read; not a queue (issue 30: a driver
+// that reads ERR? after MOV got a stale error of an earlier query from the queue).
+TEST_F(GcsInterpreterTest, ErrIsTheLastErrorPerClientResetWhenRead) {
   EXPECT_EQ(cmd("MOV Q 1", 1), "");
   for (int i = 0; i < 20; ++i)
     EXPECT_EQ(cmd("FOO", 1), "");
+  EXPECT_EQ(cmd("MOV Z", 1), "");
   EXPECT_EQ(cmd("SVO Z 2", 2), "");
-  // Client 2 has its own queue.
+  // Each client has its own.
   EXPECT_EQ(err(2), 17);
   EXPECT_EQ(err(2), 0);
-  // The oldest errors are kept: 15, then 15 of the 20 unknown commands (16 in all).
-  EXPECT_EQ(err(1), 15);
-  for (int i = 0; i < 15; ++i)
-    EXPECT_EQ(err(1), 2) << i;
+  // Only the last of client 1's 22 errors is kept, and reading it resets it.
+  EXPECT_EQ(err(1), 24);
   EXPECT_EQ(err(1), 0);
-  EXPECT_EQ(gcs_.stats().errors, 22u);
-  // A new client starts empty; a client that left and came back too.
+  EXPECT_EQ(gcs_.stats().errors, 23u);
+  // A good command does not reset it: only ERR? does.
+  EXPECT_EQ(cmd("FOO", 1), "");
+  EXPECT_EQ(cmd("CSV?", 1), "2.0\n");
+  EXPECT_EQ(err(1), 2);
+  // A new client starts at 0; a client that left and came back too.
   gcs_.on_connect(3);
   EXPECT_EQ(err(3), 0);
   EXPECT_EQ(cmd("FOO", 3), "");
   gcs_.on_disconnect(3);
   gcs_.on_connect(3);
   EXPECT_EQ(err(3), 0);
-}
-
-class ShortQueueTest : public GcsInterpreterTest {
- protected:
-  static GcsOptions options() {
-    GcsOptions o;
-    o.error_queue_length = 2;
-    return o;
-  }
-  ShortQueueTest() : GcsInterpreterTest(options()) {}
-};
-
-TEST_F(ShortQueueTest, QueueLengthIsTheOption) {
-  EXPECT_EQ(cmd("MOV Q 1"), "");
-  EXPECT_EQ(cmd("MOV Z"), "");
-  EXPECT_EQ(cmd("FOO"), "");
-  EXPECT_EQ(err(), 15);
-  EXPECT_EQ(err(), 24);
-  EXPECT_EQ(err(), 0);
 }
 
 TEST_F(GcsInterpreterTest, FaultSwitchesTheServoOffForEveryClient) {
@@ -730,10 +718,10 @@ TEST_F(GcsInterpreterTest, RecorderRecordsTheLoopsSamples) {
 
 TEST_F(GcsInterpreterTest, AFailedQueryAnswersOneEmptyLineAndASetCommandNothing) {
   EXPECT_EQ(cmd("FOO?"), "\n");
-  EXPECT_EQ(cmd("POS? W"), "\n");
-  EXPECT_EQ(cmd("FOO"), "");
   EXPECT_EQ(err(), 2);
+  EXPECT_EQ(cmd("POS? W"), "\n");
   EXPECT_EQ(err(), 15);
+  EXPECT_EQ(cmd("FOO"), "");
   EXPECT_EQ(err(), 2);
   EXPECT_EQ(err(), 0);
 }
@@ -898,6 +886,115 @@ TEST_F(GcsInterpreterTest, CountsSamplesAndDrops) {
   cmd("POS?");
   cmd("FOO");
   EXPECT_EQ(gcs_.stats().lines, 2u);
+}
+
+// Issue 30: what EPICS's motorPIGCS2 needs to drive this server as an E-727.
+TEST_F(GcsInterpreterTest, IdentificationNamesTheE727AndWhatAnswers) {
+  std::string idn = cmd("*IDN?");
+  EXPECT_EQ(idn,
+            "(c)2026 piezoshift, E-727 compatible semi-closed-loop PZT phase shifter, 0, "
+            "0.1.0\n");
+  EXPECT_EQ(default_identification("sim"),
+            "(c)2026 piezoshift, E-727 compatible semi-closed-loop PZT phase shifter (sim), 0, "
+            "0.1.0");
+  // The driver upper-cases the answer and takes the first model it finds in it.
+  std::transform(idn.begin(), idn.end(), idn.begin(), [](char c) { return std::toupper(c); });
+  EXPECT_NE(idn.find("E-727"), std::string::npos);
+  for (const char* other : {"E-873", "C-663", "C-863", "C-867", "C-884", "E-861", "E-871", "E-517",
+                            "E-518", "C-885", "E-753", "E-754", "E-709", "E-712", "E-725"})
+    EXPECT_EQ(idn.find(other), std::string::npos) << other;
+}
+
+TEST_F(GcsInterpreterTest, AClientConnectingWhileAFaultIsLatchedReadsIt) {
+  const std::uint64_t on = servo_on_at({3.0, 0.0, 0.0});
+  HostSample f = at({3.0, 0.0, 0.0}, on, false);
+  f.state = static_cast<std::uint8_t>(runtime::SupervisorState::kFaulted);
+  feed(f);
+  gcs_.on_connect(3);
+  EXPECT_EQ(cmd("SVO?", 3), "Z=0 \nU=0 \nV=0\n");
+  EXPECT_EQ(err(3), -1024);
+  EXPECT_EQ(err(3), 0);
+  // Once SVO has cleared the latch, a newcomer starts at 0.
+  EXPECT_EQ(cmd("SVO Z 0"), "");
+  const HostCommand c = only_command();
+  HostSample cleared = at({3.0, 0.0, 0.0}, c.sequence, false);
+  feed(cleared);
+  gcs_.on_connect(4);
+  EXPECT_EQ(err(4), 0);
+}
+
+TEST_F(GcsInterpreterTest, OverflowIsAPidAtItsLimitInClosedLoop) {
+  EXPECT_EQ(cmd("OVF?"), "Z=0 \nU=0 \nV=0\n");  // no sample yet
+  const std::uint64_t on = servo_on_at({3.0, 0.0, 0.0});
+  HostSample s = at({3.0, 0.0, 0.0}, on, true);
+  s.saturated_mask = 0b100;  // channel 3 at its rail
+  feed(s);
+  EXPECT_EQ(cmd("OVF? Z V"), "Z=1 \nV=1\n");
+  s.saturated_mask = 0;
+  feed(s);
+  EXPECT_EQ(cmd("OVF? U"), "U=0\n");
+  s.saturated_mask = 0b001;
+  s.closed_loop = 0;  // open loop: no PID runs
+  feed(s);
+  EXPECT_EQ(cmd("OVF? Z"), "Z=0\n");
+  EXPECT_EQ(cmd("OVF? W"), "\n");
+  EXPECT_EQ(err(), 15);
+}
+
+TEST_F(GcsInterpreterTest, E727ServoParametersAndCommandLevels) {
+  const control::SemiClosedLoopParams& running = model_.params().controller;
+  const std::string kp = fmt::format("{:.12g}", running.gains.kp);
+  EXPECT_EQ(cmd("SPA? Z 0x07000300"), "Z 0x07000300=" + kp + "\n");
+  // motorPIGCS2 sends the id in decimal ("SPA? %s %d").
+  EXPECT_EQ(cmd("SPA? U 117441280"), "U 0x07000300=" + kp + "\n");
+  EXPECT_EQ(cmd("SPA? Z 0x07030600 Z 0x08000100 Z 0x06000500"),
+            "Z 0x07030600=1 \nZ 0x08000100=0 \nZ 0x06000500=0\n");
+  EXPECT_EQ(err(), 0);
+  // Writing needs command level 1.
+  EXPECT_EQ(cmd("CCL?"), "0\n");
+  EXPECT_EQ(cmd("SPA Z 0x07000300 0.25"), "");
+  EXPECT_EQ(err(), 60);
+  EXPECT_EQ(cmd("CCL 1 secret"), "");
+  EXPECT_EQ(err(), 56);
+  EXPECT_EQ(cmd("CCL 2 advanced"), "");
+  EXPECT_EQ(err(), 17);
+  EXPECT_TRUE(commands().empty());
+  EXPECT_EQ(cmd("CCL 1 advanced"), "");
+  EXPECT_EQ(cmd("CCL?"), "1\n");
+  EXPECT_EQ(cmd("CCL?", 2), "0\n");  // per connection
+  // Read-only, unknown, out of range: nothing reaches the loop.
+  EXPECT_EQ(cmd("SPA Z 0x07030600 0.5"), "");
+  EXPECT_EQ(err(), 64);
+  EXPECT_EQ(cmd("SPA Z 0x07000300 -1"), "");
+  EXPECT_EQ(err(), 17);
+  EXPECT_EQ(cmd("SPA Z 0x07000399 1"), "");
+  EXPECT_EQ(err(), 54);
+  EXPECT_EQ(cmd("SPA Z 0x07000300 0.25 Z 0x07030600 1"), "");  // checked whole
+  EXPECT_EQ(err(), 64);
+  EXPECT_TRUE(commands().empty());
+  // A good write: one parameter set through the loop's parameter path.
+  EXPECT_EQ(cmd("SPA Z 0x07000300 0.25 V 0x07000301 0.125"), "");
+  EXPECT_EQ(err(), 0);
+  const HostCommand c = only_command();
+  EXPECT_EQ(c.kind, Kind::kConfigure);
+  control::SemiClosedLoopParams sent{};
+  ASSERT_TRUE(link_.params.try_pop(sent));
+  EXPECT_EQ(sent.gains.kp, 0.25);
+  EXPECT_EQ(sent.gains.ki, 0.125);
+  EXPECT_EQ(sent.gains.kd, running.gains.kd);
+  EXPECT_EQ(sent.polynomial.p1, running.polynomial.p1);
+  EXPECT_EQ(sent.sample_time_s, 1e-3);
+  EXPECT_EQ(cmd("SPA? U 0x07000300 U 0x07000301"), "U 0x07000300=0.25 \nU 0x07000301=0.125\n");
+  // The loop refuses the set (configure_problem): the old values are the running ones again.
+  HostSample refused = at({0.0, 0.0, 0.0}, c.sequence, false);
+  refused.configure_problem = 1;
+  feed(refused);
+  EXPECT_EQ(cmd("SPA? Z 0x07000300"), "Z 0x07000300=" + kp + "\n");
+  EXPECT_EQ(cmd("CCL 0"), "");
+  EXPECT_EQ(cmd("SPA Z 0x07000300 0.25"), "");
+  EXPECT_EQ(err(), 60);
+  const std::string hpa = cmd("HPA?");
+  EXPECT_NE(hpa.find("0x07000300=\t0\t1\tFLOAT\tServo\t"), std::string::npos) << hpa;
 }
 
 }  // namespace

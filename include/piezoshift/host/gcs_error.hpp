@@ -20,8 +20,11 @@ enum class GcsError : int {
   kInvalidReal = 25,            //!< Invalid floating point number
   kCommunication = 52,          //!< Communication error: the command did not reach the loop
   kUnknownParameter = 54,       //!< Unknown parameter
+  kInvalidPassword = 56,        //!< Invalid password (CCL)
   kNoRecordTable = 57,          //!< Data record table does not exist
   kNoRecordOption = 58,         //!< Record source option does not exist
+  kParamProtection = 60,        //!< Protected parameter: current command level (CCL) too low
+  kReadOnlyParameter = 64,      //!< Parameter is read-only
   kVoltageOutOfLimits = 66,     //!< Voltage out of limits
   kNotEnoughData = 77,          //!< Data record table does not hold enough recorded data
   kTableDeactivated = 78,       //!< Data record table is not configured for recording

@@ -5,10 +5,12 @@
 // One table of commands (name, syntax, help, handler) serves the dispatch and HLP?; the wave
 // generators (WaveGenerators) and the recorder's trigger (RecordTrigger) are classes of their own.
 //
-//   per client   an error queue: a failed command queues its GCS error number; a failed set
-//                command answers nothing, a failed query (name ending in '?') one empty line,
-//                so that no client waits for an answer that never comes; ERR? pops the oldest,
-//                0 when empty
+//   per client   the last error, as PI defines ERR?: a failed command sets its GCS error
+//                number (a later error replaces an earlier one); a failed set command answers
+//                nothing, a failed query (name ending in '?') one empty line, so that no client
+//                waits for an answer that never comes; ERR? answers the error and resets it to
+//                0. A client that connects while a fault is latched starts with -1024
+//   levels       CCL 1 advanced lets SPA write the P and I terms (servo_parameters.hpp)
 //   immediate    the single-character commands #5 (moving, hex mask), #7 (ready, 0xB1), #8
 //                (macro running, 0), #9 (wave generators running, hex mask), #24 (stop all)
 //                arrive as the control byte alone (LineHandler::on_immediate)
@@ -20,7 +22,7 @@
 //   on target    ONT? of an axis is 1 when the servo is on, the loop has applied the last move
 //                and |POS? - MOV?| <= tolerance has held for settle_time_s
 //   faults       when the safety supervisor latches a fault, the servo is reported off and every
-//                client's queue gets -1024; SVO (either value) clears the fault
+//                client's error becomes -1024; SVO (either value) clears the fault
 //   STP, #24     stop the wave generators and hold where the stage is (servo on: MOV? :=
 //                POS?; off: the volts applied); queue error 10 for the client that sent it
 //   wave gen.    generator g (1..3) plays the table WSL gives it into axis g (Z, U, V) in
@@ -30,7 +32,6 @@
 //                whose tick applied it (record_trigger.hpp)
 // Sample drops (the host thread stalled for > 4 s) are counted, never blocking the loop.
 #include <cstdint>
-#include <deque>
 #include <string>
 #include <string_view>
 #include <unordered_map>
@@ -41,18 +42,24 @@
 #include "piezoshift/host/line_server.hpp"
 #include "piezoshift/host/record_trigger.hpp"
 #include "piezoshift/host/sample_observer.hpp"
+#include "piezoshift/host/servo_parameters.hpp"
 #include "piezoshift/host/stage_model.hpp"
 #include "piezoshift/host/wave_generators.hpp"
 #include "piezoshift/runtime/host_link.hpp"
 
 namespace piezoshift::host {
 
+//! `(c)2026 piezoshift, E-727 compatible semi-closed-loop PZT phase shifter (DAQ), 0, 0.1.0`,
+//! without the brackets when daq is empty.
+std::string default_identification(const std::string& daq);
+
 struct GcsOptions {
   double on_target_tolerance_um = 0.01;   //!< Z: 10 nm, ~7 sigma of the gauges' 1.5 nm noise
   double on_target_tolerance_urad = 0.5;  //!< U, V: 0.5 urad tilts P1..P3 by ~20 nm
   double settle_time_s = 0.01;            //!< within tolerance this long
-  std::size_t error_queue_length = 16;    //!< per client; the oldest errors are kept when full
-  std::string identification = "piezoshift, semi-closed-loop PZT phase shifter, 0, 0.1.0";
+  //! *IDN?: "E-727" lets clients that pick their handling by model (EPICS's motorPIGCS2
+  //! matches the text) drive this server as an E-727; the rest says what it is.
+  std::string identification = default_identification("");
 };
 
 struct GcsStats {
@@ -106,8 +113,9 @@ class GcsInterpreter final : public LineHandler {
  private:
   using Args = std::vector<std::string_view>;
   struct Session {
-    std::deque<GcsError> errors;
-    DataRecorder::Reading reading;  //!< the rest of a DRR? answer
+    GcsError error = GcsError::kNone;  //!< the last error, until ERR? reads it
+    int command_level = 0;             //!< CCL
+    DataRecorder::Reading reading;     //!< the rest of a DRR? answer
   };
   //! Returns the answer (empty for set commands) or fails the session.
   using Handler = std::string (GcsInterpreter::*)(Session&, const Args&);
@@ -178,6 +186,10 @@ class GcsInterpreter final : public LineHandler {
   std::string velocity_query(Session& s, const Args& args);
   std::string velocity_control_query(Session& s, const Args& args);
   std::string parameters(Session& s, const Args& args);
+  std::string set_parameters(Session& s, const Args& args);
+  std::string command_level(Session& s, const Args& args);
+  std::string command_level_query(Session& s, const Args& args);
+  std::string overflow_query(Session& s, const Args& args);
   std::string parameter_list(Session& s, const Args& args);
   std::string open_loop(Session& s, const Args& args);
   std::string open_loop_query(Session& s, const Args& args);
@@ -217,6 +229,10 @@ class GcsInterpreter final : public LineHandler {
   DataRecorder recorder_;
   RecordTrigger trigger_{recorder_};
   SampleObserver* observer_ = nullptr;
+  ServoParameters servo_params_;
+  // SPA's set until the loop acknowledges it; reverted if the loop refuses it.
+  std::uint64_t configure_sequence_ = 0;
+  control::SemiClosedLoopParams before_configure_{};
   GcsStats stats_;
 
   // The loop as last seen.
