@@ -110,9 +110,12 @@ GcsError WaveTables::define(int table, const std::vector<std::string_view>& a) {
       return GcsError::kParamSyntax;
     if (n < 1 || static_cast<std::size_t>(n) != a.size() - 4)
       return GcsError::kWaveParamCount;
-    // X and & take the segment from its first point (PIPython's writewavepoints sends 1 with
-    // every bunch it appends); + adds from any point of the table.
-    if (start < 1 || (mode != "+" && start != 1) || static_cast<std::size_t>(start) > kPoints)
+    // X takes the segment from its first point; & appends it, named by 1 (its own first point:
+    // older PIPython's writewavepoints) or by the table's next point (newer ones send
+    // `WAV 1 & PNT 21 20 ...` after 20 points); + adds from any point of the table.
+    const bool appends_at_end = start == 1 || static_cast<std::size_t>(start) == t.size() + 1;
+    if (start < 1 || (mode == "X" && start != 1) || (mode == "&" && !appends_at_end) ||
+        static_cast<std::size_t>(start) > kPoints)
       return GcsError::kWaveParamOutOfRange;
     segment.resize(static_cast<std::size_t>(n));
     for (long long i = 0; i < n; ++i)

@@ -11,6 +11,7 @@
 #include <cstdint>
 #include <cstdlib>
 #include <fstream>
+#include <iterator>
 #include <limits>
 #include <set>
 #include <sstream>
@@ -810,6 +811,42 @@ TEST_F(GcsInterpreterTest, WaveTablesAndGeneratorSettings) {
     EXPECT_EQ(err(), k.error) << k.line;
   }
   EXPECT_EQ(cmd("WAV? 1 1"), "1 1=5\n");  // the failed definitions left it as it was
+}
+
+// Issue 30: pitools.writewavepoints writes a table in bunches, `WAV 1 X PNT 1 20 ...`, then
+// `WAV 1 & PNT 21 20 ...` (newer releases name the table's next point; older ones 1).
+TEST_F(GcsInterpreterTest, AppendedBunchesNameTheTablesNextPointOrOne) {
+  const auto bunch = [](const char* mode, int start, int first) {
+    std::string line = fmt::format("WAV 1 {} PNT {} 20", mode, start);
+    for (int i = 0; i < 20; ++i)
+      line += fmt::format(" {}", 0.01 * (first + i));
+    return line;
+  };
+  EXPECT_EQ(cmd(bunch("X", 1, 0)), "");
+  EXPECT_EQ(cmd(bunch("&", 21, 20)), "");
+  EXPECT_EQ(cmd(bunch("&", 41, 40)), "");
+  EXPECT_EQ(cmd(bunch("&", 1, 60)), "");
+  EXPECT_EQ(err(), 0);
+  EXPECT_EQ(cmd("WAV? 1 1"), "1 1=80\n");
+  // Any other start would leave a gap or overwrite: refused, the table unchanged.
+  for (int start : {2, 80, 82}) {
+    EXPECT_EQ(cmd(bunch("&", start, 80)), "") << start;
+    EXPECT_EQ(err(), 405) << start;
+  }
+  EXPECT_EQ(cmd("WAV? 1 1"), "1 1=80\n");
+  // The points are in order (the same lines given to the tables alone).
+  WaveTables tables;
+  for (const auto& [mode, start] : {std::pair{"X", 1}, {"&", 21}, {"&", 41}, {"&", 1}}) {
+    const std::string line = bunch(mode, start, static_cast<int>(tables.values(1).size()));
+    std::istringstream words(line.substr(std::string("WAV 1 ").size()));
+    std::vector<std::string> owned{std::istream_iterator<std::string>(words), {}};
+    const std::vector<std::string_view> args(owned.begin(), owned.end());
+    ASSERT_EQ(tables.define(1, args), GcsError::kNone) << line;
+  }
+  const std::vector<double>& t = tables.values(1);
+  ASSERT_EQ(t.size(), 80u);
+  for (std::size_t i = 0; i < t.size(); ++i)
+    EXPECT_DOUBLE_EQ(t[i], 0.01 * static_cast<double>(i)) << i;
 }
 
 TEST_F(GcsInterpreterTest, WaveGeneratorHandsAFixedSlotToTheLoopAndFollowsItsSamples) {

@@ -2,9 +2,10 @@
 // The wave tables of `piezoshift serve` as GCS WAV defines them (docs/gcs.md): kTables tables of
 // up to kPoints values each, in the unit of the axis a generator plays them into (um or urad).
 //
-//   WAV t X|&|+ PNT   start n v1 .. vn           n points; start is 1-based and must be 1 with X
-//                                                and & (PIPython's writewavepoints sends 1 for
-//                                                every bunch it appends); + adds from `start`
+//   WAV t X|&|+ PNT   start n v1 .. vn           n points; start is 1-based: 1 with X; with &
+//                                                1 or the table's length + 1, both the end
+//                                                (PIPython's writewavepoints sends either, by
+//                                                release); + adds from `start`
 //   WAV t X|&|+ LIN   seg amp off len start sud  a segment of seg points: off before `start`
 //                                                (0-based), a line to off+amp over len points,
 //                                                off+amp after; sud speed-up/down points at each
