@@ -24,7 +24,7 @@
 //   faults       when the safety supervisor latches a fault, the servo is reported off and every
 //                client's error becomes -1024; SVO (either value) clears the fault
 //   STP, #24     stop the wave generators and hold where the stage is (servo on: MOV? :=
-//                POS?; off: the volts applied); queue error 10 for the client that sent it
+//                POS?; off: the volts applied); set error 10 for the client that sent it
 //   wave gen.    generator g (1..3) plays the table WSL gives it into axis g (Z, U, V) in
 //                closed loop (wave_generators.hpp); while it runs, MOV?, recorder option 1 and
 //                ONT? follow the wave
@@ -67,7 +67,7 @@ struct GcsStats {
   std::uint64_t samples_missed = 0;  //!< ticks whose sample the ring dropped
   std::uint64_t commands_sent = 0;   //!< HostCommands pushed to the loop
   std::uint64_t lines = 0;           //!< command lines handled
-  std::uint64_t errors = 0;          //!< GCS errors queued
+  std::uint64_t errors = 0;          //!< GCS errors set
   std::uint64_t faults = 0;          //!< supervisor faults seen
   std::uint64_t answer_bytes = 0;    //!< answers made to command lines (parts included)
 };
@@ -138,13 +138,13 @@ class GcsInterpreter final : public LineHandler {
 
   std::string execute(Session& session, std::string_view name, const Args& args);
   void fail(Session& session, GcsError error);
-  //! True for kNone; otherwise queues the error and returns false.
+  //! True for kNone; otherwise sets the error and returns false.
   bool accepted(Session& session, GcsError error);
   //! Open-loop values := the volts the loop applies now (servo off, STP).
   void hold_applied_volts();
-  //! answer, or nothing with the error queued.
+  //! answer, or nothing with the error set.
   std::string reply(Session& session, GcsError error, std::string& answer);
-  //! Pushes the command to the loop; false (and error 52 queued) when the ring is full.
+  //! Pushes the command to the loop; false (and error 52 set) when the ring is full.
   bool send(Session& session, runtime::HostCommand command);
   void take(const runtime::HostSample& sample);
   void moved();
@@ -152,14 +152,14 @@ class GcsInterpreter final : public LineHandler {
   AxisValues commanded() const;
   //! Bit a: axis a not on target or its generator running, or its command not applied yet.
   unsigned moving_mask() const;
-  //! Stops every generator (STP, #24); false (52 queued) when the ring is full.
+  //! Stops every generator (STP, #24); false (52 set) when the ring is full.
   bool stop_waves(Session& s);
-  //! Stops generator g (it holds where it is); false (52 queued) when the ring is full.
+  //! Stops generator g (it holds where it is); false (52 set) when the ring is full.
   bool stop_wave(Session& s, std::size_t g);
   //! Waits (at most ~50 ms, draining samples) until the loop has applied generator g's last
   //! start or stop, so that the slot it no longer reads may be written.
   bool slot_free(std::size_t g);
-  //! Starts generator g (WGO g 1); false with the error queued.
+  //! Starts generator g (WGO g 1); false with the error set.
   bool start_wave(Session& s, std::size_t g, long long mode);
 
   // The commands (kCommands), in docs/gcs.md's order.
