@@ -416,6 +416,25 @@ TEST_F(Serve, SeveralClientsAtOnceEachWithItsOwnErrorQueue) {
   EXPECT_EQ(summary.at("clients_refused"), 1);
 }
 
+// Issue 30: a client that connects after a fault latched learns it as from a PI controller: its
+// first ERR? is -1024 (then 0), and SVO? answers 0.
+TEST_F(Serve, AClientConnectingAfterAFaultReadsItFromErr) {
+  const std::uint16_t port = start({"--fault", "sgs-open@0.3:1"});
+  ASSERT_NE(port, 0);
+  {
+    GcsClient first("127.0.0.1", port);
+    first.send("SVO Z 1");
+    EXPECT_EQ(error(first), 0);
+  }
+  std::this_thread::sleep_for(std::chrono::milliseconds(1500));  // the fault latches at 0.3 s
+  GcsClient late("127.0.0.1", port);
+  EXPECT_EQ(late.query_lines("SVO? Z"), std::vector<std::string>{"Z=0"});
+  EXPECT_EQ(error(late), -1024);
+  EXPECT_EQ(error(late), 0);
+  const nlohmann::json summary = stop();
+  EXPECT_GE(summary.at("faults"), 1);
+}
+
 TEST_F(Serve, GarbageOversizedLinesAndDisconnectsMidAnswerLeaveTheLoopRunning) {
   const std::uint16_t port = start({"--max-line-bytes", "256"});
   ASSERT_NE(port, 0);
