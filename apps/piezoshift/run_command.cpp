@@ -340,7 +340,8 @@ int run(const RunOptions& o) {
   LoopStatus live;
   const bool show_live = ::isatty(STDERR_FILENO) == 1 && !o.free_run;
   config.status = &live;  // the live line's and the fault reports' source
-  const SafetyLimits limits = loop_safety_limits(installation.safety, o.max_overruns);
+  const SafetyLimits limits = resolve_overrun_trip(
+      loop_safety_limits(installation.safety, o.max_overruns), stack.sim() != nullptr);
   if (!o.json)
     fmt::print("safety: {}\n", describe(limits));
   ControlLoop loop(config, cal.params, limits, stack.daq(), stack.clock(), std::move(profile),

@@ -411,9 +411,10 @@ int serve(const ServeOptions& o) {
     instrument.installation = runtime::load_installation_config(o.config);
   const runtime::InstallationConfig& installation = instrument.installation;
   const config::ProjectConfig& config = installation.project;
-  const runtime::SafetyLimits safety = loop_safety_limits(installation.safety, o.max_overruns);
+  const runtime::SafetyLimits limits = loop_safety_limits(installation.safety, o.max_overruns);
   // The stack first: a bad --fault, --daq or device is named before the twin's calibration runs.
   LoopStack stack(stack_options(o), config);
+  const runtime::SafetyLimits safety = resolve_overrun_trip(limits, stack.sim() != nullptr);
   const LoopCalibration cal = resolve_calibration(o.calibration, o.daq, config, o.seed,
                                                   1.0 / o.rate_Hz, o.max_physics_steps);
   const host::StageModel model = make_stage_model(o, config, cal.params, cal, safety);
