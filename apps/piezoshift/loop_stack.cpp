@@ -85,6 +85,8 @@ LoopStack::LoopStack(const LoopStackOptions& o, const config::ProjectConfig& con
     runtime::CsvLoggerOptions lo;
     lo.path = o.log;
     lo.with_truth = sim_ != nullptr;
+    if (!o.log_reports_faults)
+      lo.events = nullptr;
     logger_ = std::make_unique<runtime::CsvLogger>(lo);
   }
 }

@@ -37,6 +37,9 @@ struct LoopStackOptions {
   StackClock clock = StackClock::kRealTime;
   std::vector<std::string> faults;  //!< --fault specs (the twin only)
   std::string log;                  //!< --log CSV path ("" none)
+  //! The log's thread reports each latched fault on stderr (false: the command has a
+  //! FaultReporter, fault_report.hpp, which names its value and limit too)
+  bool log_reports_faults = true;
   //! --trigger-line SUBDEVICE/CHANNEL: the Comedi board's trigger output ("" none; the twin's
   //! line is built in)
   std::string trigger_line;

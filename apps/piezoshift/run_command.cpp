@@ -23,6 +23,7 @@
 #include <nlohmann/json.hpp>
 
 #include "command.hpp"
+#include "fault_report.hpp"
 #include "loop_setup.hpp"
 #include "loop_stack.hpp"
 #include "physics_budget.hpp"
@@ -130,6 +131,7 @@ struct RunRecord {
   const LoopResult& result;
   const SafetyLimits& limits;
   const RealtimeReport& realtime;
+  const std::vector<std::string>& fault_loads;  //!< the load each fault's report read
 };
 
 // The tick the first fault was injected on, when the supervisor's fault came after it.
@@ -180,6 +182,7 @@ void add_fault_json(nlohmann::json& j, const RunRecord& run) {
                            : nlohmann::json(nullptr);
   j["fault_value"] = r.fault_detected ? nlohmann::json(r.fault.value) : nullptr;
   j["fault_limit"] = r.fault_detected ? nlohmann::json(r.fault.limit) : nullptr;
+  j["faults_latched"] = faults_json(r.faults, run.fault_loads);
   nlohmann::json injected_list = nlohmann::json::array();
   const FaultInjectingBackend* injector = run.stack.injector();
   for (std::size_t i = 0; injector && i < injector->faults().size(); ++i) {
@@ -281,11 +284,12 @@ void print_run(const RunRecord& run) {
   }
   if (r.fault_detected) {
     const std::optional<std::uint64_t> injected = injected_before_fault(run);
-    fmt::print("FAULT          {} at tick {}{} (value {:.4g}, limit {:.4g}){}\n",
-               to_string(r.fault.reason), r.fault.tick,
-               r.fault.channel >= 0 ? fmt::format(" on channel {}", r.fault.channel + 1) : "",
-               r.fault.value, r.fault.limit,
-               injected ? fmt::format(", {} ticks after injection", r.fault.tick - *injected) : "");
+    for (std::uint32_t i = 0; i < r.faults.kept(); ++i)
+      fmt::print(
+          "FAULT          {}{}\n",
+          describe_fault(r.faults.entries[i], i < run.fault_loads.size() ? run.fault_loads[i] : ""),
+          i == 0 && injected ? fmt::format(", {} ticks after injection", r.fault.tick - *injected)
+                             : "");
   } else {
     fmt::print("faults         none\n");
   }
@@ -304,6 +308,7 @@ LoopStackOptions stack_options(const RunOptions& o) {
   so.clock = o.free_run ? StackClock::kFreeRun : StackClock::kRealTime;
   so.faults = o.faults;
   so.log = o.log;
+  so.log_reports_faults = false;  // run's FaultReporter does, with the value and limit
   return so;
 }
 
@@ -334,9 +339,9 @@ int run(const RunOptions& o) {
   config.stop_signal = &g_stop_signal;
   LoopStatus live;
   const bool show_live = ::isatty(STDERR_FILENO) == 1 && !o.free_run;
-  if (show_live)
-    config.status = &live;
-  const SafetyLimits limits = loop_safety_limits(installation.safety, o.max_overruns);
+  config.status = &live;  // the live line's and the fault reports' source
+  const SafetyLimits limits = resolve_overrun_trip(
+      loop_safety_limits(installation.safety, o.max_overruns), stack.sim() != nullptr);
   if (!o.json)
     fmt::print("safety: {}\n", describe(limits));
   ControlLoop loop(config, cal.params, limits, stack.daq(), stack.clock(), std::move(profile),
@@ -347,6 +352,7 @@ int run(const RunOptions& o) {
   std::optional<LiveStatus> status_line;  // likewise: it must not inherit the loop's priority
   if (show_live)
     status_line.emplace(live);
+  FaultReporter fault_reporter(live);  // each fault on stderr as it latches
   RealtimeReport rt;
   if (stack.clock().real_time())
     rt = request_realtime_or_warn(o.cpu);
@@ -354,10 +360,12 @@ int run(const RunOptions& o) {
   stack.daq().activate();
   const LoopResult r = loop.run();
   status_line.reset();  // clears its line before the summary
+  fault_reporter.stop();
   stack.daq().deactivate();
   stack.stop_logging();
 
-  const RunRecord record{o, stack, loop, r, limits, rt};
+  const std::vector<std::string> fault_loads = fault_reporter.loads();
+  const RunRecord record{o, stack, loop, r, limits, rt, fault_loads};
   if (o.json)
     fmt::print("{}\n", run_json(record).dump(2));
   else

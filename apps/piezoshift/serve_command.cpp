@@ -29,6 +29,7 @@
 
 #include "command.hpp"
 #include "dashboard_page.hpp"
+#include "fault_report.hpp"
 #include "loop_setup.hpp"
 #include "loop_stack.hpp"
 #include "physics_budget.hpp"
@@ -216,6 +217,7 @@ LoopStackOptions stack_options(const ServeOptions& o) {
   so.config_path = o.config;
   so.faults = o.faults;
   so.log = o.log;
+  so.log_reports_faults = false;  // serve's FaultReporter does, with the value and limit
   return so;
 }
 
@@ -343,7 +345,8 @@ class Network {
 
 void print_serve_summary(const ServeOptions& o, Network& net, const std::string& daq_name,
                          const runtime::ControlLoop& loop, const runtime::LoopResult& r,
-                         const runtime::SafetyLimits& safety, const runtime::RealtimeReport& rt) {
+                         const runtime::SafetyLimits& safety, const runtime::RealtimeReport& rt,
+                         const std::vector<std::string>& fault_loads) {
   const host::GcsStats& gs = net.gcs().stats();
   const host::LineServerStats ns = net.server().stats();
   const runtime::LoopStats& st = loop.stats();
@@ -354,6 +357,7 @@ void print_serve_summary(const ServeOptions& o, Network& net, const std::string&
         "faults, {} samples dropped, {} overruns\n",
         r.ticks, stop_reason, ns.accepted, ns.refused_max_clients, gs.lines, gs.errors, gs.faults,
         r.host_samples_dropped, st.overruns);
+    fmt::print("{}", faults_text(r.faults, fault_loads));
     return;
   }
   nlohmann::json j;
@@ -371,6 +375,8 @@ void print_serve_summary(const ServeOptions& o, Network& net, const std::string&
   j["wake_latency_max_us"] = us(st.wake_latency.max_ns());
   j["realtime"] = {{"sched_fifo", rt.fifo}, {"mlockall", rt.memory_locked}};
   j["faults"] = gs.faults;
+  j["faults_latched"] = faults_json(r.faults, fault_loads);
+  j["faults_latched_count"] = r.faults.count;
   j["clients_accepted"] = ns.accepted;
   j["clients_refused"] = ns.refused_max_clients;
   j["clients_dropped_slow"] = ns.disconnected_slow;
@@ -407,9 +413,10 @@ int serve(const ServeOptions& o) {
     instrument.installation = runtime::load_installation_config(o.config);
   const runtime::InstallationConfig& installation = instrument.installation;
   const config::ProjectConfig& config = installation.project;
-  const runtime::SafetyLimits safety = loop_safety_limits(installation.safety, o.max_overruns);
+  const runtime::SafetyLimits limits = loop_safety_limits(installation.safety, o.max_overruns);
   // The stack first: a bad --fault, --daq or device is named before the twin's calibration runs.
   LoopStack stack(stack_options(o), config);
+  const runtime::SafetyLimits safety = resolve_overrun_trip(limits, stack.sim() != nullptr);
   const LoopCalibration cal = resolve_calibration(o.calibration, o.daq, config, o.seed,
                                                   1.0 / o.rate_Hz, o.max_physics_steps);
   const host::StageModel model = make_stage_model(o, config, cal.params, cal, safety);
@@ -434,12 +441,15 @@ int serve(const ServeOptions& o) {
   lc.stop_signal = &g_stop_signal;
   lc.stop_when_safe_after_fault = false;  // a client clears faults (SVO)
   lc.host = &link;
+  runtime::LoopStatus status;  // the faults' source for the reporter
+  lc.status = &status;
   runtime::ControlLoop loop(lc, cal.params, safety, stack.daq(), stack.clock(),
                             runtime::SetpointProfile::step(0.0), stack.telemetry());
 
   StopSignals signals;
   stack.start_logging();
   net.start();  // before the real-time request: the network threads stay normal threads
+  FaultReporter fault_reporter(status);  // likewise; each fault on stderr as it latches
   if (const host::HttpServer* http = net.http())
     fmt::print("piezoshift serve: dashboard on http://{}:{}/{}\n", o.http_bind, http->port(),
                token.empty() ? "" : " (token required)");
@@ -463,10 +473,11 @@ int serve(const ServeOptions& o) {
   stack.daq().activate();
   const runtime::LoopResult r = loop.run();
   stack.daq().deactivate();
+  fault_reporter.stop();
   net.stop();
   stack.stop_logging();
   net.rethrow_failure();
-  print_serve_summary(o, net, daq_name, loop, r, safety, rt);
+  print_serve_summary(o, net, daq_name, loop, r, safety, rt, fault_reporter.loads());
   return 0;
 }
 

@@ -76,6 +76,11 @@ void ControlLoop::start() noexcept {
   previous_deadline_ns_ = start_ns_ - period_ns_;
   previous_wake_ns_ = start_ns_;
   previous_overran_ = false;
+  overrun_worst_late_ns_ = 0;
+  was_faulted_ = false;
+  recorded_fault_tick_ = 0;
+  if (config_.status != nullptr)
+    config_.status->faults_published.store(0, std::memory_order_release);
   stop_requested_ = false;
   finish_requested_ = false;
   done_ = false;
@@ -118,6 +123,8 @@ bool ControlLoop::tick() noexcept {
 
   const std::int64_t end = clock_.now_ns();
   previous_overran_ = stats_.record(deadline_ns_, wake, end, previous_wake_ns_, period_ns_);
+  overrun_worst_late_ns_ =
+      previous_overran_ ? std::max(overrun_worst_late_ns_, end - deadline_ns_ - period_ns_) : 0;
   push_telemetry(cs, zd, ct, wake, end);
   push_host_sample(cs, zd, ct, wake);
 
@@ -245,6 +252,7 @@ void ControlLoop::record_outputs(const CycleSample& cs, const Vec3& zd) noexcept
     result_.fault_detected = true;
     result_.fault = supervisor.fault();
   }
+  record_fault();
   const double period_ms = params_.sample_time_s * 1e3;
   const Vec3& ao = cs.supervisor.ao_V;
   for (std::size_t i = 0; i < ao.size(); ++i) {
@@ -266,6 +274,32 @@ void ControlLoop::record_outputs(const CycleSample& cs, const Vec3& zd) noexcept
       const double nan = std::numeric_limits<double>::quiet_NaN();
       result_.end_interferometer_um = Vec3{nan, nan, nan};
     }
+  }
+}
+
+// A latch is new when the previous tick had none, or when its tick differs from the last one
+// recorded (a clear at the start of this tick and a new latch in it). It was latched in this
+// tick's step: its time is this tick's.
+void ControlLoop::record_fault() noexcept {
+  const SafetySupervisor& supervisor = cycle_.supervisor();
+  const bool faulted = supervisor.faulted();
+  const bool fresh = faulted && (!was_faulted_ || supervisor.fault().tick != recorded_fault_tick_);
+  was_faulted_ = faulted;
+  if (!fresh)
+    return;
+  LatchedFault f{};
+  f.fault = supervisor.fault();
+  recorded_fault_tick_ = f.fault.tick;
+  f.t_s = static_cast<double>(deadline_ns_ - start_ns_) * 1e-9;
+  // The supervisor saw the overruns of the ticks before this one: the run still in the stats.
+  if (f.fault.reason == FaultReason::kOverruns)
+    f.worst_lateness_s = static_cast<double>(overrun_worst_late_ns_) * 1e-9;
+  const std::uint32_t index = result_.faults.count;
+  result_.faults.append(f);
+  if (config_.status != nullptr) {
+    if (index < kMaxFaultsKept)
+      config_.status->faults[index] = f;
+    config_.status->faults_published.store(index + 1, std::memory_order_release);
   }
 }
 

@@ -63,11 +63,14 @@ std::string describe(const SafetyLimits& l) {
   return fmt::format(
       "outputs {} to {} V, slew {} V/s (stop ramp {} V/s), SGS {} to {} V (rail within {} V of "
       "{} V, jump {} x slew + {} V), tracking {} um for {} s, response {} to {} +- {} um for {} "
-      "s, saturation {} s, {} overruns in a row, oscillation {} reversals of {} um in {} s",
+      "s, saturation {} s, {} overruns in a row{}, oscillation {} reversals of {} um in {} s",
       l.output_min_V, l.output_max_V, l.max_slew_V_per_s, l.safe_ramp_V_per_s, l.sgs_min_V,
       l.sgs_max_V, l.rail_margin_V, l.adc_full_scale_V, l.jump_factor, l.sgs_noise_V,
       l.tracking_error_um, l.tracking_time_s, l.response_gain_min, l.response_gain_max,
       l.response_band_um, l.response_time_s, l.saturation_time_s, l.max_consecutive_overruns,
+      l.trip_on_overruns == kOverrunTripNever        ? " (counted, no trip)"
+      : l.trip_on_overruns == kOverrunTripOnHardware ? " (trip on hardware)"
+                                                     : "",
       l.oscillation_reversals, l.oscillation_band_um, l.oscillation_time_s);
 }
 

@@ -167,7 +167,8 @@ void SafetySupervisor::check(const SupervisorInput& in) noexcept {
     return;
   }
   consecutive_overruns_ = in.previous_tick_overran ? consecutive_overruns_ + 1 : 0;
-  if (consecutive_overruns_ >= limits_.max_consecutive_overruns) {
+  if (limits_.trip_on_overruns != kOverrunTripNever &&
+      consecutive_overruns_ >= limits_.max_consecutive_overruns) {
     latch(FaultReason::kOverruns, k, -1, consecutive_overruns_, limits_.max_consecutive_overruns);
     return;
   }

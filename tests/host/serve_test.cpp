@@ -547,6 +547,44 @@ TEST_F(Serve, SafetySectionIsAppliedAndShown) {
   EXPECT_EQ(j.at("safety").at("max_consecutive_overruns"), 1000000);
 }
 
+// Issue 30: serve prints each fault on stderr when it latches, while it runs on, and its
+// summaries (JSON and text) name every fault: rule, channel, time, value and limit.
+TEST_F(Serve, EveryFaultIsPrintedWhenItLatchesAndNamedInTheSummary) {
+  ASSERT_NE(start({"--fault", "sgs-open@0.3:1"}), 0);
+  const std::string line_start = "piezoshift: fault latched at tick ";
+  std::string err;
+  for (int i = 0; i < 3000 && err.find(line_start) == std::string::npos; ++i) {  // up to 30 s
+    std::this_thread::sleep_for(std::chrono::milliseconds(10));
+    err = slurp(path("err.txt"));
+  }
+  ASSERT_NE(err.find(line_start), std::string::npos) << err;
+  EXPECT_EQ(kill(server_.pid, 0), 0) << "still serving";
+  EXPECT_NE(err.find(": sgs-rail on channel 1, value 10 V, limit 9.98 V; outputs ramping to 0 V\n"),
+            std::string::npos)
+      << err;
+  const nlohmann::json j = stop();
+  ASSERT_EQ(j.at("faults_latched").size(), 1U) << j.dump();
+  const nlohmann::json& f = j.at("faults_latched")[0];
+  EXPECT_EQ(f.at("reason"), "sgs-rail");
+  EXPECT_EQ(f.at("channel"), 1);
+  // The first tick at or after 0.3 s (later when slots were skipped on a loaded machine).
+  EXPECT_GE(f.at("time_s").get<double>(), 0.3);
+  EXPECT_LT(f.at("time_s").get<double>(), 0.4);
+  EXPECT_DOUBLE_EQ(f.at("value").get<double>(), 10.0 - 20.0 / 65536.0);  // the ADC's top code
+  EXPECT_DOUBLE_EQ(f.at("limit").get<double>(), 9.98);
+  EXPECT_EQ(f.at("unit"), "V");
+  EXPECT_EQ(j.at("faults_latched_count"), 1);
+
+  const Spawned text = spawn({"serve", "--port", "0", "--max-overruns", "1000000", "--calibration",
+                              calibration_, "--duration-s", "0.5", "--fault", "sgs-open@0.2:3"},
+                             path("text.txt"), path("text_err.txt"));
+  EXPECT_EQ(wait_exit_or_kill(text, 120), 0) << slurp(path("text_err.txt"));
+  const std::string out = slurp(path("text.txt"));
+  const std::size_t at = out.find("fault 1        sgs-rail on channel 3 at t = 0.2");
+  ASSERT_NE(at, std::string::npos) << out;
+  EXPECT_NE(out.find("value 10 V, limit 9.98 V\n", at), std::string::npos) << out;
+}
+
 TEST_F(Serve, RefusesARemoteAddressWithoutAllowRemoteAndBadInputWithExit2) {
   const auto refused = [&](std::vector<std::string> args, const std::string& piece) {
     const Spawned s = spawn(args, path("o.txt"), path("e.txt"));

@@ -7,6 +7,8 @@
 
 #include "fake_backend.hpp"
 #include "piezoshift/runtime/fault_injection.hpp"
+#include "piezoshift/runtime/fault_list.hpp"
+#include "piezoshift/runtime/loop_status.hpp"
 
 #include "allocation_counter.hpp"
 
@@ -158,6 +160,75 @@ TEST(ControlLoop, ExplicitClearResumesControl) {
   EXPECT_EQ(loop.supervisor().state(), SupervisorState::kStopped);
   EXPECT_FALSE(loop.supervisor().faulted());
   EXPECT_LE(r.max_output_slew_V_per_ms, 1.5 + 1e-9);
+}
+
+// Issue 30: every latch is kept, a cleared fault and the next one are two entries, each with its
+// scheduled time, and each is published to the status for the host's reporter.
+TEST(ControlLoop, EveryLatchedFaultIsKeptAndPublished) {
+  FakeBackend daq;
+  SimulatedClock clock;
+  FaultInjectingBackend faulty(
+      daq, clock, 1'000'000,
+      {FaultSpec{FaultKind::kAdcSpike, 0.1, 1}, FaultSpec{FaultKind::kAdcNan, 0.4, 2}},
+      FaultInjectionParams{}, &daq);
+  faulty.configure();
+  faulty.activate();
+  LoopStatus status;
+  LoopConfig cfg = config(1000.0, 0.6);
+  cfg.stop_when_safe_after_fault = false;
+  cfg.status = &status;
+  ControlLoop loop(cfg, control::SemiClosedLoopParams{}, SafetyLimits{}, faulty, clock,
+                   SetpointProfile::step(6.0));
+  daq.on_tick_at = 250;  // the "operator" clears the first at 0.25 s
+  daq.on_tick_context = &loop;
+  daq.on_tick = [](void* ctx) { static_cast<ControlLoop*>(ctx)->request_clear(); };
+  const LoopResult r = loop.run();
+  ASSERT_EQ(r.faults.count, 2U);
+  EXPECT_EQ(r.faults.entries[0].fault.reason, FaultReason::kSgsJump);
+  EXPECT_EQ(r.faults.entries[0].fault.tick, 100U);
+  EXPECT_EQ(r.faults.entries[0].fault.channel, 1);
+  EXPECT_DOUBLE_EQ(r.faults.entries[0].t_s, 0.1);
+  EXPECT_EQ(r.faults.entries[1].fault.reason, FaultReason::kSgsNotFinite);
+  EXPECT_EQ(r.faults.entries[1].fault.tick, 400U);
+  EXPECT_EQ(r.faults.entries[1].fault.channel, 2);
+  EXPECT_DOUBLE_EQ(r.faults.entries[1].t_s, 0.4);
+  EXPECT_EQ(status.faults_published.load(), 2U);
+  EXPECT_EQ(status.faults[1].fault.tick, 400U);
+  EXPECT_EQ(r.fault.tick, 400U) << "LoopResult::fault: the one latched at the end";
+}
+
+// Issue 30: an overrun trip carries the worst lateness of its overruns. The burst's ticks take
+// 1.5 periods each: 0.5 ms past the next deadline, and each skips a slot, so the latch at tick
+// 103 is scheduled at 106 ms.
+TEST(ControlLoop, AnOverrunTripCarriesItsWorstLateness) {
+  FakeBackend daq;
+  SimulatedClock clock;
+  FaultInjectingBackend faulty(daq, clock, 1'000'000,
+                               {FaultSpec{FaultKind::kOverrunBurst, 0.1, -1}},
+                               FaultInjectionParams{}, &daq);
+  faulty.configure();
+  faulty.activate();
+  ControlLoop loop(config(1000.0, 0.3), control::SemiClosedLoopParams{}, SafetyLimits{}, faulty,
+                   clock, SetpointProfile::step(3.0));
+  const LoopResult r = loop.run();
+  ASSERT_EQ(r.faults.count, 1U);
+  const LatchedFault& f = r.faults.entries[0];
+  EXPECT_EQ(f.fault.reason, FaultReason::kOverruns);
+  EXPECT_EQ(f.fault.tick, 103U);
+  EXPECT_DOUBLE_EQ(f.t_s, 0.106);
+  EXPECT_DOUBLE_EQ(f.worst_lateness_s, 0.5e-3);
+}
+
+TEST(FaultList, KeepsTheFirstSixteenAndCountsEveryOne) {
+  FaultList list;
+  for (std::uint64_t k = 0; k < 20; ++k) {
+    LatchedFault f;
+    f.fault.tick = k;
+    list.append(f);
+  }
+  EXPECT_EQ(list.count, 20U);
+  EXPECT_EQ(list.kept(), 16U);
+  EXPECT_EQ(list.entries[15].fault.tick, 15U);
 }
 
 TEST(ControlLoop, DaqReadErrorLatches) {

@@ -10,6 +10,7 @@
 #include <cmath>
 #include <filesystem>
 #include <fstream>
+#include <regex>
 #include <sstream>
 #include <string>
 #include <thread>
@@ -139,6 +140,96 @@ TEST_F(RunCommand, InjectedFaultIsReportedWithItsLatencyAndExit3) {
     const auto c = std::find(header.begin(), header.end(), col) - header.begin();
     EXPECT_EQ(std::stod(last[static_cast<std::size_t>(c)]), 0.0) << col;
   }
+}
+
+// Issue 30: every fault is named by its rule, channel, time and the value that tripped it
+// against its limit, with their unit: on stderr as it latches (no --log needed) and in both
+// summaries.
+TEST_F(RunCommand, EveryFaultIsNamedWithItsRuleChannelTimeValueAndLimit) {
+  const std::vector<std::string> args{"run", "--daq",        "sim", "--free-run", "--step-um",
+                                      "6",   "--duration-s", "0.5", "--fault",    "sgs-open@0.2:2"};
+  const Spawned text = spawn(args, path("out"), path("err"));
+  ASSERT_EQ(wait_exit(text), 3) << slurp(path("err"));
+  EXPECT_NE(slurp(path("out"))
+                .find("FAULT          sgs-rail on channel 2 at t = 0.2000 s (tick "
+                      "200): value 10 V, limit 9.98 V, 0 ticks after injection\n"),
+            std::string::npos)
+      << slurp(path("out"));
+  EXPECT_NE(slurp(path("err"))
+                .find("piezoshift: fault latched at tick 200 (t = 0.2000 s): "
+                      "sgs-rail on channel 2, value 10 V, limit 9.98 V; outputs "
+                      "ramping to 0 V\n"),
+            std::string::npos)
+      << slurp(path("err"));
+
+  std::vector<std::string> json_args = args;
+  json_args.push_back("--json");
+  const Spawned json = spawn(json_args, path("out.json"), path("err2"));
+  ASSERT_EQ(wait_exit(json), 3) << slurp(path("err2"));
+  const nlohmann::json j = nlohmann::json::parse(slurp(path("out.json")));
+  ASSERT_EQ(j["faults_latched"].size(), 1U) << j.dump();
+  const nlohmann::json& f = j["faults_latched"][0];
+  EXPECT_EQ(f["reason"], "sgs-rail");
+  EXPECT_EQ(f["channel"], 2);
+  EXPECT_EQ(f["tick"], 200);
+  EXPECT_DOUBLE_EQ(f["time_s"].get<double>(), 0.2);
+  // The open bridge's 12 V, clipped by the ADC at its top code: 10 V less one LSB (20 V / 2^16).
+  EXPECT_DOUBLE_EQ(f["value"].get<double>(), 10.0 - 20.0 / 65536.0);
+  EXPECT_DOUBLE_EQ(f["limit"].get<double>(), 9.98);
+  EXPECT_EQ(f["unit"], "V");
+  EXPECT_FALSE(f.contains("load_average")) << "only an overrun trip names the load";
+}
+
+// Issue 30: on the twin a late host is counted and reported, not a fault, unless [safety] asks
+// (trip_on_overruns: 0 never, 1 always, 2 on hardware only, the default). The burst makes five
+// ticks of 1.5 periods each on the simulated clock: deterministic lateness.
+TEST_F(RunCommand, OnTheTwinOverrunsAreCountedNotTrippedByDefault) {
+  const Spawned s = spawn({"run", "--daq", "sim", "--free-run", "--step-um", "6", "--duration-s",
+                           "0.5", "--fault", "overrun-burst@0.2", "--json"},
+                          path("out"), path("err"));
+  ASSERT_EQ(wait_exit(s), 0) << slurp(path("err"));
+  const nlohmann::json j = nlohmann::json::parse(slurp(path("out")));
+  EXPECT_FALSE(j["fault_detected"].get<bool>()) << j.dump();
+  EXPECT_EQ(j["faults_latched"].size(), 0U);
+  EXPECT_EQ(j["overruns"], 5);
+  EXPECT_EQ(j["max_consecutive_overruns"], 5);
+  EXPECT_EQ(j["safety"]["trip_on_overruns"], 0) << "resolved for the twin";
+  EXPECT_EQ(j["stop_reason"], "duration");
+
+  const std::string bad_site = write("bad.toml", "[safety]\ntrip_on_overruns = 3\n");
+  const Spawned bad =
+      spawn({"run", "--daq", "sim", "--free-run", "--duration-s", "0.1", "--config", bad_site},
+            path("out2"), path("err2"));
+  EXPECT_EQ(wait_exit(bad), 2);
+  EXPECT_NE(slurp(path("err2")).find("trip_on_overruns"), std::string::npos) << slurp(path("err2"));
+}
+
+// Issue 30: an overrun trip names its rule (the count against its limit), the worst lateness and
+// the machine's load. On the simulated clock the burst's ticks each take 1.5 periods: 500 us
+// past the next deadline, three in a row. The twin trips on them only when [safety] asks.
+TEST_F(RunCommand, AnOverrunTripNamesItsRuleLatenessAndTheLoad) {
+  const std::string site = write("site.toml", "[safety]\ntrip_on_overruns = 1\n");
+  const Spawned s = spawn({"run", "--daq", "sim", "--free-run", "--step-um", "6", "--duration-s",
+                           "0.5", "--fault", "overrun-burst@0.2", "--json", "--config", site},
+                          path("out"), path("err"));
+  ASSERT_EQ(wait_exit(s), 3) << slurp(path("err"));
+  const nlohmann::json j = nlohmann::json::parse(slurp(path("out")));
+  ASSERT_EQ(j["faults_latched"].size(), 1U) << j.dump();
+  const nlohmann::json& f = j["faults_latched"][0];
+  EXPECT_EQ(f["reason"], "overruns");
+  EXPECT_TRUE(f["channel"].is_null());
+  EXPECT_EQ(f["value"], 3.0);
+  EXPECT_EQ(f["limit"], 3.0);
+  EXPECT_EQ(f["unit"], "ticks");
+  EXPECT_DOUBLE_EQ(f["worst_lateness_us"].get<double>(), 500.0);
+  const std::regex load(R"([0-9]+\.[0-9]+ [0-9]+\.[0-9]+ [0-9]+\.[0-9]+)");
+  EXPECT_TRUE(std::regex_match(f["load_average"].get<std::string>(), load)) << f.dump();
+  const std::string err = slurp(path("err"));
+  EXPECT_NE(err.find("overruns, 3 consecutive ticks overran (limit 3), the worst ended 500.0 us "
+                     "after the next deadline; load average " +
+                     f["load_average"].get<std::string>()),
+            std::string::npos)
+      << err;
 }
 
 TEST_F(RunCommand, SigkillMidRunLeavesAValidCsvUpToTheLastFlush) {

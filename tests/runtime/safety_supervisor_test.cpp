@@ -249,6 +249,28 @@ TEST(SafetySupervisor, ThreeConsecutiveOverrunsLatch) {
   EXPECT_EQ(s.fault().value, 3.0);
 }
 
+// Issue 30: with trip_on_overruns never (the twin's default in run and serve) a late host is
+// counted, not a fault; "on hardware" is "always" to the supervisor.
+TEST(SafetySupervisor, OverrunsTripOnlyWhereTheLimitsAskForIt) {
+  for (const std::uint32_t mode : {kOverrunTripNever, kOverrunTripAlways, kOverrunTripOnHardware}) {
+    SafetyLimits limits;
+    limits.trip_on_overruns = mode;
+    SafetySupervisor s;
+    s.configure(limits, kT, {});
+    SupervisorInput in = steady(0, 0.0);
+    for (std::uint64_t k = 0; k < 10; ++k) {
+      in.tick = k;
+      in.previous_tick_overran = true;
+      s.update(in);
+    }
+    EXPECT_EQ(s.faulted(), mode != kOverrunTripNever) << "mode " << mode;
+    if (mode != kOverrunTripNever) {
+      EXPECT_EQ(s.fault().reason, FaultReason::kOverruns);
+      EXPECT_EQ(s.fault().tick, 2U) << "the third overrun in a row";
+    }
+  }
+}
+
 TEST(SafetySupervisor, DaqErrorsLatch) {
   SafetySupervisor a = make();
   SupervisorInput in = steady(0, 0.0);

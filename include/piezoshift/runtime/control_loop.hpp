@@ -19,6 +19,9 @@
 //     cycle.step(daq, k, overrun(k-1))                   the one control tick (control_cycle.hpp):
 //                                                        read, controller, supervisor, write
 //                                                        E_k = end of work
+//     a newly latched fault is appended to result().faults (fault_list.hpp) and published to
+//     the status (loop_status.hpp), with its time and, for `overruns`, the worst lateness
+//     E_j - D_{j+1} of the consecutive overruns that tripped it
 //     stats (period error, wake latency, compute, overrun = E_k - D_k > T), telemetry push,
 //     host sample push
 //     done when the supervisor has stopped, or has faulted and the outputs are at 0 V
@@ -51,6 +54,7 @@
 #include "piezoshift/control/semi_closed_loop.hpp"
 #include "piezoshift/runtime/control_cycle.hpp"
 #include "piezoshift/runtime/daq_backend.hpp"
+#include "piezoshift/runtime/fault_list.hpp"
 #include "piezoshift/runtime/host_link.hpp"
 #include "piezoshift/runtime/loop_clock.hpp"
 #include "piezoshift/runtime/loop_status.hpp"
@@ -85,8 +89,10 @@ const char* to_string(StopReason reason) noexcept;
 struct LoopResult {
   std::uint64_t ticks = 0;
   StopReason stop_reason = StopReason::kDuration;
-  int signal = 0;               //!< the stop_signal value that stopped the run
-  FaultRecord fault{};          //!< reason kNone when none was latched (the last one if cleared)
+  int signal = 0;       //!< the stop_signal value that stopped the run
+  FaultRecord fault{};  //!< reason kNone when none was latched (the last one if cleared)
+  //! Every fault latched, in order (a cleared fault and the next are two entries).
+  FaultList faults{};
   bool fault_detected = false;  //!< a fault was latched at some point
   double max_output_V = 0.0;
   double min_output_V = 0.0;
@@ -177,6 +183,7 @@ class ControlLoop {
   void choose_setpoint(const CycleTime& t) noexcept;
   void drive_trigger_line(const CycleTime& t) noexcept;
   void record_outputs(const CycleSample& cs, const Vec3& zd) noexcept;
+  void record_fault() noexcept;
   void publish_status(const CycleSample& cs, const Vec3& zd, const CycleTime& t) noexcept;
   void push_telemetry(const CycleSample& cs, const Vec3& zd, const CycleTime& t,
                       std::int64_t wake_ns, std::int64_t end_ns) noexcept;
@@ -205,6 +212,9 @@ class ControlLoop {
   std::int64_t previous_deadline_ns_ = 0;
   std::int64_t previous_wake_ns_ = 0;
   bool previous_overran_ = false;
+  std::int64_t overrun_worst_late_ns_ = 0;  // over the present run of consecutive overruns
+  bool was_faulted_ = false;                // the supervisor's latch at the previous tick
+  std::uint64_t recorded_fault_tick_ = 0;   // the tick of the last fault recorded
   bool stop_requested_ = false;
   bool finish_requested_ = false;
   bool done_ = false;

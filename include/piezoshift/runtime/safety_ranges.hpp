@@ -22,7 +22,8 @@ namespace piezoshift::runtime {
 inline constexpr std::uint32_t kMaxConsecutiveOverruns = 1000000;
 
 //! Calls visit(section, key, value, bounds) for each limit (const or not); value is a double or
-//! the std::uint32_t overrun count. The ranges keep every rule meaningful: the outputs within the
+//! a std::uint32_t (the overrun count, trip_on_overruns, oscillation_reversals). The ranges keep
+//! every rule meaningful: the outputs within the
 //! +-10 V a DAQ writes, times from one tick to a minute.
 template <typename Limits, typename Visit>
 void visit_safety_limits(Limits& l, Visit&& visit) {
@@ -47,6 +48,8 @@ void visit_safety_limits(Limits& l, Visit&& visit) {
   visit("safety", "saturation_time_s", l.saturation_time_s, B::above(0.0, 60.0));
   visit("safety", "max_consecutive_overruns", l.max_consecutive_overruns,
         B::closed(1, kMaxConsecutiveOverruns));
+  visit("safety", "trip_on_overruns", l.trip_on_overruns,
+        B::closed(kOverrunTripNever, kOverrunTripOnHardware));
   visit("safety", "oscillation_band_um", l.oscillation_band_um, B::above(0.0, 100.0));
   visit("safety", "oscillation_reversals", l.oscillation_reversals,
         B::closed(2, kMaxOscillationReversals));

@@ -5,7 +5,8 @@
 //   rules (while running or stopping; the first that trips is latched with reason, tick, channel):
 //     read status != ok                                   -> daq-read
 //     previous write status is an error                   -> daq-write
-//     consecutive overrun ticks >= max_consecutive_overruns -> overruns
+//     consecutive overrun ticks >= max_consecutive_overruns -> overruns (unless
+//                                                            trip_on_overruns is never)
 //     per channel i, v = sgs_V[i]:
 //       v is NaN or infinite                              -> sgs-not-finite
 //       |v| >= adc_full_scale_V - rail_margin_V           -> sgs-rail   (ADC clipped: "stuck at a
@@ -102,7 +103,15 @@ struct SafetyLimits {
 
   //! Consecutive ticks that missed their next deadline.
   std::uint32_t max_consecutive_overruns = 3;
+  //! Whether `overruns` trips (kOverrunTrip*): never (overruns are counted and reported only),
+  //! always, or on hardware only. The supervisor takes "on hardware" as always; `run` and `serve`
+  //! make it "never" on the twin, whose stage does not suffer when the host is late.
+  std::uint32_t trip_on_overruns = 2;
 };
+
+inline constexpr std::uint32_t kOverrunTripNever = 0;
+inline constexpr std::uint32_t kOverrunTripAlways = 1;
+inline constexpr std::uint32_t kOverrunTripOnHardware = 2;
 
 enum class FaultReason : std::uint8_t {
   kNone,
