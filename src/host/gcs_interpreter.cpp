@@ -450,8 +450,10 @@ bool GcsInterpreter::stop_wave(Session& s, std::size_t g) {
   const AxisValues now = commanded();
   if (!send(s, WaveGenerators::stop_command(g)))
     return false;
-  if (waves_.running(g))
+  if (waves_.running(g)) {
     target_[g] = now[g];  // where the loop folds it, to within the ticks until it applies this
+    measured_target_[g] = false;
+  }
   waves_.stopped(g, sequence_);
   return true;
 }
@@ -493,8 +495,10 @@ void GcsInterpreter::take(const runtime::HostSample& s) {
   if (const unsigned finished = waves_.update(s.applied_sequence, s.wave_running); finished != 0) {
     const AxisValues ended = model_.pose_from_points(s.zd_um);
     for (std::size_t g = 0; g < kGenerators; ++g)
-      if (((finished >> g) & 1u) != 0)
+      if (((finished >> g) & 1u) != 0) {
         target_[g] = ended[g];
+        measured_target_[g] = false;
+      }
   }
   const AxisValues target = commanded();
 
@@ -728,9 +732,12 @@ std::string GcsInterpreter::move(Session& s, const Args& args, bool relative) {
     }
   }
   AxisValues target = target_;
-  for (const AxisValue& p : pairs)
+  std::array<bool, 3> named{};
+  for (const AxisValue& p : pairs) {
     target[p.axis] = relative ? target[p.axis] + p.value : p.value;
-  if (!model_.reachable(target)) {
+    named[p.axis] = true;
+  }
+  if (!model_.reachable(target) && !nominal_tilts(target, named)) {
     fail(s, GcsError::kPositionOutOfLimits);
     return {};
   }
@@ -739,9 +746,28 @@ std::string GcsInterpreter::move(Session& s, const Args& args, bool relative) {
   c.zd_um = model_.points_for(target);
   if (!send(s, c))
     return {};
+  for (std::size_t a = 0; a < named.size(); ++a)
+    measured_target_[a] = measured_target_[a] && !named[a] && target[a] == target_[a];
   target_ = target;
   moved();
   return {};
+}
+
+// A tilt target a MOV does not name but took from the gauges at servo-on or STP (their noise:
+// about 0.1 urad) is set to its nominal 0 when it alone puts the move out of the travel, so that
+// `MOV Z` to TMN? or TMX? alone is reached (issue 30). A tilt a client set is never changed.
+bool GcsInterpreter::nominal_tilts(AxisValues& target, const std::array<bool, 3>& named) const {
+  AxisValues nominal = target;
+  bool changed = false;
+  for (std::size_t a = 1; a < nominal.size(); ++a)
+    if (!named[a] && measured_target_[a] && nominal[a] != 0.0) {
+      nominal[a] = 0.0;
+      changed = true;
+    }
+  if (!changed || !model_.reachable(nominal))
+    return false;
+  target = nominal;
+  return true;
 }
 
 std::string GcsInterpreter::servo(Session& s, const Args& args) {
@@ -779,6 +805,7 @@ std::string GcsInterpreter::servo(Session& s, const Args& args) {
   servo_on_ = on == 1.0;
   if (servo_on_) {
     target_ = position_;
+    measured_target_ = {true, true, true};
   } else {
     hold_applied_volts();
   }
@@ -834,6 +861,7 @@ std::string GcsInterpreter::stop(Session& s, const Args&) {
     return {};
   if (servo_on_) {
     target_ = position_;
+    measured_target_ = {true, true, true};
   } else {
     hold_applied_volts();
   }

@@ -456,6 +456,30 @@ TEST_F(GcsInterpreterTest, TravelLimitQueries) {
   EXPECT_NEAR(std::stod(tmn.substr(2)), model_.min_limits()[2], 1e-6);
 }
 
+// Servo-on takes the measured pose as the target, the gauges' tilt noise too; a MOV Z alone to
+// the end of the travel then set that tilt to 0 rather than refuse (7) for it. A tilt a client
+// set is kept, and the move refused.
+TEST_F(GcsInterpreterTest, MovZAloneReachesTheTravelEndsPastTheTiltMeasuredAtServoOn) {
+  const double z_max = model_.max_limits()[0];
+  const double z_min = model_.min_limits()[0];
+  const AxisValues with_tilt{z_max, 0.5, -0.5};
+  ASSERT_FALSE(model_.reachable(with_tilt));  // else this test shows nothing
+  servo_on_at({5.0, 0.5, -0.5});
+  EXPECT_EQ(cmd(fmt::format("MOV Z {}", z_max)), "");
+  EXPECT_EQ(err(), 0);
+  expect_near(only_command().zd_um, model_.points_for({z_max, 0.0, 0.0}), 1e-9);
+  EXPECT_EQ(cmd("MOV? U V"), "U=0.000000 \nV=0.000000\n");
+  EXPECT_EQ(cmd(fmt::format("MOV Z {}", z_min)), "");
+  EXPECT_EQ(err(), 0);
+  commands();
+  // a tilt the client asked for is its own: the same move is refused
+  EXPECT_EQ(cmd("MOV Z 5 U 0.5"), "");
+  EXPECT_EQ(err(), 0);
+  EXPECT_EQ(cmd(fmt::format("MOV Z {}", z_max)), "");
+  EXPECT_EQ(err(), 7);
+  EXPECT_EQ(cmd("MOV? U"), "U=0.500000\n");
+}
+
 TEST_F(GcsInterpreterTest, StopHoldsWhereTheStageIsAndQueues10ForItsClient) {
   const std::uint64_t on = servo_on_at({3.0, 12.0, -8.0});
   EXPECT_EQ(cmd("MOV Z 8"), "");

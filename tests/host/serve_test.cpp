@@ -138,6 +138,16 @@ TEST_F(Serve, EveryZUpToTheAdvertisedTravelIsReachedByOneMove) {
     ASSERT_TRUE(wait_on_target(c)) << "MOV Z " << z;
     EXPECT_NEAR(value_of(c.query_lines("POS?"), "Z"), z, 0.01);
   }
+  // MOV Z alone, each time after a servo-on that takes the gauges' pose, their tilt noise too, as
+  // the target (issue 30: it was refused with 7 at the ends)
+  for (const double z : {z_max, z_min, 5.0, z_max}) {
+    c.send("SVO Z 0 U 0 V 0");
+    c.send("SVO Z 1 U 1 V 1");
+    c.send(fmt::format("MOV Z {}", z));
+    EXPECT_EQ(error(c), 0) << z;
+    ASSERT_TRUE(wait_on_target(c)) << "MOV Z " << z << " alone";
+    EXPECT_NEAR(value_of(c.query_lines("POS?"), "Z"), z, 0.01);
+  }
   c.send(fmt::format("MOV Z {}", z_max + 0.1));
   EXPECT_EQ(error(c), 7);
   c.send(fmt::format("MOV Z {}", z_min - 0.1));

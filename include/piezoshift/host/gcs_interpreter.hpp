@@ -175,6 +175,7 @@ class GcsInterpreter final : public LineHandler {
   std::string move_absolute(Session& s, const Args& args) { return move(s, args, false); }
   std::string move_relative(Session& s, const Args& args) { return move(s, args, true); }
   std::string move(Session& s, const Args& args, bool relative);
+  bool nominal_tilts(AxisValues& target, const std::array<bool, 3>& named) const;
   std::string target_query(Session& s, const Args& args);
   std::string position_query(Session& s, const Args& args);
   std::string on_target_query(Session& s, const Args& args);
@@ -247,6 +248,8 @@ class GcsInterpreter final : public LineHandler {
   std::uint64_t clear_sequence_ = 0;  // the last SVO (which clears a latched fault)
   bool servo_on_ = false;
   AxisValues target_{};
+  // Axes whose target is the pose the gauges measured (servo-on, STP), not one a client set.
+  std::array<bool, 3> measured_target_{};
   AxisValues open_loop_V_{};
   std::array<std::uint64_t, 3> settled_{};
   std::array<double, 3> velocity_{};  // VEL, stored (velocity control is off, VCO? 0)
