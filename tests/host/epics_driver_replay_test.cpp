@@ -167,16 +167,7 @@ class EpicsDriverReplay : public piezoshift::testing::TempDirTest {
     server_ = spawn({"serve", "--port", "0", "--max-overruns", "1000000", "--json", "--calibration",
                      calibration},
                     path("out.txt"), path("err.txt"));
-    const std::string marker = "GCS 2.0 on 127.0.0.1:";
-    for (int i = 0; i < 3000; ++i) {
-      const std::string out = slurp(path("out.txt"));
-      const std::size_t at = out.find(marker);
-      if (at != std::string::npos && out.find(',', at) != std::string::npos)
-        return static_cast<std::uint16_t>(std::stoi(out.substr(at + marker.size())));
-      std::this_thread::sleep_for(std::chrono::milliseconds(10));
-    }
-    ADD_FAILURE() << "server did not start: " << slurp(path("err.txt"));
-    return 0;
+    return piezoshift::testing::wait_for_gcs_port(path("out.txt"), path("err.txt"));
   }
 
   int stop() {

@@ -69,16 +69,7 @@ class Serve : public piezoshift::testing::TempDirTest {
                                   "--calibration",  calibration_};
     args.insert(args.end(), extra.begin(), extra.end());
     server_ = spawn(args, path("out.txt"), path("err.txt"));
-    const std::string marker = "GCS 2.0 on 127.0.0.1:";
-    for (int i = 0; i < 3000; ++i) {  // up to 30 s
-      const std::string out = slurp(path("out.txt"));
-      const std::size_t at = out.find(marker);
-      if (at != std::string::npos && out.find(',', at) != std::string::npos)
-        return static_cast<std::uint16_t>(std::stoi(out.substr(at + marker.size())));
-      std::this_thread::sleep_for(std::chrono::milliseconds(10));
-    }
-    ADD_FAILURE() << "server did not start: " << slurp(path("err.txt"));
-    return 0;
+    return piezoshift::testing::wait_for_gcs_port(path("out.txt"), path("err.txt"));
   }
 
   // SIGTERM, exit status 0, and the JSON summary.

@@ -6,7 +6,10 @@
 #include <sys/wait.h>
 #include <unistd.h>
 
+#include <chrono>
+#include <cstdint>
 #include <string>
+#include <thread>
 #include <vector>
 
 #include <gtest/gtest.h>
@@ -53,6 +56,22 @@ inline int wait_exit(const Spawned& s, bool* signaled = nullptr, int* signo = nu
   if (signo && WIFSIGNALED(status))
     *signo = WTERMSIG(status);
   return WIFEXITED(status) ? WEXITSTATUS(status) : -1;
+}
+
+//! The GCS port `serve` prints on its stdout (file out) once it listens ("GCS 2.0 on
+//! 127.0.0.1:PORT,"), waiting up to 30 s; 0 with a test failure naming its stderr (file err) when
+//! it does not come.
+inline std::uint16_t wait_for_gcs_port(const std::string& out, const std::string& err) {
+  const std::string marker = "GCS 2.0 on 127.0.0.1:";
+  for (int i = 0; i < 3000; ++i) {
+    const std::string text = slurp(out);
+    const std::size_t at = text.find(marker);
+    if (at != std::string::npos && text.find(',', at) != std::string::npos)
+      return static_cast<std::uint16_t>(std::stoi(text.substr(at + marker.size())));
+    std::this_thread::sleep_for(std::chrono::milliseconds(10));
+  }
+  ADD_FAILURE() << "server did not start: " << slurp(err);
+  return 0;
 }
 
 }  // namespace piezoshift::testing
