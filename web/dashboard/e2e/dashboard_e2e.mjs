@@ -113,6 +113,8 @@ try {
     return { n: window.piezoshift.events(), k: t.length, t: t[t.length - 1], gaps,
       overruns: tm.overruns ?? 0, dropped: tm.samples_dropped ?? 0 };
   };
+  // The first update may carry the status alone: wait for samples, so that the span has a start.
+  await page.waitForFunction(() => window.piezoshift.store.t_s.length > 0, null, { timeout: 10000 });
   const before = await page.evaluate(snapshot, 0);
   await page.waitForTimeout(4000);
   const after = await page.evaluate(snapshot, before.k);
@@ -240,9 +242,12 @@ try {
     return m && !m.running && m.last && m.last.valid &&
       document.getElementById("meas-surface").naturalWidth > 256 &&
       document.getElementById("meas-fig").textContent.includes("nm");
-  }, null, { timeout: 20000 }).then(() => true, () => false);
+  // A bound for a hang, not a speed target: the analysis runs on the camera thread at nice 10, and
+  // with two busy processes beside it on this 2-core machine a measurement took over 20 s.
+  }, null, { timeout: 90000 }).then(() => true, () => false);
   const fig = await page.textContent("#meas-fig");
-  check(measured, `a measurement from the page shows its surface: PV / PVr / RMS ${fig}`);
+  const state = measured ? "" : ` (${JSON.stringify(await page.evaluate(() => window.piezoshift.measurement()))})`;
+  check(measured, `a measurement from the page shows its surface: PV / PVr / RMS ${fig}${state}`);
   await page.screenshot({ path: join(artifacts, "dashboard-camera.png"), fullPage: true });
   console.log(`     (camera panel: ${Date.now() - cameraStart} ms, the server's start-up included)`);
   console.log(`screenshots: ${join(artifacts, "dashboard.png")}, dashboard-fault.png, dashboard-camera.png`);
