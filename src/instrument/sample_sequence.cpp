@@ -2,7 +2,6 @@
 
 #include <algorithm>
 #include <cmath>
-#include <numbers>
 #include <utility>
 
 #include <fmt/core.h>
@@ -38,9 +37,7 @@ SampleSequence::SampleSequence(camera::Camera& camera, const SequenceParams& par
     throw core::InputError("measurement: " + why);
   result_.frames.reserve(total_);
   result_.exposures.reserve(total_);
-  result_.floor_s =
-      static_cast<double>(total_) * (static_cast<double>(window_.length()) * period_s +
-                                     camera.settings().exposure_s + camera.settings().readout_s);
+  result_.floor_s = sequence_floor_s(params, window_.length(), period_s, camera.settings());
 }
 
 void SampleSequence::fail(const std::string& why) {
@@ -139,9 +136,7 @@ void SampleSequence::feed(const LoopSample& s) {
       if (window_.add(s.gauge_error_nm))
         on_settled(s);
       else if (s.t_s - phase_t0_s_ >= p_.on_target.timeout_s)
-        fail(fmt::format(
-            "the stage did not settle within {} nm (mean over {} s) in {} s at {:.3f} s",
-            p_.on_target.band_nm, p_.on_target.hold_s, p_.on_target.timeout_s, s.t_s));
+        fail(window_.timeout_reason(s.t_s));
       break;
     case Phase::kTrigger:
       if (camera_.trigger(s.t_s)) {
@@ -180,13 +175,7 @@ void SampleSequence::on_settled(const LoopSample& s) {
 }
 
 void SampleSequence::next_frame(const LoopSample& s) {
-  const std::size_t n = p_.steps_rad.size();
-  rec_ = ExposureRecord{};
-  rec_.average = static_cast<int>(next_ / n);
-  rec_.frame = static_cast<int>(next_ % n);
-  rec_.commanded_step_rad = p_.steps_rad[next_ % n];
-  rec_.commanded_piston_nm = rec_.commanded_step_rad * p_.wavelength_nm / (4.0 * std::numbers::pi);
-  rec_.move_time_s = s.t_s;
+  rec_ = planned_exposure(p_, next_, s.t_s);
   ++next_;
   phase_t0_s_ = s.t_s;
   command(p_.base_um + rec_.commanded_piston_nm * 1e-3);

@@ -57,9 +57,7 @@ class Runner {
       result_.wall_time_s = seconds_since(start_wall_);
     }
     finish_loop();
-    result_.floor_s = static_cast<double>(total_) *
-                      (static_cast<double>(window_.length()) * period_s_ +
-                       camera_.settings().exposure_s + camera_.settings().readout_s);
+    result_.floor_s = sequence_floor_s(p_, window_.length(), period_s_, camera_.settings());
     return std::move(result_);
   }
 
@@ -141,18 +139,15 @@ class Runner {
       if (window_.add(gauge_error_nm()))
         return true;
     }
-    fail(fmt::format("the stage did not settle within {} nm (mean over {} s) in {} s at {:.3f} s",
-                     p_.on_target.band_nm, p_.on_target.hold_s, p_.on_target.timeout_s, now_s()));
+    fail(window_.timeout_reason(now_s()));
     return false;
   }
 
   void take_frame(int average, int frame) {
-    ExposureRecord rec;
-    rec.average = average;
-    rec.frame = frame;
-    rec.commanded_step_rad = p_.steps_rad[static_cast<std::size_t>(frame)];
-    rec.commanded_piston_nm = rec.commanded_step_rad * p_.wavelength_nm / (4.0 * std::numbers::pi);
-    rec.move_time_s = now_s();
+    ExposureRecord rec = planned_exposure(
+        p_,
+        static_cast<std::size_t>(average) * p_.steps_rad.size() + static_cast<std::size_t>(frame),
+        now_s());
     const double z = p_.base_um + rec.commanded_piston_nm * 1e-3;
     loop_.drive_points({z, z, z});
     if (!settle())
@@ -352,6 +347,28 @@ std::string take_frame(camera::FrameStatus s, camera::Frame& f, const camera::Ca
   return {};
 }
 
+double step_piston_nm(const SequenceParams& p, std::size_t k) {
+  return p.steps_rad[k] * p.wavelength_nm / (4.0 * std::numbers::pi);
+}
+
+ExposureRecord planned_exposure(const SequenceParams& p, std::size_t index, double move_time_s) {
+  const std::size_t n = p.steps_rad.size();
+  ExposureRecord rec;
+  rec.average = static_cast<int>(index / n);
+  rec.frame = static_cast<int>(index % n);
+  rec.commanded_step_rad = p.steps_rad[index % n];
+  rec.commanded_piston_nm = step_piston_nm(p, index % n);
+  rec.move_time_s = move_time_s;
+  return rec;
+}
+
+double sequence_floor_s(const SequenceParams& p, std::size_t hold_ticks, double period_s,
+                        const camera::CameraSettings& settings) {
+  const double frames = static_cast<double>(p.averages) * static_cast<double>(p.steps_rad.size());
+  return frames *
+         (static_cast<double>(hold_ticks) * period_s + settings.exposure_s + settings.readout_s);
+}
+
 const char* to_string(TriggerMode mode) noexcept {
   return mode == TriggerMode::kLine ? "line" : "software";
 }
@@ -378,8 +395,8 @@ std::vector<double> commanded_steps(psi::Algorithm a, const std::vector<double>&
 std::string travel_problem(const SequenceParams& p, std::optional<double> travel_z_max_um,
                            std::string_view calibration_source) {
   double top_nm = 0.0;
-  for (double step : p.steps_rad)
-    top_nm = std::max(top_nm, step * p.wavelength_nm / (4.0 * std::numbers::pi));
+  for (std::size_t k = 0; k < p.steps_rad.size(); ++k)
+    top_nm = std::max(top_nm, step_piston_nm(p, k));
   const double top_um = p.base_um + top_nm * 1e-3;
   if (!travel_z_max_um || top_um <= *travel_z_max_um)
     return {};

@@ -1,5 +1,7 @@
 #include "piezoshift/instrument/settle_window.hpp"
 
+#include <fmt/core.h>
+
 #include <algorithm>
 #include <cmath>
 
@@ -34,6 +36,11 @@ double SettleWindow::worst_mean_nm() const noexcept {
     worst = std::max(worst, std::fabs(sum / static_cast<double>(filled_)));
   }
   return worst;
+}
+
+std::string SettleWindow::timeout_reason(double t_s) const {
+  return fmt::format("the stage did not settle within {} nm (mean over {} s) in {} s at {:.3f} s",
+                     criterion_.band_nm, criterion_.hold_s, criterion_.timeout_s, t_s);
 }
 
 }  // namespace piezoshift::instrument

@@ -2,7 +2,6 @@
 
 #include <algorithm>
 #include <cmath>
-#include <numbers>
 #include <span>
 
 #include "piezoshift/plant/random.hpp"
@@ -17,8 +16,7 @@ double ideal_stage_error_rms_nm(const camera::TwinScene& scene, const camera::Ca
   const double top = std::ldexp(1.0, sensor.bit_depth) - 1.0;
   std::vector<psi::Map> frames;
   for (std::size_t k = 0; k < params.steps_rad.size(); ++k) {
-    const double piston_nm = params.steps_rad[k] * params.wavelength_nm / (4.0 * std::numbers::pi);
-    const psi::PoseSample still{0.0, piston_nm, 0.0, 0.0};
+    const psi::PoseSample still{0.0, step_piston_nm(params, k), 0.0, 0.0};
     plant::Rng rng(camera::frame_seed(scene.seed, k));
     psi::Map f = psi::render_frame(scene.surface_nm, scene.mask, scene.fizeau, sensor,
                                    std::span<const psi::PoseSample>(&still, 1), rng);

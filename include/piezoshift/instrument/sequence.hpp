@@ -113,6 +113,17 @@ struct SequenceResult {
   rig::Validity validity;
 };
 
+//! The piston that makes frame k's phase step in reflection: steps_rad[k] lambda / (4 pi) [nm].
+double step_piston_nm(const SequenceParams& p, std::size_t k);
+
+//! Exposure `index` of the sequence (average after average), as commanded at move_time_s: its
+//! average, frame, step and piston; the rest is filled as it is taken.
+ExposureRecord planned_exposure(const SequenceParams& p, std::size_t index, double move_time_s);
+
+//! The wall-time floor: frames x (hold_ticks x period + exposure + readout).
+double sequence_floor_s(const SequenceParams& p, std::size_t hold_ticks, double period_s,
+                        const camera::CameraSettings& settings);
+
 //! A frame polled from camera into result (the next exposure's frame_id and arrival_wall_s, the
 //! frame appended): "" when taken, else why the sequence fails (lost, an error, a frame no
 //! trigger asked for). Both drivers of a sequence use it (sample_sequence.hpp).

@@ -10,6 +10,7 @@
 // (sample_sequence.hpp). Fixed size after construction; add() allocates nothing.
 #include <array>
 #include <cstddef>
+#include <string>
 #include <vector>
 
 #include "piezoshift/psi/stage.hpp"
@@ -28,6 +29,8 @@ class SettleWindow {
   //! max_i |mean(e_i)| over the window [nm] (over the ticks held when not full).
   double worst_mean_nm() const noexcept;
   std::size_t length() const noexcept { return window_.size(); }
+  //! Why a step that has not settled within the criterion's timeout fails, at loop time t_s.
+  std::string timeout_reason(double t_s) const;
 
  private:
   psi::OnTarget criterion_;
