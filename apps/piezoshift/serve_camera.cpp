@@ -46,18 +46,11 @@ json number(double v) {
   return std::isfinite(v) ? json(v) : json(nullptr);
 }
 
-// The modulation map's colour scale: 0 to its 99th percentile (a robust maximum, as the pupil
-// detection's), so that a few hot pixels do not wash it out.
-double robust_max(const psi::Map& m) {
-  std::vector<double> v;
-  for (double x : m.v)
-    if (std::isfinite(x))
-      v.push_back(x);
-  if (v.empty())
-    return 1.0;
-  const auto at = v.begin() + static_cast<std::ptrdiff_t>(0.99 * static_cast<double>(v.size() - 1));
-  std::nth_element(v.begin(), at, v.end());
-  return *at > 0.0 ? *at : 1.0;
+// The modulation map's colour scale: 0 to its robust maximum (as the pupil detection's), so
+// that a few hot pixels do not wash it out; 1 for a map without modulation.
+double colour_top(const psi::Map& m) {
+  const double top = psi::robust_max(m.v);
+  return top > 0.0 ? top : 1.0;
 }
 
 }  // namespace
@@ -95,7 +88,7 @@ MeasurementOutcome analyse(const instrument::SequenceResult& r, psi::Algorithm a
   const std::vector<psi::Map> frames = instrument::frame_maps(
       std::vector<camera::Frame>(r.frames.begin(), r.frames.begin() + static_cast<long>(n)));
   const psi::Map modulation = psi::modulation_map(frames);
-  const double mod_hi = robust_max(modulation);
+  const double mod_hi = colour_top(modulation);
   out.modulation_png = psi::encode_false_colour_png(modulation, 0.0, mod_hi);
   out.j["modulation"] = {{"unit", "counts"},
                          {"lo", 0.0},

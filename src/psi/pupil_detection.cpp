@@ -88,6 +88,19 @@ double median(std::vector<double> v) {
 
 }  // namespace
 
+double robust_max(const std::vector<double>& m) {
+  std::vector<double> v;
+  v.reserve(m.size());
+  for (double x : m)
+    if (std::isfinite(x))
+      v.push_back(x);
+  if (v.empty())
+    return 0.0;
+  const auto at = v.begin() + static_cast<std::ptrdiff_t>(0.99 * static_cast<double>(v.size() - 1));
+  std::nth_element(v.begin(), at, v.end());
+  return *at;
+}
+
 Map modulation_map(std::span<const Map> frames) {
   if (frames.empty() || frames.front().size() == 0)
     throw std::invalid_argument("modulation: no frames, or frames without pixels");
@@ -101,11 +114,8 @@ DetectedPupil pupil_from_modulation(std::span<const Map> frames, const PupilDete
     throw std::invalid_argument("pupil: no frames, or frames without pixels");
   const Map& f0 = frames.front();
   const std::vector<double> m = temporal_std(frames);
-  std::vector<double> sorted = m;
-  const auto at = sorted.begin() + static_cast<std::ptrdiff_t>(0.99 * (sorted.size() - 1));
-  std::nth_element(sorted.begin(), at, sorted.end());
   DetectedPupil out;
-  out.modulation_max = *at;
+  out.modulation_max = robust_max(m);
   out.threshold = d.fraction * out.modulation_max;
   Mask above(f0.width, f0.height, 0);
   std::size_t n_above = 0;

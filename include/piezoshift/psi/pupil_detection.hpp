@@ -18,6 +18,7 @@
 // give the whole frame.
 #include <cstddef>
 #include <span>
+#include <vector>
 
 #include "piezoshift/psi/grid.hpp"
 
@@ -41,6 +42,10 @@ struct DetectedPupil {
 };
 
 DetectedPupil pupil_from_modulation(std::span<const Map> frames, const PupilDetection& d = {});
+
+//! The robust maximum of a modulation map: the 99th percentile of its finite values (a few hot or
+//! saturated pixels do not set it); 0 when none is finite.
+double robust_max(const std::vector<double>& m);
 
 //! m(pixel), the temporal standard deviation above [frame units], as a map of the frames' size.
 //! std::invalid_argument for no frames.
