@@ -9,6 +9,10 @@
 
 namespace piezoshift::app {
 
+//! Exit status of a command whose loop stopped on a latched fault, or whose outputs could not be
+//! brought to 0 V (docs/runtime.md).
+inline constexpr int kExitFault = 3;
+
 using Action = std::function<int()>;
 
 void add_design_command(CLI::App& app, Action& action);     // design_command.cpp

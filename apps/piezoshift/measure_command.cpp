@@ -45,8 +45,6 @@ namespace piezoshift::app {
 
 namespace {
 
-constexpr int kExitFault = 3;
-
 struct MeasureOptions {
   double max_physics_steps = plant::kDefaultPhysicsStepBudget;  // the start-up calibration
   std::string camera = "twin";

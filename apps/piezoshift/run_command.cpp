@@ -44,8 +44,6 @@ namespace {
 
 using namespace piezoshift::runtime;
 
-constexpr int kExitFault = 3;
-
 struct RunOptions {
   double max_physics_steps = plant::kDefaultPhysicsStepBudget;  // the start-up calibration
   std::string daq = "sim";
@@ -196,6 +194,10 @@ void add_fault_json(nlohmann::json& j, const RunRecord& run) {
           t != FaultInjectingBackend::kNotYet ? nlohmann::json(t) : nlohmann::json(nullptr)}});
   }
   j["faults_injected"] = injected_list;
+  const std::string device_error = run.stack.daq().device_error();
+  j["device_error"] = device_error.empty() ? nlohmann::json(nullptr) : nlohmann::json(device_error);
+  const std::string unsafe = run.stack.daq().safe_state_error();
+  j["outputs_at_0_V"] = unsafe.empty();
   const std::optional<std::uint64_t> injected = injected_before_fault(run);
   j["detect_latency_ticks"] =
       injected ? nlohmann::json(r.fault.tick - *injected) : nlohmann::json(nullptr);
@@ -293,6 +295,8 @@ void print_run(const RunRecord& run) {
   } else {
     fmt::print("faults         none\n");
   }
+  if (const std::string e = run.stack.daq().device_error(); !e.empty())
+    fmt::print("device error   {} (the last transaction that failed)\n", e);
   if (const runtime::CsvLogger* logger = run.stack.logger()) {
     fmt::print("log            {} ({} records{})\n", o.log, logger->records_written(),
                r.telemetry_dropped ? fmt::format(", {} DROPPED", r.telemetry_dropped) : "");
@@ -373,6 +377,13 @@ int run(const RunOptions& o) {
   const runtime::CsvLogger* logger = stack.logger();
   if (logger && !logger->error().empty())
     fmt::print(stderr, "piezoshift: error: log {}: {}\n", o.log, logger->error());
+  if (const std::string unsafe = stack.daq().safe_state_error(); !unsafe.empty()) {
+    fmt::print(stderr,
+               "piezoshift: error: {}; the outputs hold their last value: switch the "
+               "amplifier off\n",
+               unsafe);
+    return kExitFault;
+  }
   return r.fault_detected ? kExitFault : 0;
 }
 

@@ -45,8 +45,6 @@
 namespace piezoshift::app {
 namespace {
 
-constexpr int kExitFault = 3;  // the supervisor tripped, as `run`
-
 using Json = nlohmann::ordered_json;
 using control::Vec3;
 

@@ -55,6 +55,8 @@ struct ComediBackend::Impl {
   unsigned n_writes = 3;
   comedi_insnlist list{};
   bool active = false;
+  int read_errno = 0;  // comedi_errno() of the last failed transaction; 0: none
+  int safe_errno = 0;  // of a deactivate() the device refused
 
   ~Impl() {
     if (calibration != nullptr)
@@ -221,15 +223,30 @@ void ComediBackend::deactivate() noexcept {
   write(CycleTime{}, Vec3{});
   stage_trigger_line(false);
   comedi_insnlist zeros{impl_->n_writes, impl_->insns.data()};  // the writes only
-  comedi_do_insnlist(impl_->dev, &zeros);
+  impl_->safe_errno = comedi_do_insnlist(impl_->dev, &zeros) == static_cast<int>(zeros.n_insns)
+                          ? 0
+                          : comedi_errno();
   impl_->active = false;
+}
+
+std::string ComediBackend::device_error() const {
+  return impl_ && impl_->read_errno != 0 ? comedi_strerror(impl_->read_errno) : std::string();
+}
+
+std::string ComediBackend::safe_state_error() const {
+  if (!impl_ || impl_->safe_errno == 0)
+    return {};
+  return fmt::format("{}: writing 0 V to the outputs failed: {}", name(),
+                     comedi_strerror(impl_->safe_errno));
 }
 
 DaqStatus ComediBackend::read(const CycleTime&, Vec3& ai_V) noexcept {
   if (!impl_ || !impl_->active)
     return DaqStatus::kInactive;
-  if (comedi_do_insnlist(impl_->dev, &impl_->list) != static_cast<int>(impl_->list.n_insns))
+  if (comedi_do_insnlist(impl_->dev, &impl_->list) != static_cast<int>(impl_->list.n_insns)) {
+    impl_->read_errno = comedi_errno();
     return DaqStatus::kError;
+  }
   for (std::size_t i = 0; i < 3; ++i) {
     const lsampl_t code = impl_->data[3 + i];
     if (code == 0)
@@ -288,6 +305,12 @@ void ComediBackend::activate() {
   configure();
 }
 void ComediBackend::deactivate() noexcept {}
+std::string ComediBackend::device_error() const {
+  return {};
+}
+std::string ComediBackend::safe_state_error() const {
+  return {};
+}
 void ComediBackend::stage_trigger_line(bool) noexcept {}
 DaqStatus ComediBackend::read(const CycleTime&, Vec3&) noexcept {
   return DaqStatus::kInactive;

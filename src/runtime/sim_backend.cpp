@@ -9,6 +9,14 @@
 
 namespace piezoshift::runtime {
 
+plant::TwinParams twin_params_at_period(plant::TwinParams p, std::int64_t period_ns) {
+  p.daq.sample_time_s = static_cast<double>(period_ns) * 1e-9;
+  const double control_rate_Hz = 1.0 / p.daq.sample_time_s;
+  const double substeps = std::ceil(p.physics_rate_Hz / control_rate_Hz - 1e-9);
+  p.physics_rate_Hz = control_rate_Hz * (substeps < 1.0 ? 1.0 : substeps);
+  return p;
+}
+
 SimBackend::SimBackend(SimOptions options) : options_(std::move(options)) {}
 SimBackend::~SimBackend() = default;
 
@@ -16,11 +24,7 @@ void SimBackend::configure() {
   if (!(options_.rate_Hz > 0.0) || !std::isfinite(options_.rate_Hz))
     throw core::InputError(fmt::format("sim: rate {} Hz is not > 0", options_.rate_Hz));
   period_ns_ = std::llround(1e9 / options_.rate_Hz);
-  plant::TwinParams p = options_.twin;
-  p.daq.sample_time_s = static_cast<double>(period_ns_) * 1e-9;
-  const double control_rate_Hz = 1.0 / p.daq.sample_time_s;
-  const double substeps = std::ceil(p.physics_rate_Hz / control_rate_Hz - 1e-9);
-  p.physics_rate_Hz = control_rate_Hz * (substeps < 1.0 ? 1.0 : substeps);
+  const plant::TwinParams p = twin_params_at_period(options_.twin, period_ns_);
   // The config was valid at its own DAQ period; at the loop's rate it may not be (the physics
   // rate rounded up past its range, or no longer a multiple of the interferometer's).
   const auto cannot = [&](const std::string& why) {

@@ -13,7 +13,9 @@
 //                 reads as the range's end, so the supervisor sees the rail.
 //                 write(): clamp to the AO range, then convert (comedi's conversion would clip
 //                 silently), then clamp the code to [0, maxdata]; kClamped says it happened.
-//   deactivate(): one insnlist writing 0 V to the three AO (and the trigger line low).
+//   deactivate(): one insnlist writing 0 V to the three AO (and the trigger line low); when the
+//                 device refuses it, safe_state_error() says so (the outputs hold their value).
+//   read() keeps comedi_errno() of a failed transaction (an int) for device_error().
 //
 // Trigger line (optional, ComediOptions::trigger_line; the PCI-6229's DIO port 0 is subdevice 2):
 // configure() checks that the subdevice is digital (DIO or DO) and has the channel, and makes a
@@ -66,6 +68,8 @@ class ComediBackend final : public DaqBackend {
   DaqStatus read(const CycleTime& t, Vec3& ai_V) noexcept override;
   DaqStatus write(const CycleTime& t, const Vec3& ao_V) noexcept override;
   std::string name() const override { return "comedi:" + options_.device; }
+  std::string device_error() const override;
+  std::string safe_state_error() const override;
   bool has_trigger_line() const noexcept override { return options_.trigger_line.has_value(); }
   void stage_trigger_line(bool high) noexcept override;
 

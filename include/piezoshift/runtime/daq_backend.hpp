@@ -70,6 +70,13 @@ class DaqBackend {
   //! Set-up: a short name for logs and summaries ("sim", "comedi:/dev/comedi0").
   virtual std::string name() const = 0;
 
+  //! For reports after the loop: the device's own text for the last transaction that failed
+  //! (read() returned kError), or empty.
+  virtual std::string device_error() const { return {}; }
+  //! For reports after deactivate(): empty when the outputs were set to 0 V, else why they could
+  //! not be (the device's error); the amplifier must then be switched off by hand.
+  virtual std::string safe_state_error() const { return {}; }
+
   //! Real-time safe. Ground truth at the measurement points P1..P3 (um), where the backend knows
   //! it (the twin: true displacement and the interferometer's reading). False on hardware.
   virtual bool truth(Vec3& /*z_um*/, Vec3& /*interferometer_um*/) const noexcept { return false; }

@@ -47,6 +47,11 @@ struct SimOptions {
   std::string source = "the built-in configuration";
 };
 
+//! The twin's parameters at a DAQ period: that period, and the physics rate rounded up to the
+//! smallest whole multiple of the DAQ rate at or above the configured one. Also the emulated
+//! Comedi board's (emulation/comedi), so both put the same twin on their wires.
+plant::TwinParams twin_params_at_period(plant::TwinParams p, std::int64_t period_ns);
+
 class SimBackend final : public DaqBackend, public PlantFaultHooks {
  public:
   explicit SimBackend(SimOptions options);
