@@ -183,7 +183,8 @@ std::string style_clause(const Series& s, const CycleStyle& c) {
       return fmt::format("using 1:2 with linespoints lw {} {} pt {} ps 0.7 {}", s.line_width,
                          dash_clause(c.dash), c.point_type, lc);
     case SeriesStyle::kBoxes:
-      return fmt::format("using 1:2:3 with boxes fs solid 0.5 border {}", lc);
+      // The colour before the fill style colours the fill, the one after it the border.
+      return fmt::format("using 1:2:3 with boxes {0} fs solid 0.45 border {0}", lc);
     case SeriesStyle::kBand:
       return fmt::format("using 1:2:3 with filledcurves fs transparent solid 0.25 noborder {}", lc);
     case SeriesStyle::kImage:

@@ -320,11 +320,15 @@ bool write_figures(const ReproductionResult& r, const fs::path& dir, ReportFiles
         std::pair{&f12, "fig12_repeatability"}, std::pair{&fps, "phase_step"}}) {
     const io::PlotFiles pf = io::render(*fig, dir / stem);
     files.figures.push_back(*pf.png);
+    files.captions.push_back(fig->caption);
   }
   const bool any_loop = std::any_of(r.inner_loop.begin(), r.inner_loop.end(),
                                     [](const InnerLoopAnalysis& a) { return a.validity.valid; });
-  if (any_loop)
-    files.figures.push_back(*io::render(inner_loop_figure(r), dir / "inner_loop_bode").png);
+  if (any_loop) {
+    const io::Figure bode = inner_loop_figure(r);
+    files.figures.push_back(*io::render(bode, dir / "inner_loop_bode").png);
+    files.captions.push_back(bode.caption);
+  }
   return any_loop;
 }
 
@@ -468,7 +472,7 @@ void phase_step_section(Document& doc, const ReproductionResult& r) {
       "loop feeds of the gauges' noise into the plate while it holds; the settling time is when "
       "every later exposure stays within +-1 nm of the target, within {:g} ms.",
       r.phase_step.step_nm, 1e3 * r.schedule.phase_step.record_s));
-  doc.image("Phase step", "phase_step.png");
+  doc.image(phase_step_figure(r).caption, "phase_step.png");
 }
 
 // Per loop rate and actuator: the identified plant and the calibrated PID's margins on it.
@@ -501,7 +505,7 @@ void inner_loop_section(Document& doc, const ReproductionResult& r, bool any_loo
       "the twin's DAQ at 0.1 ms with the same gains re-expressed per sample. The margins are "
       "those of the calibrated PID on that model (calibration/stability_margins.hpp).");
   if (any_loop)
-    doc.image("Inner loop Bode plot", "inner_loop_bode.png");
+    doc.image(inner_loop_figure(r).caption, "inner_loop_bode.png");
 }
 
 // The three calibration stages: PID gains, A and p, each beside the paper's.
@@ -549,11 +553,20 @@ void calibration_section(Document& doc, const ReproductionResult& r) {
       "differ where the paper's stage had effects the twin does not model (docs/twin.md).");
 }
 
+// The caption write_figures kept for the figure drawn to file_name.
+std::string caption_of(const ReportFiles& files, const std::string& file_name) {
+  for (std::size_t i = 0; i < files.figures.size() && i < files.captions.size(); ++i) {
+    if (files.figures[i].filename() == file_name)
+      return files.captions[i];
+  }
+  return {};
+}
+
 void figures_and_files_section(Document& doc, const ReportFiles& files) {
   doc.heading(2, "Figures");
-  doc.image("Figure 10: step response", "fig10_step_response.png");
-  doc.image("Figure 11: linearity, (a) displacement, (b) error", "fig11_linearity.png");
-  doc.image("Figure 12: repeatability at 5 and 10 um", "fig12_repeatability.png");
+  doc.image("Figure 10: " + caption_of(files, "fig10_step_response.png"), "fig10_step_response.png");
+  doc.image("Figure 11: " + caption_of(files, "fig11_linearity.png"), "fig11_linearity.png");
+  doc.image("Figure 12: " + caption_of(files, "fig12_repeatability.png"), "fig12_repeatability.png");
 
   doc.heading(2, "Files");
   std::string list;

@@ -22,7 +22,8 @@ namespace piezoshift::reproduction {
 struct ReportFiles {
   std::filesystem::path markdown;
   std::filesystem::path html;
-  std::vector<std::filesystem::path> figures;
+  std::vector<std::filesystem::path> figures;  //!< the PNGs (an SVG beside each)
+  std::vector<std::string> captions;  //!< per figure, its one-line caption (empty: none)
   std::vector<std::filesystem::path> data;  //!< CSV, JSON and TOML files
 };
 
