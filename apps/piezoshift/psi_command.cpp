@@ -26,10 +26,10 @@
 #include "piezoshift/psi/frame_set.hpp"
 #include "piezoshift/psi/npy.hpp"
 #include "piezoshift/psi/png_image.hpp"
-#include "piezoshift/psi/surface_figure.hpp"
 #include "piezoshift/psi/pupil_detection.hpp"
 #include "piezoshift/psi/simulation.hpp"
 #include "piezoshift/psi/step_calibration.hpp"
+#include "piezoshift/psi/surface_figure.hpp"
 #include "piezoshift/psi/zernike.hpp"
 #include "piezoshift/rig/validity.hpp"
 #include "piezoshift/runtime/safety_ranges.hpp"
@@ -90,9 +90,10 @@ Json write_analysis(const psi::Analysis& a, psi::Algorithm alg, double wavelengt
   fs::create_directories(out);
   psi::write_npy((fs::path(out) / "surface_nm.npy").string(), a.surface_nm);
   const auto [lo, hi] = psi::finite_range(a.surface_nm);
-  psi::write_surface_map(fs::path(out) / "surface_nm.png", a.surface_nm, lo, hi,
-                         fmt::format("Surface, piston and tilt removed: RMS {:.2f} nm, PV {:.2f} nm",
-                                     a.figures.rms, a.figures.pv));
+  psi::write_surface_map(
+      fs::path(out) / "surface_nm.png", a.surface_nm, lo, hi,
+      fmt::format("Surface, piston and tilt removed: RMS {:.2f} nm, PV {:.2f} nm", a.figures.rms,
+                  a.figures.pv));
   Json j{{"algorithm", psi::algorithm_name(alg)}, {"wavelength_nm", wavelength_nm},
          {"frames", a.phase.steps_rad.size()},    {"steps_rad", a.phase.steps_rad},
          {"iterations", a.phase.iterations},      {"converged", a.phase.converged},

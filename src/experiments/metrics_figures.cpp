@@ -72,17 +72,17 @@ io::Figure step_response_figure(std::span<const double> t_s, std::span<const dou
   zoom.x_range = window;
   zoom.y_range = std::pair{-5.0 * o.band_nm, 5.0 * o.band_nm};
   if (std::isfinite(m.settling_time_pct_s))
-    zoom.markers.push_back({.vertical = true,
-                            .at = t_step + m.settling_time_pct_s,
-                            .label = fmt::format("±{:g} %: {:.3f} s", o.band_pct,
-                                                 m.settling_time_pct_s),
-                            .label_at = 0.88});
+    zoom.markers.push_back(
+        {.vertical = true,
+         .at = t_step + m.settling_time_pct_s,
+         .label = fmt::format("±{:g} %: {:.3f} s", o.band_pct, m.settling_time_pct_s),
+         .label_at = 0.88});
   if (std::isfinite(m.settling_time_abs_s))
-    zoom.markers.push_back({.vertical = true,
-                            .at = t_step + m.settling_time_abs_s,
-                            .label = fmt::format("±{:g} nm: {:.3f} s", o.band_nm,
-                                                 m.settling_time_abs_s),
-                            .label_at = 0.12});
+    zoom.markers.push_back(
+        {.vertical = true,
+         .at = t_step + m.settling_time_abs_s,
+         .label = fmt::format("±{:g} nm: {:.3f} s", o.band_nm, m.settling_time_abs_s),
+         .label_at = 0.12});
   f.panels = {std::move(top), std::move(zoom)};
   f.caption = fmt::format("Step response: {}; {}; record {:.2f} s, zoomed on the transient.",
                           settled_pct, settled_abs, t1 - t0);
@@ -135,9 +135,10 @@ io::Figure linearity_figure(std::span<const double> desired_um, std::span<const 
   curve.x_range = std::pair{x0, x1};
   curve.y_range = padded_range(err_nm, line_nm);
 
-  io::Panel err = make_panel(fmt::format("(b) linearity error: zero-end {:.3f} %, best-fit {:.3f} %",
-                                         m.linearity_zero_end_pct, m.linearity_best_fit_pct),
-                             "desired displacement [µm]", "deviation [nm]", "below");
+  io::Panel err =
+      make_panel(fmt::format("(b) linearity error: zero-end {:.3f} %, best-fit {:.3f} %",
+                             m.linearity_zero_end_pct, m.linearity_best_fit_pct),
+                 "desired displacement [µm]", "deviation [nm]", "below");
   std::vector<double> d0(m.n), d1(m.n);
   for (std::size_t i = 0; i < m.n; ++i) {
     d0[i] = 1000.0 * m.deviation_zero_end_um[i];
@@ -210,8 +211,9 @@ io::Figure repeatability_figure(std::span<const RepeatabilitySet> sets, double b
     const double bin = histogram_bin_nm(1000.0 * (r.max_um - r.min_um), bin_nm);
     io::Panel p = make_panel(
         fmt::format("{}: e_R = {:.2f} nm (n = {})", s.label, r.repeatability_nm, r.n),
-        bin == bin_nm ? fmt::format("z − mean [nm]; mean {:.4f} µm", r.mean_um)
-                      : fmt::format("z − mean [nm]; mean {:.4f} µm, bins of {:g} nm", r.mean_um, bin),
+        bin == bin_nm
+            ? fmt::format("z − mean [nm]; mean {:.4f} µm", r.mean_um)
+            : fmt::format("z − mean [nm]; mean {:.4f} µm, bins of {:g} nm", r.mean_um, bin),
         "count", "below");
     p.series.push_back(io::histogram_series(
         bin == bin_nm ? fmt::format("z_i, bins of {:g} nm", bin) : std::string("z_i"), dev_nm,
@@ -224,10 +226,8 @@ io::Figure repeatability_figure(std::span<const RepeatabilitySet> sets, double b
       const double lo = 1000.0 * (r.min_um - r.mean_um) - bin;
       const double hi = 1000.0 * (r.max_um - r.mean_um) + bin;
       p.series.push_back(gaussian_series(r.repeatability_nm, r.n, bin, lo, hi));
-      p.markers.push_back({.vertical = true,
-                           .at = -r.repeatability_nm,
-                           .label = "−1 σ",
-                           .label_at = 0.9});
+      p.markers.push_back(
+          {.vertical = true, .at = -r.repeatability_nm, .label = "−1 σ", .label_at = 0.9});
       p.markers.push_back({.vertical = true,
                            .at = r.repeatability_nm,
                            .label = fmt::format("+1 σ = {:.2f} nm", r.repeatability_nm),

@@ -28,7 +28,8 @@ namespace {
 // takes a dash pattern and a point shape of its own, so the cycle survives greyscale printing.
 constexpr const char* kPalette[] = {"#0072B2", "#D55E00", "#009E73", "#CC79A7",
                                     "#E69F00", "#56B4E9", "#000000"};
-constexpr const char* kDashes[] = {"solid", "(8,4)", "(2,3)", "(10,3,2,3)", "(4,4)", "(12,3,3,3,3,3)"};
+constexpr const char* kDashes[] = {"solid",      "(8,4)", "(2,3)",
+                                   "(10,3,2,3)", "(4,4)", "(12,3,3,3,3,3)"};
 constexpr int kPointTypes[] = {7, 5, 9, 13, 11, 15};  // filled circle, square, triangles, diamond
 constexpr const char* kFont = "Sans";
 constexpr int kFontPt = 10;
@@ -141,8 +142,8 @@ void validate(const Figure& f) {
       }
       if (!s.dash.empty() && s.dash != "solid" &&
           s.dash.find_first_not_of("0123456789.,() ") != std::string::npos)
-        throw std::invalid_argument(fmt::format(
-            "plot: dash '{}' of series '{}' is not a pattern", one_line(s.dash), s.title));
+        throw std::invalid_argument(fmt::format("plot: dash '{}' of series '{}' is not a pattern",
+                                                one_line(s.dash), s.title));
       const bool needs_w = s.style == SeriesStyle::kBoxes || s.style == SeriesStyle::kBand ||
                            s.style == SeriesStyle::kImage;
       if (s.x.empty() || s.x.size() != s.y.size() || (needs_w && s.w.size() != s.x.size()))
@@ -209,18 +210,18 @@ std::string marker_commands(const Panel& p) {
           "'{1}' front\n",
           at, kMarkerColor);
       if (!m.label.empty())
-        b += fmt::format(
-            "set label {} at first {}, graph {} offset 0.6,0 tc rgb '{}' boxed front\n",
-            gp_quote(m.label), at, along, kMarkerColor);
+        b +=
+            fmt::format("set label {} at first {}, graph {} offset 0.6,0 tc rgb '{}' boxed front\n",
+                        gp_quote(m.label), at, along, kMarkerColor);
     } else {
       b += fmt::format(
           "set arrow from graph 0, first {0} to graph 1, first {0} nohead dt (6,4) lw 1.2 lc rgb "
           "'{1}' front\n",
           at, kMarkerColor);
       if (!m.label.empty())
-        b += fmt::format(
-            "set label {} at graph {}, first {} offset 0,0.7 tc rgb '{}' boxed front\n",
-            gp_quote(m.label), along, at, kMarkerColor);
+        b +=
+            fmt::format("set label {} at graph {}, first {} offset 0,0.7 tc rgb '{}' boxed front\n",
+                        gp_quote(m.label), along, at, kMarkerColor);
     }
   }
   for (const Label& l : p.labels) {
@@ -312,16 +313,15 @@ std::string script_body(const Figure& f) {
 
 // The style every terminal shares (plot.hpp): grid, ticks, text boxes, the maps' palette.
 std::string style_preamble() {
-  return
-      "set grid lt 1 lw 0.5 lc rgb '#d0d0d0'\n"
-      "set border lw 1 lc rgb '#000000'\n"
-      "set tics out nomirror\n"
-      "set style textbox opaque noborder margins 1,1\n"
-      "set key noenhanced samplen 3 spacing 1.1\n"
-      // Maps: Paul Tol's diverging BuRd scheme (https://personal.sron.nl/~pault/), white at the
-      // middle, readable in greyscale as dark-light-dark.
-      "set palette defined (0 '#2166AC', 0.25 '#6EA6CD', 0.5 '#F7F7F7', 0.75 '#F4A582', "
-      "1 '#B2182B')\n";
+  return "set grid lt 1 lw 0.5 lc rgb '#d0d0d0'\n"
+         "set border lw 1 lc rgb '#000000'\n"
+         "set tics out nomirror\n"
+         "set style textbox opaque noborder margins 1,1\n"
+         "set key noenhanced samplen 3 spacing 1.1\n"
+         // Maps: Paul Tol's diverging BuRd scheme (https://personal.sron.nl/~pault/), white at the
+         // middle, readable in greyscale as dark-light-dark.
+         "set palette defined (0 '#2166AC', 0.25 '#6EA6CD', 0.5 '#F7F7F7', 0.75 '#F4A582', "
+         "1 '#B2182B')\n";
 }
 
 std::string read_text(const fs::path& p) {

@@ -16,8 +16,8 @@ io::Figure surface_figure(const Map& surface_nm, double lo_nm, double hi_nm, std
   f.width_px = 640;
   f.height_px = 560;
   io::Panel p;
-  p.title = stride == 1 ? std::move(title)
-                        : fmt::format("{} (every {}th pixel drawn)", title, stride);
+  p.title =
+      stride == 1 ? std::move(title) : fmt::format("{} (every {}th pixel drawn)", title, stride);
   p.x_label = "x [pixel]";
   p.y_label = "y [pixel]";
   p.cb_label = "height [nm]";

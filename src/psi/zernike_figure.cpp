@@ -7,7 +7,9 @@ io::Figure zernike_figure(std::span<const double> zernike_nm) {
   f.width_px = 800;
   f.height_px = 440;
   io::Panel p;
-  p.title = "Zernike coefficients, piston and tilt removed (j = 4 defocus, 5-6 astigmatism, 7-8 coma, 11 spherical)";
+  p.title =
+      "Zernike coefficients, piston and tilt removed (j = 4 defocus, 5-6 astigmatism, 7-8 coma, 11 "
+      "spherical)";
   p.x_label = "Noll index j";
   p.y_label = "coefficient, RMS [nm]";
   p.key = "off";

@@ -105,7 +105,8 @@ io::Figure step_figure(const SeedComparison& sc) {
   all.x_range = zoom.x_range = std::pair{t0, std::min(t1, t0 + 0.2)};
   zoom.series.insert(zoom.series.begin(), io::band_series("±10 nm", t0, t1, -10.0, 10.0));
   f.panels = {std::move(all), std::move(zoom)};
-  f.caption = "The 11 µm step of the three controllers; below, the last 50 nm with the ±10 nm band.";
+  f.caption =
+      "The 11 µm step of the three controllers; below, the last 50 nm with the ±10 nm band.";
   return f;
 }
 
@@ -131,23 +132,23 @@ io::Figure phase_step_figure(const SeedComparison& sc, double tolerance_nm) {
       continue;
     t1 = std::max(t1, ps.time_s.back());
     step_nm = ps.step_nm;
-    p.series.push_back(variant_line(
-        k,
-        fmt::format("{}: settled {}, hold jitter {:.2f} nm rms", variant_key(k),
-                    std::isfinite(ps.settling_time_s)
-                        ? fmt::format("{:.1f} ms", 1e3 * ps.settling_time_s)
-                        : std::string("never"),
-                    ps.hold_jitter_nm_rms),
-        ps.time_s, ps.exposure_mean_nm));
+    p.series.push_back(
+        variant_line(k,
+                     fmt::format("{}: settled {}, hold jitter {:.2f} nm rms", variant_key(k),
+                                 std::isfinite(ps.settling_time_s)
+                                     ? fmt::format("{:.1f} ms", 1e3 * ps.settling_time_s)
+                                     : std::string("never"),
+                                 ps.hold_jitter_nm_rms),
+                     ps.time_s, ps.exposure_mean_nm));
     std::vector<double> err(ps.exposure_mean_nm);
     for (double& v : err)
       v -= ps.step_nm;
     near.series.push_back(variant_line(k, "", ps.time_s, err));
   }
   // The band over the whole axis, in both panels.
-  p.series.insert(p.series.begin(), io::band_series(fmt::format("±{:g} nm", tolerance_nm), 0.0, t1,
-                                                    step_nm - tolerance_nm,
-                                                    step_nm + tolerance_nm));
+  p.series.insert(p.series.begin(),
+                  io::band_series(fmt::format("±{:g} nm", tolerance_nm), 0.0, t1,
+                                  step_nm - tolerance_nm, step_nm + tolerance_nm));
   near.series.insert(near.series.begin(),
                      io::band_series("", 0.0, t1, -tolerance_nm, tolerance_nm));
   p.x_range = near.x_range = std::pair{0.0, t1};
@@ -201,7 +202,8 @@ io::Figure linearity_error_figure(const SeedComparison& sc) {
     }
   }
   f.panels = {std::move(a), std::move(b)};
-  f.caption = "Zero-end linearity error of the three controllers (legend: linearity in % of range).";
+  f.caption =
+      "Zero-end linearity error of the three controllers (legend: linearity in % of range).";
   return f;
 }
 
@@ -244,8 +246,7 @@ std::vector<SeedComparison>::const_iterator draw_figures(const ComparisonResult&
                              linearity_error_figure(*drawn), repeatability_figure(*drawn)};
   const char* const stems[] = {"compare_step_response", "compare_phase_step",
                                "compare_linearity_error", "compare_repeatability"};
-  for (std::size_t i = 0; i < 4; ++i)
-  {
+  for (std::size_t i = 0; i < 4; ++i) {
     files.figures.push_back(*io::render(figs[i], dir / stems[i]).png);
     files.captions.push_back(figs[i].caption);
   }
@@ -330,9 +331,10 @@ void figures_section(Document& doc, const ComparisonResult& r,
     doc.heading(2, fmt::format("Figures (seed {})", drawn->seed));
     doc.image("The 11 µm step of the three controllers; below, the last 50 nm with the ±10 nm band",
               "compare_step_response.png");
-    doc.image("The λ/8 phase step on 1 ms exposure means with the ±1 nm band; below, around the "
-              "target",
-              "compare_phase_step.png");
+    doc.image(
+        "The λ/8 phase step on 1 ms exposure means with the ±1 nm band; below, around the "
+        "target",
+        "compare_phase_step.png");
     doc.image("Zero-end linearity error curves (legend: linearity in % of range)",
               "compare_linearity_error.png");
     doc.image("Repeatability histograms at 5 and 10 µm with the normal density of σ = e_R",

@@ -27,6 +27,14 @@ std::string seconds(double t) {
   return std::isfinite(t) ? fmt::format("{:.3f} s", t) : "not settled";
 }
 
+// A figure with its caption printed under it ("Figure 10: ..."), as a paper prints one.
+void figure(Document& doc, const std::string& name, const std::string& file,
+            const std::string& caption) {
+  doc.image(name, file);
+  if (!caption.empty())
+    doc.paragraph(name + ": " + caption);
+}
+
 // The lambda/8 step of both controllers on the true plate's 1 ms exposure means, with the +-1 nm
 // band around the target over the whole record; below, the same around the target at nm scale,
 // where the hold jitter of the two controllers differs.
@@ -149,7 +157,8 @@ io::Figure inner_loop_figure(const ReproductionResult& r) {
     for (std::size_t i = 0; i < 3; ++i) {
       const LoopCurve c = loop_curve(a, i);
       io::Series m = io::line_series("", c.hz, c.db, colour);
-      io::Series p = io::line_series(fmt::format("{}, actuator {}", khz, i + 1), c.hz, c.deg, colour);
+      io::Series p =
+          io::line_series(fmt::format("{}, actuator {}", khz, i + 1), c.hz, c.deg, colour);
       m.dash = p.dash = actuator_dash[i];
       mag.series.push_back(std::move(m));
       ph.series.push_back(std::move(p));
@@ -472,7 +481,7 @@ void phase_step_section(Document& doc, const ReproductionResult& r) {
       "loop feeds of the gauges' noise into the plate while it holds; the settling time is when "
       "every later exposure stays within +-1 nm of the target, within {:g} ms.",
       r.phase_step.step_nm, 1e3 * r.schedule.phase_step.record_s));
-  doc.image(phase_step_figure(r).caption, "phase_step.png");
+  figure(doc, "Phase step", "phase_step.png", phase_step_figure(r).caption);
 }
 
 // Per loop rate and actuator: the identified plant and the calibrated PID's margins on it.
@@ -505,7 +514,7 @@ void inner_loop_section(Document& doc, const ReproductionResult& r, bool any_loo
       "the twin's DAQ at 0.1 ms with the same gains re-expressed per sample. The margins are "
       "those of the calibrated PID on that model (calibration/stability_margins.hpp).");
   if (any_loop)
-    doc.image(inner_loop_figure(r).caption, "inner_loop_bode.png");
+    figure(doc, "Inner loop Bode plot", "inner_loop_bode.png", inner_loop_figure(r).caption);
 }
 
 // The three calibration stages: PID gains, A and p, each beside the paper's.
@@ -564,9 +573,10 @@ std::string caption_of(const ReportFiles& files, const std::string& file_name) {
 
 void figures_and_files_section(Document& doc, const ReportFiles& files) {
   doc.heading(2, "Figures");
-  doc.image("Figure 10: " + caption_of(files, "fig10_step_response.png"), "fig10_step_response.png");
-  doc.image("Figure 11: " + caption_of(files, "fig11_linearity.png"), "fig11_linearity.png");
-  doc.image("Figure 12: " + caption_of(files, "fig12_repeatability.png"), "fig12_repeatability.png");
+  for (const auto& [name, file] : {std::pair{"Figure 10", "fig10_step_response.png"},
+                                   std::pair{"Figure 11", "fig11_linearity.png"},
+                                   std::pair{"Figure 12", "fig12_repeatability.png"}})
+    figure(doc, name, file, caption_of(files, file));
 
   doc.heading(2, "Files");
   std::string list;

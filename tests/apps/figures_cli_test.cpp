@@ -60,8 +60,8 @@ TEST_F(FiguresCli, PsiSurfaceMapHasANumberedColourBarInNanometres) {
   std::string frames;
   for (int k = 0; k < 5; ++k)
     frames += " '" + path("sim") + "/frame_0" + std::to_string(k) + ".png'";
-  const testing::CliResult r =
-      run("psi analyze" + frames + " --mask '" + path("sim") + "/mask.png' --out '" + path("a") + "'");
+  const testing::CliResult r = run("psi analyze" + frames + " --mask '" + path("sim") +
+                                   "/mask.png' --out '" + path("a") + "'");
   ASSERT_EQ(r.status, 0) << r.err;
   expect_clean_figures(path("a"), 1);
   const std::string gp = testing::read_whole_file(path("a") + "/surface_nm.gp");

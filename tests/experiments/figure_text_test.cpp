@@ -112,8 +112,8 @@ TEST(FigureText, PaperFiguresPassTheTextChecks) {
   so.step_time_s = 0.01;
   const StepResponseMetrics sm = step_response_metrics(t, y, so);
   const fs::path dir = out_dir("paper");
-  const auto f10 = io::render(svg_only(step_response_figure(t, y, sm, so, "Step response to 11 µm")),
-                              dir / "fig10");
+  const auto f10 = io::render(
+      svg_only(step_response_figure(t, y, sm, so, "Step response to 11 µm")), dir / "fig10");
   std::vector<double> xd, yd;
   for (int k = 0; k <= 11; ++k) {
     xd.push_back(k);
@@ -126,8 +126,8 @@ TEST(FigureText, PaperFiguresPassTheTextChecks) {
     sets[0].measured_um.push_back(5.0 + 0.002 * std::sin(1.7 * k));
     sets[1].measured_um.push_back(10.0 + 0.003 * std::cos(2.3 * k));
   }
-  const auto f12 = io::render(svg_only(repeatability_figure(sets, 1.0, "Repeatability")),
-                              dir / "fig12");
+  const auto f12 =
+      io::render(svg_only(repeatability_figure(sets, 1.0, "Repeatability")), dir / "fig12");
   int figures = 0;
   EXPECT_EQ(joined(testing::folder_figure_problems(dir, figures)), "");
   EXPECT_EQ(figures, 3);

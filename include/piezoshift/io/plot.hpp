@@ -91,8 +91,8 @@ struct Panel {
   std::optional<std::pair<double, double>> y_range;
   //! gnuplot legend placement, outside the data by default; "off" hides the legend
   std::string key = "below";
-  bool x_log = false;  //!< logarithmic x axis (Bode plots); every x must be > 0
-  std::string cb_label;                               //!< colour bar of a kImage panel, with unit
+  bool x_log = false;    //!< logarithmic x axis (Bode plots); every x must be > 0
+  std::string cb_label;  //!< colour bar of a kImage panel, with unit
   std::optional<std::pair<double, double>> cb_range;  //!< kImage colour scale; empty: autoscale
   bool equal_axes = false;                            //!< one x unit as long as one y unit (maps)
 };
