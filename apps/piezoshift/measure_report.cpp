@@ -127,6 +127,9 @@ io::Figure steps_figure(const MeasureRecord& r) {
     k.push_back(static_cast<double>(i));
     diff.push_back(1000.0 * (lhs[i] - rhs[i]));
   }
+  // Frames are whole numbers: a margin of a third of a frame keeps the first and last off the
+  // frame of the plot.
+  top.x_range = bottom.x_range = std::pair{-0.35, static_cast<double>(commanded.size()) - 0.65};
   top.series.push_back(io::line_series("commanded", k, commanded));
   if (!rec.empty())
     top.series.push_back(io::point_series("recovered (AIA)", k, rec));

@@ -282,6 +282,15 @@ std::string panel_settings(const Panel& p) {
                       : fmt::format("set key {}{} noautotitle\n", p.key, outside ? "" : " opaque");
   b += p.x_log ? "set logscale x\n" : "unset logscale x\n";
   b += fmt::format("set xrange {}\nset yrange {}\n", range(p.x_range), range(p.y_range));
+  // An autoscaled axis keeps a margin so that no point sits on the frame (offsets apply to
+  // autoscaled ranges only); x only for discrete data (points, bars), where a curve's ends
+  // would otherwise leave a gap.
+  const bool discrete = std::all_of(p.series.begin(), p.series.end(), [](const Series& s) {
+    return s.style != SeriesStyle::kLines && s.style != SeriesStyle::kBand &&
+           s.style != SeriesStyle::kImage;
+  });
+  b += fmt::format("set offsets graph {0}, graph {0}, graph 0.06, graph 0.06\n",
+                   discrete ? "0.04" : "0");
   const bool image = std::any_of(p.series.begin(), p.series.end(),
                                  [](const Series& s) { return s.style == SeriesStyle::kImage; });
   if (image) {

@@ -199,6 +199,7 @@ io::Figure linearity_error_figure(const SeedComparison& sc) {
       panel->series.push_back(variant_line(
           k, fmt::format("{}: {:.3f} %", variant_key(k), lin->metrics.linearity_zero_end_pct),
           lin->desired_um, nm));
+      panel->x_range = std::pair{lin->desired_um.front(), lin->desired_um.back()};
     }
   }
   f.panels = {std::move(a), std::move(b)};
