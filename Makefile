@@ -7,7 +7,7 @@ BUILD_DIR = build/$(PRESET)
 PIEZOSHIFT = $(BUILD_DIR)/apps/piezoshift/piezoshift
 DEMO_OUT ?= out/demo
 
-.PHONY: all deps configure build test test-fast demo mcu python python-install sanitize fuzz bench format format-check clean
+.PHONY: all deps configure build test test-fast demo figures mcu python python-install sanitize fuzz bench format format-check clean
 
 all: build
 
@@ -34,6 +34,11 @@ test-fast:
 demo: configure
 	@cmake --build --preset $(PRESET) -j $(JOBS) --target piezoshift_cli
 	@$(PIEZOSHIFT) reproduce --out $(DEMO_OUT)
+
+# Every figure the project draws, as SVG in docs/figures/ (the gallery docs/figures.md).
+figures: configure
+	@cmake --build --preset $(PRESET) -j $(JOBS) --target piezoshift_cli
+	@scripts/figures $(PIEZOSHIFT)
 
 # The controller in float on a Cortex-M4F under QEMU (docs/mcu.md): cross-builds the firmware,
 # runs it and prints its sizes, the equivalence with the host controller and the cost per tick.

@@ -15,6 +15,7 @@
 #include "piezoshift/io/plot.hpp"
 #include "piezoshift/psi/npy.hpp"
 #include "piezoshift/psi/png_image.hpp"
+#include "piezoshift/psi/surface_figure.hpp"
 #include "piezoshift/psi/zernike_figure.hpp"
 
 namespace piezoshift::app {
@@ -95,9 +96,7 @@ void write_frames(const MeasureRecord& r, const fs::path& dir) {
 }
 
 io::Figure zernike_figure(const instrument::MeasurementAnalysis& a) {
-  io::Figure f = psi::zernike_figure(a.zernike_nm);
-  f.svg = true;
-  return f;
+  return psi::zernike_figure(a.zernike_nm);
 }
 
 // The steps as commanded, as recovered from the fringes (AIA) and, on the twin, as made; below,
@@ -113,28 +112,29 @@ io::Figure steps_figure(const MeasureRecord& r) {
   const std::vector<double>& rhs = rec.empty() || !truth ? commanded : a.true_steps_rad.front();
   io::Figure f;
   f.rows = 2;
-  f.width_px = 900;
-  f.height_px = 800;
-  f.svg = true;
+  f.width_px = 800;
+  f.height_px = 760;
   io::Panel top =
       panel(rec.empty() ? "Phase steps, average 1 (not recovered: " + a.steps_reason + ")"
                         : "Phase steps, average 1",
-            "frame", "step [rad]");
+            "frame number", "step [rad]");
   io::Panel bottom =
       panel(rec.empty() ? (truth ? "true - commanded" : "(no recovered steps)")
                         : (truth ? "recovered from the fringes - true" : "recovered - commanded"),
-            "frame", "difference [mrad]");
+            "frame number", "difference [mrad]");
   std::vector<double> k, diff;
   for (std::size_t i = 0; i < commanded.size(); ++i) {
     k.push_back(static_cast<double>(i));
     diff.push_back(1000.0 * (lhs[i] - rhs[i]));
   }
+  // Frames are whole numbers: a margin of a third of a frame keeps the first and last off the
+  // frame of the plot.
+  top.x_range = bottom.x_range = std::pair{-0.35, static_cast<double>(commanded.size()) - 0.65};
   top.series.push_back(io::line_series("commanded", k, commanded));
   if (!rec.empty())
     top.series.push_back(io::point_series("recovered (AIA)", k, rec));
   if (truth)
     top.series.push_back(io::point_series("true (twin)", k, a.true_steps_rad.front()));
-  top.key = "top left";
   bottom.series.push_back(io::point_series("", k, diff));
   bottom.markers.push_back({.vertical = false, .at = 0.0, .label = ""});
   bottom.key = "off";
@@ -145,10 +145,9 @@ io::Figure steps_figure(const MeasureRecord& r) {
 // Where the stage was while each frame was exposed, against the commanded piston.
 io::Figure stage_figure(const MeasureRecord& r) {
   io::Figure f;
-  f.width_px = 900;
-  f.height_px = 500;
-  f.svg = true;
-  io::Panel p = panel("The stage during each exposure", "exposure", "error [nm]");
+  f.width_px = 800;
+  f.height_px = 520;
+  io::Panel p = panel("The stage during each exposure", "exposure number", "error [nm]");
   std::vector<double> k, gauge, truth;
   for (std::size_t i = 0; i < r.sequence->exposures.size(); ++i) {
     const instrument::ExposureRecord& e = r.sequence->exposures[i];
@@ -263,7 +262,9 @@ void write_measurement(const MeasureRecord& r, const std::string& out_name) {
     psi::write_mask_png((tmp / "mask.png").string(), *r.mask);
     psi::write_npy((tmp / "surface_nm.npy").string(), r.analysis->surface_nm);
     const auto [lo, hi] = psi::finite_range(r.analysis->surface_nm);
-    psi::write_false_colour_png((tmp / "surface_nm.png").string(), r.analysis->surface_nm, lo, hi);
+    psi::write_surface_map(tmp / "surface_nm.png", r.analysis->surface_nm, lo, hi,
+                           fmt::format("Measured surface: RMS {:.2f} nm, PV {:.2f} nm",
+                                       r.analysis->figures.rms, r.analysis->figures.pv));
     if (r.truth_nm != nullptr)
       psi::write_npy((tmp / "surface_truth_nm.npy").string(), *r.truth_nm);
     write_exposures_csv(*r.sequence, tmp / "exposures.csv");

@@ -29,6 +29,7 @@
 #include "piezoshift/psi/pupil_detection.hpp"
 #include "piezoshift/psi/simulation.hpp"
 #include "piezoshift/psi/step_calibration.hpp"
+#include "piezoshift/psi/surface_figure.hpp"
 #include "piezoshift/psi/zernike.hpp"
 #include "piezoshift/rig/validity.hpp"
 #include "piezoshift/runtime/safety_ranges.hpp"
@@ -89,7 +90,10 @@ Json write_analysis(const psi::Analysis& a, psi::Algorithm alg, double wavelengt
   fs::create_directories(out);
   psi::write_npy((fs::path(out) / "surface_nm.npy").string(), a.surface_nm);
   const auto [lo, hi] = psi::finite_range(a.surface_nm);
-  psi::write_false_colour_png((fs::path(out) / "surface_nm.png").string(), a.surface_nm, lo, hi);
+  psi::write_surface_map(
+      fs::path(out) / "surface_nm.png", a.surface_nm, lo, hi,
+      fmt::format("Surface, piston and tilt removed: RMS {:.2f} nm, PV {:.2f} nm", a.figures.rms,
+                  a.figures.pv));
   Json j{{"algorithm", psi::algorithm_name(alg)}, {"wavelength_nm", wavelength_nm},
          {"frames", a.phase.steps_rad.size()},    {"steps_rad", a.phase.steps_rad},
          {"iterations", a.phase.iterations},      {"converged", a.phase.converged},

@@ -5,6 +5,7 @@
 #include <sys/wait.h>
 #include <unistd.h>
 
+#include <algorithm>
 #include <cerrno>
 #include <cmath>
 #include <cstdlib>
@@ -21,9 +22,20 @@ namespace piezoshift::io {
 namespace fs = std::filesystem;
 namespace {
 
-// A colour-blind-friendly cycle (the "tab10" palette).
-constexpr const char* kPalette[] = {"#1f77b4", "#d62728", "#2ca02c", "#ff7f0e",
-                                    "#9467bd", "#8c564b", "#e377c2", "#7f7f7f"};
+// The house style (plot.hpp). Colours: the Okabe-Ito palette (M. Okabe and K. Ito, "Color
+// Universal Design", 2008; https://jfly.uni-koeln.de/color/), which stays apart for the common
+// colour-vision deficiencies; its yellow is left out (unreadable on white). Each series also
+// takes a dash pattern and a point shape of its own, so the cycle survives greyscale printing.
+constexpr const char* kPalette[] = {"#0072B2", "#D55E00", "#009E73", "#CC79A7",
+                                    "#E69F00", "#56B4E9", "#000000"};
+constexpr const char* kDashes[] = {"solid",      "(8,4)", "(2,3)",
+                                   "(10,3,2,3)", "(4,4)", "(12,3,3,3,3,3)"};
+constexpr int kPointTypes[] = {7, 5, 9, 13, 11, 15};  // filled circle, square, triangles, diamond
+constexpr const char* kFont = "Sans";
+constexpr int kFontPt = 10;
+constexpr const char* kMarkerColor = "#404040";
+// Bands (tolerances) in a neutral green-grey so that they never read as one of the series.
+constexpr const char* kBandColor = "#009E73";
 
 // Text that must stay on one line of the script or the data file: a line break (or any other
 // control character) in a title or a file name would end the comment or string it is in and put
@@ -101,9 +113,18 @@ void validate(const Figure& f) {
         fmt::format("plot: a {}x{} grid cannot hold {} panels", f.rows, f.cols, f.panels.size()));
   if (f.width_px < 16 || f.height_px < 16 || f.width_px > 20000 || f.height_px > 20000)
     throw std::invalid_argument("plot: figure size out of [16, 20000] pixels");
+  if (!(f.png_scale >= 0.25 && f.png_scale <= 8.0) ||
+      f.png_scale * std::max(f.width_px, f.height_px) > 20000.0)
+    throw std::invalid_argument("plot: png_scale out of [0.25, 8] or a PNG over 20000 pixels");
   for (const Panel& p : f.panels) {
     if (p.series.empty())
       throw std::invalid_argument(fmt::format("plot: panel '{}' has no series", p.title));
+    for (const Label& l : p.labels) {
+      if (l.align != "left" && l.align != "center" && l.align != "right")
+        throw std::invalid_argument(fmt::format("plot: label '{}' of panel '{}' aligns '{}'",
+                                                one_line(l.text), one_line(p.title),
+                                                one_line(l.align)));
+    }
     // The key's position is written into the script as it is (`set key bottom right`): words
     // and numbers only, nothing that could end the command (a line break, `;`, a quote).
     if (p.key.find_first_not_of("abcdefghijklmnopqrstuvwxyzABCDEFGHIJKLMNOPQRSTUVWXYZ0123456789_"
@@ -119,7 +140,12 @@ void validate(const Figure& f) {
                             s.title, p.title, x));
         }
       }
-      const bool needs_w = s.style == SeriesStyle::kBoxes || s.style == SeriesStyle::kBand;
+      if (!s.dash.empty() && s.dash != "solid" &&
+          s.dash.find_first_not_of("0123456789.,() ") != std::string::npos)
+        throw std::invalid_argument(fmt::format("plot: dash '{}' of series '{}' is not a pattern",
+                                                one_line(s.dash), s.title));
+      const bool needs_w = s.style == SeriesStyle::kBoxes || s.style == SeriesStyle::kBand ||
+                           s.style == SeriesStyle::kImage;
       if (s.x.empty() || s.x.size() != s.y.size() || (needs_w && s.w.size() != s.x.size()))
         throw std::invalid_argument(
             fmt::format("plot: series '{}' of panel '{}' has {} x, {} y and {} w values", s.title,
@@ -128,25 +154,153 @@ void validate(const Figure& f) {
   }
 }
 
-std::string style_clause(const Series& s, const std::string& color) {
-  const std::string lc = fmt::format("lc rgb {}", gp_quote(color));
+// What the cycle gives series number k of a panel: colour, dash and point shape together.
+struct CycleStyle {
+  std::string color;
+  std::string dash;
+  int point_type;
+};
+
+CycleStyle cycle_style(const Series& s, std::size_t k) {
+  const std::size_t n = std::size(kPalette);
+  CycleStyle c{s.color.empty() ? kPalette[k % n] : s.color,
+               s.dash.empty() ? kDashes[k % std::size(kDashes)] : s.dash,
+               kPointTypes[k % std::size(kPointTypes)]};
+  return c;
+}
+
+std::string dash_clause(const std::string& dash) {
+  return dash == "solid" ? "dt solid" : "dt " + dash;
+}
+
+std::string style_clause(const Series& s, const CycleStyle& c) {
+  const std::string lc = fmt::format("lc rgb {}", gp_quote(c.color));
   switch (s.style) {
     case SeriesStyle::kLines:
-      return fmt::format("using 1:2 with lines lw {} {}", s.line_width, lc);
+      return fmt::format("using 1:2 with lines lw {} {} {}", s.line_width, dash_clause(c.dash), lc);
     case SeriesStyle::kPoints:
-      return fmt::format("using 1:2 with points pt 7 ps 0.6 {}", lc);
+      return fmt::format("using 1:2 with points pt {} ps 0.7 {}", c.point_type, lc);
     case SeriesStyle::kLinesPoints:
-      return fmt::format("using 1:2 with linespoints lw {} pt 7 ps 0.6 {}", s.line_width, lc);
+      return fmt::format("using 1:2 with linespoints lw {} {} pt {} ps 0.7 {}", s.line_width,
+                         dash_clause(c.dash), c.point_type, lc);
     case SeriesStyle::kBoxes:
-      return fmt::format("using 1:2:3 with boxes fs solid 0.5 border {}", lc);
+      // The colour before the fill style colours the fill, the one after it the border.
+      return fmt::format("using 1:2:3 with boxes {0} fs solid 0.45 border {0}", lc);
     case SeriesStyle::kBand:
-      return fmt::format("using 1:2:3 with filledcurves fs transparent solid 0.2 noborder {}", lc);
+      return fmt::format("using 1:2:3 with filledcurves fs transparent solid 0.25 noborder {}", lc);
+    case SeriesStyle::kImage:
+      return "using 1:2:3 with image";
   }
   return {};
 }
 
 std::string range(const std::optional<std::pair<double, double>>& r) {
   return r ? fmt::format("[{}:{}]", number(r->first), number(r->second)) : "[*:*]";
+}
+
+// Dashed reference lines with their labels on an opaque box, in front of the data.
+std::string marker_commands(const Panel& p) {
+  std::string b;
+  for (const Marker& m : p.markers) {
+    const std::string at = number(m.at);
+    const std::string along = number(m.label_at);
+    if (m.vertical) {
+      b += fmt::format(
+          "set arrow from first {0}, graph 0 to first {0}, graph 1 nohead dt (6,4) lw 1.2 lc rgb "
+          "'{1}' front\n",
+          at, kMarkerColor);
+      if (!m.label.empty())
+        b +=
+            fmt::format("set label {} at first {}, graph {} offset 0.6,0 tc rgb '{}' boxed front\n",
+                        gp_quote(m.label), at, along, kMarkerColor);
+    } else {
+      b += fmt::format(
+          "set arrow from graph 0, first {0} to graph 1, first {0} nohead dt (6,4) lw 1.2 lc rgb "
+          "'{1}' front\n",
+          at, kMarkerColor);
+      if (!m.label.empty())
+        b +=
+            fmt::format("set label {} at graph {}, first {} offset 0,0.7 tc rgb '{}' boxed front\n",
+                        gp_quote(m.label), along, at, kMarkerColor);
+    }
+  }
+  for (const Label& l : p.labels) {
+    b += fmt::format("set label {} at {} {}, {} {} {} boxed front\n", gp_quote(l.text),
+                     l.data_coords ? "first" : "graph", number(l.x),
+                     l.data_coords ? "first" : "graph", number(l.y), l.align);
+  }
+  return b;
+}
+
+// The plot command of one panel: bands first so the curves are drawn over their fill, then the
+// curves, then the bands' edges over the curves (a band hidden under data is no band).
+std::string plot_command(const Panel& p, int first_index) {
+  std::vector<std::string> fills, curves, edges;
+  std::size_t next = 0;
+  for (std::size_t si = 0; si < p.series.size(); ++si) {
+    const Series& s = p.series[si];
+    const int index = first_index + static_cast<int>(si);
+    CycleStyle c;
+    if (s.style == SeriesStyle::kBand || s.style == SeriesStyle::kImage)
+      c = {s.color.empty() ? kBandColor : s.color, "(4,3)", 7};
+    else
+      c = cycle_style(s, next++);
+    const std::string clause =
+        fmt::format("datafile index {} {} {}", index, style_clause(s, c),
+                    s.title.empty() ? "notitle" : "title " + gp_quote(s.title));
+    if (s.style == SeriesStyle::kBand) {
+      fills.push_back(clause);
+      for (const char* col : {"2", "3"})
+        edges.push_back(
+            fmt::format("datafile index {} using 1:{} with lines lw 1 dt (4,3) lc rgb {} notitle",
+                        index, col, gp_quote(c.color)));
+    } else {
+      curves.push_back(clause);
+    }
+  }
+  std::string plot;
+  for (const auto* group : {&fills, &curves, &edges}) {
+    for (const std::string& clause : *group) {
+      plot += plot.empty() ? "plot " : ", \\\n     ";
+      plot += clause;
+    }
+  }
+  return plot + "\n";
+}
+
+// The settings one panel changes, reset for each panel of a multiplot.
+std::string panel_settings(const Panel& p) {
+  std::string b = "unset arrow\nunset label\n";
+  b += fmt::format("set title {}\nset xlabel {}\nset ylabel {}\n", gp_quote(p.title),
+                   gp_quote(p.x_label), gp_quote(p.y_label));
+  // A key inside the data gets an opaque box; one outside must not (its box would cover the
+  // axis label next to it).
+  const bool outside = p.key.find("below") != std::string::npos ||
+                       p.key.find("outside") != std::string::npos ||
+                       p.key.find("above") != std::string::npos;
+  b += p.key == "off" ? "unset key\n"
+                      : fmt::format("set key {}{} noautotitle\n", p.key, outside ? "" : " opaque");
+  b += p.x_log ? "set logscale x\n" : "unset logscale x\n";
+  b += fmt::format("set xrange {}\nset yrange {}\n", range(p.x_range), range(p.y_range));
+  // An autoscaled axis keeps a margin so that no point sits on the frame (offsets apply to
+  // autoscaled ranges only); x only for discrete data (points, bars), where a curve's ends
+  // would otherwise leave a gap.
+  const bool discrete = std::all_of(p.series.begin(), p.series.end(), [](const Series& s) {
+    return s.style != SeriesStyle::kLines && s.style != SeriesStyle::kBand &&
+           s.style != SeriesStyle::kImage;
+  });
+  b += fmt::format("set offsets graph {0}, graph {0}, graph 0.06, graph 0.06\n",
+                   discrete ? "0.04" : "0");
+  const bool image = std::any_of(p.series.begin(), p.series.end(),
+                                 [](const Series& s) { return s.style == SeriesStyle::kImage; });
+  if (image) {
+    b += fmt::format("set cblabel {}\nset cbrange {}\nset colorbox\n", gp_quote(p.cb_label),
+                     range(p.cb_range));
+  } else {
+    b += "unset colorbox\n";
+  }
+  b += p.equal_axes ? "set size ratio -1\n" : "set size noratio\n";
+  return b + marker_commands(p);
 }
 
 // The plot commands, the same for every terminal.
@@ -158,56 +312,25 @@ std::string script_body(const Figure& f) {
   for (std::size_t pi = 0; pi < f.panels.size(); ++pi) {
     const Panel& p = f.panels[pi];
     b += fmt::format("\n# panel {}\n", pi + 1);
-    b += "unset arrow\nunset label\nset grid\n";
-    b += fmt::format("set title {}\nset xlabel {}\nset ylabel {}\n", gp_quote(p.title),
-                     gp_quote(p.x_label), gp_quote(p.y_label));
-    b += p.key == "off" ? "unset key\n" : fmt::format("set key {} opaque\n", p.key);
-    b += p.x_log ? "set logscale x\n" : "unset logscale x\n";
-    b += fmt::format("set xrange {}\nset yrange {}\n", range(p.x_range), range(p.y_range));
-    for (const Marker& m : p.markers) {
-      if (m.vertical) {
-        b += fmt::format(
-            "set arrow from first {0}, graph 0 to first {0}, graph 1 nohead dt 2 lc rgb "
-            "'#555555'\n",
-            number(m.at));
-        if (!m.label.empty())
-          b += fmt::format("set label {} at first {}, graph 0.06 offset 0.5,0 tc rgb '#555555'\n",
-                           gp_quote(m.label), number(m.at));
-      } else {
-        b += fmt::format(
-            "set arrow from graph 0, first {0} to graph 1, first {0} nohead dt 2 lc rgb "
-            "'#555555'\n",
-            number(m.at));
-        if (!m.label.empty())
-          b += fmt::format("set label {} at graph 0.02, first {} offset 0,0.6 tc rgb '#555555'\n",
-                           gp_quote(m.label), number(m.at));
-      }
-    }
-    // Bands first so that curves are drawn over them; colours follow the series order.
-    std::vector<std::string> clauses(p.series.size());
-    std::size_t next_color = 0;
-    for (std::size_t si = 0; si < p.series.size(); ++si) {
-      const Series& s = p.series[si];
-      const std::string color =
-          s.color.empty() ? kPalette[next_color++ % std::size(kPalette)] : s.color;
-      clauses[si] = fmt::format("datafile index {} {} {}", index + static_cast<int>(si),
-                                style_clause(s, color),
-                                s.title.empty() ? "notitle" : "title " + gp_quote(s.title));
-    }
-    std::string plot;
-    for (int pass = 0; pass < 2; ++pass) {
-      for (std::size_t si = 0; si < p.series.size(); ++si) {
-        if ((p.series[si].style == SeriesStyle::kBand) != (pass == 0))
-          continue;
-        plot += plot.empty() ? "plot " : ", \\\n     ";
-        plot += clauses[si];
-      }
-    }
-    b += plot + "\n";
+    b += panel_settings(p);
+    b += plot_command(p, index);
     index += static_cast<int>(p.series.size());
   }
   b += "unset multiplot\n";
   return b;
+}
+
+// The style every terminal shares (plot.hpp): grid, ticks, text boxes, the maps' palette.
+std::string style_preamble() {
+  return "set grid lt 1 lw 0.5 lc rgb '#d0d0d0'\n"
+         "set border lw 1 lc rgb '#000000'\n"
+         "set tics out nomirror\n"
+         "set style textbox opaque noborder margins 1,1\n"
+         "set key noenhanced samplen 3 spacing 1.1\n"
+         // Maps: Paul Tol's diverging BuRd scheme (https://personal.sron.nl/~pault/), white at the
+         // middle, readable in greyscale as dark-light-dark.
+         "set palette defined (0 '#2166AC', 0.25 '#6EA6CD', 0.5 '#F7F7F7', 0.75 '#F4A582', "
+         "1 '#B2182B')\n";
 }
 
 std::string read_text(const fs::path& p) {
@@ -311,6 +434,8 @@ PlotFiles write_plot_files(const Figure& figure, const fs::path& stem_in) {
     for (const Series& s : figure.panels[pi].series) {
       data += fmt::format("# index {}: panel {}, '{}'\n", index++, pi + 1, one_line(s.title));
       for (std::size_t i = 0; i < s.x.size(); ++i) {
+        if (s.style == SeriesStyle::kImage && i > 0 && s.y[i] != s.y[i - 1])
+          data += '\n';  // a map's rows are scan lines, one blank line apart
         data += number(s.x[i]) + ' ' + number(s.y[i]);
         if (!s.w.empty())
           data += ' ' + number(s.w[i]);
@@ -329,19 +454,23 @@ PlotFiles write_plot_files(const Figure& figure, const fs::path& stem_in) {
       "set encoding utf8\n",
       figure.title.empty() ? "" : ": ", comment_end(figure.title), one_line(name),
       gp_quote(name + ".dat"));
-  const std::string size = fmt::format("size {},{}", figure.width_px, figure.height_px);
+  script += style_preamble();
   if (figure.png) {
+    const double k = figure.png_scale;
     script += fmt::format(
-        "\nset terminal pngcairo noenhanced {} font 'Sans,10' background '#ffffff'\n"
+        "\nset terminal pngcairo noenhanced size {},{} fontscale {} linewidth {} pointscale {} "
+        "font '{},{}' background '#ffffff'\n"
         "set output {}\n",
-        size, gp_quote(name + ".png"));
+        static_cast<int>(std::lround(k * figure.width_px)),
+        static_cast<int>(std::lround(k * figure.height_px)), number(k), number(k), number(k), kFont,
+        kFontPt, gp_quote(name + ".png"));
     script += body + "set output\n";
   }
   if (figure.svg) {
     script += fmt::format(
-        "\nset terminal svg noenhanced {} font 'Sans,10' background '#ffffff'\n"
+        "\nset terminal svg noenhanced size {},{} font '{},{}' background '#ffffff'\n"
         "set output {}\n",
-        size, gp_quote(name + ".svg"));
+        figure.width_px, figure.height_px, kFont, kFontPt, gp_quote(name + ".svg"));
     script += body + "set output\n";
   }
   write_text(files.script, script);
@@ -420,22 +549,31 @@ PlotFiles render(const Figure& figure, const fs::path& stem_in, const PlotOption
 
 Series line_series(std::string title, std::span<const double> x, std::span<const double> y,
                    std::string color) {
-  return Series{
-      std::move(title), SeriesStyle::kLines, {x.begin(), x.end()}, {y.begin(), y.end()}, {},
-      std::move(color)};
+  Series s;
+  s.title = std::move(title);
+  s.x.assign(x.begin(), x.end());
+  s.y.assign(y.begin(), y.end());
+  s.color = std::move(color);
+  return s;
 }
 
 Series point_series(std::string title, std::span<const double> x, std::span<const double> y,
                     std::string color) {
-  return Series{
-      std::move(title), SeriesStyle::kPoints, {x.begin(), x.end()}, {y.begin(), y.end()}, {},
-      std::move(color)};
+  Series s = line_series(std::move(title), x, y, std::move(color));
+  s.style = SeriesStyle::kPoints;
+  return s;
 }
 
 Series band_series(std::string title, double x_lo, double x_hi, double y_lo, double y_hi,
                    std::string color) {
-  return Series{std::move(title), SeriesStyle::kBand, {x_lo, x_hi},
-                {y_lo, y_lo},     {y_hi, y_hi},       color.empty() ? "#2ca02c" : std::move(color)};
+  Series s;
+  s.title = std::move(title);
+  s.style = SeriesStyle::kBand;
+  s.x = {x_lo, x_hi};
+  s.y = {y_lo, y_lo};
+  s.w = {y_hi, y_hi};
+  s.color = color.empty() ? kBandColor : std::move(color);
+  return s;
 }
 
 Series histogram_series(std::string title, std::span<const double> values, double bin_width,
@@ -456,7 +594,10 @@ Series histogram_series(std::string title, std::span<const double> values, doubl
     throw std::invalid_argument("histogram: more than 10000 bins; choose a wider bin");
   for (double v : values)
     counts[static_cast<long long>(std::floor(v / bin_width))] += 1.0;
-  Series s{std::move(title), SeriesStyle::kBoxes, {}, {}, {}, std::move(color)};
+  Series s;
+  s.title = std::move(title);
+  s.style = SeriesStyle::kBoxes;
+  s.color = std::move(color);
   const long long first = counts.begin()->first;
   const long long last = counts.rbegin()->first;
   for (long long k = first; k <= last; ++k) {

@@ -4,10 +4,12 @@ namespace piezoshift::psi {
 
 io::Figure zernike_figure(std::span<const double> zernike_nm) {
   io::Figure f;
-  f.width_px = 1000;
-  f.height_px = 500;
+  f.width_px = 800;
+  f.height_px = 440;
   io::Panel p;
-  p.title = "Zernike coefficients of the measured surface (piston and tilt removed)";
+  p.title =
+      "Zernike coefficients, piston and tilt removed (j = 4 defocus, 5-6 astigmatism, 7-8 coma, 11 "
+      "spherical)";
   p.x_label = "Noll index j";
   p.y_label = "coefficient, RMS [nm]";
   p.key = "off";
@@ -20,6 +22,7 @@ io::Figure zernike_figure(std::span<const double> zernike_nm) {
   }
   p.series.push_back(std::move(bars));
   f.panels.push_back(std::move(p));
+  f.caption = "Zernike coefficients of the measured surface (Noll j ≥ 4), RMS-normalised in nm.";
   return f;
 }
 

@@ -54,21 +54,33 @@ std::string value_text(const FigureValue& f, const std::string& unit) {
   return fmt::format("{:.4g} {}", f.value, unit);
 }
 
-const char* const kColour[3] = {"#d62728", "#1f77b4", "#2ca02c"};  // paper, improved, oracle
+// paper, improved, oracle: the house cycle's first three (plot.hpp), fixed per controller so that
+// a controller has one colour and one dash in every figure.
+const char* const kColour[3] = {"#0072B2", "#D55E00", "#009E73"};
+const char* const kDash[3] = {"solid", "(8,4)", "(2,3)"};
+
+io::Series variant_line(LoopVariant k, std::string title, std::span<const double> x,
+                        std::span<const double> y) {
+  io::Series s = io::line_series(std::move(title), x, y, kColour[idx(k)]);
+  s.dash = kDash[idx(k)];
+  return s;
+}
 
 // The 11 um steps as the interferometer saw them, and a zoom on the last 50 nm around the
 // target with the +-10 nm band.
 io::Figure step_figure(const SeedComparison& sc) {
   io::Figure f;
-  f.title = fmt::format("11 um step, seed {} (twin, interferometer dynamic mode)", sc.seed);
+  f.title = fmt::format("11 µm step, seed {} (twin, interferometer dynamic mode)", sc.seed);
   f.rows = 2;
-  f.width_px = 900;
-  f.height_px = 750;
+  f.width_px = 800;
+  f.height_px = 720;
   io::Panel all, zoom;
+  all.title = "(a) the step";
+  zoom.title = "(b) near the target, ±10 nm band";
   all.x_label = zoom.x_label = "time from the step [s]";
-  all.y_label = "mean of P1..P3 [um]";
+  all.y_label = "mean of P1..P3 [µm]";
   zoom.y_label = "error from the target [nm]";
-  all.key = "bottom right";
+  zoom.key = "off";
   zoom.y_range = std::pair{-50.0, 50.0};
   double t0 = 0.0, t1 = 0.0;
   for (LoopVariant k : kLoopVariants) {
@@ -81,39 +93,65 @@ io::Figure step_figure(const SeedComparison& sc) {
     std::vector<double> err_nm;
     for (std::size_t n = 0; n < st.measured_um.size(); ++n)
       err_nm.push_back(1e3 * (st.measured_um[n] - st.desired_um.back()));
-    all.series.push_back(
-        io::line_series(variant_key(k), st.time_s, st.measured_um, kColour[idx(k)]));
-    zoom.series.push_back(io::line_series(variant_key(k), st.time_s, err_nm, kColour[idx(k)]));
+    const double ts = st.metrics.settling_time_abs_s;
+    all.series.push_back(variant_line(
+        k,
+        std::isfinite(ts) ? fmt::format("{}: settled to ±10 nm in {:.3f} s", variant_key(k), ts)
+                          : fmt::format("{}: not settled to ±10 nm", variant_key(k)),
+        st.time_s, st.measured_um));
+    zoom.series.push_back(variant_line(k, "", st.time_s, err_nm));
   }
-  zoom.series.insert(zoom.series.begin(), io::band_series("+-10 nm", t0, t1, -10.0, 10.0));
+  // The transient is tens of ms of a record of a second: the first 0.2 s.
+  all.x_range = zoom.x_range = std::pair{t0, std::min(t1, t0 + 0.2)};
+  zoom.series.insert(zoom.series.begin(), io::band_series("±10 nm", t0, t1, -10.0, 10.0));
   f.panels = {std::move(all), std::move(zoom)};
+  f.caption =
+      "The 11 µm step of the three controllers; below, the last 50 nm with the ±10 nm band.";
   return f;
 }
 
 io::Figure phase_step_figure(const SeedComparison& sc, double tolerance_nm) {
   io::Figure f;
-  f.title = fmt::format("lambda/8 step, seed {} (true plate, 1 ms exposure means)", sc.seed);
-  f.width_px = 900;
-  f.height_px = 500;
-  io::Panel p;
-  p.x_label = "time from the step command [s]";
-  p.y_label = "exposure mean - level before [nm]";
-  p.key = "bottom right";
-  bool band = false;
+  f.title = fmt::format("λ/8 step, seed {} (true plate, 1 ms exposure means)", sc.seed);
+  f.rows = 2;
+  f.width_px = 800;
+  f.height_px = 800;
+  io::Panel p, near;
+  p.title = "(a) the step";
+  near.title = fmt::format("(b) around the target, ±{:g} nm band: the hold jitter", tolerance_nm);
+  p.x_label = near.x_label = "time from the step command [s]";
+  p.y_label = "exposure mean − level before [nm]";
+  near.y_label = "exposure mean − target [nm]";
+  near.key = "off";
+  near.y_range = std::pair{-4.0 * tolerance_nm, 4.0 * tolerance_nm};
+  double t1 = 0.0, step_nm = 0.0;
   for (LoopVariant k : kLoopVariants) {
     const VariantRun& run = sc[k];
     const auto& ps = run.set.phase_step;
     if (!run.calibration.valid || ps.time_s.empty())
       continue;
-    if (!band) {
-      p.series.push_back(io::band_series(fmt::format("+-{:g} nm", tolerance_nm), ps.time_s.front(),
-                                         ps.time_s.back(), ps.step_nm - tolerance_nm,
-                                         ps.step_nm + tolerance_nm));
-      band = true;
-    }
+    t1 = std::max(t1, ps.time_s.back());
+    step_nm = ps.step_nm;
     p.series.push_back(
-        io::line_series(variant_key(k), ps.time_s, ps.exposure_mean_nm, kColour[idx(k)]));
+        variant_line(k,
+                     fmt::format("{}: settled {}, hold jitter {:.2f} nm rms", variant_key(k),
+                                 std::isfinite(ps.settling_time_s)
+                                     ? fmt::format("{:.1f} ms", 1e3 * ps.settling_time_s)
+                                     : std::string("never"),
+                                 ps.hold_jitter_nm_rms),
+                     ps.time_s, ps.exposure_mean_nm));
+    std::vector<double> err(ps.exposure_mean_nm);
+    for (double& v : err)
+      v -= ps.step_nm;
+    near.series.push_back(variant_line(k, "", ps.time_s, err));
   }
+  // The band over the whole axis, in both panels.
+  p.series.insert(p.series.begin(),
+                  io::band_series(fmt::format("±{:g} nm", tolerance_nm), 0.0, t1,
+                                  step_nm - tolerance_nm, step_nm + tolerance_nm));
+  near.series.insert(near.series.begin(),
+                     io::band_series("", 0.0, t1, -tolerance_nm, tolerance_nm));
+  p.x_range = near.x_range = std::pair{0.0, t1};
   // The improved controller's run without the step, lifted to the target: how much of its
   // trace is the plate's own wander (the gauges' drift), not the step.
   if (const VariantRun& run = sc[LoopVariant::kImproved];
@@ -122,10 +160,16 @@ io::Figure phase_step_figure(const SeedComparison& sc, double tolerance_nm) {
     std::vector<double> lifted(ps.still_exposure_mean_nm);
     for (double& v : lifted)
       v += ps.step_nm;
-    p.series.push_back(io::line_series("improved, same seed without the step, + step", ps.time_s,
-                                       lifted, "#7f7f7f"));
+    io::Series still = io::line_series("improved, same seed without the step, + step", ps.time_s,
+                                       lifted, "#000000");
+    still.dash = "(1,3)";
+    p.series.push_back(std::move(still));
   }
-  f.panels.push_back(std::move(p));
+  f.panels = {std::move(p), std::move(near)};
+  f.caption = fmt::format(
+      "The λ/8 phase step of the three controllers on 1 ms exposure means, ±{:g} nm band; below, "
+      "around the target.",
+      tolerance_nm);
   return f;
 }
 
@@ -134,12 +178,12 @@ io::Figure linearity_error_figure(const SeedComparison& sc) {
   io::Figure f;
   f.title = fmt::format("Linearity error (zero-end line), seed {}", sc.seed);
   f.cols = 2;
-  f.width_px = 1100;
-  f.height_px = 500;
+  f.width_px = 1000;
+  f.height_px = 520;
   io::Panel a, b;
-  a.title = "the paper's protocol (1 um levels)";
-  b.title = "unseen 0.25 um grid";
-  a.x_label = b.x_label = "desired [um]";
+  a.title = "(a) the paper's protocol (1 µm levels)";
+  b.title = "(b) unseen 0.25 µm grid";
+  a.x_label = b.x_label = "desired [µm]";
   a.y_label = b.y_label = "deviation from the zero-end line [nm]";
   for (LoopVariant k : kLoopVariants) {
     const VariantRun& run = sc[k];
@@ -152,11 +196,15 @@ io::Figure linearity_error_figure(const SeedComparison& sc) {
         nm.push_back(1e3 * d);
       if (nm.size() != lin->desired_um.size() || nm.empty())
         continue;
-      panel->series.push_back(
-          io::line_series(variant_key(k), lin->desired_um, nm, kColour[idx(k)]));
+      panel->series.push_back(variant_line(
+          k, fmt::format("{}: {:.3f} %", variant_key(k), lin->metrics.linearity_zero_end_pct),
+          lin->desired_um, nm));
+      panel->x_range = std::pair{lin->desired_um.front(), lin->desired_um.back()};
     }
   }
   f.panels = {std::move(a), std::move(b)};
+  f.caption =
+      "Zero-end linearity error of the three controllers (legend: linearity in % of range).";
   return f;
 }
 
@@ -166,8 +214,8 @@ io::Figure repeatability_figure(const SeedComparison& sc) {
     const VariantRun& run = sc[k];
     if (!run.calibration.valid)
       continue;
-    sets.push_back({fmt::format("{}, 5 um", variant_key(k)), run.set.repeat_5um.measured_um});
-    sets.push_back({fmt::format("{}, 10 um", variant_key(k)), run.set.repeat_10um.measured_um});
+    sets.push_back({fmt::format("{}, 5 µm", variant_key(k)), run.set.repeat_5um.measured_um});
+    sets.push_back({fmt::format("{}, 10 µm", variant_key(k)), run.set.repeat_10um.measured_um});
   }
   io::Figure f = experiments::repeatability_figure(
       sets, 1.0, fmt::format("Repeatability, seed {} (interferometer)", sc.seed));
@@ -179,8 +227,8 @@ io::Figure repeatability_figure(const SeedComparison& sc) {
     for (std::size_t c = r; c < f.panels.size(); c += 2)
       reordered.push_back(f.panels[c]);
   f.panels = std::move(reordered);
-  f.width_px = 400 * f.cols;
-  f.height_px = 700;
+  f.width_px = 420 * f.cols;
+  f.height_px = 860;
   return f;
 }
 
@@ -199,8 +247,10 @@ std::vector<SeedComparison>::const_iterator draw_figures(const ComparisonResult&
                              linearity_error_figure(*drawn), repeatability_figure(*drawn)};
   const char* const stems[] = {"compare_step_response", "compare_phase_step",
                                "compare_linearity_error", "compare_repeatability"};
-  for (std::size_t i = 0; i < 4; ++i)
+  for (std::size_t i = 0; i < 4; ++i) {
     files.figures.push_back(*io::render(figs[i], dir / stems[i]).png);
+    files.captions.push_back(figs[i].caption);
+  }
   return drawn;
 }
 
@@ -280,10 +330,16 @@ void figures_section(Document& doc, const ComparisonResult& r,
                      std::vector<SeedComparison>::const_iterator drawn) {
   if (drawn != r.seeds.end()) {
     doc.heading(2, fmt::format("Figures (seed {})", drawn->seed));
-    doc.image("The 11 um step of the three controllers", "compare_step_response.png");
-    doc.image("The lambda/8 phase step on 1 ms exposure means", "compare_phase_step.png");
-    doc.image("Linearity error curves", "compare_linearity_error.png");
-    doc.image("Repeatability histograms at 5 and 10 um", "compare_repeatability.png");
+    doc.image("The 11 µm step of the three controllers; below, the last 50 nm with the ±10 nm band",
+              "compare_step_response.png");
+    doc.image(
+        "The λ/8 phase step on 1 ms exposure means with the ±1 nm band; below, around the "
+        "target",
+        "compare_phase_step.png");
+    doc.image("Zero-end linearity error curves (legend: linearity in % of range)",
+              "compare_linearity_error.png");
+    doc.image("Repeatability histograms at 5 and 10 µm with the normal density of σ = e_R",
+              "compare_repeatability.png");
   } else {
     doc.heading(2, "Figures");
     doc.paragraph("None: no controller was calibrated on any seed, so no experiment ran.");

@@ -11,6 +11,7 @@
 #include "piezoshift/io/csv_writer.hpp"
 #include "piezoshift/io/plot.hpp"
 #include "piezoshift/psi/png_image.hpp"
+#include "piezoshift/psi/surface_figure.hpp"
 #include "piezoshift/psi/zernike_figure.hpp"
 
 namespace piezoshift::reproduction {
@@ -21,9 +22,9 @@ namespace fs = std::filesystem;
 std::string surface_caption(const PhaseMeasurement& m) {
   const auto [lo, hi] = psi::finite_range(m.analysis.surface_nm);
   return fmt::format(
-      "Measured surface [nm], piston and tilt removed: the scale bar runs from {:.1f} nm (blue, "
-      "bottom) through white to {:.1f} nm (red, top), a tick every {:.1f} nm; gray: no value",
-      lo, hi, (hi - lo) / 4.0);
+      "Measured surface, piston and tilt removed: RMS {:.2f} nm, PV {:.2f} nm; colour scale {:.1f} "
+      "to {:.1f} nm (blue to white to red); blank: no value",
+      m.analysis.figures.rms, m.analysis.figures.pv, lo, hi);
 }
 
 // Per frame of the (single) average: commanded, recovered, true, their difference, settling.
@@ -50,11 +51,15 @@ void write_measurement_files(const PhaseMeasurement& m, const fs::path& dir, Rep
   if (!m.validity.valid)
     return;
   const auto [lo, hi] = psi::finite_range(m.analysis.surface_nm);
-  psi::write_false_colour_png((dir / "measurement_surface_nm.png").string(), m.analysis.surface_nm,
-                              lo, hi);
-  files.figures.push_back(dir / "measurement_surface_nm.png");
-  files.figures.push_back(
-      *io::render(psi::zernike_figure(m.analysis.zernike_nm), dir / "measurement_zernike").png);
+  const io::Figure surface =
+      psi::surface_figure(m.analysis.surface_nm, lo, hi,
+                          fmt::format("Measured surface: RMS {:.2f} nm, PV {:.2f} nm",
+                                      m.analysis.figures.rms, m.analysis.figures.pv));
+  files.figures.push_back(*io::render(surface, dir / "measurement_surface_nm").png);
+  files.captions.push_back(surface_caption(m));
+  const io::Figure zernike = psi::zernike_figure(m.analysis.zernike_nm);
+  files.figures.push_back(*io::render(zernike, dir / "measurement_zernike").png);
+  files.captions.push_back(zernike.caption);
   io::CsvWriter w(
       (dir / "measurement_exposures.csv").string(),
       {"frame", "commanded_step_rad", "recovered_step_rad", "true_step_rad", "settle_s",
@@ -108,7 +113,8 @@ void measurement_section(Document& doc, const PhaseMeasurement& m) {
       "estimate (S - feedback, mean over {:g} ms) is within {:g} nm on every channel.",
       1e3 * m.params.on_target.hold_s, m.params.on_target.band_nm));
   doc.image(surface_caption(m), "measurement_surface_nm.png");
-  doc.image("Zernike coefficients of the measured surface", "measurement_zernike.png");
+  doc.image("Zernike coefficients of the measured surface (Noll j ≥ 4), RMS-normalised in nm",
+            "measurement_zernike.png");
 }
 
 }  // namespace piezoshift::reproduction

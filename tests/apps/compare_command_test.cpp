@@ -2,6 +2,7 @@
 #include <nlohmann/json.hpp>
 
 #include "../support/cli_test.hpp"
+#include "../support/svg_text_check.hpp"
 
 namespace piezoshift {
 namespace {
@@ -30,6 +31,13 @@ TEST_F(CompareCommand, QuickRunPrintsTheMediansAndWritesTheReport) {
         "per_seed_oracle.csv", "compare_step_response.png", "compare_phase_step.png",
         "compare_linearity_error.png", "compare_repeatability.png"})
     EXPECT_TRUE(std::filesystem::exists(out + "/" + f)) << f;
+  // Issue 32: each figure also as SVG, whose text does not overlap and whose axes have units.
+  int figures = 0;
+  std::string problems;
+  for (const std::string& p : testing::folder_figure_problems(out, figures))
+    problems += p + "\n";
+  EXPECT_EQ(problems, "");
+  EXPECT_EQ(figures, 4);
 }
 
 TEST_F(CompareCommand, ABadSeedListExitsWithStatusTwoNamingTheOption) {

@@ -47,6 +47,8 @@ Figure two_panel_figure() {
   f.rows = 2;
   f.width_px = 640;
   f.height_px = 480;
+  f.png_scale = 1.0;  // PNG pixels = points, and no SVG unless a test asks
+  f.svg = false;
   Panel a;
   a.title = "response of s1_um";
   a.x_label = "time [s]";

@@ -3,14 +3,21 @@
 //   <stem>.dat  the data, one gnuplot "index" block per series;
 //   <stem>.gp   a gnuplot script that reads <stem>.dat by its relative name, so a user can edit
 //               the style and run `gnuplot <stem>.gp` in that folder to redraw;
-//   <stem>.png  (pngcairo, width_px x height_px pixels) and/or <stem>.svg,
+//   <stem>.svg  (width_px x height_px points) and <stem>.png (pngcairo at print resolution:
+//               png_scale times the points, 2000 px for an 800 pt wide figure),
 // by running gnuplot (found on PATH) in the output folder.
 //
 //   io::Figure f;
-//   f.panels.push_back({.title = "Step response", .x_label = "time [s]", .y_label = "z [um]"});
+//   f.panels.push_back({.x_label = "time [s]", .y_label = "z [µm]"});
 //   f.panels[0].series.push_back(io::line_series("measured", t_s, z_um));
-//   f.panels[0].series.push_back(io::band_series("+-2 %", t0, t1, 10.78, 11.22));
-//   io::render(f, "out/step");            // out/step.{dat,gp,png}
+//   f.panels[0].series.push_back(io::band_series("±2 %", t0, t1, 10.78, 11.22));
+//   io::render(f, "out/step");            // out/step.{dat,gp,svg,png}
+//
+// The house style lives here and nowhere else (plot.cpp): one sans font, the Okabe-Ito colour
+// cycle with a dash pattern and a point shape per series (so series stay apart in greyscale and
+// for colour-blind readers), the legend below the data, marker labels and annotations on an
+// opaque box in front of the curves, tolerance bands with their edges drawn over the curves, and
+// UTF-8 text: write units as µm, nm, ±, λ, σ, °, and give every axis label its unit in brackets.
 //
 // Several panels form a grid (rows x cols, filled row by row): enough for a time series with a
 // tolerance band, an x-y curve above its error curve, and histograms side by side.
@@ -37,7 +44,8 @@ enum class SeriesStyle {
   kPoints,
   kLinesPoints,
   kBoxes,  //!< bars centred on x, height y, width w (histograms)
-  kBand,   //!< filled area between y (lower edge) and w (upper edge) over x
+  kBand,   //!< filled area between y (lower edge) and w (upper edge) over x, edges drawn dashed
+  kImage,  //!< a map: value w at pixel (x, y) of a regular grid, row by row; Panel::cb_label
 };
 
 struct Series {
@@ -48,6 +56,9 @@ struct Series {
   std::vector<double> w;  //!< kBoxes: box widths; kBand: upper edges; otherwise unused (empty)
   std::string color;      //!< "#rrggbb"; empty: the next colour of the default cycle
   double line_width = 1.5;
+  //! gnuplot dash pattern, "solid" or e.g. "(6,3)"; empty: the next pattern of the cycle, which
+  //! advances with the colour (the first series of a panel is solid)
+  std::string dash;
 };
 
 //! A straight reference line across the whole panel, drawn dashed: x = at or y = at.
@@ -55,6 +66,18 @@ struct Marker {
   bool vertical = true;
   double at = 0.0;
   std::string label;  //!< written beside the line; empty: none
+  //! where along the line the label sits, as a fraction of the panel (0 bottom/left, 1 top/right):
+  //! two markers close together get different heights so their labels do not merge
+  double label_at = 0.06;
+};
+
+//! Text placed on a panel: a key number next to what it is about.
+struct Label {
+  double x = 0.0;  //!< position, in graph fractions (0..1) or, with data_coords, in data units
+  double y = 0.0;
+  std::string text;
+  bool data_coords = false;
+  std::string align = "left";  //!< left, center or right: which end of the text is at (x, y)
 };
 
 struct Panel {
@@ -63,10 +86,15 @@ struct Panel {
   std::string y_label;
   std::vector<Series> series;
   std::vector<Marker> markers;
+  std::vector<Label> labels;
   std::optional<std::pair<double, double>> x_range;  //!< empty: autoscale
   std::optional<std::pair<double, double>> y_range;
-  std::string key = "top right";  //!< gnuplot legend placement; "off" hides the legend
-  bool x_log = false;             //!< logarithmic x axis (Bode plots); every x must be > 0
+  //! gnuplot legend placement, outside the data by default; "off" hides the legend
+  std::string key = "below";
+  bool x_log = false;    //!< logarithmic x axis (Bode plots); every x must be > 0
+  std::string cb_label;  //!< colour bar of a kImage panel, with unit
+  std::optional<std::pair<double, double>> cb_range;  //!< kImage colour scale; empty: autoscale
+  bool equal_axes = false;                            //!< one x unit as long as one y unit (maps)
 };
 
 struct Figure {
@@ -74,10 +102,15 @@ struct Figure {
   int rows = 1;       //!< panel grid; rows * cols must hold all panels
   int cols = 1;
   std::vector<Panel> panels;
-  int width_px = 800;  //!< PNG size in pixels (the SVG gets the same size in points)
+  int width_px = 800;  //!< layout size: the SVG's in points, the PNG's in pixels / png_scale
   int height_px = 600;
   bool png = true;
-  bool svg = false;
+  bool svg = true;
+  //! PNG pixels per point: 2.5 draws an 800 pt figure 2000 px wide (300 dpi at 17 cm), with
+  //! fonts, lines and points scaled alike so the PNG looks like the SVG
+  double png_scale = 2.5;
+  //! one line a report prints under the figure (what it shows and its key numbers)
+  std::string caption;
 };
 
 struct PlotOptions {

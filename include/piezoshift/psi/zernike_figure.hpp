@@ -8,8 +8,7 @@
 
 namespace piezoshift::psi {
 
-//! zernike_nm: Noll j = 1.., RMS-normalised [nm]. 1000 x 500 px, PNG only (the caller may add
-//! SVG).
+//! zernike_nm: Noll j = 1.., RMS-normalised [nm]. 800 x 440 pt, SVG and PNG.
 io::Figure zernike_figure(std::span<const double> zernike_nm);
 
 }  // namespace piezoshift::psi

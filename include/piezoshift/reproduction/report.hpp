@@ -22,8 +22,9 @@ namespace piezoshift::reproduction {
 struct ReportFiles {
   std::filesystem::path markdown;
   std::filesystem::path html;
-  std::vector<std::filesystem::path> figures;
-  std::vector<std::filesystem::path> data;  //!< CSV, JSON and TOML files
+  std::vector<std::filesystem::path> figures;  //!< the PNGs (an SVG beside each)
+  std::vector<std::string> captions;           //!< per figure, its one-line caption (empty: none)
+  std::vector<std::filesystem::path> data;     //!< CSV, JSON and TOML files
 };
 
 //! config_label says where the configuration came from (a path, or the built-in defaults).
