@@ -17,6 +17,8 @@ PaperBandRow row(std::string figure, std::string paper, std::string band, double
   r.figure = std::move(figure);
   r.paper = std::move(paper);
   r.band = std::move(band);
+  r.lo = lo;
+  r.hi = hi;
   r.valid = v.valid;
   if (!v.valid) {
     r.twin = "NOT VALID: " + v.reason;

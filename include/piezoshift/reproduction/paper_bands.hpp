@@ -20,7 +20,9 @@ struct PaperBandRow {
   std::string figure;  //!< "Figure 10: 11 µm step, settling to ±2 %"
   std::string paper;   //!< the paper's value as it prints it
   std::string band;    //!< "0.1 to 0.4 %"
-  std::string twin;    //!< this run's value (format_figure), or "NOT VALID: why"
+  double lo = 0.0;     //!< the band's ends, in the figure's unit
+  double hi = 0.0;
+  std::string twin;  //!< this run's value (format_figure), or "NOT VALID: why"
   bool valid = true;
   bool within = false;  //!< valid and inside the band
   bool below = false;   //!< valid and under its lower end
