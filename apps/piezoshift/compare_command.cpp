@@ -16,7 +16,9 @@
 #include "piezoshift/config/project_config.hpp"
 #include "piezoshift/reproduction/comparison.hpp"
 #include "piezoshift/reproduction/comparison_report.hpp"
+#include "piezoshift/reproduction/figure_format.hpp"
 #include "piezoshift/reproduction/reproduction_cost.hpp"
+#include "piezoshift/reproduction/text_table.hpp"
 #include "piezoshift/runtime/safety_ranges.hpp"
 #include "progress_bar.hpp"
 
@@ -63,16 +65,36 @@ std::optional<std::vector<std::uint64_t>> parse_seeds(const std::string& text) {
   return out;
 }
 
-// A median as the terminal shows it: never a number when it is not valid.
-std::string cell(const reproduction::FigureValue& m, const std::string& unit) {
+// A median as the terminal shows it, formatted as the report does: never a number when it is
+// not valid (the reasons follow on stderr).
+std::string cell(const reproduction::FigureValue& m, const std::string& unit, double resolution) {
   if (!m.measured)
     return "-";
   if (!m.validity.valid)
     return "NOT VALID";
-  if (!std::isfinite(m.value))
-    return unit == "s" ? "not settled" : "none";
-  return unit == "s" ? fmt::format("{:.2f} ms", 1e3 * m.value)
-                     : fmt::format("{:.4g} {}", m.value, unit);
+  return reproduction::format_figure(m.value, unit, resolution);
+}
+
+// The medians and the targets as two aligned tables.
+std::string summary_tables(const reproduction::ComparisonResult& result) {
+  std::vector<std::vector<std::string>> medians{
+      {"median over seeds", "paper", "improved", "oracle"}};
+  for (std::size_t i = 0; i < result.figures.size(); ++i) {
+    const auto& f = result.figures[i];
+    std::vector<std::string> row{f.label};
+    for (const auto& m : result.medians[i])
+      row.push_back(cell(m, f.unit, f.resolution));
+    medians.push_back(std::move(row));
+  }
+  std::vector<std::vector<std::string>> targets{
+      {"target (improved controller's median)", "bound", "median", "met"}};
+  std::string not_judged;
+  for (const auto& t : result.targets) {
+    targets.push_back({t.text, t.bound_text, cell(t.improved, t.unit, t.resolution), t.verdict()});
+    if (!t.not_applicable.empty())
+      not_judged += fmt::format("  n/a: {}: {}\n", t.text, t.not_applicable);
+  }
+  return reproduction::text_table(medians) + "\n" + reproduction::text_table(targets) + not_judged;
 }
 
 struct Options {
@@ -117,24 +139,7 @@ int run(const Options& o) {
   } else {
     fmt::print("piezoshift compare: {} seed(s), {:.0f} s simulated in {:.1f} s\n", co.seeds.size(),
                result.simulated_time_s, result.wall_time_s);
-    fmt::print("  {:<48} {:>14} {:>14} {:>14}\n", "median over seeds", "paper", "improved",
-               "oracle");
-    for (std::size_t i = 0; i < result.figures.size(); ++i) {
-      const auto& f = result.figures[i];
-      std::string cells;
-      for (const auto& m : result.medians[i])
-        cells += fmt::format(" {:>14}", cell(m, f.unit));
-      fmt::print("  {:<48}{}\n", f.label, cells);
-    }
-    fmt::print("targets (improved controller's medians):\n");
-    for (const auto& t : result.targets) {
-      const auto& m = t.improved;
-      const std::string value =
-          !m.measured || !m.validity.valid
-              ? cell(m, "")
-              : fmt::format("{} (median {})", t.met ? "met" : "NOT MET", cell(m, t.unit));
-      fmt::print("  {:<54} {:<28} {}\n", t.text, t.bound_text, value);
-    }
+    fmt::print("{}", summary_tables(result));
     fmt::print("{}", report);
   }
   if (status != 0) {

@@ -4,6 +4,7 @@
 #include <cstdio>
 #include <memory>
 #include <string>
+#include <vector>
 
 #include <fmt/core.h>
 
@@ -11,10 +12,13 @@
 #include "physics_budget.hpp"
 #include "piezoshift/config/project_config.hpp"
 #include "piezoshift/core/input_error.hpp"
+#include "piezoshift/reproduction/figure_format.hpp"
+#include "piezoshift/reproduction/paper_bands.hpp"
 #include "piezoshift/reproduction/report.hpp"
 #include "piezoshift/reproduction/reproduction.hpp"
 #include "piezoshift/reproduction/reproduction_cost.hpp"
 #include "piezoshift/reproduction/summary.hpp"
+#include "piezoshift/reproduction/text_table.hpp"
 #include "piezoshift/runtime/safety_ranges.hpp"
 #include "progress_bar.hpp"
 #include "whole_number.hpp"
@@ -61,50 +65,36 @@ int run(const Options& o) {
   const auto& t = result;
   fmt::print("piezoshift reproduce: {:.0f} s simulated in {:.2f} s\n", t.simulated_time_s,
              t.wall_time_s);
-  // A row that is not valid shows why, never a number.
-  const auto row = [](const char* name, const rig::Validity& v, const std::string& value,
-                      const char* paper) {
-    if (v.valid)
-      fmt::print("  {:<16} {:<46} (paper: {})\n", name, value, paper);
-    else
-      fmt::print("  {:<16} NOT VALID: {}\n", name, v.reason);
-  };
-  row("travel range", t.travel.validity,
-      fmt::format("{:.2f} um open loop, {:.1f} um semi-closed loop", t.travel.open_loop_um,
-                  t.travel.semi_closed_um),
-      "12.9, 11.5");
-  row("step response", t.step.validity,
-      fmt::format("settles (+-2 %) in {:.3f} s at {:g} um", t.step.metrics.settling_time_pct_s,
-                  t.step.desired_um.back()),
-      "< 0.3 s");
-  row("linearity", t.linearity.validity,
-      fmt::format("{:.3f} % zero-end, {:.3f} % best fit",
-                  t.linearity.metrics.linearity_zero_end_pct,
-                  t.linearity.metrics.linearity_best_fit_pct),
-      "0.21 %");
-  rig::Validity repeat = t.repeat_5um.validity;
-  if (!t.repeat_10um.validity.valid)
-    repeat.fail(t.repeat_10um.validity.reason);
-  row("repeatability", repeat,
-      fmt::format("{:.2f} nm at 5 um, {:.2f} nm at 10 um", t.repeat_5um.metrics.repeatability_nm,
-                  t.repeat_10um.metrics.repeatability_nm),
-      "2, 3 nm");
-  rig::Validity oracle;
-  if (!t.oracle.table4_valid())
-    oracle.fail(t.oracle.invalid_reasons().front());
-  row("oracle", oracle,
-      fmt::format("{:.3f} %, {:.2f} / {:.2f} nm (plate feedback: impossible on hardware)",
-                  t.oracle.linearity.metrics.linearity_zero_end_pct,
-                  t.oracle.repeat_5um.metrics.repeatability_nm,
-                  t.oracle.repeat_10um.metrics.repeatability_nm),
-      "-");
+  // Table 4 against the paper's bands (the report's table); a row that is not valid shows no
+  // number (the reasons follow on stderr).
+  std::vector<std::vector<std::string>> rows{
+      {"Table 4", "twin (this run)", "the paper", "band", "against the band"}};
+  for (const reproduction::PaperBandRow& b : reproduction::paper_band_rows(t))
+    rows.push_back({b.figure, b.valid ? b.twin : "NOT VALID", b.paper, b.band, b.verdict()});
+  fmt::print("{}", reproduction::text_table(rows));
+  const auto& ol = t.oracle.linearity.metrics;
+  if (t.oracle.table4_valid()) {
+    fmt::print(
+        "  oracle (plate feedback: impossible on hardware): linearity {}{}, repeatability {} at "
+        "5 µm, {} at 10 µm\n",
+        reproduction::format_figure(ol.linearity_zero_end_pct, "%"),
+        ol.linearity_zero_end_pct == 0.0 ? " (exact by construction)" : "",
+        reproduction::format_figure(t.oracle.repeat_5um.metrics.repeatability_nm, "nm"),
+        reproduction::format_figure(t.oracle.repeat_10um.metrics.repeatability_nm, "nm"));
+  } else {
+    fmt::print("  oracle: NOT VALID: {}\n", t.oracle.invalid_reasons().front());
+  }
   const reproduction::PhaseMeasurement& m = t.measurement;
-  row("measurement", m.validity,
-      fmt::format("{} on the twin camera: {:.2f} nm RMS, {:.3f} nm from the truth (floor "
-                  "{:.3f}), steps within {:.1f} mrad",
-                  m.algorithm, m.analysis.figures.rms, m.error_rms_nm, m.ideal_error_rms_nm,
-                  m.analysis.step_error_max_mrad),
-      "-");
+  if (m.validity.valid) {
+    fmt::print(
+        "  measurement: {} on the twin camera: {} RMS, {} from the truth (floor {}), steps "
+        "within {:.1f} mrad\n",
+        m.algorithm, reproduction::format_figure(m.analysis.figures.rms, "nm"),
+        reproduction::format_figure(m.error_rms_nm, "nm"),
+        reproduction::format_figure(m.ideal_error_rms_nm, "nm"), m.analysis.step_error_max_mrad);
+  } else {
+    fmt::print("  measurement: NOT VALID: {}\n", m.validity.reason);
+  }
   fmt::print("report: {}\n        {}\n", files.markdown.string(), files.html.string());
   if (status != 0) {
     fmt::print(stderr, "piezoshift: reproduce: not valid (exit status 4):\n");

@@ -3,6 +3,7 @@
 #include <algorithm>
 #include <chrono>
 #include <cmath>
+#include <cstdlib>
 #include <limits>
 #include <utility>
 
@@ -194,6 +195,7 @@ void Dashboard::on_poll(HttpServer& server) {
     }
     last_ = r;
   }
+  remember(batch_);
   while (latencies_us_.size() > window)
     latencies_us_.pop_front();
   while (period_errors_us_.size() > window)
@@ -262,6 +264,41 @@ void Dashboard::on_poll(HttpServer& server) {
   events_sent_.fetch_add(1);
 }
 
+void Dashboard::remember(const std::vector<Row>& rows) {
+  for (const Row& r : rows)
+    if (r.tick % stride_ == 0)
+      history_.push_back(r);
+  while (!history_.empty() && history_.front().t_s < history_.back().t_s - options_.history_s)
+    history_.pop_front();
+}
+
+HttpResponse Dashboard::history(const HttpRequest& request) const {
+  double seconds = 2.0;
+  if (const auto it = request.query.find("seconds"); it != request.query.end()) {
+    char* end = nullptr;
+    seconds = std::strtod(it->second.c_str(), &end);
+    if (it->second.empty() || *end != '\0' || !(seconds > 0.0 && seconds <= options_.history_s))
+      return HttpResponse::text(
+          400, fmt::format("seconds: a number above 0 and at most {:g}", options_.history_s));
+  }
+  std::vector<Row> rows;
+  if (!history_.empty()) {
+    const double from = history_.back().t_s - seconds;
+    const auto first = std::lower_bound(history_.begin(), history_.end(), from,
+                                        [](const Row& r, double t) { return r.t_s < t; });
+    const auto n = static_cast<std::size_t>(history_.end() - first);
+    // Every k-th row counted from the newest, so that the answer ends where the stream goes on.
+    const std::size_t k =
+        std::max<std::size_t>(1, (n + options_.max_history_rows - 1) /
+                                     std::max<std::size_t>(1, options_.max_history_rows));
+    for (std::size_t i = (n - 1) % k; i < n; i += k)
+      rows.push_back(*(first + static_cast<std::ptrdiff_t>(i)));
+    return HttpResponse::json(
+        200, fmt::format("{{\"every\":{},\"samples\":{}}}", k, samples_json(rows)));
+  }
+  return HttpResponse::json(200, "{\"every\":1,\"samples\":{}}");
+}
+
 std::string Dashboard::samples_json(const std::vector<Row>& rows) const {
   // Columns: cheap to append to the page's chart arrays, and half the bytes of row objects.
   std::vector<const Row*> picked;
@@ -327,6 +364,11 @@ HttpResponse Dashboard::on_request(const HttpRequest& request) {
     if (!last_status_.empty())
       r.body += "event: update\ndata: {\"status\":" + last_status_ + ",\"samples\":{}}\n\n";
     return r;
+  }
+  if (request.path == "/api/history") {
+    if (request.method != "GET")
+      return HttpResponse::text(405, "GET only");
+    return history(request);
   }
   if (request.path == "/api/status") {
     if (request.method != "GET")

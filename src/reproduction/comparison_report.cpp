@@ -11,6 +11,7 @@
 #include "piezoshift/io/csv_writer.hpp"
 #include "piezoshift/io/plot.hpp"
 #include "piezoshift/reproduction/document.hpp"
+#include "piezoshift/reproduction/figure_format.hpp"
 
 namespace piezoshift::reproduction {
 namespace {
@@ -42,16 +43,13 @@ void prefixed(nlohmann::json& j, const ComparisonResult& r, LoopVariant k, Value
   j[prefix + "not_valid"] = not_valid;
 }
 
-std::string value_text(const FigureValue& f, const std::string& unit) {
+// As reproduce's report prints it (figure_format.hpp).
+std::string value_text(const FigureValue& f, const std::string& unit, double resolution = 0.0) {
   if (!f.measured)
     return "-";
   if (!f.validity.valid)
     return "NOT VALID: " + f.validity.reason;
-  if (std::isinf(f.value))
-    return unit == "s" ? "not settled" : "none";
-  if (unit == "s")
-    return fmt::format("{:.2f} ms", 1e3 * f.value);
-  return fmt::format("{:.4g} {}", f.value, unit);
+  return format_figure(f.value, unit, resolution);
 }
 
 // paper, improved, oracle: the house cycle's first three (plot.hpp), fixed per controller so that
@@ -301,28 +299,34 @@ void medians_section(Document& doc, const ComparisonResult& r) {
   for (std::size_t i = 0; i < r.figures.size(); ++i) {
     std::vector<std::string> row{r.figures[i].label};
     for (LoopVariant k : kLoopVariants)
-      row.push_back(value_text(r.medians[i][idx(k)], r.figures[i].unit));
+      row.push_back(value_text(r.medians[i][idx(k)], r.figures[i].unit, r.figures[i].resolution));
     rows.push_back(std::move(row));
   }
   doc.table(std::move(rows));
   doc.paragraph(
       "The oracle is the paper's loop with its calibrated gains and A, fed the plate's true point "
       "displacements instead of the strain gauges (so with no cubic to correct): the floor no "
-      "controller fed by the gauges can beat. It has no margins of its own (the paper's PID).");
+      "controller fed by the gauges can beat. It has no margins of its own (the paper's PID). "
+      "Its linearity by the paper's protocol reads 0 % exactly, by construction, not as a "
+      "placeholder: it holds the plate on its true position at each whole-micron level, and the "
+      "interferometer reads that plate to 1 nm, so every reading is its level.");
 }
 
 void targets_section(Document& doc, const ComparisonResult& r) {
   doc.heading(2, "Issue 12's targets, on the improved controller's medians");
   std::vector<std::vector<std::string>> rows{{"target", "bound", "improved (median)", "met"}};
+  std::vector<std::string> not_judged;
   for (const Target& t : r.targets) {
-    rows.push_back(
-        {t.text, t.bound_text,
-         t.improved.measured ? value_text(t.improved, t.unit) : "not measured by compare",
-         !t.improved.measured ? "-"
-         : t.met              ? "yes"
-                              : "no"});
+    rows.push_back({t.text, t.bound_text,
+                    t.improved.measured ? value_text(t.improved, t.unit, t.resolution)
+                                        : "not measured by compare",
+                    t.verdict()});
+    if (!t.not_applicable.empty())
+      not_judged.push_back(t.text + ": " + t.not_applicable + ".");
   }
   doc.table(std::move(rows));
+  for (const std::string& why : not_judged)
+    doc.paragraph("Not applicable, " + why);
 }
 
 // drawn: the seed draw_figures() drew, or r.seeds.end() when none.
@@ -353,7 +357,7 @@ void per_seed_section(Document& doc, const ComparisonResult& r, const ReportFile
     for (const FigureSpec& f : r.figures) {
       std::vector<std::string> row{std::to_string(sc.seed), f.label};
       for (LoopVariant k : kLoopVariants)
-        row.push_back(value_text(f.of(sc[k]), f.unit));
+        row.push_back(value_text(f.of(sc[k]), f.unit, f.resolution));
       rows.push_back(std::move(row));
     }
   }
@@ -390,6 +394,8 @@ nlohmann::json comparison_json(const ComparisonResult& r) {
     if (!t.improved.validity.valid)
       x["not_valid"] = t.improved.validity.reason;
     x["met"] = t.met;
+    if (!t.not_applicable.empty())
+      x["not_applicable"] = t.not_applicable;
     targets.push_back(std::move(x));
   }
   j["targets"] = std::move(targets);

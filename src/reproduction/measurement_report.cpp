@@ -79,9 +79,9 @@ void measurement_section(Document& doc, const PhaseMeasurement& m) {
   doc.heading(2, "A phase-shifting measurement");
   const camera::CameraSettings& cs = m.camera.settings;
   doc.paragraph(fmt::format(
-      "What the stage is for: {} frames of Hariharan's algorithm (steps of pi/2 at {:g} nm, "
-      "pistons of {:.1f} nm) taken from {:g} um with the controller calibrated above, on a fresh "
-      "twin session (seed {}) with the twin camera: a {} x {} px Fizeau looking at the default "
+      "What the stage is for: {} frames of Hariharan's algorithm (steps of π/2 at {:g} nm, "
+      "pistons of {:.1f} nm) taken from {:g} µm with the controller calibrated above, on a fresh "
+      "twin session (seed {}) with the twin camera: a {} × {} px Fizeau looking at the default "
       "test surface, {:g} ms exposures, {:.1f} ms readout, the default [camera] (docs/camera.md). "
       "Each frame is exposed once the controller's own estimate has settled; the twin's truth is "
       "used only to score. The same code runs in `piezoshift measure` (docs/measure.md): "
@@ -103,7 +103,7 @@ void measurement_section(Document& doc, const PhaseMeasurement& m) {
              {"measured - true surface, RMS", fmt::format("{:.3f} nm", m.error_rms_nm)},
              {"the same noise from an ideal stage (camera and algorithm floor)",
               fmt::format("{:.3f} nm", m.ideal_error_rms_nm)},
-             {"what the stage added, sqrt(error^2 - floor^2)", fmt::format("{:.3f} nm", added)},
+             {"what the stage added, √(error² − floor²)", fmt::format("{:.3f} nm", added)},
              {"steps: largest recovered - true, in magnitude",
               fmt::format("{:.2f} mrad", m.analysis.step_error_max_mrad)}});
   doc.table(steps_table(m));

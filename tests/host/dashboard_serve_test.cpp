@@ -433,6 +433,42 @@ TEST_F(DashboardCamera, AnotherClientsMoveFailsTheMeasurementWithItsReason) {
 }
 
 // Without --camera the camera's endpoints say why there is nothing.
+// A page opened now fetches the last window of samples (the page draws it at once; the browser
+// test checks that): GET /api/history answers the stream's columns of the last S seconds, every
+// tick at 1 kHz, ending where the stream goes on; bad S is refused naming it.
+TEST_F(Dashboard, TheRecentHistoryIsServedForAPageOpenedNow) {
+  ASSERT_TRUE(start({}));
+  const auto get = [&](const std::string& target) {
+    return http_exchange(http_port_, "GET " + target + " HTTP/1.1\r\n" + host() + "\r\n");
+  };
+  double t_s = 0.0;
+  for (int i = 0; i < 3000 && t_s < 1.5; ++i) {
+    std::this_thread::sleep_for(std::chrono::milliseconds(10));
+    const std::string body = http_body(get("/api/status"));
+    const nlohmann::json st = nlohmann::json::parse(body == "{}" ? "{\"t_s\": 0}" : body);
+    t_s = st["t_s"].get<double>();
+  }
+  ASSERT_GE(t_s, 1.5) << "the loop's time never passed 1.5 s";
+  const std::string a = get("/api/history?seconds=1");
+  ASSERT_EQ(http_status(a), 200) << a;
+  const nlohmann::json h = nlohmann::json::parse(http_body(a));
+  EXPECT_EQ(h["every"], 1);
+  const auto t = h["samples"]["t_s"].get<std::vector<double>>();
+  ASSERT_GE(t.size(), 500U);
+  EXPECT_EQ(h["samples"]["position_z_um"].size(), t.size());
+  EXPECT_GE(t.back() - t.front(), 0.95);  // the whole second
+  EXPECT_LE(t.back() - t.front(), 1.0);
+  EXPECT_GE(t.back(), t_s - 0.01);  // up to the status the page saw, or newer
+  for (std::size_t i = 1; i < t.size(); ++i)
+    ASSERT_GT(t[i], t[i - 1]) << i;
+  for (const std::string bad : {"0", "61", "x", ""}) {
+    const std::string r = get("/api/history?seconds=" + bad);
+    EXPECT_EQ(http_status(r), 400) << bad;
+    EXPECT_NE(http_body(r).find("seconds"), std::string::npos) << r;
+  }
+  EXPECT_EQ(stop(), 0);
+}
+
 TEST_F(Dashboard, WithoutACameraTheCameraEndpointsAreRefusedSayingWhy) {
   ASSERT_TRUE(start({}));
   for (const std::string target : {"/api/camera", "/api/camera/frame.png", "/api/measure"}) {

@@ -83,13 +83,39 @@ TEST(ComparisonSummary, TargetsRelativeToAnOracleThatIsNotValidCannotBeMet) {
     if (t.key == "repeatability_5um_nm" && t.bound_text.find("oracle") != std::string::npos) {
       found = true;
       EXPECT_EQ(t.bound, -std::numeric_limits<double>::infinity());
-      EXPECT_EQ(t.bound_text, "<= 1.2 x oracle (oracle not valid)");
+      EXPECT_EQ(t.bound_text, "≤ 1.2 × oracle (oracle not valid)");
     }
     if (t.key == "travel_semi_closed_um") {
       EXPECT_EQ(t.bound, 12.5);
       EXPECT_TRUE(t.at_least);
     }
   }
+  EXPECT_TRUE(found);
+}
+
+// Issue 31: linearity against the oracle is judged on the grid and downwards; on the paper's
+// whole-micron levels, where the oracle reads exactly 0, the target is not applicable and says why.
+TEST(ComparisonSummary, TheOraclesExactZeroIsNotATarget) {
+  const ComparisonResult r = nothing_calibrated();
+  int relative_linearity = 0;
+  for (const Target& t : r.targets) {
+    if (t.text.find("linearity") == std::string::npos || t.text.find("oracle") == std::string::npos)
+      continue;
+    ++relative_linearity;
+    if (t.key == "linearity_zero_end_pct") {
+      EXPECT_NE(t.not_applicable.find("exactly 0"), std::string::npos) << t.not_applicable;
+      EXPECT_STREQ(t.verdict(), "n/a");
+    } else {
+      EXPECT_TRUE(t.not_applicable.empty()) << t.key;
+      EXPECT_STREQ(t.verdict(), "no");  // its median is not valid here
+    }
+  }
+  EXPECT_EQ(relative_linearity, 3);  // the paper's levels (n/a), the grid, downwards
+  const nlohmann::json j = comparison_json(r);
+  bool found = false;
+  for (const auto& t : j["targets"])
+    if (t["key"] == "improved_linearity_zero_end_pct" && t.contains("not_applicable"))
+      found = !t["met"].get<bool>();
   EXPECT_TRUE(found);
 }
 

@@ -209,7 +209,23 @@ TEST(Reproduction, ReportHasTable4FiguresAndData) {
     EXPECT_GT(std::filesystem::file_size(f), 5000U) << f;
   std::ifstream md(files.markdown);
   const std::string text((std::istreambuf_iterator<char>(md)), std::istreambuf_iterator<char>());
-  EXPECT_NE(text.find("| This paper | 12.9 um @open loop"), std::string::npos);
+  EXPECT_NE(text.find("| This paper | 12.9 µm @open loop"), std::string::npos);
+  // The paper's order first: Table 4 and Figures 10 to 12 against the paper's bands, then the
+  // oracle, then what goes beyond the paper.
+  const std::size_t table4 = text.find("## Table 4 and Figures 10 to 12");
+  const std::size_t fig12 = text.find("![Figure 12");
+  const std::size_t oracle = text.find("## The oracle");
+  const std::size_t beyond = text.find("## Beyond the paper");
+  ASSERT_NE(table4, std::string::npos);
+  EXPECT_LT(table4, text.find("![Figure 10"));
+  EXPECT_LT(text.find("![Figure 10"), fig12);
+  EXPECT_LT(fig12, oracle);
+  EXPECT_LT(oracle, beyond);
+  EXPECT_LT(beyond, text.find("![Phase step]"));
+  EXPECT_NE(text.find("| Figure 11: linearity (zero-end line) | 0.21 % | 0.1 to 0.4 % |"),
+            std::string::npos);
+  // seed 1's quick run: 0 % exactly for the oracle on the paper's levels, said to be exact
+  EXPECT_NE(text.find("0 % / 0 % (exact by construction)"), std::string::npos);
   EXPECT_NE(text.find("| S315.10 (PI)"), std::string::npos);
   EXPECT_NE(text.find("| NPS-Z-15H (Queensgate)"), std::string::npos);
   EXPECT_NE(text.find("![Figure 10"), std::string::npos);

@@ -8,6 +8,12 @@
 //             that the oldest are dropped and counted) and, every update_period_s, turned into
 //             one Server-Sent Event for all streams: columns of at most max_stream_rate_Hz
 //             samples per second (every k-th sample, k = ceil(loop rate / max rate))
+//   history   the stream's rows of the last history_s (60 s, the page's longest window) kept on
+//             the HTTP thread, so that a page opened now draws its whole window at once: GET
+//             /api/history?seconds=S answers the last S seconds in the stream's columns, thinned
+//             to at most max_history_rows (every k-th row, the newest kept) so that 60 s stays
+//             within a client's send queue. The GCS data recorder cannot serve this: its tables
+//             hold what DRC chose, restart on every motion command and stop when full
 //   status    with each update: servo, on target, target and position (the interpreter's own
 //             SVO?, ONT?, MOV?, POS? on the dashboard's session), the supervisor's state and
 //             latched fault with its reason, period-error and wake-latency percentiles over
@@ -60,6 +66,8 @@ struct DashboardOptions {
   //! One turn of a POST's lines stops once it has taken this long [s] (LineServerLimits').
   double turn_budget_s = 1e-3;
   std::string daq_name = "sim";
+  double history_s = 60.0;              //!< rows kept for GET /api/history
+  std::size_t max_history_rows = 8192;  //!< per answer (~1.6 MB of JSON)
 };
 
 //! What `serve` learnt at start-up, shown in the status (set from the loop's thread).
@@ -141,6 +149,10 @@ class Dashboard final : public HttpHandler, public SampleObserver {
   HttpResponse job_response(const Job& job) const;
   std::string status_json();
   std::string samples_json(const std::vector<Row>& rows) const;
+  //! Keeps the batch's stream rows in history_, dropping those older than history_s.
+  void remember(const std::vector<Row>& rows);
+  //! GET /api/history?seconds=S.
+  HttpResponse history(const HttpRequest& request) const;
   //! Under the mutex: a query on the dashboard's session, its answer lines.
   std::vector<std::string> query(std::string_view line);
 
@@ -163,6 +175,7 @@ class Dashboard final : public HttpHandler, public SampleObserver {
   // HTTP thread only.
   std::uint64_t next_update_ns_ = 0;
   std::vector<Row> batch_;
+  std::deque<Row> history_;  //!< the stream's rows (every stride_-th tick), oldest first
   std::deque<double> latencies_us_;
   std::deque<double> period_errors_us_;
   std::uint64_t overruns_ = 0;

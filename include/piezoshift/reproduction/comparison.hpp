@@ -20,7 +20,9 @@
 // every figure of that variant on that seed not valid). The median over seeds of a figure is not
 // valid when any seed's value is not: a failure is never averaged away.
 //
-// The targets are issue 12's done-when criteria, judged on the improved controller's medians.
+// The targets are issue 12's done-when criteria, judged on the improved controller's medians;
+// linearity against the oracle is judged on the unseen grid and downwards (issue 31): on the
+// paper's levels that target is not applicable (Target::not_applicable says why).
 #include <array>
 #include <cstdint>
 #include <functional>
@@ -88,6 +90,7 @@ struct FigureSpec {
   std::string label;  //!< the report's row
   std::string unit;   //!< shown after the number: "s", "nm", "%", "um", "dB", "deg"
   std::function<FigureValue(const VariantRun&)> of;
+  double resolution = 0.0;  //!< the step it is measured in (format_figure); 0: the unit's
 };
 
 //! The figures compare reports, in the report's order (the margins at the config's loop rates).
@@ -100,14 +103,20 @@ FigureValue median_over_seeds(const std::vector<FigureValue>& per_seed,
 
 //! One of issue 12's done-when criteria on the improved controller's median.
 struct Target {
-  std::string text;  //!< e.g. "11 um step settles to +-10 nm"
-  std::string key;   //!< the figure
-  std::string unit;  //!< the figure's
+  std::string text;         //!< e.g. "11 um step settles to +-10 nm"
+  std::string key;          //!< the figure
+  std::string unit;         //!< the figure's
+  double resolution = 0.0;  //!< the figure's
   std::string bound_text;
   FigureValue improved;   //!< its median (not measured: compare cannot judge it)
   double bound = 0.0;     //!< the limit, absolute or oracle_factor x the oracle's median
   bool at_least = false;  //!< >= bound (travel, margins), else <= bound
+  //! Why the target is not judged ("": it is); such a target is never met.
+  std::string not_applicable;
   bool met = false;
+
+  //! "yes", "no", "n/a" (not applicable) or "-" (compare does not measure it).
+  const char* verdict() const noexcept;
 };
 
 struct ComparisonResult {

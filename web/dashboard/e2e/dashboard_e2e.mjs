@@ -1,7 +1,10 @@
 // End-to-end test of the dashboard in a real browser (ctest: dashboard_e2e). Starts
 // `piezoshift serve --daq sim --http-port 0` (then a second one with --fault sgs-open@T), opens the page in Debian's
 // headless Chromium through playwright-core (no browser is downloaded), and checks:
-//   the stream delivers every loop sample (gaps only where the loop skipped slots); a click on "Move absolute" to Z = 5 um shows in the scope's
+//   the first picture spans the scope's window (the recent history is fetched on load); the
+//   stream delivers every loop sample (gaps only where the loop skipped slots), joined to the
+//   history without a gap; the toolbar shows the rate; the set-point is drawn last, dashed, and a
+//   checkbox hides it; a click on "Move absolute" to Z = 5 um shows in the scope's
 //   position trace and the readout within 2 s; GCS POS? (a second client) sees that move; a GCS
 //   MOV is seen on the page; the injected fault is shown with its reason; with --camera twin (a
 //   third server) the live frame shows and a measurement started from the page shows its
@@ -90,14 +93,32 @@ function gcsQuery(line) {
 }
 const zOf = (answer) => Number(/Z=(-?[\d.]+)/.exec(answer)?.[1]);
 
+// The loop time of a server, from its status (0 before the first).
+async function loopTime(base) {
+  const res = await fetch(base + "api/status").catch(() => null);
+  const st = res && res.ok ? await res.json() : {};
+  return st.t_s ?? 0;
+}
+
 const browser = await chromium.launch({ executablePath: CHROMIUM, args: ["--no-sandbox"] });
 try {
   const page = await browser.newPage({ viewport: { width: 1500, height: 960 } });
   page.on("pageerror", (e) => check(false, `page error: ${e.message}`));
+  // Open the page once the loop has run longer than the scope's window (2 s), so that the last
+  // window of data exists before the page does: its first picture must show it.
+  for (let i = 0; i < 600 && (await loopTime(url)) < 2.5; i++) await new Promise((r) => setTimeout(r, 50));
   await page.goto(url);
   await page.waitForFunction(() => document.getElementById("pill-link").textContent === "STREAM LIVE",
     null, { timeout: 10000 });
   check(true, "page loaded, event stream live");
+
+  // The first drawn picture spans the window: the history came before anything was drawn.
+  const first = await page.waitForFunction(() => window.piezoshift.firstDrawn(), null,
+    { timeout: 10000 }).then((h) => h.jsonValue(), () => null);
+  const history = await page.evaluate(() => window.piezoshift.history());
+  check(first && first.t1 - first.t0 >= 0.8 * first.window_s,
+    `first load: the first picture spans ${first ? (first.t1 - first.t0).toFixed(3) : "nothing"} s ` +
+    `of the ${first?.window_s} s window (at least 80 %; history ${history})`);
 
   // The stream over 4 s: every loop sample reaches the page, and updates keep coming. A gap in
   // loop time is allowed only where the loop itself skipped slots after an overrun (counted in the
@@ -113,11 +134,41 @@ try {
     return { n: window.piezoshift.events(), k: t.length, t: t[t.length - 1], gaps,
       overruns: tm.overruns ?? 0, dropped: tm.samples_dropped ?? 0 };
   };
-  // The first update may carry the status alone: wait for samples, so that the span has a start.
-  await page.waitForFunction(() => window.piezoshift.store.t_s.length > 0, null, { timeout: 10000 });
+  // The first update may carry the status alone: wait for samples, so that the span has a start,
+  // and for the history, which goes before them (indices are counted after it).
+  await page.waitForFunction(() => window.piezoshift.store.t_s.length > 0 &&
+    window.piezoshift.history() !== "pending", null, { timeout: 10000 });
   const before = await page.evaluate(snapshot, 0);
   await page.waitForTimeout(4000);
   const after = await page.evaluate(snapshot, before.k);
+  // The history and the stream join without a gap: over everything the page holds, a gap only
+  // where the loop skipped slots after an overrun (counted since the server started).
+  const whole = await page.evaluate(snapshot, 1);
+  check(whole.gaps <= whole.overruns,
+    `history and stream: ${whole.k} samples from t = ${(await page.evaluate(() => window.piezoshift.store.t_s[0])).toFixed(3)} s, ` +
+    `${whole.gaps} gaps for ${whole.overruns} overruns`);
+  const rate = await page.textContent("#rate");
+  check(/^\d+ updates\/s, \d+ samples\/s$/.test(rate), `the toolbar shows the stream's rate: "${rate}"`);
+
+  // The set-point is drawn last (on top), dashed, in a colour of its own; a checkbox per trace
+  // hides and shows it.
+  const sp = await page.evaluate(() => {
+    const u = window.piezoshift.charts.z;
+    const stroke = (i) => (typeof u.series[i].stroke === "function" ? u.series[i].stroke(u, i) : u.series[i].stroke);
+    const n = u.series.length - 1;
+    const last = u.series[n];
+    const others = Array.from({ length: n - 1 }, (_, k) => stroke(k + 1));
+    return { label: last.label, dashed: Array.isArray(last.dash) && last.dash.length > 0,
+      stroke: stroke(n), own: !others.includes(stroke(n)) };
+  });
+  check(sp.label === "set-point" && sp.dashed && sp.own,
+    `the Z set-point is drawn last, dashed, in its own colour (${JSON.stringify(sp)})`);
+  const box = '#chart-z-traces input[data-series="4"]';
+  await page.uncheck(box);
+  const hiddenNow = await page.evaluate(() => !window.piezoshift.charts.z.series[4].show);
+  await page.check(box);
+  const shownAgain = await page.evaluate(() => window.piezoshift.charts.z.series[4].show);
+  check(hiddenNow && shownAgain, "the set-point's checkbox hides and shows its trace");
   const span = after.t - before.t;
   console.log(`     stream: ${(after.n - before.n) / 4} updates/s (25 by design), ${span.toFixed(3)} s ` +
     `of loop time, ${after.gaps} gaps, ${after.overruns - before.overruns} overruns`);
@@ -141,9 +192,9 @@ try {
     }, { capture: true, once: true });
   });
   await page.click("#btn-move");
-  // The scope's Z position trace (series 2) and the readout, both within 10 nm of 5 um.
+  // The scope's Z position trace (series 1) and the readout, both within 10 nm of 5 um.
   const handle = await page.waitForFunction(() => {
-    const z = window.piezoshift.charts.z.data[2];
+    const z = window.piezoshift.charts.z.data[1];
     const last = z.length ? z[z.length - 1] : NaN;
     const readout = Number(document.getElementById("pos-z").textContent);
     return Math.abs(last - 5) < 0.01 && Math.abs(readout - 5) < 0.01 &&

@@ -6,6 +6,7 @@ import "uplot/dist/uPlot.min.css";
 
 const $ = (id) => document.getElementById(id);
 const token = new URLSearchParams(location.search).get("token");
+const withToken = (url) => (token ? url + (url.includes("?") ? "&" : "?") + "token=" + encodeURIComponent(token) : url);
 
 // Column store of everything received, trimmed to the longest window (60 s) plus slack.
 const KEEP_S = 65;
@@ -20,14 +21,54 @@ const store = Object.fromEntries(COLUMNS.map((c) => [c, []]));
 
 function append(samples) {
   if (!samples || !samples.t_s || samples.t_s.length === 0) return;
+  // Only what is newer than the store: a stream event may repeat the end of the history.
+  const t = store.t_s;
+  const last = t.length ? t[t.length - 1] : -Infinity;
+  let from = 0;
+  while (from < samples.t_s.length && samples.t_s[from] <= last) from++;
   for (const c of COLUMNS) {
     const src = samples[c] || [];
     const dst = store[c];
-    for (let i = 0; i < samples.t_s.length; i++) dst.push(src[i] ?? null);
+    for (let i = from; i < samples.t_s.length; i++) dst.push(src[i] ?? null);
   }
+  trim();
+}
+
+// The history (GET /api/history) goes before what the stream brought: only what is older.
+function prepend(samples) {
+  if (!samples || !samples.t_s || samples.t_s.length === 0) return;
+  const first = store.t_s.length ? store.t_s[0] : Infinity;
+  const n = lowerBound(samples.t_s, first);
+  for (const c of COLUMNS) {
+    const src = samples[c] || [];
+    store[c] = Array.from({ length: n }, (_, i) => src[i] ?? null).concat(store[c]);
+  }
+}
+
+function trim() {
   const t = store.t_s;
   const cut = lowerBound(t, t[t.length - 1] - KEEP_S);
   if (cut > 20000) for (const c of COLUMNS) store[c].splice(0, cut);
+}
+
+// ---- history: the last window on first load, so that the scope is full at once. The page
+// draws nothing until it has arrived (or failed), so its first picture is the whole window.
+let historyState = "pending"; // "pending", "loaded", "failed: why"
+let historyFrom = Infinity; // the oldest loop time asked for so far
+async function loadHistory(seconds) {
+  const newest = store.t_s.length ? store.t_s[store.t_s.length - 1] : null;
+  if (newest !== null && newest - seconds >= historyFrom) return; // already asked
+  try {
+    const res = await fetch(withToken(`/api/history?seconds=${Math.min(60, seconds)}`));
+    if (!res.ok) throw new Error(`HTTP ${res.status}: ${(await res.text()).trim()}`);
+    const body = await res.json();
+    prepend(body.samples);
+    if (store.t_s.length) historyFrom = Math.min(historyFrom, store.t_s[0]);
+    historyState = "loaded";
+  } catch (e) {
+    if (historyState === "pending") historyState = `failed: ${e.message}`;
+    log(`history: ${e.message}; the scope fills as data arrives`, false);
+  }
 }
 
 function lowerBound(a, x) {
@@ -40,8 +81,11 @@ function lowerBound(a, x) {
 }
 
 // ---- charts
-const palette = { sp: "#e3b341", pos: "#58a6ff", ifm: "#3fb950", tru: "#db61a2",
+// The set-point is drawn last (on top), white and dashed, so that it stands out of the traces
+// that sit within nanometres of it; the others keep the colours they had.
+const palette = { sp: "#f0f6fc", pos: "#58a6ff", ifm: "#3fb950", tru: "#db61a2",
   c1: "#58a6ff", c2: "#e3b341", c3: "#3fb950" };
+const SETPOINT_DASH = [8, 5];
 const axisStyle = { stroke: "#8a94a3", grid: { stroke: "#262c36", width: 1 },
   ticks: { stroke: "#2c323c", width: 1 } };
 
@@ -57,31 +101,68 @@ function chart(el, title, unit, series, height) {
       { ...axisStyle, label: unit, labelSize: 16, size: 60 },
     ],
     series: [{ label: "t [s]", value: (u, v) => (v == null ? "—" : v.toFixed(3)) },
-      ...series.map(([label, stroke, dash]) => ({ label, stroke, width: 1.4, dash,
-        spanGaps: false, value: (u, v) => (v == null ? "—" : v.toFixed(4)) }))],
+      ...series.map(([label, stroke, dash, width]) => ({ label, stroke, width: width ?? 1.4, dash,
+        spanGaps: false, show: traceShown(el, label),
+        value: (u, v) => (v == null ? "—" : v.toFixed(4)) }))],
+    hooks: { setSeries: [(u, i) => syncTraceBox(el, u, i)] },
   };
   const data = [[], ...series.map(() => [])];
   const u = new uPlot(opts, data, $(el));
+  traceBoxes(el, u, series);
   window.addEventListener("resize", () => u.setSize({ width: width(), height }));
   return u;
 }
 
+// ---- which traces to show: a checkbox per trace above each chart, remembered by the browser
+const SHOWN_KEY = "piezoshift.hiddenTraces";
+const hidden = new Set(JSON.parse(localStorage.getItem(SHOWN_KEY) || "[]"));
+const traceShown = (el, label) => !hidden.has(`${el}/${label}`);
+function traceBoxes(el, u, series) {
+  const bar = document.createElement("div");
+  bar.className = "traces";
+  bar.id = `${el}-traces`;
+  series.forEach(([label, stroke, dash], k) => {
+    const box = document.createElement("label");
+    const input = document.createElement("input");
+    input.type = "checkbox";
+    input.checked = traceShown(el, label);
+    input.dataset.series = String(k + 1);
+    input.onchange = () => u.setSeries(k + 1, { show: input.checked });
+    const swatch = document.createElement("span");
+    swatch.className = "swatch";
+    swatch.style.borderTop = `2px ${dash ? "dashed" : "solid"} ${stroke}`;
+    box.append(input, swatch, label);
+    bar.append(box);
+  });
+  $(el).prepend(bar);
+}
+function syncTraceBox(el, u, i) {
+  if (i == null || i < 1) return;
+  const label = u.series[i].label;
+  const input = document.querySelector(`#${el}-traces input[data-series="${i}"]`);
+  if (input) input.checked = u.series[i].show;
+  if (u.series[i].show) hidden.delete(`${el}/${label}`);
+  else hidden.add(`${el}/${label}`);
+  localStorage.setItem(SHOWN_KEY, JSON.stringify([...hidden]));
+}
+
 const charts = {
-  z: chart("chart-z", "Piston Z", "µm", [["set-point", palette.sp, [6, 3]],
-    ["position (SGS)", palette.pos], ["interferometer", palette.ifm], ["true plate", palette.tru, [2, 3]]], 250),
-  uv: chart("chart-uv", "Tip U / tilt V", "µrad", [["U set-point", palette.sp, [6, 3]],
-    ["U position", palette.pos], ["U interferometer", palette.ifm], ["U true", palette.tru, [2, 3]],
-    ["V set-point", "#a5a5a5", [6, 3]], ["V position", "#79c0ff"], ["V interferometer", "#7ee787"],
-    ["V true", "#f2a7d0", [2, 3]]], 190),
+  z: chart("chart-z", "Piston Z", "µm", [["position (SGS)", palette.pos],
+    ["interferometer", palette.ifm], ["true plate", palette.tru, [2, 3]],
+    ["set-point", palette.sp, SETPOINT_DASH, 2]], 250),
+  uv: chart("chart-uv", "Tip U / tilt V", "µrad", [["U position", palette.pos],
+    ["U interferometer", palette.ifm], ["U true", palette.tru, [2, 3]],
+    ["V position", "#79c0ff"], ["V interferometer", "#7ee787"], ["V true", "#f2a7d0", [2, 3]],
+    ["U set-point", palette.sp, SETPOINT_DASH, 2], ["V set-point", "#e3b341", SETPOINT_DASH, 2]], 190),
   sgs: chart("chart-sgs", "Strain gauges", "V", [["SGS 1", palette.c1], ["SGS 2", palette.c2],
     ["SGS 3", palette.c3]], 170),
   amp: chart("chart-amp", "Amplifier outputs", "V", [["ch 1", palette.c1], ["ch 2", palette.c2],
     ["ch 3", palette.c3]], 170),
 };
 const chartColumns = {
-  z: ["setpoint_z_um", "position_z_um", "interferometer_z_um", "true_z_um"],
-  uv: ["setpoint_u_urad", "position_u_urad", "interferometer_u_urad", "true_u_urad",
-    "setpoint_v_urad", "position_v_urad", "interferometer_v_urad", "true_v_urad"],
+  z: ["position_z_um", "interferometer_z_um", "true_z_um", "setpoint_z_um"],
+  uv: ["position_u_urad", "interferometer_u_urad", "true_u_urad",
+    "position_v_urad", "interferometer_v_urad", "true_v_urad", "setpoint_u_urad", "setpoint_v_urad"],
   sgs: ["sgs1_V", "sgs2_V", "sgs3_V"],
   amp: ["amp1_V", "amp2_V", "amp3_V"],
 };
@@ -90,16 +171,22 @@ let windowS = 2;
 let paused = false;
 let view = null; // what is on screen: {from, to} indices into store (frozen while paused)
 
+let firstDrawn = null; // {t0, t1, window_s}: the first picture with data (for the browser test)
 function render() {
   const t = store.t_s;
-  if (t.length === 0) return;
+  if (t.length === 0 || historyState === "pending") return;
   if (!paused) {
     const to = t.length;
     const from = lowerBound(t, t[to - 1] - windowS);
     view = { from, to, t0: t[to - 1] - windowS, t1: t[to - 1] };
+  } else if (view) {
+    // Frozen in loop time: the indices move when older history arrives or the store is trimmed.
+    view.from = lowerBound(t, view.t0);
+    view.to = lowerBound(t, view.t1 + 1e-9);
   }
   if (!view) return;
   const x = t.slice(view.from, view.to);
+  if (!firstDrawn && x.length) firstDrawn = { t0: x[0], t1: x[x.length - 1], window_s: windowS };
   for (const [name, u] of Object.entries(charts)) {
     const data = [x, ...chartColumns[name].map((c) => store[c].slice(view.from, view.to))];
     u.batch(() => {
@@ -138,14 +225,15 @@ function showStatus(s) {
     $("pos-" + k).textContent = fmt(s.position?.[a], k === "z" ? 4 : 2);
   }
   const tm = s.timing || {};
-  $("tm-rate").textContent = `${s.loop_rate_Hz} Hz loop, ${s.stream_rate_Hz} Hz stream`;
-  $("tm-per").textContent = `${fmt(tm.period_error_p50_us, 1)} / ${fmt(tm.period_error_p99_us, 1)} / ${fmt(tm.period_error_max_us, 1)} µs`;
-  $("tm-lat").textContent = `${fmt(tm.wake_latency_p50_us, 1)} / ${fmt(tm.wake_latency_p99_us, 1)} / ${fmt(tm.wake_latency_max_us, 1)} µs`;
+  $("tm-rate").textContent = `${s.loop_rate_Hz} / ${s.stream_rate_Hz} Hz`;
+  for (const [id, key] of [["per", "period_error"], ["lat", "wake_latency"]])
+    for (const q of ["50", "99", "max"])
+      $(`tm-${id}-${q}`).textContent = fmt(tm[`${key}_${q === "max" ? "max" : "p" + q}_us`], 1);
   $("tm-window").textContent = `${fmt(tm.window_s, 1)} s`;
   $("tm-overruns").textContent = tm.overruns ?? "—";
   $("tm-dropped").textContent = tm.samples_dropped ?? "—";
   $("tm-rt").textContent = rt
-    ? `SCHED_FIFO ${rt.sched_fifo ? "yes" : "no"}, mlockall ${rt.mlockall ? "yes" : "no"}, CPU ${rt.cpu >= 0 ? rt.cpu : "not pinned"}`
+    ? `FIFO ${rt.sched_fifo ? "yes" : "no"} · mlockall ${rt.mlockall ? "yes" : "no"} · CPU ${rt.cpu >= 0 ? rt.cpu : "any"}`
     : "—";
   const lf = s.last_fault;
   $("tm-last-fault").textContent = lf ? `${lf.reason} at t = ${fmt(lf.t_s, 3)} s` : "none";
@@ -161,7 +249,14 @@ function showStatus(s) {
 
 // ---- stream
 let events = 0;
-let eventsAtLastSecond = 0;
+const arrivals = []; // performance.now() of the updates of the last 2 s
+function showRate() {
+  const now = performance.now();
+  while (arrivals.length && arrivals[0] < now - 2000) arrivals.shift();
+  const rate = lastStatus?.stream_rate_Hz;
+  $("rate").textContent = events === 0 ? "waiting for the stream"
+    : `${(arrivals.length / 2).toFixed(0)} updates/s` + (rate ? `, ${rate} samples/s` : "");
+}
 function connect() {
   const es = new EventSource("/api/stream" + (token ? "?token=" + encodeURIComponent(token) : ""));
   es.onopen = () => pill("pill-link", "STREAM LIVE", "ok");
@@ -171,12 +266,12 @@ function connect() {
     append(msg.samples);
     if (msg.status) showStatus(msg.status);
     events++;
+    arrivals.push(performance.now());
+    // The history once the stream runs, so that nothing falls between the two.
+    if (events === 1) loadHistory(windowS);
   });
 }
-setInterval(() => {
-  $("rate").textContent = `${events - eventsAtLastSecond} updates/s`;
-  eventsAtLastSecond = events;
-}, 1000);
+setInterval(showRate, 500);
 let lastFrame = 0;
 function frame(now) {
   if (now - lastFrame >= 40) { // 25 frames/s at most: the stream's own rate
@@ -255,7 +350,12 @@ $("btn-seq").onclick = async () => {
   sequenceRunning = false;
 };
 
-$("window").onchange = (e) => { windowS = Number(e.target.value); if (paused) paused = false; render(); };
+$("window").onchange = async (e) => {
+  windowS = Number(e.target.value);
+  if (paused) paused = false;
+  await loadHistory(windowS);
+  render();
+};
 $("btn-pause").onclick = (e) => {
   paused = !paused;
   e.target.textContent = paused ? "Resume" : "Pause";
@@ -275,7 +375,6 @@ $("btn-csv").onclick = () => {
 };
 
 // ---- camera (serve --camera): the live frame, its fringe visibility, measurements
-const withToken = (url) => (token ? url + (url.includes("?") ? "&" : "?") + "token=" + encodeURIComponent(token) : url);
 function ticks(id, lo, hi, digits) {
   // Five labels from hi (top) to lo (bottom): the PNGs' scale bar has its ticks at each quarter.
   const el = $(id);
@@ -365,6 +464,7 @@ setInterval(pollCamera, 500);
 
 // For tests and the console: the charts and the last status.
 window.piezoshift = { charts, store, status: () => lastStatus, events: () => events,
+  history: () => historyState, firstDrawn: () => firstDrawn, windowS: () => windowS,
   measurement: () => measurement, frameShown: () => shownFrame };
 connect();
 requestAnimationFrame(frame);
