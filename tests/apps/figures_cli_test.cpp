@@ -47,10 +47,12 @@ TEST_F(FiguresCli, ReproduceDrawsCleanFigures) {
   const testing::CliResult r = run("reproduce --quick --json --out '" + path("r") + "'");
   ASSERT_TRUE(r.status == 0 || r.status == 4) << r.err;
   expect_clean_figures(path("r"), 7);
-  // The report prints each figure's caption under it, with its key numbers.
+  // The report prints each figure's caption under it, with its key numbers, after the image.
   const std::string md = testing::read_whole_file(path("r") + "/report.md");
-  EXPECT_NE(md.find("Figure 10: Step response: settled to ±2 %: "), std::string::npos);
-  EXPECT_NE(md.find("Figure 12: Repeatability histograms with the normal density of σ = e_R: 5 µm"),
+  const std::size_t fig10 = md.find("fig10_step_response.png");
+  ASSERT_NE(fig10, std::string::npos);
+  EXPECT_NE(md.find("Step response: settled to ±2 %: ", fig10), std::string::npos);
+  EXPECT_NE(md.find("Repeatability histograms with the normal density of σ = e_R: 5 µm", fig10),
             std::string::npos);
 }
 
