@@ -92,8 +92,8 @@ io::Figure phase_step_figure(const ReproductionResult& r) {
   f.caption = fmt::format(
       "λ/8 phase step: paper's controller settles to ±{0:g} nm in {1}, oracle in {2}; hold jitter "
       "{3:.2f} against {4:.2f} nm rms.",
-      tol, format_figure(a.settling_time_s, "s"), format_figure(b.settling_time_s, "s"), a.hold_jitter_nm_rms,
-      b.hold_jitter_nm_rms);
+      tol, format_figure(a.settling_time_s, "s"), format_figure(b.settling_time_s, "s"),
+      a.hold_jitter_nm_rms, b.hold_jitter_nm_rms);
   return f;
 }
 
@@ -499,8 +499,9 @@ void paper_figures_section(Document& doc, const ReproductionResult& r,
       format_figure(r.step.truth_overshoot_pct, "%"), um(step.step_um, 0.001),
       format_figure(step.settling_time_abs_s, "s")));
   doc.heading(3, "Figure 11: linearity");
-  doc.image(fmt::format("Figure 11: linearity, (a) displacement, (b) error from the zero-end "
-                        "line. Paper: 0.21 %; twin: {}",
+  doc.image(fmt::format("Figure 11: linearity, (a) measured − desired with the zero-end line, (b) "
+                        "deviation from the "
+                        "zero-end and best-fit lines. Paper: 0.21 %; twin: {}",
                         judged(bands[3])),
             "fig11_linearity.png");
   caption("fig11_linearity.png");
