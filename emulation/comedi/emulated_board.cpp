@@ -51,9 +51,25 @@ EmulatedBoard::EmulatedBoard(EmulationSettings settings, BoardModel model)
     ao_V_[ch] = raw_volts(ao_codes_[ch], r, 0xffff, model_.ao_raw(ch));
   }
   twin_->write_ao(control::Vec3{ao_V_[0], ao_V_[1], ao_V_[2]});
+  if (!settings_.log_folder.empty()) {
+    const char* names[] = {"P1.csv", "P2.csv", "P3.csv", "centre.csv"};
+    for (std::size_t i = 0; i < logs_.size(); ++i) {
+      const std::string file = settings_.log_folder + "/" + names[i];
+      logs_[i] = std::fopen(file.c_str(), "w");
+      if (logs_[i] == nullptr)
+        throw core::InputError(fmt::format("{}: [interferometer] log_folder: cannot write {}",
+                                           settings_.source, file));
+      std::fputs("t_s,displacement_um\n", logs_[i]);
+      std::fflush(logs_[i]);
+    }
+  }
 }
 
-EmulatedBoard::~EmulatedBoard() = default;
+EmulatedBoard::~EmulatedBoard() {
+  for (std::FILE* f : logs_)
+    if (f != nullptr)
+      std::fclose(f);
+}
 
 double EmulatedBoard::elapsed_s() const {
   return static_cast<double>(steps_) * settings_.step_s;
@@ -66,6 +82,9 @@ void EmulatedBoard::advance_to_now() {
     if (!started_) {
       started_ = true;
       start_ = now;
+      unix_start_s_ =
+          std::chrono::duration<double>(std::chrono::system_clock::now().time_since_epoch())
+              .count();
     }
     const double since_s = std::chrono::duration<double>(now - start_).count();
     target = static_cast<std::int64_t>(std::floor(since_s / settings_.step_s));
@@ -81,6 +100,22 @@ void EmulatedBoard::advance_to_now() {
   for (; steps_ < target; ++steps_) {
     twin_->advance();
     sample_series();
+    write_interferometer_logs();
+  }
+}
+
+void EmulatedBoard::write_interferometer_logs() {
+  if (logs_[0] == nullptr)
+    return;
+  const double t = elapsed_s();
+  if (t + 1e-12 < next_log_s_)
+    return;
+  next_log_s_ += settings_.log_period_s;
+  const control::Vec3& z = twin_->interferometer().dynamic_um;
+  const double at[] = {z[0], z[1], z[2], (z[0] + z[1] + z[2]) / 3.0};
+  for (std::size_t i = 0; i < logs_.size(); ++i) {
+    std::fprintf(logs_[i], "%.4f,%.4f\n", unix_start_s_ + t, at[i]);
+    std::fflush(logs_[i]);  // the reader reads the whole log at each reading
   }
 }
 

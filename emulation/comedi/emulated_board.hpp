@@ -17,6 +17,7 @@
 
 #include <array>
 #include <chrono>
+#include <cstdio>
 #include <memory>
 #include <mutex>
 #include <string>
@@ -33,6 +34,8 @@ class EmulatedBoard {
   //! Builds the twin; throws core::InputError (a configuration that cannot make one).
   EmulatedBoard(EmulationSettings settings, BoardModel model);
   ~EmulatedBoard();
+  EmulatedBoard(const EmulatedBoard&) = delete;
+  EmulatedBoard& operator=(const EmulatedBoard&) = delete;
 
   const BoardModel& model() const noexcept { return model_; }
   const EmulationSettings& settings() const noexcept { return settings_; }
@@ -76,6 +79,10 @@ class EmulatedBoard {
     std::array<double, 3> ao_V, z_um, interferometer_um;
   };
   std::vector<SeriesRow> series_;
+  void write_interferometer_logs();
+  std::array<std::FILE*, 4> logs_{};  // P1, P2, P3, centre; null: not logging
+  double next_log_s_ = 0.0;
+  double unix_start_s_ = 0.0;  // the system clock at the first transaction
   double next_series_s_ = 0.0;
 };
 

@@ -33,6 +33,9 @@ EmulationSettings load_emulation_settings(const char* path) {
   record.read("json", s.record);
   record.read("csv", s.series);
   record.read("csv_period_s", s.series_period_s, core::Bounds::closed(1e-4, 10.0));
+  const io::ConfigSection ifm = file.section("interferometer");
+  ifm.read("log_folder", s.log_folder);
+  ifm.read("log_period_s", s.log_period_s, core::Bounds::closed(1e-3, 1.0));
   file.reject_unknown();
   const auto bad = [&](const char* key, const std::string& value, const char* expected) {
     return core::InputError(fmt::format("{}: {} '{}': expected {}", path, key, value, expected));

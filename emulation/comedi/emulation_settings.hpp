@@ -32,6 +32,13 @@ struct EmulationSettings {
   std::string series;  //!< csv: CSV of t_s, ao_V, truth and interferometer every series_period_s
   double series_period_s = 0.01;  //!< csv_period_s
 
+  // [interferometer]: an XL-80-like single-beam log per place the optics can be (P1.csv, P2.csv,
+  // P3.csv, centre.csv: t_s in Unix time, displacement_um, the twin's dynamic interferometer)
+  // written live every log_period_s, for `calibrate --interferometer file:` (an operator moving
+  // the optics is a link pointing at one of them). Empty: none.
+  std::string log_folder;
+  double log_period_s = 0.01;
+
   std::string source = "the built-in defaults";  //!< the file, for messages
 };
 

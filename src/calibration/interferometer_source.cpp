@@ -1,10 +1,12 @@
 #include "piezoshift/calibration/interferometer_source.hpp"
 
 #include <algorithm>
+#include <chrono>
 #include <filesystem>
 #include <limits>
 #include <stdexcept>
 #include <string_view>
+#include <thread>
 #include <vector>
 
 #include <fmt/core.h>
@@ -93,31 +95,42 @@ void PromptSource::refuse(const std::string& why) {
 }
 
 std::optional<double> LogFileSource::read(const ReadingRequest& r) {
-  std::error_code ec;
-  const auto size = std::filesystem::file_size(path_, ec);
-  if (!ec && size > max_bytes_)
-    throw core::InputError(fmt::format("{}: the log is larger than {} bytes", path_, max_bytes_));
-  const io::CsvTable t = io::CsvTable::load(path_);
-  t.require_columns({"t_s", "displacement_um"});
-  const std::vector<double> time = t.column("t_s");
-  const std::vector<double> z = t.column("displacement_um");
-  double sum = 0.0, last = -std::numeric_limits<double>::infinity();
-  std::size_t n = 0;
-  for (std::size_t i = 0; i < time.size(); ++i) {
-    last = std::max(last, time[i]);
-    if (time[i] >= r.window.start_s && time[i] <= r.window.end_s) {
-      sum += z[i];
-      ++n;
+  // The interferometer software appends and flushes in its own rhythm: a log that does not yet
+  // reach the window's end is read again until it does or wait_s has passed.
+  const auto deadline = std::chrono::steady_clock::now() + std::chrono::duration<double>(wait_s_);
+  for (;;) {
+    std::error_code ec;
+    const auto size = std::filesystem::file_size(path_, ec);
+    if (!ec && size > max_bytes_)
+      throw core::InputError(fmt::format("{}: the log is larger than {} bytes", path_, max_bytes_));
+    const io::CsvTable t = io::CsvTable::load(path_);
+    t.require_columns({"t_s", "displacement_um"});
+    const std::vector<double> time = t.column("t_s");
+    const std::vector<double> z = t.column("displacement_um");
+    double sum = 0.0, last = -std::numeric_limits<double>::infinity();
+    std::size_t n = 0;
+    for (std::size_t i = 0; i < time.size(); ++i) {
+      last = std::max(last, time[i]);
+      if (time[i] >= r.window.start_s && time[i] <= r.window.end_s) {
+        sum += z[i];
+        ++n;
+      }
     }
+    if (last < r.window.end_s) {
+      if (std::chrono::steady_clock::now() < deadline) {
+        std::this_thread::sleep_for(std::chrono::milliseconds(50));
+        continue;
+      }
+      throw core::InputError(fmt::format(
+          "{}: the log ends at t_s {:.3f}, before the end of the window {:.3f} s ({}), after "
+          "waiting {:g} s for it",
+          path_, last, r.window.end_s, r.what, wait_s_));
+    }
+    if (n == 0)
+      throw core::InputError(fmt::format("{}: no row with t_s between {:.3f} and {:.3f} s ({})",
+                                         path_, r.window.start_s, r.window.end_s, r.what));
+    return sum / static_cast<double>(n);
   }
-  if (last < r.window.end_s)
-    throw core::InputError(
-        fmt::format("{}: the log ends at t_s {:.3f}, before the end of the window {:.3f} s ({})",
-                    path_, last, r.window.end_s, r.what));
-  if (n == 0)
-    throw core::InputError(fmt::format("{}: no row with t_s between {:.3f} and {:.3f} s ({})",
-                                       path_, r.window.start_s, r.window.end_s, r.what));
-  return sum / static_cast<double>(n);
 }
 
 std::optional<double> TwinSource::read(const ReadingRequest& r) {

@@ -6,7 +6,8 @@
 //                   not a number, or a reading the plausibility checks refuse, is asked again
 //   LogFileSource   read from the CSV the interferometer software writes, columns t_s (on the
 //                   rig's clock) and displacement_um: the mean of the rows inside the window
-//                   (docs/files.md); the log must already reach past the window's end
+//                   (docs/files.md); a log that does not yet reach past the window's end is
+//                   read again for a few seconds
 //   TwinSource      the twin's own interferometer (`--daq sim`, `--daq sim-rt`)
 // read() returns nothing when the source has ended (the operator closed the input): the session
 // so far is recorded and a later run resumes it.
@@ -65,11 +66,14 @@ class PromptSource final : public InterferometerSource {
 
 class LogFileSource final : public InterferometerSource {
  public:
-  //! The log is read whole at each reading; a file larger than max_bytes is refused.
-  explicit LogFileSource(std::string path, std::size_t max_bytes = std::size_t{64} << 20)
-      : path_(std::move(path)), max_bytes_(max_bytes) {}
-  //! Throws core::InputError naming the file for a bad file, a log that ends before the window
-  //! does, or no row inside the window.
+  //! The log is read whole at each reading; a file larger than max_bytes is refused. A log that
+  //! does not yet reach the window's end is read again for up to wait_s (the interferometer
+  //! software flushes in its own rhythm).
+  explicit LogFileSource(std::string path, std::size_t max_bytes = std::size_t{64} << 20,
+                         double wait_s = 5.0)
+      : path_(std::move(path)), max_bytes_(max_bytes), wait_s_(wait_s) {}
+  //! Throws core::InputError naming the file for a bad file, a log that still ends before the
+  //! window does after wait_s, or no row inside the window.
   std::optional<double> read(const ReadingRequest& request) override;
   bool can_retry() const override { return false; }
   void refuse(const std::string&) override {}
@@ -78,6 +82,7 @@ class LogFileSource final : public InterferometerSource {
  private:
   std::string path_;
   std::size_t max_bytes_;
+  double wait_s_;
 };
 
 class TwinSource final : public InterferometerSource {
