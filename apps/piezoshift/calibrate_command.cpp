@@ -259,6 +259,7 @@ int run_guided(const Options& o) {
       o.config.empty() ? runtime::InstallationConfig{}
                        : runtime::load_installation_config(o.config);
   const config::ProjectConfig& config = installation.project;
+  work_begins();  // the session file, the interferometer, the stage
   calibration::GuidedOptions go;
   go.max_zero_drift_um = o.max_zero_drift_um;
   const std::vector<calibration::GuidedStep> plan = calibration::guided_plan(go);
@@ -337,6 +338,7 @@ int run_improved(const Options& o, const runtime::InstallationConfig& installati
   const rig::ProcedureCost improved = calibration::improved_calibration_cost();
   check_procedure_cost("calibrate --controller improved", improved, config.twin,
                        o.max_physics_steps);
+  work_begins();  // the twin's calibration
   calibration::ImprovedCalibrationOutcome ic;
   experiments::TravelRangeResult travel;
   {
@@ -414,6 +416,7 @@ int run(const Options& o) {
   check_procedure_cost("calibrate",
                        calibration::calibration_cost(co, config.twin.daq.sample_time_s),
                        config.twin, o.max_physics_steps);
+  work_begins();  // the twin's calibration
   calibration::CalibrationWithTravel ct;
   {
     ProgressBar bar(3);

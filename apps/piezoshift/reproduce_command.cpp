@@ -44,6 +44,7 @@ int run(const Options& o) {
   const config::ProjectConfig& config = installation.project;
   check_procedure_cost("reproduce", reproduction::reproduce_cost(o.quick), config.twin,
                        o.max_physics_steps);
+  work_begins();  // the calibration, the experiments, the report
   reproduction::ReproduceOptions ro;
   ro.seed = o.seed;
   ro.quick = o.quick;
