@@ -12,23 +12,6 @@
 #include "scratch_file.hpp"
 
 namespace piezoshift::fuzz {
-namespace {
-
-bool always(const CLI::App&) {
-  return true;
-}
-
-// `design` is the one subcommand quick enough to run on every input: the others would simulate,
-// serve or connect; --search ranks a whole grid and --config reads whatever path the input names.
-bool quick_design(const CLI::App& app) {
-  for (const CLI::App* sub : app.get_subcommands())
-    if (sub->get_name() == "design")
-      return sub->count("--search") == 0 && sub->count("--config") == 0;
-  return false;
-}
-
-}  // namespace
-
 void config_input(std::string_view data) {
   try {
     config::load_project_config(scratch_file("config.toml", data));
@@ -55,17 +38,21 @@ void csv_input(std::string_view data) {
   // each is given the same options every time.
   static Program programs[kPaths.size()];
   for (std::size_t i = 0; i < kPaths.size(); ++i)
-    programs[i].run({"piezoshift", kPaths[i][0], kPaths[i][1], "--data", path, "--json"}, always);
+    programs[i].run({"piezoshift", kPaths[i][0], kPaths[i][1], "--data", path, "--json"});
 }
 
-void command_line_input(std::string_view data) {
+Outcome command_line(std::string_view data) {
   std::vector<std::string> args{"piezoshift"};
   while (!data.empty()) {
     const std::size_t lf = data.find('\n');
     args.emplace_back(data.substr(0, lf));
     data.remove_prefix(lf == std::string_view::npos ? data.size() : lf + 1);
   }
-  Program().run(args, quick_design);  // a fresh app: options must not keep an earlier input's
+  return Program().run(args);  // a fresh app: options must not keep an earlier input's
+}
+
+void command_line_input(std::string_view data) {
+  command_line(data);
 }
 
 std::span<const Target> targets() {

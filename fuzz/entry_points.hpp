@@ -11,6 +11,8 @@
 #include <span>
 #include <string_view>
 
+#include "program.hpp"
+
 namespace piezoshift::fuzz {
 
 //! The project configuration (configs/paper.toml's format: design and twin sections), read
@@ -28,9 +30,12 @@ void gcs_input(std::string_view data);
 //! The texts of a figure (file name, titles, labels; fields at NUL) through io::check_output_path
 //! and io::write_plot_files: none may reach gnuplot's command stream (plot_entry.cpp).
 void plot_input(std::string_view data);
-//! A command line, one argument per input line, parsed by the program's own CLI11 app; only
-//! `design` without --search and --config runs (the others parse and validate their options).
+//! A command line, one argument per input line, parsed by the program's own CLI11 app, and the
+//! selected subcommand's action run up to its costly work (app::work_begins): every subcommand's
+//! checks run, none simulates, serves, connects or writes (docs/fuzzing.md).
 void command_line_input(std::string_view data);
+//! command_line_input, saying how the input ended (the budget test, tests/fuzz).
+Outcome command_line(std::string_view data);
 
 struct Target {
   const char* name;  //!< fuzz/corpus/<name>, fuzz/regressions/<name>, build target fuzz_<name>

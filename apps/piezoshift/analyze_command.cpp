@@ -57,6 +57,7 @@ auto with_file(const std::string& path, F&& metric) {
 int draw(const AnalyzeOptions& o, const io::Figure& figure) {
   if (o.plot_path.empty())
     return 0;
+  work_begins();  // gnuplot and the files
   io::Figure f = figure;
   const bool svg = o.plot_path.size() > 4 && o.plot_path.ends_with(".svg");
   f.png = !svg;

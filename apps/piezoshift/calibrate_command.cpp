@@ -149,8 +149,9 @@ class GuidedRigs {
     const config::ProjectConfig& config = installation.project;
     const double window_s = config.twin.interferometer.static_average_s;
     if (o.daq == "sim") {
-      bench2_ = std::make_unique<rig::Bench>(config, base, o.seed + 1);
-      bench3_ = std::make_unique<rig::Bench>(config, base, o.seed + 2);
+      const rig::BenchOptions bo{rig::Feedback::kGauges, installation.safety};
+      bench2_ = std::make_unique<rig::Bench>(config, base, o.seed + 1, bo);
+      bench3_ = std::make_unique<rig::Bench>(config, base, o.seed + 2, bo);
       bench_rig2_ = std::make_unique<rig::BenchRig>(*bench2_, window_s);
       bench_rig3_ = std::make_unique<rig::BenchRig>(*bench3_, window_s, bench_rig2_.get());
       rig2_ = bench_rig2_.get();
@@ -258,6 +259,7 @@ int run_guided(const Options& o) {
       o.config.empty() ? runtime::InstallationConfig{}
                        : runtime::load_installation_config(o.config);
   const config::ProjectConfig& config = installation.project;
+  work_begins();  // the session file, the interferometer, the stage
   calibration::GuidedOptions go;
   go.max_zero_drift_um = o.max_zero_drift_um;
   const std::vector<calibration::GuidedStep> plan = calibration::guided_plan(go);
@@ -326,7 +328,8 @@ int run_guided(const Options& o) {
 }
 
 // The improved controller (issue 12): the paper's stages for A and p, then its own models.
-int run_improved(const Options& o, const config::ProjectConfig& config) {
+int run_improved(const Options& o, const runtime::InstallationConfig& installation) {
+  const config::ProjectConfig& config = installation.project;
   if (o.pid != "paper")
     throw core::InputError("--pid search: the improved controller has no PID to search");
   control::SemiClosedLoopParams base;
@@ -335,13 +338,17 @@ int run_improved(const Options& o, const config::ProjectConfig& config) {
   const rig::ProcedureCost improved = calibration::improved_calibration_cost();
   check_procedure_cost("calibrate --controller improved", improved, config.twin,
                        o.max_physics_steps);
+  work_begins();  // the twin's calibration
   calibration::ImprovedCalibrationOutcome ic;
   experiments::TravelRangeResult travel;
   {
     ProgressBar bar(3);
-    ic = calibration::calibrate_improved(config, base, o.seed, {}, bar.callback());
-    travel = experiments::run_travel_range(config, ic.controller, o.seed + 3,
-                                           calibration::CalibrationOptions{}.travel);
+    calibration::ImprovedCalibrationOptions io;
+    io.paper.limits = installation.safety;  // every stage's supervisor, as `run`'s
+    ic = calibration::calibrate_improved(config, base, o.seed, io, bar.callback());
+    experiments::TravelRangeOptions to = calibration::CalibrationOptions{}.travel;
+    to.bench.limits = installation.safety;
+    travel = experiments::run_travel_range(config, ic.controller, o.seed + 3, to);
   }
   if (!(travel.single_move_um > 0.0))
     throw rig::ProcedureFailed(
@@ -396,16 +403,20 @@ int run(const Options& o) {
   }
   if (!o.interferometer.empty())
     throw core::InputError("--interferometer needs --daq (the guided calibration)");
-  const config::ProjectConfig config = o.config.empty()
-                                           ? config::ProjectConfig{}
-                                           : runtime::load_installation_config(o.config).project;
+  // [safety] too: every bench of the calibration is supervised as `run`'s loop is.
+  const runtime::InstallationConfig installation =
+      o.config.empty() ? runtime::InstallationConfig{}
+                       : runtime::load_installation_config(o.config);
+  const config::ProjectConfig& config = installation.project;
   if (o.controller == "improved")
-    return run_improved(o, config);
+    return run_improved(o, installation);
   calibration::CalibrationOptions co;
+  co.limits = installation.safety;
   co.pid = o.pid == "paper" ? calibration::PidChoice::kPaper : calibration::PidChoice::kSearch;
   check_procedure_cost("calibrate",
                        calibration::calibration_cost(co, config.twin.daq.sample_time_s),
                        config.twin, o.max_physics_steps);
+  work_begins();  // the twin's calibration
   calibration::CalibrationWithTravel ct;
   {
     ProgressBar bar(3);

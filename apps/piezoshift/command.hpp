@@ -28,6 +28,17 @@ void add_gcs_command(CLI::App& app, Action& action);        // gcs_command.cpp
 void add_psi_command(CLI::App& app, Action& action);        // psi_command.cpp
 void add_measure_command(CLI::App& app, Action& action);    // measure_command.cpp
 
+//! Thrown by work_begins() when the program checks only.
+struct WorkNotRun {};
+
+//! Called by every action where its costly work begins: after its options, the files they name
+//! and its cost estimate are checked, before it simulates, calibrates, serves, connects, opens a
+//! device, analyses frames or writes a file. In the program it returns at once; with
+//! set_checks_only(true) (the fuzz targets, fuzz/program.hpp) it throws WorkNotRun, so that every
+//! subcommand's input is checked in milliseconds (docs/fuzzing.md lists where each stops).
+void work_begins();
+void set_checks_only(bool checks_only);
+
 //! The whole program on an empty app: its description, --version and every subcommand above
 //! (commands.cpp). main() and the command-line fuzz target (fuzz/) build the same app.
 void build_program(CLI::App& app, Action& action);

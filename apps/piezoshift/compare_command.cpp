@@ -116,6 +116,7 @@ int run(const Options& o) {
   reproduction::CompareOptions co;
   co.seeds = *parse_seeds(o.seeds);  // checked by the option's validator
   co.quick = o.quick;
+  work_begins();  // every seed's calibrations and experiments
   reproduction::ComparisonResult result;
   {
     // The bar counts changes of label. Per seed: two calibrations (3 labels each), three

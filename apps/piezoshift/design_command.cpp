@@ -198,6 +198,7 @@ int run_search(const DesignOptions& opt, const design::DesignInputs& in,
                     "steps or narrower ranges",
                     points, design::max_search_evaluations));
   }
+  work_begins();  // the grid
   design::SearchConstraints c;
   c.max_stiffness_ratio = positive_option("--max-stiffness-ratio", opt.max_stiffness_ratio);
   c.min_stress_margin = positive_option("--min-stress-margin", opt.min_stress_margin);

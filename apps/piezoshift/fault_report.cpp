@@ -1,5 +1,6 @@
 #include "fault_report.hpp"
 
+#include <pthread.h>
 #include <unistd.h>
 
 #include <chrono>
@@ -7,6 +8,8 @@
 #include <fstream>
 
 #include <fmt/format.h>
+
+#include "piezoshift/runtime/realtime.hpp"
 
 namespace piezoshift::app {
 
@@ -90,7 +93,9 @@ std::string faults_text(const runtime::FaultList& faults, const std::vector<std:
 }
 
 FaultReporter::FaultReporter(const runtime::LoopStatus& status, std::FILE* out)
-    : status_(status), out_(out), thread_([this] { loop(); }) {}
+    : status_(status), out_(out), thread_([this] { loop(); }) {
+  ::pthread_setname_np(thread_.native_handle(), "fault-report");  // for top -H and the tests
+}
 
 FaultReporter::~FaultReporter() {
   stop();
@@ -107,6 +112,10 @@ void FaultReporter::stop() {
   thread_.join();
   std::lock_guard<std::mutex> lock(mutex_);
   report_new();  // a fault of the last ticks
+}
+
+bool FaultReporter::keep_off_cpu(int cpu) {
+  return runtime::keep_off_cpu(thread_, cpu);
 }
 
 std::vector<std::string> FaultReporter::loads() const {

@@ -7,7 +7,8 @@
 //
 // FaultReporter is the host side of it: a thread of its own polls the loop's status
 // (loop_status.hpp) a few times a second and prints what has been published since; the loop
-// itself never does I/O.
+// itself never does I/O. Its thread is named "fault-report" and, once the loop is pinned, kept
+// off the loop's CPU (keep_off_cpu) as `serve`'s network threads are.
 #include <condition_variable>
 #include <cstdio>
 #include <mutex>
@@ -55,6 +56,10 @@ class FaultReporter {
 
   //! Prints what is left and joins the thread. Idempotent.
   void stop();
+  //! Takes the loop's CPU out of the thread's CPUs (runtime::keep_off_cpu): a report read from
+  //! /proc and printed must not cost the loop a deadline. False when nothing changed (no other
+  //! CPU, refused, or stopped).
+  bool keep_off_cpu(int cpu);
   //! The load average read when fault i was printed (after stop(): every kept fault's).
   std::vector<std::string> loads() const;
 

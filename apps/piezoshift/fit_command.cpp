@@ -56,6 +56,7 @@ void write_into_calibration(const FitOptions& o, const char* what, Set&& set) {
   if (existing)
     params = calibration::load_calibration_file(o.out, &z_max, &z_min);
   params = set(params);
+  work_begins();  // the file
   calibration::write_calibration_file(
       o.out, params,
       fmt::format("piezoshift calibration: {} fitted by `piezoshift fit` from {}\n{}", what,
@@ -196,6 +197,7 @@ int run_improved(const FitOptions& o) {
   const io::CsvTable t = load_record(o.data_path);
   t.require_columns({"t_s", "u1_um", "u2_um", "u3_um", "sgs1_um", "sgs2_um", "sgs3_um"});
   const double sample_time_s = record_step_s(t, t.column("t_s"));
+  work_begins();  // the three hysteresis and creep fits, the controller's design
   std::array<calibration::HysteresisFit, 3> model;
   for (std::size_t i = 0; i < 3; ++i) {
     const std::vector<double> u = t.column(fmt::format("u{}_um", i + 1));

@@ -64,6 +64,7 @@ int gcs(const GcsClientOptions& o) {
     throw core::InputError(fmt::format("--port {}: must be 1 to 65535", o.port));
   if (!(o.timeout_s > 0.0))
     throw core::InputError(fmt::format("--timeout-s {}: must be > 0 s", o.timeout_s));
+  work_begins();  // the connection
   try {
     host::GcsClient client(o.host, static_cast<std::uint16_t>(o.port), o.timeout_s);
     for (const std::string& command : o.commands) {

@@ -5,6 +5,7 @@
 
 #include <fmt/core.h>
 
+#include "command.hpp"
 #include "loop_setup.hpp"
 #include "piezoshift/core/input_error.hpp"
 #include "piezoshift/runtime/comedi_backend.hpp"
@@ -57,6 +58,7 @@ LoopStack::LoopStack(const LoopStackOptions& o, const config::ProjectConfig& con
   if (comedi && o.clock == StackClock::kPaced)
     throw core::InputError("a paced clock needs the twin (hardware runs in real time)");
 
+  work_begins();  // the device or the twin, then the loop
   if (comedi) {
     runtime::ComediOptions co;
     if (o.daq.size() > 7)

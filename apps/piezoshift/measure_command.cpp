@@ -230,6 +230,7 @@ int measure(const MeasureOptions& o) {
   s.params = sequence_params(o, s.algorithm, wavelength_nm);
   if (o.trigger == "line")
     s.config.camera.settings.trigger = camera::TriggerSource::kLine;
+  work_begins();  // the twin's scene, the stage, the camera
   if (o.camera == "twin" || fed_by_twin(o))
     s.scene = twin_scene(o, s.config.camera, wavelength_nm);
   LoopStack stack(stack_options(o), s.config.installation.project);

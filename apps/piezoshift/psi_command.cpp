@@ -146,6 +146,7 @@ int run_analyze(const PsiOptions& o) {
       throw core::InputError(fmt::format("--steps-rad: {} values for {} frames",
                                          ao.phase.steps_rad.size(), frames.size()));
   }
+  work_begins();  // the pupil, the phase and the surface of every pixel
   const PupilChoice pupil = choose_pupil(o.mask, frames, "psi");
   const psi::Analysis a = run_analysis(frames, pupil.mask, ao);
   if (!a.phase.converged) {  // not a surface: nothing written, exit 4
@@ -218,6 +219,7 @@ int run_calibrate(const PsiOptions& o) {
         o.nominal_step_rad, psi::kMinNominalStepRad, std::numbers::pi - psi::kMaxNominalStepRad,
         psi::kMinNominalStepRad, psi::kMaxNominalStepRad));
   const std::vector<psi::Map> frames = psi::read_frame_set(o.frames);
+  work_begins();  // the pupil, the steps' recovery, the file
   const PupilChoice pupil = choose_pupil(o.mask, frames, "psi calibrate");
   const psi::StepCalibration c = recover_steps(o, frames, pupil.mask);
   if (const fs::path parent = fs::path(o.out).parent_path(); !parent.empty())
@@ -270,6 +272,7 @@ int run_simulate(const PsiOptions& o) {
   p.fizeau.pupil_radius_px = 0.47 * o.size_px;
   p.fizeau.wavelength_nm = o.wavelength_nm;
   check_wavelength(o.wavelength_nm);
+  work_begins();                             // the twin's stage and camera, the frames
   control::SemiClosedLoopParams controller;  // the paper's gains, A and p
   const psi::SimulationResult r = psi::simulate_psi(config, controller, p);
 

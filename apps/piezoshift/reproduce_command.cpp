@@ -37,14 +37,18 @@ struct Options {
 };
 
 int run(const Options& o) {
-  const config::ProjectConfig config = o.config.empty()
-                                           ? config::ProjectConfig{}
-                                           : runtime::load_installation_config(o.config).project;
+  // [safety] too: every bench is supervised as `run`'s loop is.
+  const runtime::InstallationConfig installation =
+      o.config.empty() ? runtime::InstallationConfig{}
+                       : runtime::load_installation_config(o.config);
+  const config::ProjectConfig& config = installation.project;
   check_procedure_cost("reproduce", reproduction::reproduce_cost(o.quick), config.twin,
                        o.max_physics_steps);
+  work_begins();  // the calibration, the experiments, the report
   reproduction::ReproduceOptions ro;
   ro.seed = o.seed;
   ro.quick = o.quick;
+  ro.limits = installation.safety;
   ro.pid = o.pid == "search" ? calibration::PidChoice::kSearch : calibration::PidChoice::kPaper;
   reproduction::ReproductionResult result;
   {

@@ -34,6 +34,7 @@
 #include "piezoshift/runtime/csv_logger.hpp"
 #include "piezoshift/runtime/fault_injection.hpp"
 #include "piezoshift/runtime/loop_clock.hpp"
+#include "piezoshift/runtime/realtime.hpp"
 #include "piezoshift/runtime/safety_ranges.hpp"
 #include "piezoshift/runtime/sim_backend.hpp"
 #include "whole_number.hpp"
@@ -83,6 +84,8 @@ class LiveStatus {
   }
   LiveStatus(const LiveStatus&) = delete;
   LiveStatus& operator=(const LiveStatus&) = delete;
+  //! Off the loop's CPU, as the fault reporter (fault_report.hpp).
+  bool keep_off_cpu(int cpu) { return runtime::keep_off_cpu(thread_, cpu); }
 
  private:
   void loop() {
@@ -360,6 +363,17 @@ int run(const RunOptions& o) {
   RealtimeReport rt;
   if (stack.clock().real_time())
     rt = request_realtime_or_warn(o.cpu);
+  // Printing and reading /proc there would cost the loop deadlines, as serve's network threads.
+  if (rt.cpu >= 0) {
+    bool moved = fault_reporter.keep_off_cpu(rt.cpu);
+    if (status_line)
+      moved = status_line->keep_off_cpu(rt.cpu) && moved;
+    if (!moved)
+      fmt::print(stderr,
+                 "piezoshift: warning: the fault report and status line share CPU {} with the "
+                 "loop (no other CPU, or refused)\n",
+                 rt.cpu);
+  }
 
   stack.daq().activate();
   const LoopResult r = loop.run();

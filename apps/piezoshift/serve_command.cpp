@@ -462,10 +462,11 @@ int serve(const ServeOptions& o) {
   const runtime::RealtimeReport rt = request_realtime_or_warn(o.cpu);
   // Even under SCHED_FIFO (which preempts them) they cost the loop overruns there: with them on
   // its CPU, scripts/serve-latency counted 13 and 17 overruns under attack against 9 idle.
-  if (rt.cpu >= 0 && !net.keep_off_cpu(rt.cpu))
+  // The fault reporter too: it reads /proc/loadavg and prints when a fault latches.
+  if (rt.cpu >= 0 && !(net.keep_off_cpu(rt.cpu) && fault_reporter.keep_off_cpu(rt.cpu)))
     fmt::print(stderr,
-               "piezoshift serve: warning: the network threads share CPU {} with the loop (no "
-               "other CPU, or refused)\n",
+               "piezoshift serve: warning: the network and fault-report threads share CPU {} "
+               "with the loop (no other CPU, or refused)\n",
                rt.cpu);
   if (host::Dashboard* dashboard = net.dashboard())
     dashboard->set_realtime({true, rt.fifo, rt.memory_locked, rt.cpu});

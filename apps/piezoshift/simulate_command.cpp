@@ -284,6 +284,7 @@ int run_simulate(const SimulateOptions& opt) {
   if (run.ticks < 1)
     throw core::InputError(fmt::format(
         "--duration-s = {} is shorter than one control period ({} s)", opt.duration_s, period_s));
+  work_begins();  // the twin's calibration, then the run
 
   // `run`'s controller: the file, or the twin calibrated first (open loop needs none).
   control::SemiClosedLoopParams cp;

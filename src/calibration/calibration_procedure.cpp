@@ -23,8 +23,9 @@ CalibrationWithTravel calibrate_with_travel(const config::ProjectConfig& config,
   control::SemiClosedLoopParams base;
   base.sample_time_s = config.twin.daq.sample_time_s;  // the controller runs at the DAQ's rate
   out.calibration = calibrate(config, base, seed, options, progress);
-  out.travel =
-      experiments::run_travel_range(config, out.calibration.controller, seed + 3, options.travel);
+  experiments::TravelRangeOptions travel = options.travel;
+  travel.bench.limits = options.limits;
+  out.travel = experiments::run_travel_range(config, out.calibration.controller, seed + 3, travel);
   if (!(out.travel.single_move_um > 0.0))
     throw rig::ProcedureFailed(
         fmt::format("calibration: the calibrated loop has no semi-closed-loop travel: {}",
@@ -37,7 +38,9 @@ CalibrationOutcome calibrate(const config::ProjectConfig& config,
                              const CalibrationOptions& options, const rig::Progress& progress) {
   CalibrationOutcome out;
   // Stage 1: the inner loops.
-  out.pid = tune_pid(config, base, seed, options.pid_tuning, progress);
+  PidTuningOptions pid_tuning = options.pid_tuning;
+  pid_tuning.limits = options.limits;
+  out.pid = tune_pid(config, base, seed, pid_tuning, progress);
   out.controller = base;
   out.controller.gains_sample_time_s = base.sample_time_s;
   out.controller.gains =
@@ -56,14 +59,14 @@ CalibrationOutcome calibrate(const config::ProjectConfig& config,
     }
   };
   {
-    rig::Bench bench(config, out.controller, seed + 1);
+    rig::Bench bench(config, out.controller, seed + 1, {rig::Feedback::kGauges, options.limits});
     out.matrix = identify_matrix(bench, options.matrix, progress);
     check(bench, "stage 2 (matrix A)");
   }
   out.controller.matrix = out.matrix.fit.a;
   // Stage 3: p, with the gains and A in place.
   {
-    rig::Bench bench(config, out.controller, seed + 2);
+    rig::Bench bench(config, out.controller, seed + 2, {rig::Feedback::kGauges, options.limits});
     out.polynomial = identify_polynomial(bench, options.polynomial, progress);
     check(bench, "stage 3 (polynomial p)");
   }

@@ -132,7 +132,7 @@ ImprovedCalibrationOutcome calibrate_improved(const config::ProjectConfig& confi
 
   // Stage 4: the channel models from an open-loop excitation.
   {
-    rig::Bench bench(config, paper, seed + 4);
+    rig::Bench bench(config, paper, seed + 4, {rig::Feedback::kGauges, options.paper.limits});
     const double T = bench.sample_time_s();
     const auto ticks = static_cast<std::size_t>(std::llround(improved_excitation_duration_s() / T));
     for (std::size_t k = 0; k < ticks; ++k) {
@@ -164,7 +164,7 @@ ImprovedCalibrationOutcome calibrate_improved(const config::ProjectConfig& confi
   // samples: x_k = a1 x_{k-1} + a2 x_{k-2} + c, a damped cosine's recursion, gives cos(theta)
   // = a1 / (2 sqrt(-a2)) at the interferometer's rate, folded like any sampled mode.
   {
-    rig::Bench bench(config, paper, seed + 5);
+    rig::Bench bench(config, paper, seed + 5, {rig::Feedback::kGauges, options.paper.limits});
     const auto volts = [&](double u) {
       control::Vec3 v{};
       for (std::size_t i = 0; i < 3; ++i)

@@ -53,11 +53,11 @@ bool better(const PidTrial& a, const PidTrial& b) {
 
 Vec3 maximum_step_targets(const config::ProjectConfig& config,
                           const control::SemiClosedLoopParams& base, std::uint64_t seed,
-                          double step_fraction) {
+                          double step_fraction, const runtime::SafetyLimits& limits) {
   if (!(step_fraction > 0.0 && step_fraction < 1.0)) {
     throw std::invalid_argument("PID tuning: step_fraction must be in (0, 1)");
   }
-  rig::Bench bench(config, base, seed);
+  rig::Bench bench(config, base, seed, {rig::Feedback::kGauges, limits});
   bench.drive_open_loop(Vec3{10.0, 10.0, 10.0});
   bench.run(1.0);
   Vec3 sum{};
@@ -80,7 +80,7 @@ PidTrial score_pid_gains(const config::ProjectConfig& config,
   control::SemiClosedLoopParams params = base;
   params.gains = gains;
   params.gains_sample_time_s = base.sample_time_s;
-  rig::Bench bench(config, params, seed);
+  rig::Bench bench(config, params, seed, {rig::Feedback::kGauges, options.limits});
   PidTrial trial;
   trial.gains = gains;
   const double rest_s = 0.2;
@@ -139,7 +139,8 @@ PidTuningResult tune_pid(const config::ProjectConfig& config,
     throw std::invalid_argument("PID tuning: every gain needs at least one candidate value");
   }
   PidTuningResult r;
-  r.step_target_um = maximum_step_targets(config, base, seed, options.step_fraction);
+  r.step_target_um =
+      maximum_step_targets(config, base, seed, options.step_fraction, options.limits);
   const double total = static_cast<double>(options.kp_values.size() * options.ki_values.size() *
                                            options.kd_values.size()) +
                        1.0;

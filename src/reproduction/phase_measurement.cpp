@@ -33,7 +33,7 @@ camera::TwinScene twin_scene(const camera::CameraConfig& cc, std::uint64_t seed)
 
 PhaseMeasurement run_phase_measurement(const config::ProjectConfig& config,
                                        const control::SemiClosedLoopParams& controller,
-                                       std::uint64_t seed) {
+                                       std::uint64_t seed, const runtime::SafetyLimits& limits) {
   PhaseMeasurement m;
   m.algorithm = std::string(psi::algorithm_name(kAlgorithm));
   m.params = sequence_params();
@@ -49,6 +49,7 @@ PhaseMeasurement run_phase_measurement(const config::ProjectConfig& config,
   runtime::SimulatedClock clock;
   instrument::LoopSetup loop;
   loop.controller = controller;
+  loop.limits = limits;
   loop.rate_Hz = so.rate_Hz;  // the controller runs at the DAQ's rate, as on the bench
 
   camera::TwinCamera cam(m.scene, camera::sensor_params(m.camera));

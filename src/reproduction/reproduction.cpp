@@ -61,6 +61,15 @@ Schedule with_feedback(Schedule s, rig::Feedback f) {
   return s;
 }
 
+Schedule with_limits(Schedule s, const runtime::SafetyLimits& limits) {
+  s.calibration.limits = limits;
+  for (rig::BenchOptions* b :
+       {&s.travel.bench, &s.step.bench, &s.linearity.bench, &s.linearity_grid.bench,
+        &s.linearity_down.bench, &s.phase_step.bench, &s.repeat_5um.bench, &s.repeat_10um.bench})
+    b->limits = limits;
+  return s;
+}
+
 ExperimentSet run_experiment_set(const config::ProjectConfig& config,
                                  const control::SemiClosedLoopParams& c, std::uint64_t seed,
                                  const Schedule& s, const rig::Progress& progress) {
@@ -190,7 +199,7 @@ std::vector<std::string> ReproductionResult::invalid_reasons() const {
 ReproductionResult reproduce(const config::ProjectConfig& config, const ReproduceOptions& options,
                              const rig::Progress& progress) {
   const auto start = std::chrono::steady_clock::now();
-  Schedule s = options.quick ? Schedule::quick() : Schedule::paper();
+  Schedule s = with_limits(options.quick ? Schedule::quick() : Schedule::paper(), options.limits);
   s.calibration.pid = options.pid;
   const std::uint64_t seed = options.seed;
   ReproductionResult r;
@@ -208,8 +217,8 @@ ReproductionResult reproduce(const config::ProjectConfig& config, const Reproduc
   r.linearity_without_cubic =
       experiments::run_linearity(config, r.oracle_controller, seed + 30, s.linearity, progress);
   r.inner_loop = analyze_inner_loop(config, r.calibration.controller, seed);
-  r.measurement =
-      run_phase_measurement(config, r.calibration.controller, seed + kMeasurementSeedOffset);
+  r.measurement = run_phase_measurement(config, r.calibration.controller,
+                                        seed + kMeasurementSeedOffset, options.limits);
   // The oracle: the same loop, gains and A, fed the plate's truth; nothing left for p to correct.
   r.oracle = run_experiment_set(config, r.oracle_controller, seed,
                                 with_feedback(s, rig::Feedback::kOracle), progress);

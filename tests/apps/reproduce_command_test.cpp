@@ -82,6 +82,29 @@ TEST_F(ReproduceCommand, RunOnTheTwinWithoutACalibrationMakesThePapersStep) {
       << r.err;
 }
 
+// Issue 30: calibrate and reproduce run their benches under the installation's [safety], as
+// `run` does. Outputs held to 4 V cannot reach stage 2's 7 um poses: the supervisor trips
+// (saturation) and both fail naming it; the same section at its default values calibrates.
+TEST_F(ReproduceCommand, CalibrateAndReproduceRunUnderTheInstallationsSafety) {
+  const std::string tight = write("tight.toml", "[safety]\noutput_max_V = 4\n");
+  const testing::CliResult c =
+      run("calibrate --config '" + tight + "' --out '" + path("tight.toml.out") + "'");
+  EXPECT_EQ(c.status, 4) << c.err;
+  EXPECT_NE(c.err.find("the safety supervisor tripped (saturation"), std::string::npos) << c.err;
+  EXPECT_FALSE(std::filesystem::exists(path("tight.toml.out")));
+  const testing::CliResult r =
+      run("reproduce --quick --json --config '" + tight + "' --out '" + path("o") + "'");
+  EXPECT_EQ(r.status, 4) << r.err;
+  EXPECT_NE(r.err.find("the safety supervisor tripped (saturation"), std::string::npos) << r.err;
+  EXPECT_EQ(r.out.find("travel_open_loop_um"), std::string::npos) << r.out;
+
+  const std::string defaults = write("defaults.toml", "[safety]\noutput_max_V = 10\n");
+  const testing::CliResult d =
+      run("calibrate --json --config '" + defaults + "' --out '" + path("cal.toml") + "'");
+  ASSERT_EQ(d.status, 0) << d.err;
+  EXPECT_DOUBLE_EQ(nlohmann::json::parse(d.out)["pid_gains"]["kp"].get<double>(), 0.6);
+}
+
 TEST_F(ReproduceCommand, BadInputExitsWithStatusTwo) {
   const std::string bad = write("bad.toml", "[twin.piezo]\nfree_stroke_scale = [1, -1, 1]\n");
   testing::CliResult r = run("reproduce --quick --config '" + bad + "' --out '" + path("o") + "'");

@@ -27,6 +27,9 @@ struct CalibrationOptions {
   PolynomialIdentificationOptions polynomial{};
   //! The semi-closed-loop travel measured after the three stages (calibrate_with_travel).
   experiments::TravelRangeOptions travel{};
+  //! The supervisor's limits on every stage's bench and the travel's (the installation's
+  //! [safety], as `run` uses them); they replace pid_tuning.limits and travel.bench.limits.
+  runtime::SafetyLimits limits{};
 
   //! The paper's gains, scored alone (no grid): the quickest calibration, for `run` and `serve`
   //! on the twin without a calibration file.

@@ -30,6 +30,7 @@
 #include "piezoshift/config/project_config.hpp"
 #include "piezoshift/control/semi_closed_loop.hpp"
 #include "piezoshift/rig/progress.hpp"
+#include "piezoshift/runtime/safety_supervisor.hpp"
 
 namespace piezoshift::calibration {
 
@@ -62,6 +63,9 @@ struct PidTuningOptions {
   double steady_window_s = 0.1;
   double max_overshoot_pct = 1.0;
   double max_steady_state_error_nm = 5.0;
+  //! The supervisor's on every bench of the stage (the installation's [safety]; CalibrationOptions
+  //! sets it).
+  runtime::SafetyLimits limits{};
 };
 
 struct PidTuningResult {
@@ -79,10 +83,11 @@ PidTrial score_pid_gains(const config::ProjectConfig& config,
                          const control::Vec3& step_target_um, std::uint64_t seed,
                          const PidTuningOptions& options = {});
 
-//! S_max,i: the SGS readings at 10 V open loop (settled for 1 s), times step_fraction.
+//! S_max,i: the SGS readings at 10 V open loop (settled for 1 s), times step_fraction, on a bench
+//! supervised with limits.
 control::Vec3 maximum_step_targets(const config::ProjectConfig& config,
                                    const control::SemiClosedLoopParams& base, std::uint64_t seed,
-                                   double step_fraction);
+                                   double step_fraction, const runtime::SafetyLimits& limits = {});
 
 //! The full grid search; throws std::invalid_argument for an empty grid or a bad option.
 PidTuningResult tune_pid(const config::ProjectConfig& config,

@@ -21,6 +21,7 @@
 #include "piezoshift/instrument/measurement.hpp"
 #include "piezoshift/instrument/sequence.hpp"
 #include "piezoshift/rig/validity.hpp"
+#include "piezoshift/runtime/safety_supervisor.hpp"
 
 namespace piezoshift::reproduction {
 
@@ -42,9 +43,11 @@ struct PhaseMeasurement {
   rig::Validity validity;
 };
 
-//! One measurement on a fresh twin session (seed: the session's and the scene's).
+//! One measurement on a fresh twin session (seed: the session's and the scene's), supervised
+//! with limits.
 PhaseMeasurement run_phase_measurement(const config::ProjectConfig& config,
                                        const control::SemiClosedLoopParams& controller,
-                                       std::uint64_t seed);
+                                       std::uint64_t seed,
+                                       const runtime::SafetyLimits& limits = {});
 
 }  // namespace piezoshift::reproduction

@@ -45,6 +45,9 @@ struct ReproduceOptions {
   std::uint64_t seed = 1;
   bool quick = false;
   calibration::PidChoice pid = calibration::PidChoice::kPaper;
+  //! The supervisor's limits on every bench, the calibration's, the experiments' and the
+  //! measurement's (the installation's [safety]): a trip fails the calibration or the experiment.
+  runtime::SafetyLimits limits{};
 };
 
 struct Schedule {
@@ -103,6 +106,8 @@ struct InnerLoopAnalysis {
 
 //! The schedule with every experiment's feedback set to f (the oracle: Feedback::kOracle).
 Schedule with_feedback(Schedule s, rig::Feedback f);
+//! s with limits on every bench it sets up, the calibration's included.
+Schedule with_limits(Schedule s, const runtime::SafetyLimits& limits);
 
 //! Every experiment of the set with one controller, each on its own seed (the table above:
 //! seed + 10 ... seed + 80). reproduce() and compare() run their controllers through this.
