@@ -146,6 +146,8 @@ comedi_t* comedi_open(const char* fn) {
       return nullptr;
     }
     auto model = ni_m_series_board(settings.model);
+    for (comedi_range& r : model->subdevices[kAoSubdevice].ranges)
+      r = comedi_range{-settings.ao_reference_V, settings.ao_reference_V, UNIT_volt};
     auto it = std::make_unique<comedi_t_struct>();
     it->calibration_path = fmt::format("/var/lib/comedi/calibrations/{}_{}_comedi{}", model->driver,
                                        model->name, minor_of(settings.device));

@@ -17,6 +17,7 @@ EmulationSettings load_emulation_settings(const char* path) {
   board.read("device", s.device);
   board.read("model", s.model);
   board.read("calibrated", s.calibrated);
+  board.read("ao_reference_V", s.ao_reference_V, core::Bounds::closed(1.0, 10.0));
   const io::ConfigSection twin = file.section("twin");
   twin.read("config", s.config);
   twin.read("seed", s.seed, core::Bounds::closed(0, 9.2e18));

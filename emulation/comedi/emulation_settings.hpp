@@ -13,6 +13,10 @@ struct EmulationSettings {
   std::string model = "pci-6229";       //!< or "pci-6220" (no analog output)
   //! comedi_soft_calibrate was run: the calibration file exists (M Series boards need it).
   bool calibrated = true;
+  //! The AO's reference: 10 V internal gives +-10 V; a board wired to a smaller external
+  //! reference (NI M Series allow one) has only +-ao_reference_V, a range the amplifiers' 0..10 V
+  //! does not fit in.
+  double ao_reference_V = 10.0;
   // [twin]: the plant on AO 0..2 (amplifiers) and AI 0..2 (gauge conditioners)
   std::string config;  //!< piezoshift configuration (the twin's sections); empty: built in
   std::int64_t seed = 1;

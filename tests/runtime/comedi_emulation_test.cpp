@@ -394,11 +394,14 @@ TEST_F(ComediEmulation, OutputsTheDeviceWillNotZeroAreReportedNotHidden) {
   EXPECT_GT(record()["ao_V"][0].get<double>(), 1.0) << "the emulated outputs did hold";
 }
 
+// A missing subdevice, a missing calibration, a wrong device and a range that cannot hold the
+// amplifiers' 0..10 V: each found before anything is written to the outputs.
 TEST_F(ComediEmulation, BoardsItCannotUseExit2NamingWhy) {
   const std::vector<std::pair<std::string, std::string>> cases = {
       {"[board]\nmodel = \"pci-6220\"\n", "no analog output subdevice"},
       {"[board]\ncalibrated = false\n", "comedi_soft_calibrate"},
       {"[board]\ndevice = \"/dev/comedi1\"\n", "cannot open the DAQ device"},
+      {"[board]\nao_reference_V = 5\n", "subdevice 1 channel 0 has no range holding [0, 10] V"},
   };
   for (const auto& [toml, message] : cases) {
     SCOPED_TRACE(toml);
