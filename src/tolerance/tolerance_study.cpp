@@ -91,14 +91,15 @@ const char* procedure_name(Procedure p) {
 
 const std::vector<Metric>& metrics() {
   static const std::vector<Metric> m{
-      {"first_mode_Hz", "first mode (design, Eqs. 2-3)"},
-      {"mechanism_stiffness_N_per_um", "mechanism stiffness k_m (Eqs. 2-3)"},
-      {"hinge_stress_MPa", "hinge stress at stroke (design)"},
-      {"travel_semi_closed_um", "semi-closed-loop travel"},
-      {"travel_open_loop_um", "open-loop travel"},
-      {"step_settling_time_s", "11 µm step, settling to ±2 %"},
-      {"linearity_zero_end_pct", "linearity (zero-end, the paper's levels held 4 s)"},
-      {"repeatability_5um_nm", "repeatability at 5 µm (40 moves, 1 σ)"},
+      {"first_mode_Hz", "first mode (design, Eqs. 2-3)", "first mode [Hz]"},
+      {"mechanism_stiffness_N_per_um", "mechanism stiffness k_m (Eqs. 2-3)", "k_m [N/µm]"},
+      {"hinge_stress_MPa", "hinge stress at stroke (design)", "hinge stress [MPa]"},
+      {"travel_semi_closed_um", "semi-closed-loop travel", "semi-closed travel [µm]"},
+      {"travel_open_loop_um", "open-loop travel", "open-loop travel [µm]"},
+      {"step_settling_time_s", "11 µm step, settling to ±2 %", "settling time [s]"},
+      {"linearity_zero_end_pct", "linearity (zero-end, the paper's levels held 4 s)",
+       "linearity [%]"},
+      {"repeatability_5um_nm", "repeatability at 5 µm (40 moves, 1 σ)", "repeatability [nm]"},
   };
   return m;
 }

@@ -6,6 +6,7 @@
 #include <nlohmann/json.hpp>
 
 #include "../support/cli_test.hpp"
+#include "../support/svg_text_check.hpp"
 
 namespace piezoshift {
 namespace {
@@ -35,8 +36,17 @@ TEST_F(ToleranceCli, OneTwoThreadsAndTwoShardsGiveTheSameBytesAndARunResumes) {
   const testing::CliResult one = run(study + "--jobs 1 --spec '" + spec + "' --out " + path("j1"));
   ASSERT_EQ(one.status, 0) << one.err;
   EXPECT_NE(one.err.find("16/16 done"), std::string::npos) << one.err;  // the progress lines
-  const testing::CliResult two = run(study + "--jobs 2 --spec '" + spec + "' --out " + path("j2"));
+  const testing::CliResult two =
+      run(study + "--jobs 2 --figures --spec '" + spec + "' --out " + path("j2"));
   ASSERT_EQ(two.status, 0) << two.err;
+  // The figures (a histogram and a cumulative curve per metric that varies) change no byte of
+  // the JSON; their text does not overlap and their axes have units (docs/figures.md).
+  int figures = 0;
+  std::string problems;
+  for (const std::string& p : testing::folder_figure_problems(path("j2"), figures))
+    problems += p + "\n";
+  EXPECT_EQ(problems, "");
+  EXPECT_GE(figures, 6);
   for (const char* shard : {"0/2", "1/2"}) {
     const testing::CliResult s = run(study + "--jobs 1 --shard " + shard + " --out " + path("s"));
     ASSERT_EQ(s.status, 0) << s.err;

@@ -28,6 +28,7 @@ const char* procedure_name(Procedure p);
 struct Metric {
   const char* key;    //!< "first_mode_Hz": JSON and CSV column, the spec's <key>_min / _max
   const char* label;  //!< the report's
+  const char* axis;   //!< a figure's axis, with its unit: "first mode [Hz]"
 };
 const std::vector<Metric>& metrics();
 
