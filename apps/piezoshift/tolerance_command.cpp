@@ -250,6 +250,11 @@ int run(const Options& o) {
     fmt::print("{}\n", j.dump(2));
     return 0;
   }
+  // A shard writes its samples only: what needs all of them is merge's (or a whole run's).
+  if (!o.shard.empty() && (o.sensitivity || o.figures || !o.spec.empty()))
+    throw core::InputError(
+        "tolerance: --shard writes samples only: give --spec and --figures to `tolerance merge`, "
+        "and run --sensitivity without --shard");
   std::uint64_t first = 0, stride = 1;
   if (!o.shard.empty())
     std::tie(first, stride) = *parse_shard(o.shard);  // checked by the option's validator

@@ -102,6 +102,11 @@ Distribution read_distribution(const io::ConfigSection& s, const std::string& so
 }
 
 void check_range(const Tolerance& t, const std::string& source, const std::string& section) {
+  if (t.distribution.relative && t.nominal == 0.0)
+    refuse(source, section,
+           fmt::format("relative deviations of {} (nominal 0) would vary nothing: give them in "
+                       "the key's unit",
+                       t.key));
   for (const double dev : {t.distribution.min_deviation(), t.distribution.max_deviation()}) {
     const std::string problem = core::range_problem(t.key, t.value_at(dev), t.bounds);
     if (!problem.empty())

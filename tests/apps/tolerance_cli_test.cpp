@@ -118,6 +118,12 @@ TEST_F(ToleranceCli, BadTolerancesExit2NamingTheKey) {
   r = run("tolerance --tolerances '" + sampling + "' --shard 2/2");
   EXPECT_EQ(r.status, 2);
   EXPECT_NE(r.err.find("--shard"), std::string::npos) << r.err;
+  // What a shard would ignore is refused, not dropped.
+  const std::string good = write("g.toml", kTolerances);
+  r = run("tolerance --tolerances '" + good + "' --shard 0/2 --sensitivity --out " + path("x"));
+  EXPECT_EQ(r.status, 2);
+  EXPECT_NE(r.err.find("run --sensitivity without --shard"), std::string::npos) << r.err;
+  EXPECT_FALSE(std::filesystem::exists(path("x")));
 }
 
 }  // namespace

@@ -93,6 +93,11 @@ TEST(ToleranceFile, DistributionsThatCannotBeSampledAreRefused) {
   // Every refusal names the parameter's section.
   EXPECT_NE(with("distribution = \"discrete\"\n").find("[tolerance.hinge.radius_m]"),
             std::string::npos);
+  // Relative to a nominal 0 (the first leg's height error) would vary nothing.
+  EXPECT_NE(refusal("[tolerance.twin.geometry.height_errors_um]\ndistribution = \"uniform\"\n"
+                    "lo = -0.1\nhi = 0.1\nrelative = true\nsource = \"x\"\n")
+                .find("twin.geometry.height_errors_um[0] (nominal 0) would vary nothing"),
+            std::string::npos);
   // A tolerance without its source, and an integer parameter, are refused too.
   EXPECT_NE(refusal("[tolerance.hinge.radius_m]\ndistribution = \"uniform\"\nlo = 0\nhi = 0\n")
                 .find("source missing"),
