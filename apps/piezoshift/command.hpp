@@ -27,6 +27,7 @@ void add_serve_command(CLI::App& app, Action& action);      // serve_command.cpp
 void add_gcs_command(CLI::App& app, Action& action);        // gcs_command.cpp
 void add_psi_command(CLI::App& app, Action& action);        // psi_command.cpp
 void add_measure_command(CLI::App& app, Action& action);    // measure_command.cpp
+void add_tolerance_command(CLI::App& app, Action& action);  // tolerance_command.cpp
 
 //! Thrown by work_begins() when the program checks only.
 struct WorkNotRun {};

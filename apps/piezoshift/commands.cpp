@@ -34,6 +34,7 @@ void build_program(CLI::App& app, Action& action) {
   add_compare_command(app, action);
   add_psi_command(app, action);
   add_measure_command(app, action);
+  add_tolerance_command(app, action);
 }
 
 }  // namespace piezoshift::app

@@ -1,0 +1,57 @@
+#pragma once
+// One sample of a tolerance study (issue 33, docs/tolerance.md): a plant drawn from the
+// tolerances, its design evaluated (Eqs. 1-4: first mode, hinge stress), its twin calibrated by
+// the chosen procedure and measured by a quick experiment set, each through the machinery
+// `reproduce` and `compare` use (calibration::calibrate or calibrate_improved, then the
+// experiments on the seeds run_experiment_set gives them: travel seed + 10, step + 20,
+// linearity + 30, repeatability + 40). Every sample uses the study's seed for the twin's noise
+// (common random numbers: two samples differ only by their tolerances), and its deviations come
+// from (seed, index) alone, so a sample is the same whichever process or shard runs it.
+//
+// A sample whose plant cannot be built, whose calibration fails or whose experiment is not valid
+// is not valid, with its reason; its metrics that were not measured are NaN, and it fails any
+// spec (never dropped).
+#include <cstdint>
+#include <string>
+#include <vector>
+
+#include "piezoshift/config/project_config.hpp"
+#include "piezoshift/reproduction/reproduction.hpp"
+#include "piezoshift/tolerance/tolerance_file.hpp"
+
+namespace piezoshift::tolerance {
+
+enum class Procedure { kPaper, kImproved };
+const char* procedure_name(Procedure p);
+
+//! The metrics every sample records, in this order.
+struct Metric {
+  const char* key;    //!< "first_mode_Hz": JSON and CSV column, the spec's <key>_min / _max
+  const char* label;  //!< the report's
+  const char* axis;   //!< a figure's axis, with its unit: "first mode [Hz]"
+};
+const std::vector<Metric>& metrics();
+
+struct StudyOptions {
+  std::uint64_t seed = 1;
+  Procedure procedure = Procedure::kPaper;
+};
+
+struct SampleResult {
+  std::uint64_t index = 0;
+  std::vector<double> deviations;  //!< per tolerance of the set
+  std::vector<double> metrics;     //!< per metrics(); NaN where not measured or not valid
+  bool valid = true;
+  std::string reason;  //!< why not valid ("" when valid)
+};
+
+//! The quick set's schedule: Schedule::quick() with the paper's gains (no PID grid), its
+//! linearity (the paper's levels held 4 s), repeatability of 40 moves, a 0.5 s step record.
+reproduction::Schedule quick_schedule();
+
+//! Builds, calibrates and measures the plant of one set of deviations.
+SampleResult run_sample(const config::ProjectConfig& nominal, const ToleranceSet& set,
+                        const std::vector<double>& deviations, std::uint64_t index,
+                        const StudyOptions& options);
+
+}  // namespace piezoshift::tolerance
