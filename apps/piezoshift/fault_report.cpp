@@ -92,6 +92,15 @@ std::string faults_text(const runtime::FaultList& faults, const std::vector<std:
   return text;
 }
 
+bool report_unsafe_outputs(const runtime::DaqBackend& daq, const std::string& program) {
+  const std::string unsafe = daq.safe_state_error();
+  if (unsafe.empty())
+    return false;
+  fmt::print(stderr, "{}: error: {}; the outputs hold their last value: switch the amplifier off\n",
+             program, unsafe);
+  return true;
+}
+
 FaultReporter::FaultReporter(const runtime::LoopStatus& status, std::FILE* out)
     : status_(status), out_(out), thread_([this] { loop(); }) {
   ::pthread_setname_np(thread_.native_handle(), "fault-report");  // for top -H and the tests

@@ -18,6 +18,7 @@
 
 #include <nlohmann/json.hpp>
 
+#include "piezoshift/runtime/daq_backend.hpp"
 #include "piezoshift/runtime/fault_list.hpp"
 #include "piezoshift/runtime/loop_status.hpp"
 
@@ -45,6 +46,10 @@ nlohmann::json faults_json(const runtime::FaultList& faults,
 //! The text summary's fault lines ("fault 1  ...", one per kept fault, and how many more).
 std::string faults_text(const runtime::FaultList& faults,
                         const std::vector<std::string>& loads = {});
+
+//! After deactivate(): when the device would not take 0 V on its outputs, says so on stderr (the
+//! amplifier must be switched off by hand) and returns true; `program` prefixes the message.
+bool report_unsafe_outputs(const runtime::DaqBackend& daq, const std::string& program);
 
 class FaultReporter {
  public:

@@ -391,13 +391,8 @@ int run(const RunOptions& o) {
   const runtime::CsvLogger* logger = stack.logger();
   if (logger && !logger->error().empty())
     fmt::print(stderr, "piezoshift: error: log {}: {}\n", o.log, logger->error());
-  if (const std::string unsafe = stack.daq().safe_state_error(); !unsafe.empty()) {
-    fmt::print(stderr,
-               "piezoshift: error: {}; the outputs hold their last value: switch the "
-               "amplifier off\n",
-               unsafe);
+  if (report_unsafe_outputs(stack.daq(), "piezoshift"))
     return kExitFault;
-  }
   return r.fault_detected ? kExitFault : 0;
 }
 

@@ -481,14 +481,7 @@ int serve(const ServeOptions& o) {
   print_serve_summary(o, net, daq_name, loop, r, safety, rt, fault_reporter.loads());
   if (const std::string e = stack.daq().device_error(); !e.empty())
     fmt::print("device error   {} (the last transaction that failed)\n", e);
-  if (const std::string unsafe = stack.daq().safe_state_error(); !unsafe.empty()) {
-    fmt::print(stderr,
-               "piezoshift serve: error: {}; the outputs hold their last value: switch "
-               "the amplifier off\n",
-               unsafe);
-    return kExitFault;
-  }
-  return 0;
+  return report_unsafe_outputs(stack.daq(), "piezoshift serve") ? kExitFault : 0;
 }
 
 }  // namespace
