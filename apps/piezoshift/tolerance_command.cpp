@@ -241,6 +241,12 @@ nlohmann::json run_sensitivity(const Study& s, const Options& o) {
 
 int run(const Options& o) {
   const Study s = load_study(o);
+  // A shard writes its samples only: what needs all of them is merge's (or a whole run's).
+  if (!o.shard.empty() && (o.sensitivity || o.figures || !o.spec.empty()))
+    throw core::InputError(
+        "tolerance: --shard writes samples only: give --spec and --figures to `tolerance merge`, "
+        "and run --sensitivity without --shard");
+  work_begins();        // the samples' calibrations and experiments, the files
   if (o.sample >= 0) {  // one sample alone, e.g. a worst one
     const auto index = static_cast<std::uint64_t>(o.sample);
     const SampleResult r = tolerance::run_sample(
@@ -250,11 +256,6 @@ int run(const Options& o) {
     fmt::print("{}\n", j.dump(2));
     return 0;
   }
-  // A shard writes its samples only: what needs all of them is merge's (or a whole run's).
-  if (!o.shard.empty() && (o.sensitivity || o.figures || !o.spec.empty()))
-    throw core::InputError(
-        "tolerance: --shard writes samples only: give --spec and --figures to `tolerance merge`, "
-        "and run --sensitivity without --shard");
   std::uint64_t first = 0, stride = 1;
   if (!o.shard.empty())
     std::tie(first, stride) = *parse_shard(o.shard);  // checked by the option's validator
@@ -320,6 +321,7 @@ int run_merge(const Options& given) {
       throw core::InputError(fmt::format("merge: sample {} is in no shard given", i));
     samples.push_back(std::move(*by_index[i]));
   }
+  work_begins();  // the outputs
   write_outputs(s, samples, o, std::nullopt);
   return 0;
 }

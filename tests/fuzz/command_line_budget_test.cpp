@@ -6,18 +6,25 @@
 #include <gtest/gtest.h>
 #include <unistd.h>
 
+#include <cmath>
+#include <cstdio>
 #include <filesystem>
 #include <map>
 #include <string>
 #include <vector>
 
 #include <fmt/format.h>
+#include <nlohmann/json.hpp>
 
 #include "../support/test_paths.hpp"
 #include "command.hpp"
 #include "entry_points.hpp"
+#include "piezoshift/config/project_config.hpp"
 #include "piezoshift/psi/png_image.hpp"
 #include "piezoshift/rig/simulation_meter.hpp"
+#include "piezoshift/tolerance/tolerance_file.hpp"
+#include "piezoshift/tolerance/tolerance_study.hpp"
+#include "piezoshift/tolerance/tolerance_summary.hpp"
 
 namespace piezoshift::fuzz {
 namespace {
@@ -66,6 +73,27 @@ class CommandLineBudget : public ::testing::Test {
   }
   void TearDown() override { fs::remove_all(dir_); }
 
+  // tolerance merge's input: a shard of a one-sample study of the example tolerances, its one
+  // record a sample that was not valid (merging reads it; nothing is computed).
+  std::string tolerance_shard() const {
+    const std::string file = testing::source_dir() + "/configs/tolerances/paper_stage.toml";
+    const tolerance::ToleranceSet set = tolerance::load_tolerances(file, config::ProjectConfig{});
+    nlohmann::json header = tolerance::study_header(set, tolerance::StudyOptions{}, 1);
+    header["tolerance_file"] = file;
+    header["config"] = "built-in defaults";
+    tolerance::SampleResult r;
+    r.deviations.assign(set.tolerances.size(), 0.0);
+    r.metrics.assign(tolerance::metrics().size(), std::nan(""));
+    r.valid = false;
+    r.reason = "made by the test";
+    const nlohmann::json shard{
+        {"study", header}, {"shard", {0, 1}}, {"samples", {tolerance::sample_json(set, r)}}};
+    std::FILE* f = std::fopen(in("shard.json").c_str(), "w");
+    std::fputs(shard.dump().c_str(), f);
+    std::fclose(f);
+    return in("shard.json");
+  }
+
   std::string in(const char* name) const { return (dir_ / name).string(); }
   std::string frame(int k) const { return (dir_ / "frames" / fmt::format("f{}.png", k)).string(); }
   std::map<std::string, Case> cases() const;
@@ -112,6 +140,11 @@ std::map<std::string, Case> CommandLineBudget::cases() const {
       {"psi analyze", psi_analyze},
       {"psi calibrate", psi_calibrate},
       {"measure", {{"measure", "--camera", "twin", "--out", out}}},
+      {"tolerance",
+       {{"tolerance", "--tolerances",
+         testing::source_dir() + "/configs/tolerances/paper_stage.toml", "--samples", "4", "--out",
+         out}}},
+      {"tolerance merge", {{"tolerance", "merge", tolerance_shard(), "--out", out}}},
   };
 }
 
