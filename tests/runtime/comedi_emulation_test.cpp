@@ -13,6 +13,7 @@
 
 #include "http_client.hpp"
 #include "piezoshift/calibration/calibration_file.hpp"
+#include "piezoshift/io/csv_table.hpp"
 #include "spawned_process.hpp"
 #include "temp_dir_test.hpp"
 #include "test_paths.hpp"
@@ -28,15 +29,26 @@ const std::string kEmulationDir = PIEZOSHIFT_COMEDI_EMULATION_DIR;
 
 class ComediEmulation : public piezoshift::testing::TempDirTest {
  protected:
-  // `piezoshift args...` on the emulated board described by `toml`; its exit status.
-  int run_emulated(const std::vector<std::string>& args, const std::string& toml) {
+  // Starts `piezoshift args...` on the emulated board described by `toml`.
+  Spawned spawn_emulated(const std::vector<std::string>& args, const std::string& toml) {
     const std::string settings = write("emulation.toml", toml);
     setenv("LD_LIBRARY_PATH", kEmulationDir.c_str(), 1);
     setenv("PIEZOSHIFT_COMEDI_EMULATION", settings.c_str(), 1);
     const Spawned s = spawn(args, path("out"), path("err"));
     unsetenv("LD_LIBRARY_PATH");
     unsetenv("PIEZOSHIFT_COMEDI_EMULATION");
-    return wait_exit(s);
+    return s;
+  }
+  // The same, run to its end: its exit status.
+  int run_emulated(const std::vector<std::string>& args, const std::string& toml) {
+    return wait_exit(spawn_emulated(args, toml));
+  }
+  // `calibrate` on the twin (the emulation's default plant), written to `name`; its path.
+  std::string twin_calibration(const std::string& name) {
+    const std::string cal = path(name);
+    EXPECT_EQ(wait_exit(spawn({"calibrate", "--out", cal}, path("out"), path("err"))), 0)
+        << slurp(path("err"));
+    return cal;
   }
   nlohmann::json record() { return nlohmann::json::parse(slurp(path("record.json"))); }
   std::string record_toml() { return "[record]\njson = \"" + path("record.json") + "\"\n"; }
@@ -150,31 +162,19 @@ std::string staircase_csv() {
   return csv;
 }
 
-// Means of the three points' true displacement over the last half of each hold.
-std::vector<double> hold_means(const std::string& csv, const std::string& t_col,
-                               const std::string& z1_col) {
-  std::istringstream in(csv);
-  std::string line;
-  std::getline(in, line);
-  std::vector<std::string> header;
-  for (std::istringstream h(line); std::getline(h, line, ',');)
-    header.push_back(line);
-  const auto col = [&](const std::string& name) {
-    return static_cast<std::size_t>(std::find(header.begin(), header.end(), name) - header.begin());
-  };
-  const std::size_t ti = col(t_col), zi = col(z1_col);
-  EXPECT_LT(zi, header.size()) << z1_col;
+// Means of the three points' true displacement over the last half of each hold, from the
+// columns t_s and <z>1_um, <z>2_um, <z>3_um of a CSV file.
+std::vector<double> hold_means(const std::string& file, const std::string& z) {
+  const piezoshift::io::CsvTable table = piezoshift::io::CsvTable::load(file);
+  const std::vector<double> t = table.column("t_s");
+  const std::vector<double> z1 = table.column(z + "1_um"), z2 = table.column(z + "2_um"),
+                            z3 = table.column(z + "3_um");
   std::vector<double> sum(kStairs_um.size(), 0.0), n(kStairs_um.size(), 0.0);
-  while (std::getline(in, line)) {
-    std::vector<double> v;
-    for (std::istringstream row(line); std::getline(row, line, ',');)
-      v.push_back(std::strtod(line.c_str(), nullptr));
-    if (v.size() < zi + 3)
+  for (std::size_t i = 0; i < t.size(); ++i) {
+    const auto k = static_cast<std::size_t>(t[i] / kHold_s);
+    if (k >= kStairs_um.size() || t[i] - kHold_s * static_cast<double>(k) < kHold_s / 2)
       continue;
-    const auto k = static_cast<std::size_t>(v[ti] / kHold_s);
-    if (k >= kStairs_um.size() || v[ti] - kHold_s * static_cast<double>(k) < kHold_s / 2)
-      continue;
-    sum[k] += (v[zi] + v[zi + 1] + v[zi + 2]) / 3.0;
+    sum[k] += (z1[i] + z2[i] + z3[i]) / 3.0;
     n[k] += 1.0;
   }
   for (std::size_t k = 0; k < sum.size(); ++k)
@@ -183,9 +183,8 @@ std::vector<double> hold_means(const std::string& csv, const std::string& t_col,
 }
 
 TEST_F(ComediEmulation, RunClosesTheLoopOnTheTwinAsTheSimBackendDoes) {
-  const std::string cal = path("cal.toml");
-  ASSERT_EQ(wait_exit(spawn({"calibrate", "--out", cal}, path("out"), path("err"))), 0)
-      << slurp(path("err"));
+  const std::string cal = twin_calibration("cal.toml");
+  ASSERT_FALSE(HasFailure());
   const std::string profile = write("stairs.csv", staircase_csv());
   const double duration_s = kHold_s * static_cast<double>(kStairs_um.size());
   const auto run_args = [&](const std::string& daq, int seed) {
@@ -210,14 +209,14 @@ TEST_F(ComediEmulation, RunClosesTheLoopOnTheTwinAsTheSimBackendDoes) {
   for (const int seed : {1, 2, 3}) {
     ASSERT_EQ(wait_exit(spawn(run_args("sim", seed), path("out"), path("err"))), 0)
         << slurp(path("err"));
-    sim.push_back(hold_means(slurp(path("log.csv")), "t_s", "truth1_um"));
+    sim.push_back(hold_means(path("log.csv"), "truth"));
   }
   // The twin (seed 1) on the emulated board's wires, following the wall clock as a board's
   // plant does (in 0.1 ms steps where --daq sim takes the loop's 1 ms: another noise draw).
   const std::string toml = record_toml() + "csv = \"" + path("series.csv") +
                            "\"\ncsv_period_s = 0.001\n[twin]\nseed = 1\n";
   ASSERT_EQ(run_emulated(run_args("comedi:/dev/comedi0", 1), toml), 0) << slurp(path("err"));
-  const std::vector<double> comedi = hold_means(slurp(path("series.csv")), "t_s", "z1_um");
+  const std::vector<double> comedi = hold_means(path("series.csv"), "z");
   double spread_um = 0.0;  // the largest seed spread of any hold
   for (std::size_t k = 0; k < kStairs_um.size(); ++k) {
     const auto [lo, hi] = std::minmax({sim[0][k], sim[1][k], sim[2][k]});
@@ -242,17 +241,12 @@ TEST_F(ComediEmulation, RunClosesTheLoopOnTheTwinAsTheSimBackendDoes) {
 
 // `serve` on the emulated board: a GCS client's move reaches its target through the board.
 TEST_F(ComediEmulation, ServeMovesTheStageThroughTheBoard) {
-  const std::string cal = path("cal.toml");
-  ASSERT_EQ(wait_exit(spawn({"calibrate", "--out", cal}, path("out"), path("err"))), 0)
-      << slurp(path("err"));
-  const std::string settings = write("emulation.toml", record_toml());
-  setenv("LD_LIBRARY_PATH", kEmulationDir.c_str(), 1);
-  setenv("PIEZOSHIFT_COMEDI_EMULATION", settings.c_str(), 1);
-  const Spawned s = spawn({"serve", "--daq", "comedi:/dev/comedi0", "--port", "0", "--calibration",
-                           cal, "--duration-s", "3", "--max-overruns", "1000000"},
-                          path("out"), path("err"));
-  unsetenv("LD_LIBRARY_PATH");
-  unsetenv("PIEZOSHIFT_COMEDI_EMULATION");
+  const std::string cal = twin_calibration("cal.toml");
+  ASSERT_FALSE(HasFailure());
+  const Spawned s =
+      spawn_emulated({"serve", "--daq", "comedi:/dev/comedi0", "--port", "0", "--calibration", cal,
+                      "--duration-s", "3", "--max-overruns", "1000000"},
+                     record_toml());
   const std::uint16_t port = piezoshift::testing::wait_for_gcs_port(path("out"), path("err"));
   ASSERT_NE(port, 0);
   piezoshift::testing::HttpConnection gcs(port);
@@ -282,9 +276,8 @@ TEST_F(ComediEmulation, ServeMovesTheStageThroughTheBoard) {
 // emulation's live XL-80-like logs; the operator moving the optics is the test re-pointing a
 // link when the program says where they go. Acceptance tier: it runs in real time (~150 s).
 TEST_F(ComediEmulation, GuidedCalibrationOnTheBoardAgreesWithTheTwinCalibration) {
-  const std::string twin_cal = path("twin_cal.toml");
-  ASSERT_EQ(wait_exit(spawn({"calibrate", "--out", twin_cal}, path("out"), path("err"))), 0)
-      << slurp(path("err"));
+  const std::string twin_cal = twin_calibration("twin_cal.toml");
+  ASSERT_FALSE(HasFailure());
   const std::filesystem::path logs = path("ifm");
   std::filesystem::create_directory(logs);
   const std::filesystem::path optics = logs / "optics.csv";
@@ -298,17 +291,11 @@ TEST_F(ComediEmulation, GuidedCalibrationOnTheBoardAgreesWithTheTwinCalibration)
   // The overrun rule off: a calibration of minutes on a shared test machine would otherwise end
   // on one late burst; the test is about the board and the procedure, not the host.
   const std::string config = write("safety.toml", "[safety]\ntrip_on_overruns = 0\n");
-  const std::string settings =
-      write("emulation.toml",
-            record_toml() + "[interferometer]\nlog_folder = \"" + logs.string() + "\"\n");
   const std::string guided_cal = path("guided_cal.toml");
-  setenv("LD_LIBRARY_PATH", kEmulationDir.c_str(), 1);
-  setenv("PIEZOSHIFT_COMEDI_EMULATION", settings.c_str(), 1);
-  const Spawned s = spawn({"calibrate", "--daq", "comedi:/dev/comedi0", "--interferometer",
-                           "file:" + optics.string(), "--config", config, "--out", guided_cal},
-                          path("out"), path("err"));
-  unsetenv("LD_LIBRARY_PATH");
-  unsetenv("PIEZOSHIFT_COMEDI_EMULATION");
+  const Spawned s =
+      spawn_emulated({"calibrate", "--daq", "comedi:/dev/comedi0", "--interferometer",
+                      "file:" + optics.string(), "--config", config, "--out", guided_cal},
+                     record_toml() + "[interferometer]\nlog_folder = \"" + logs.string() + "\"\n");
   // Follow the instructions as they appear on stderr, as the operator would.
   std::size_t seen = 0;
   int status = -1;
