@@ -92,6 +92,11 @@ std::string faults_text(const runtime::FaultList& faults, const std::vector<std:
   return text;
 }
 
+std::string device_error_line(const runtime::DaqBackend& daq) {
+  const std::string e = daq.device_error();
+  return e.empty() ? e : fmt::format("device error   {} (the last transaction that failed)\n", e);
+}
+
 bool report_unsafe_outputs(const runtime::DaqBackend& daq, const std::string& program) {
   const std::string unsafe = daq.safe_state_error();
   if (unsafe.empty())

@@ -47,6 +47,10 @@ nlohmann::json faults_json(const runtime::FaultList& faults,
 std::string faults_text(const runtime::FaultList& faults,
                         const std::vector<std::string>& loads = {});
 
+//! The summaries' line for the device's own error text of its last failed transaction
+//! ("device error   Timer expired (...)"), or "" when none failed.
+std::string device_error_line(const runtime::DaqBackend& daq);
+
 //! After deactivate(): when the device would not take 0 V on its outputs, says so on stderr (the
 //! amplifier must be switched off by hand) and returns true; `program` prefixes the message.
 bool report_unsafe_outputs(const runtime::DaqBackend& daq, const std::string& program);

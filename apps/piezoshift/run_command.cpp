@@ -298,8 +298,7 @@ void print_run(const RunRecord& run) {
   } else {
     fmt::print("faults         none\n");
   }
-  if (const std::string e = run.stack.daq().device_error(); !e.empty())
-    fmt::print("device error   {} (the last transaction that failed)\n", e);
+  fmt::print("{}", device_error_line(run.stack.daq()));
   if (const runtime::CsvLogger* logger = run.stack.logger()) {
     fmt::print("log            {} ({} records{})\n", o.log, logger->records_written(),
                r.telemetry_dropped ? fmt::format(", {} DROPPED", r.telemetry_dropped) : "");

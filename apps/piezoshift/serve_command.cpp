@@ -479,8 +479,7 @@ int serve(const ServeOptions& o) {
   stack.stop_logging();
   net.rethrow_failure();
   print_serve_summary(o, net, daq_name, loop, r, safety, rt, fault_reporter.loads());
-  if (const std::string e = stack.daq().device_error(); !e.empty())
-    fmt::print("device error   {} (the last transaction that failed)\n", e);
+  fmt::print("{}", device_error_line(stack.daq()));
   return report_unsafe_outputs(stack.daq(), "piezoshift serve") ? kExitFault : 0;
 }
 

@@ -42,13 +42,12 @@ EmulatedBoard::EmulatedBoard(EmulationSettings settings, BoardModel model)
     throw core::InputError(
         fmt::format("{}: the twin cannot be built: {}", settings_.source, e.what()));
   }
-  // Power-up: the DACs at mid code (0 V on the +-10 V range), as ni_ao_reset leaves them.
-  for (unsigned ch = 0; ch < 4; ++ch) {
-    if (model_.subdevices[kAoSubdevice].type != COMEDI_SUBD_AO)
-      break;
-    const comedi_range& r = model_.subdevices[kAoSubdevice].ranges[0];
-    ao_codes_[ch] = raw_code(0.0, r, 0xffff, model_.ao_raw(ch));
-    ao_V_[ch] = raw_volts(ao_codes_[ch], r, 0xffff, model_.ao_raw(ch));
+  // Power-up: the DACs at 0 V on their range, as ni_ao_reset leaves them.
+  if (const SubdeviceModel& ao = model_.subdevices[kAoSubdevice]; ao.type == COMEDI_SUBD_AO) {
+    for (unsigned ch = 0; ch < ao.n_chan && ch < ao_codes_.size(); ++ch) {
+      ao_codes_[ch] = raw_code(0.0, ao.ranges[0], ao.maxdata, model_.ao_raw(ch));
+      ao_V_[ch] = raw_volts(ao_codes_[ch], ao.ranges[0], ao.maxdata, model_.ao_raw(ch));
+    }
   }
   twin_->write_ao(control::Vec3{ao_V_[0], ao_V_[1], ao_V_[2]});
   if (!settings_.log_folder.empty()) {
