@@ -113,7 +113,8 @@ void EmulatedBoard::write_interferometer_logs() {
   const control::Vec3& z = twin_->interferometer().dynamic_um;
   const double at[] = {z[0], z[1], z[2], (z[0] + z[1] + z[2]) / 3.0};
   for (std::size_t i = 0; i < logs_.size(); ++i) {
-    std::fprintf(logs_[i], "%.4f,%.4f\n", unix_start_s_ + t, at[i]);
+    // Unix time of this step: the twin's time plus whatever a host stall dropped from it.
+    std::fprintf(logs_[i], "%.4f,%.4f\n", unix_start_s_ + t + time_dropped_s_, at[i]);
     std::fflush(logs_[i]);  // the reader reads the whole log at each reading
   }
 }
