@@ -1,12 +1,15 @@
 // `piezoshift tolerance`: which tolerances matter, and what fraction of stages built with them
 // meet the spec after calibration (issue 33, docs/tolerance.md).
+#include <unistd.h>
+
+#include <cerrno>
 #include <charconv>
-#include <cmath>
+#include <cstdio>
+#include <cstdlib>
+#include <cstring>
 #include <filesystem>
-#include <fstream>
 #include <memory>
 #include <optional>
-#include <sstream>
 #include <string>
 #include <vector>
 
@@ -17,10 +20,7 @@
 #include "piezoshift/core/input_error.hpp"
 #include "piezoshift/io/atomic_file.hpp"
 #include "piezoshift/io/input_file.hpp"
-#include "piezoshift/io/plot.hpp"
-#include "piezoshift/runtime/safety_ranges.hpp"
-#include "piezoshift/tolerance/tolerance_summary.hpp"
-#include "sample_pool.hpp"
+#include "piezoshift/tolerance/study_run.hpp"
 #include "whole_number.hpp"
 
 namespace piezoshift::app {
@@ -35,7 +35,9 @@ struct Options {
   std::string spec;
   std::string out = "tolerance-study";
   std::string procedure = "paper";
-  std::string shard;  // "i/N"
+  std::string experiments = "quick";
+  std::string scheduler;  // a Dask scheduler: the study runs through the Python package
+  std::string shard;      // "i/N"
   std::uint64_t samples = 100;
   std::uint64_t seed = 1;
   unsigned jobs = 0;
@@ -70,187 +72,94 @@ nlohmann::json read_json(const std::string& path) {
   }
 }
 
-fs::path record_path(const std::string& out, std::uint64_t index) {
-  return fs::path(out) / "samples" / fmt::format("sample-{:06}.json", index);
-}
-
-// A record written by an earlier run of the same study, or nothing (absent, or another study's:
-// then it is run again and overwritten).
-std::optional<SampleResult> resumed(const fs::path& path, const nlohmann::json& header,
-                                    const tolerance::ToleranceSet& set) {
-  std::error_code ec;
-  if (!fs::is_regular_file(path, ec))
-    return std::nullopt;
-  const nlohmann::json j = read_json(path.string());
-  if (!j.contains("study") || j.at("study") != header || !j.contains("sample"))
-    return std::nullopt;
-  return tolerance::sample_from_json(set, j.at("sample"), path.string());
-}
-
-struct Study {
-  config::ProjectConfig config;
-  tolerance::ToleranceSet set;
-  tolerance::Spec spec;
-  tolerance::StudyOptions options;
-  nlohmann::json header;
-};
-
-Study load_study(const Options& o) {
-  Study s;
-  if (!o.config.empty())
-    s.config = runtime::load_installation_config(o.config).project;
-  if (o.tolerances.empty())
-    throw core::InputError("tolerance: --tolerances FILE is required");
-  s.set = tolerance::load_tolerances(o.tolerances, s.config);
-  s.spec = o.spec.empty() ? tolerance::parse_spec("", "no spec") : tolerance::load_spec(o.spec);
-  s.options.seed = o.seed;
-  s.options.procedure =
+tolerance::Study load_study(const Options& o) {
+  tolerance::StudyInputs in;
+  in.tolerances = o.tolerances;
+  in.config = o.config;
+  in.spec = o.spec;
+  in.samples = o.samples;
+  in.options.seed = o.seed;
+  in.options.procedure =
       o.procedure == "improved" ? tolerance::Procedure::kImproved : tolerance::Procedure::kPaper;
-  s.header = tolerance::study_header(s.set, s.options, o.samples);
-  s.header["tolerance_file"] = o.tolerances;
-  s.header["config"] = o.config.empty() ? "built-in defaults" : o.config;
-  return s;
+  in.options.experiments = o.experiments == "table4" ? tolerance::ExperimentSet::kTable4
+                                                     : tolerance::ExperimentSet::kQuick;
+  return tolerance::load_study(in);
 }
 
-// The samples of `indices`, each resumed from its record or run and recorded.
-std::vector<SampleResult> run_samples(const Study& s, const std::vector<std::uint64_t>& indices,
-                                      const Options& o) {
-  std::vector<SampleResult> results(indices.size());
-  std::vector<std::size_t> todo;
-  for (std::size_t k = 0; k < indices.size(); ++k) {
-    if (auto r = resumed(record_path(o.out, indices[k]), s.header, s.set))
-      results[k] = std::move(*r);
-    else
-      todo.push_back(k);
-  }
-  if (todo.size() < indices.size())
-    fmt::print(stderr, "piezoshift: tolerance: {} sample(s) resumed from {}\n",
-               indices.size() - todo.size(), (fs::path(o.out) / "samples").string());
-  fs::create_directories(fs::path(o.out) / "samples");
-  run_pool(
-      todo.size(), o.jobs,
-      [&](std::size_t t) {
-        const std::size_t k = todo[t];
-        const std::vector<double> dev =
-            tolerance::draw_deviations(s.set, s.options.seed, indices[k]);
-        results[k] = tolerance::run_sample(s.config, s.set, dev, indices[k], s.options);
-        const nlohmann::json rec{{"study", s.header},
-                                 {"sample", tolerance::sample_json(s.set, results[k])}};
-        io::write_file_atomically(record_path(o.out, indices[k]).string(), rec.dump(1) + "\n");
-      },
-      "tolerance");
-  return results;
-}
-
-// A metric's distribution over the valid samples: its histogram and its cumulative curve, as the
-// change from the median in % (absolute values of a narrow spread, 0.03601 to 0.03605 s, make
-// tick labels that overlap); the caption gives the median and the range.
-io::Figure metric_figure(std::size_t m, std::vector<double> v) {
-  std::sort(v.begin(), v.end());
-  const tolerance::Metric& metric = tolerance::metrics()[m];
-  const double median = v[v.size() / 2];
-  std::vector<double> change_pct, fraction_pct;
-  for (std::size_t i = 0; i < v.size(); ++i) {
-    change_pct.push_back(median != 0.0 ? 100.0 * (v[i] - median) / std::abs(median) : v[i]);
-    fraction_pct.push_back(100.0 * static_cast<double>(i + 1) / static_cast<double>(v.size()));
-  }
-  const std::string_view name =
-      std::string_view(metric.axis)
-          .substr(0, std::string_view(metric.axis).find(" ["));  // "first mode [Hz]": "first mode"
-  const std::string axis = fmt::format("{}, change from the median [%]", name);
-  io::Figure f;
-  f.cols = 2;
-  f.png = false;
-  f.width_px = 900;
-  f.height_px = 380;
-  f.caption = fmt::format("{}: {} valid samples, median {:.6g}, {:.6g} to {:.6g} ({})",
-                          metric.label, v.size(), median, v.front(), v.back(), metric.axis);
-  io::Panel hist;
-  hist.title = "histogram";
-  hist.x_label = axis;
-  hist.y_label = "sample count";
-  hist.key = "off";
-  const double span = change_pct.back() - change_pct.front();
-  hist.series.push_back(io::histogram_series("samples", change_pct, span / 20.0));
-  io::Panel cdf;
-  cdf.title = "cumulative";
-  cdf.x_label = axis;
-  cdf.y_label = "valid samples at or below [%]";
-  cdf.key = "off";
-  cdf.series.push_back(io::line_series("cumulative", change_pct, fraction_pct));
-  f.panels = {std::move(hist), std::move(cdf)};
-  return f;
-}
-
-// One figure per metric with a spread; gnuplot missing or failing costs the figures only.
-std::vector<std::string> write_figures(const std::vector<SampleResult>& samples,
-                                       const std::string& out) {
-  std::vector<std::string> stems;
-  for (std::size_t m = 0; m < tolerance::metrics().size(); ++m) {
-    std::vector<double> v;
-    for (const SampleResult& s : samples)
-      if (std::isfinite(s.metrics[m]))
-        v.push_back(s.metrics[m]);
-    if (v.size() < 2 ||
-        !(*std::max_element(v.begin(), v.end()) > *std::min_element(v.begin(), v.end())))
-      continue;
-    const std::string stem = fmt::format("dist_{}", tolerance::metrics()[m].key);
-    try {
-      io::render(metric_figure(m, std::move(v)), fs::path(out) / stem);
-      stems.push_back(stem);
-    } catch (const io::PlotError& e) {
-      fmt::print(stderr, "piezoshift: tolerance: no figures: {}\n", e.what());
-      break;
-    }
-  }
-  return stems;
-}
-
-void write_outputs(const Study& s, const std::vector<SampleResult>& samples, const Options& o,
-                   const std::optional<nlohmann::json>& sensitivity) {
-  const nlohmann::json study = tolerance::study_json(s.set, s.header, s.spec, samples);
-  const fs::path out(o.out);
-  fs::create_directories(out);
-  io::write_file_atomically((out / "tolerance.json").string(), study.dump(1) + "\n");
-  io::write_file_atomically((out / "tolerance.csv").string(),
-                            tolerance::study_csv(s.set, s.spec, samples));
-  if (sensitivity)
-    io::write_file_atomically((out / "sensitivity.json").string(), sensitivity->dump(1) + "\n");
-  const std::vector<std::string> figures =
-      o.figures ? write_figures(samples, o.out) : std::vector<std::string>{};
-  io::write_file_atomically((out / "tolerance.md").string(),
-                            tolerance::study_markdown(s.set, study, sensitivity, figures));
-  const nlohmann::json& y = study.at("yield");
+void write_outputs(const tolerance::Study& s, const std::vector<SampleResult>& samples,
+                   const Options& o, const std::optional<nlohmann::json>& sensitivity) {
+  const tolerance::StudyOutputs out =
+      tolerance::write_study_outputs(s, samples, o.out, o.figures, sensitivity);
   fmt::print("piezoshift tolerance: {} samples, {} valid, {} meet the spec ({:.1f} %)\n",
-             y.at("samples").get<std::size_t>(), y.at("valid").get<std::size_t>(),
-             y.at("pass").get<std::size_t>(), 100.0 * y.at("fraction").get<double>());
-  fmt::print("report: {}\n", (out / "tolerance.md").string());
+             out.samples, out.valid, out.pass, 100.0 * out.fraction);
+  fmt::print("report: {} and {}\n", out.markdown.string(), out.html.string());
 }
 
-nlohmann::json run_sensitivity(const Study& s, const Options& o) {
-  const std::vector<std::vector<double>> devs = tolerance::sensitivity_deviations(s.set);
-  std::vector<SampleResult> runs(devs.size());
-  run_pool(
-      devs.size(), o.jobs,
-      [&](std::size_t k) {
-        runs[k] = tolerance::run_sample(s.config, s.set, devs[k], k, s.options);
-      },
-      "tolerance sensitivity");
-  return tolerance::sensitivity_json(s.set, runs[0], tolerance::sensitivity_table(s.set, runs));
+// The study on a Dask cluster: the Python package's `python3 -m piezoshift.tolerance`, given the
+// same study, in this process's place (its exit status is the command's). The interpreter is
+// $PIEZOSHIFT_PYTHON, else python3; without the package it says so and exits 2.
+[[noreturn]] void run_on_scheduler(const Options& o) {
+  const char* env = std::getenv("PIEZOSHIFT_PYTHON");
+  const std::string python = env != nullptr && *env != '\0' ? env : "python3";
+  std::vector<std::string> args{
+      python,
+      "-c",
+      "import sys\n"
+      "try:\n"
+      "    import piezoshift.tolerance as t\n"
+      "except ImportError as e:\n"
+      "    print(f'piezoshift: error: tolerance --scheduler needs the Python package piezoshift "
+      "and dask.distributed ({e}): docs/python.md, docs/tolerance.md', file=sys.stderr)\n"
+      "    sys.exit(2)\n"
+      "sys.exit(t.main(sys.argv[1:]))\n",
+      "--scheduler",
+      o.scheduler,
+      "--tolerances",
+      o.tolerances,
+      "--samples",
+      std::to_string(o.samples),
+      "--seed",
+      std::to_string(o.seed),
+      "--procedure",
+      o.procedure,
+      "--experiments",
+      o.experiments,
+      "--out",
+      o.out};
+  for (const auto& [flag, value] : {std::pair{"--config", &o.config}, {"--spec", &o.spec}})
+    if (!value->empty())
+      args.insert(args.end(), {flag, *value});
+  if (o.figures)
+    args.emplace_back("--figures");
+  if (o.sensitivity)
+    args.emplace_back("--sensitivity");
+  std::vector<char*> argv;
+  for (std::string& a : args)
+    argv.push_back(a.data());
+  argv.push_back(nullptr);
+  std::fflush(stdout);
+  ::execvp(argv[0], argv.data());
+  throw core::InputError(
+      fmt::format("tolerance --scheduler: cannot run {}: {}", python, std::strerror(errno)));
 }
 
 int run(const Options& o) {
-  const Study s = load_study(o);
+  const tolerance::Study s = load_study(o);
   // A shard writes its samples only: what needs all of them is merge's (or a whole run's).
   if (!o.shard.empty() && (o.sensitivity || o.figures || !o.spec.empty()))
     throw core::InputError(
         "tolerance: --shard writes samples only: give --spec and --figures to `tolerance merge`, "
         "and run --sensitivity without --shard");
-  work_begins();        // the samples' calibrations and experiments, the files
+  if (!o.scheduler.empty() && (!o.shard.empty() || o.sample >= 0))
+    throw core::InputError(
+        "tolerance: --scheduler runs a whole study: without --shard or --sample (run those "
+        "locally)");
+  work_begins();  // the samples' calibrations and experiments, the files
+  if (!o.scheduler.empty())
+    run_on_scheduler(o);
   if (o.sample >= 0) {  // one sample alone, e.g. a worst one
     const auto index = static_cast<std::uint64_t>(o.sample);
-    const SampleResult r = tolerance::run_sample(
-        s.config, s.set, tolerance::draw_deviations(s.set, o.seed, index), index, s.options);
+    const SampleResult r = tolerance::run_study_sample(s, index);
     nlohmann::json j = tolerance::sample_json(s.set, r);
     j["spec_failure"] = tolerance::spec_failure(s.spec, r);
     fmt::print("{}\n", j.dump(2));
@@ -262,7 +171,8 @@ int run(const Options& o) {
   std::vector<std::uint64_t> indices;
   for (std::uint64_t i = first; i < o.samples; i += stride)
     indices.push_back(i);
-  const std::vector<SampleResult> samples = run_samples(s, indices, o);
+  const std::vector<SampleResult> samples = tolerance::run_study_samples(
+      s, indices, o.out, o.jobs, tolerance::progress_lines("tolerance"));
   if (!o.shard.empty()) {
     nlohmann::json shard{{"study", s.header}, {"shard", {first, stride}}};
     shard["samples"] = nlohmann::json::array();
@@ -276,7 +186,9 @@ int run(const Options& o) {
   }
   std::optional<nlohmann::json> sensitivity;
   if (o.sensitivity)
-    sensitivity = run_sensitivity(s, o);
+    sensitivity = tolerance::sensitivity_from_runs(
+        s,
+        tolerance::run_sensitivity(s, o.jobs, tolerance::progress_lines("tolerance sensitivity")));
   write_outputs(s, samples, o, sensitivity);
   return 0;
 }
@@ -296,11 +208,12 @@ int run_merge(const Options& given) {
       o.seed = h.at("seed").get<std::uint64_t>();
       o.samples = h.at("samples").get<std::uint64_t>();
       o.procedure = h.at("procedure").get<std::string>();
+      o.experiments = h.at("experiments").get<std::string>();
     } catch (const nlohmann::json::exception& e) {
       throw core::InputError(fmt::format("{}: not a shard file: {}", o.shard_files[0], e.what()));
     }
   }
-  const Study s = load_study(o);
+  const tolerance::Study s = load_study(o);
   std::vector<std::optional<SampleResult>> by_index(o.samples);
   for (const std::string& path : o.shard_files) {
     const nlohmann::json j = read_json(path);
@@ -335,6 +248,10 @@ void add_study_options(CLI::App* cmd, Options& o) {
       ->check(whole_number(0, kAnyUnsigned));
   cmd->add_option("--procedure", o.procedure, "calibration procedure")
       ->check(CLI::IsMember({"paper", "improved"}));
+  cmd->add_option("--experiments", o.experiments,
+                  "what each sample measures: quick (about 0.45 s of CPU) or table4 (the "
+                  "paper's protocols whole)")
+      ->check(CLI::IsMember({"quick", "table4"}));
   cmd->add_option("--spec", o.spec, "TOML file with [spec] <metric>_min / <metric>_max");
   cmd->add_option("--out", o.out, "output folder");
   cmd->add_flag("--figures", o.figures, "histograms of the metrics (gnuplot)");
@@ -348,6 +265,9 @@ void add_tolerance_command(CLI::App& app, Action& action) {
       "tolerance", "Monte Carlo tolerance study: sensitivity and yield after calibration");
   add_study_options(cmd, *o);
   cmd->add_option("--jobs", o->jobs, "local threads (0: every core)")->check(whole_number(0, 1024));
+  cmd->add_option("--scheduler", o->scheduler,
+                  "a Dask scheduler (tcp://host:8786): the samples run on its workers through "
+                  "the Python package (docs/tolerance.md)");
   cmd->add_option("--shard", o->shard, "run samples i, i+N, ... and write a shard file")
       ->check(CLI::Validator(
           [](std::string& t) -> std::string {

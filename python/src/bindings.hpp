@@ -22,5 +22,6 @@ void bind_calibration(py::module_& m);   // calibration_py.cpp
 void bind_reproduction(py::module_& m);  // reproduction_py.cpp
 void bind_camera(py::module_& m);        // camera_py.cpp
 void bind_instrument(py::module_& m);    // instrument_py.cpp: after the controller and cameras
+void bind_tolerance(py::module_& m);     // tolerance_py.cpp
 
 }  // namespace piezoshift::python

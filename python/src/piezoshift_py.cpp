@@ -26,4 +26,5 @@ PYBIND11_MODULE(_piezoshift, m) {
   bind::bind_reproduction(m);
   bind::bind_camera(m);
   bind::bind_instrument(m);
+  bind::bind_tolerance(m);
 }

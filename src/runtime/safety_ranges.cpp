@@ -49,14 +49,26 @@ void read_safety_section(const io::ConfigFile& file, SafetyLimits& limits) {
     throw core::InputError(fmt::format("{}: {}", file.source(), problem));
 }
 
-InstallationConfig load_installation_config(const std::string& path) {
-  const io::ConfigFile file = io::ConfigFile::load(path);
+namespace {
+
+InstallationConfig read_installation_config(const io::ConfigFile& file) {
   InstallationConfig c;
   config::read_design_sections(file, c.project.design);
   config::read_twin_sections(file, c.project.design, c.project.twin);
   read_safety_section(file, c.safety);
   file.reject_unknown();
   return c;
+}
+
+}  // namespace
+
+InstallationConfig load_installation_config(const std::string& path) {
+  return read_installation_config(io::ConfigFile::load(path));
+}
+
+InstallationConfig parse_installation_config(std::string_view text,
+                                             const std::string& source_name) {
+  return read_installation_config(io::ConfigFile::parse(text, source_name));
 }
 
 std::string describe(const SafetyLimits& l) {

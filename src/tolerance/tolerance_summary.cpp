@@ -43,6 +43,21 @@ double change_pct(double v, double nominal) {
   return 100.0 * (v - nominal) / std::abs(nominal);
 }
 
+// What the calibration changed to absorb a deviation: the largest |change| of an element of A
+// (absolute: some elements are near 0) and the change of p(6 um) in %.
+nlohmann::json compensator_change(const SampleResult& s, const SampleResult& nominal) {
+  const std::size_t p = compensators().size() - 1;
+  double a = kNaN;
+  for (std::size_t i = 0; i < p; ++i) {
+    const double d = std::abs(s.compensators.at(i) - nominal.compensators.at(i));
+    if (std::isfinite(d))
+      a = std::isnan(a) ? d : std::max(a, d);
+  }
+  return {
+      {"A_max_abs_change", number(a)},
+      {"p_6um_change_pct", number(change_pct(s.compensators.at(p), nominal.compensators.at(p)))}};
+}
+
 }  // namespace
 
 bool Spec::empty() const {
@@ -124,6 +139,7 @@ nlohmann::json study_header(const ToleranceSet& set, const StudyOptions& options
     m.push_back(x.key);
   return {{"seed", options.seed},
           {"procedure", procedure_name(options.procedure)},
+          {"experiments", experiment_set_name(options.experiments)},
           {"samples", samples},
           {"tolerances", tol},
           {"metrics", m}};
@@ -138,8 +154,11 @@ nlohmann::json sample_json(const ToleranceSet& set, const SampleResult& s) {
   }
   for (std::size_t i = 0; i < metrics().size(); ++i)
     met[metrics()[i].key] = number(s.metrics.at(i));
-  return {{"index", s.index},  {"valid", s.valid}, {"reason", s.reason},
-          {"deviations", dev}, {"values", val},    {"metrics", met}};
+  nlohmann::json cal = nlohmann::json::object();
+  for (std::size_t i = 0; i < compensators().size(); ++i)
+    cal[compensators()[i].key] = i < s.compensators.size() ? number(s.compensators[i]) : nullptr;
+  return {{"index", s.index}, {"valid", s.valid}, {"reason", s.reason}, {"deviations", dev},
+          {"values", val},    {"metrics", met},   {"calibration", cal}};
 }
 
 SampleResult sample_from_json(const ToleranceSet& set, const nlohmann::json& j,
@@ -153,6 +172,8 @@ SampleResult sample_from_json(const ToleranceSet& set, const nlohmann::json& j,
       s.deviations.push_back(j.at("deviations").at(t.key).get<double>());
     for (const Metric& m : metrics())
       s.metrics.push_back(from_number(j.at("metrics").at(m.key)));
+    for (const Compensator& c : compensators())
+      s.compensators.push_back(from_number(j.at("calibration").at(c.key)));
     return s;
   } catch (const nlohmann::json::exception& e) {
     throw core::InputError(fmt::format("{}: not a sample of this study: {}", source, e.what()));
@@ -276,7 +297,8 @@ nlohmann::json sensitivity_json(const ToleranceSet& set, const SampleResult& nom
                    {"valid", s->valid},
                    {"reason", s->reason},
                    {"metrics", sample_json(set, *s).at("metrics")},
-                   {"change_pct", change}};
+                   {"change_pct", change},
+                   {"calibration_change", compensator_change(*s, nominal)}};
     }
     out["rows"].push_back(std::move(row));
   }

@@ -56,6 +56,24 @@ TEST(ToleranceStudy, HingeThicknessMovesTheFirstModeAsTheClosedFormSays) {
   const std::vector<SensitivityRow> rows = sensitivity_table(set, runs);
   ASSERT_EQ(rows.size(), 1U);
   EXPECT_GE(rows[0].effect_pct, 100.0 * (std::pow(1.01, 2.5) - 1.0) - 1e-9);
+  // What the calibration absorbed. A is the tripod's geometry and the gauges' gains (docs/twin.md),
+  // which the neck does not touch: it stays within the calibration's own 0.001
+  // (docs/calibration.md). p(6 um) moves a little, opposite ways at the two limits (measured -0.063
+  // % at +20 um, +0.077 % at -20 um): the contact in series with each stack compresses under the
+  // flexure's force.
+  const std::size_t p6 = compensators().size() - 1;
+  ASSERT_EQ(std::string(compensators()[p6].key), "p_6um_um");
+  for (std::size_t i = 0; i < p6; ++i)
+    for (const SampleResult* r : {&runs[1], &runs[2]})
+      EXPECT_NEAR(r->compensators[i], runs[0].compensators[i], 1e-3) << compensators()[i].key;
+  const double rise_pct = 100.0 * (runs[2].compensators[p6] / runs[0].compensators[p6] - 1.0);
+  const double fall_pct = 100.0 * (runs[1].compensators[p6] / runs[0].compensators[p6] - 1.0);
+  EXPECT_LT(rise_pct * fall_pct, 0.0);
+  EXPECT_LT(std::abs(rise_pct), 0.2);
+  EXPECT_GT(std::abs(rise_pct), 0.01);
+  const nlohmann::json sens = sensitivity_json(set, runs[0], rows);
+  EXPECT_NEAR(sens["rows"][0]["hi"]["calibration_change"]["p_6um_change_pct"].get<double>(),
+              rise_pct, 1e-9);
 }
 
 TEST(ToleranceStudy, AnUnbuildablePlantIsASampleThatFailsTheSpec) {
@@ -109,6 +127,7 @@ TEST(ToleranceStudy, ASampleRecordReadsBackBitForBit) {
   r.metrics.assign(metrics().size(), 0.1 + 0.2);
   r.metrics[1] = std::numeric_limits<double>::quiet_NaN();
   r.metrics[2] = std::numeric_limits<double>::infinity();
+  r.compensators.assign(compensators().size(), -0.1 - 0.2);
   const SampleResult back =
       sample_from_json(set, nlohmann::json::parse(sample_json(set, r).dump()), "rec");
   EXPECT_EQ(back.index, 3U);
@@ -116,6 +135,12 @@ TEST(ToleranceStudy, ASampleRecordReadsBackBitForBit) {
   EXPECT_EQ(back.metrics[0], 0.1 + 0.2);
   EXPECT_TRUE(std::isnan(back.metrics[1]));
   EXPECT_TRUE(std::isinf(back.metrics[2]));
+  EXPECT_EQ(back.compensators.back(), -0.1 - 0.2);
+  // A sample that never reached its calibration has no compensators: null, read back as NaN.
+  r.compensators.clear();
+  EXPECT_TRUE(
+      std::isnan(sample_from_json(set, nlohmann::json::parse(sample_json(set, r).dump()), "rec")
+                     .compensators[0]));
 }
 
 }  // namespace

@@ -9,6 +9,7 @@
 //   max_consecutive_overruns = 5
 #include <cstdint>
 #include <string>
+#include <string_view>
 
 #include "piezoshift/config/project_config.hpp"
 #include "piezoshift/core/bounds.hpp"
@@ -74,6 +75,8 @@ struct InstallationConfig {
 
 //! Loads a configuration file as config::load_project_config() does, with [safety] besides.
 InstallationConfig load_installation_config(const std::string& path);
+//! The same from a file's text (a worker given the text of a file it has not: tolerance studies).
+InstallationConfig parse_installation_config(std::string_view text, const std::string& source_name);
 
 //! One line for start-up summaries: every limit with its unit.
 std::string describe(const SafetyLimits& limits);

@@ -24,6 +24,11 @@ namespace piezoshift::tolerance {
 enum class Procedure { kPaper, kImproved };
 const char* procedure_name(Procedure p);
 
+//! What each sample measures: the quick set (quick_schedule(), about 0.45 s of CPU a sample), or
+//! Table 4's (table4_schedule(): the paper's protocols whole, with repeatability at 10 um too).
+enum class ExperimentSet { kQuick, kTable4 };
+const char* experiment_set_name(ExperimentSet e);
+
 //! The metrics every sample records, in this order.
 struct Metric {
   const char* key;    //!< "first_mode_Hz": JSON and CSV column, the spec's <key>_min / _max
@@ -35,12 +40,23 @@ const std::vector<Metric>& metrics();
 struct StudyOptions {
   std::uint64_t seed = 1;
   Procedure procedure = Procedure::kPaper;
+  ExperimentSet experiments = ExperimentSet::kQuick;
 };
+
+//! What the calibration set to absorb the sample's deviations (the lens designer's compensators):
+//! the transmission matrix A (Eq. 8, row-major) and the polynomial's command for 6 um of gauge
+//! reading p(6 um) (mid-travel), in this order. NaN when the calibration failed.
+struct Compensator {
+  const char* key;  //!< "A11", ..., "A33", "p_6um_um"
+  const char* label;
+};
+const std::vector<Compensator>& compensators();
 
 struct SampleResult {
   std::uint64_t index = 0;
-  std::vector<double> deviations;  //!< per tolerance of the set
-  std::vector<double> metrics;     //!< per metrics(); NaN where not measured or not valid
+  std::vector<double> deviations;    //!< per tolerance of the set
+  std::vector<double> metrics;       //!< per metrics(); NaN where not measured or not valid
+  std::vector<double> compensators;  //!< per compensators(); NaN where not calibrated
   bool valid = true;
   std::string reason;  //!< why not valid ("" when valid)
 };
@@ -48,6 +64,10 @@ struct SampleResult {
 //! The quick set's schedule: Schedule::quick() with the paper's gains (no PID grid), its
 //! linearity (the paper's levels held 4 s), repeatability of 40 moves, a 0.5 s step record.
 reproduction::Schedule quick_schedule();
+//! Table 4's: Schedule::paper() (the paper's protocols: linearity held 10 s a level, 230 moves at
+//! 5 and at 10 um) with the paper's gains, as the quick set (a PID grid per sample would measure
+//! the search, not the tolerances).
+reproduction::Schedule table4_schedule();
 
 //! Builds, calibrates and measures the plant of one set of deviations.
 SampleResult run_sample(const config::ProjectConfig& nominal, const ToleranceSet& set,

@@ -3,7 +3,7 @@
 // the worst samples, the sensitivity table, and the files: tolerance.json (the study, every
 // sample, the yield and the worst samples; no wall times, so the same study gives the same bytes
 // whatever the number of jobs or shards), tolerance.csv, a per-sample record for resuming, and
-// tolerance.md.
+// tolerance.md and tolerance.html.
 #include <cstdint>
 #include <limits>
 #include <optional>
@@ -12,6 +12,7 @@
 
 #include <nlohmann/json.hpp>
 
+#include "piezoshift/reproduction/document.hpp"
 #include "piezoshift/tolerance/tolerance_study.hpp"
 
 namespace piezoshift::tolerance {
@@ -63,10 +64,15 @@ std::vector<SensitivityRow> sensitivity_table(const ToleranceSet& set,
 nlohmann::json sensitivity_json(const ToleranceSet& set, const SampleResult& nominal,
                                 const std::vector<SensitivityRow>& rows);
 
-//! tolerance.md: the tolerances, the yield, the sensitivity table (when run), the worst samples,
-//! and the metrics' histograms (figure stems given, relative to the report).
-std::string study_markdown(const ToleranceSet& set, const nlohmann::json& study,
-                           const std::optional<nlohmann::json>& sensitivity,
-                           const std::vector<std::string>& figures);
+//! A figure of the report: its caption and its file, relative to the report.
+struct ReportFigure {
+  std::string caption, path;
+};
+//! The report, rendered as tolerance.md and tolerance.html (reproduction/document.hpp): the
+//! tolerances, the yield, the sensitivity table with what the calibration absorbed (when run), the
+//! worst samples, and the metrics' distributions.
+std::vector<reproduction::Block> study_report(const ToleranceSet& set, const nlohmann::json& study,
+                                              const std::optional<nlohmann::json>& sensitivity,
+                                              const std::vector<ReportFigure>& figures);
 
 }  // namespace piezoshift::tolerance
