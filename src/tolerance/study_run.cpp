@@ -25,6 +25,7 @@ Study build_study(const std::string& tolerance_name, std::string tolerance_text,
   Study s;
   if (!config_name.empty())
     s.config = runtime::parse_installation_config(config_text, config_name).project;
+  const std::string pinned = pin_identified_contact(s.config);
   s.set = parse_tolerances(tolerance_text, tolerance_name, s.config);
   s.spec = parse_spec("", "no spec");
   s.options = options;
@@ -32,6 +33,7 @@ Study build_study(const std::string& tolerance_name, std::string tolerance_text,
   s.header = study_header(s.set, options, samples);
   s.header["tolerance_file"] = tolerance_name;
   s.header["config"] = config_name.empty() ? kBuiltIn : config_name;
+  s.header["pinned"] = pinned;
   s.tolerance_text = std::move(tolerance_text);
   s.config_text = std::move(config_text);
   return s;

@@ -1,5 +1,7 @@
 #include "piezoshift/tolerance/tolerance_file.hpp"
 
+#include "piezoshift/plant/twin_model.hpp"
+
 #include <algorithm>
 #include <array>
 #include <cmath>
@@ -13,6 +15,7 @@
 #include "piezoshift/design/design_ranges.hpp"
 #include "piezoshift/io/config_file.hpp"
 #include "piezoshift/io/input_file.hpp"
+#include "piezoshift/plant/twin_model.hpp"
 #include "piezoshift/plant/twin_ranges.hpp"
 
 namespace piezoshift::tolerance {
@@ -239,6 +242,20 @@ ToleranceSet parse_tolerances(std::string_view text, const std::string& source_n
   if (set.tolerances.empty())
     throw core::InputError(fmt::format("{}: no [tolerance.<parameter>] section", source_name));
   return set;
+}
+
+std::string pin_identified_contact(config::ProjectConfig& config) {
+  const plant::TwinModel m = plant::make_twin_model(config.design, config.twin);
+  if (m.contact_preload_identified) {
+    config.twin.contact.preload_N = m.contact_preload_N;
+    return fmt::format("twin.contact.preload_N = {} (identified)", m.contact_preload_N);
+  }
+  if (m.contact_identified && !m.contact_hertz) {
+    config.twin.contact.stiffness_N_per_um = m.contact_stiffness_N_per_um;
+    return fmt::format("twin.contact.stiffness_N_per_um = {} (identified)",
+                       m.contact_stiffness_N_per_um);
+  }
+  return "";
 }
 
 ToleranceSet load_tolerances(const std::string& path, const config::ProjectConfig& nominal) {

@@ -69,6 +69,15 @@ struct ToleranceSet {
 //! no number of the range lists has that key (or it is an optional without a value).
 double* parameter_slot(config::ProjectConfig& config, std::string_view key, core::Bounds* bounds);
 
+//! The nominal stage's contact as a built stage has it. Unless the configuration gives it, the twin
+//! identifies the contact (its preload, or a linear stiffness) from the open-loop travel and the
+//! stacks' mean stroke; a sample with other stacks would then be given another contact, softer for
+//! stronger stacks, so that its open-loop travel stays the paper's. A built stage keeps its set
+//! screw's preload whatever its stacks: this sets the identified value into the configuration
+//! (twin.contact.preload_N, or stiffness_N_per_um for a linear contact), which also makes it a
+//! parameter a tolerance can name. Returns what it set ("" when the configuration gave it).
+std::string pin_identified_contact(config::ProjectConfig& config);
+
 //! Parses a tolerance file against the nominal configuration. Throws core::InputError.
 ToleranceSet load_tolerances(const std::string& path, const config::ProjectConfig& nominal);
 ToleranceSet parse_tolerances(std::string_view text, const std::string& source_name,
