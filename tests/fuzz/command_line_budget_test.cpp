@@ -22,9 +22,7 @@
 #include "piezoshift/config/project_config.hpp"
 #include "piezoshift/psi/png_image.hpp"
 #include "piezoshift/rig/simulation_meter.hpp"
-#include "piezoshift/tolerance/tolerance_file.hpp"
-#include "piezoshift/tolerance/tolerance_study.hpp"
-#include "piezoshift/tolerance/tolerance_summary.hpp"
+#include "piezoshift/tolerance/study_run.hpp"
 
 namespace piezoshift::fuzz {
 namespace {
@@ -76,11 +74,12 @@ class CommandLineBudget : public ::testing::Test {
   // tolerance merge's input: a shard of a one-sample study of the example tolerances, its one
   // record a sample that was not valid (merging reads it; nothing is computed).
   std::string tolerance_shard() const {
-    const std::string file = testing::source_dir() + "/configs/tolerances/paper_stage.toml";
-    const tolerance::ToleranceSet set = tolerance::load_tolerances(file, config::ProjectConfig{});
-    nlohmann::json header = tolerance::study_header(set, tolerance::StudyOptions{}, 1);
-    header["tolerance_file"] = file;
-    header["config"] = "built-in defaults";
+    tolerance::StudyInputs study;
+    study.tolerances = testing::source_dir() + "/configs/tolerances/paper_stage.toml";
+    study.samples = 1;
+    const tolerance::Study s = tolerance::load_study(study);
+    const tolerance::ToleranceSet& set = s.set;
+    const nlohmann::json& header = s.header;
     tolerance::SampleResult r;
     r.deviations.assign(set.tolerances.size(), 0.0);
     r.metrics.assign(tolerance::metrics().size(), std::nan(""));
