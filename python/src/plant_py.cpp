@@ -112,6 +112,17 @@ void bind_sensing_params(py::module_& m) {
       .PS_RW(pl::LabParams, metrology_loop_cte_per_K)
       .PS_RW(pl::LabParams, dead_path_m)
       .PS_RW(pl::LabParams, air_index_per_K);
+  py::class_<pl::CavityParams>(m, "CavityParams")
+      .def(py::init<>())
+      .PS_RW(pl::CavityParams, gap_m)
+      .PS_RW(pl::CavityParams, wavelength_nm)
+      .PS_RW(pl::CavityParams, pressure_Pa)
+      .PS_RW(pl::CavityParams, pressure_rate_rms_Pa_per_s)
+      .PS_RW(pl::CavityParams, pressure_rate_correlation_time_s)
+      .PS_RW(pl::CavityParams, water_vapour_pressure_Pa)
+      .PS_RW(pl::CavityParams, mount_path_length_m)
+      .PS_RW(pl::CavityParams, mount_cte_per_K)
+      .PS_RW(pl::CavityParams, in_fringes);
 }
 
 void bind_twin_values(py::module_& m) {
@@ -138,7 +149,10 @@ void bind_twin_values(py::module_& m) {
       .PS_RO(Tr, sgs_excitation_drift_ppm)
       .PS_V3(Tr, sgs_zero_flicker_nm)
       .PS_V3(Tr, gauge_creep_um)
-      .PS_RO(Tr, interferometer_drift_nm);
+      .PS_RO(Tr, interferometer_drift_nm)
+      .PS_RO(Tr, air_pressure_Pa)
+      .PS_RO(Tr, cavity_drift_nm)
+      .PS_RO(Tr, cavity_path_nm);
 
   using Ifm = pl::InterferometerReading;
   py::class_<Ifm>(m, "InterferometerReading")
@@ -195,6 +209,7 @@ void bind_twin_class(py::module_& m) {
           "Holds ao_V for `ticks` control periods; returns (ai_V, points_um), each ticks x 3")
       .def("truth", [](const pl::Twin& t) { return t.truth(); })
       .def("interferometer", [](const pl::Twin& t) { return t.interferometer(); })
+      .def_property_readonly("fringe_piston_nm", &pl::Twin::fringe_piston_nm)
       .def_property_readonly("time_s", &pl::Twin::time_s)
       .def_property_readonly("ticks", &pl::Twin::ticks)
       .def_property_readonly("seed", &pl::Twin::seed)
@@ -219,7 +234,8 @@ void bind_twin_params(py::module_& m) {
       .PS_RW(pl::TwinParams, geometry)
       .PS_RW(pl::TwinParams, sgs)
       .PS_RW(pl::TwinParams, interferometer)
-      .PS_RW(pl::TwinParams, lab);
+      .PS_RW(pl::TwinParams, lab)
+      .PS_RW(pl::TwinParams, cavity);
   m.def("twin_params_problem", &pl::twin_params_problem, py::arg("design"), py::arg("twin"),
         "Why design and twin parameters cannot make a twin, or '' when they can");
 }

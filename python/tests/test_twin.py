@@ -16,6 +16,25 @@ def test_same_seed_same_outputs(config):
     assert a.ticks == 200 and a.time_s == pytest.approx(0.2)
 
 
+def test_cavity_in_the_truth_and_in_the_fringes_only_when_on(config):
+    # plant/fizeau_cavity.hpp: the truth carries the cavity's drift; the fringes see it when on.
+    assert config.twin.cavity.gap_m == pytest.approx(0.05)
+    assert not config.twin.cavity.in_fringes
+    t = ps.Twin(config, 3)
+    t.run([2.0, 2.0, 2.0], 500)
+    tr = t.truth()
+    assert tr.cavity_drift_nm != 0.0
+    assert tr.cavity_path_nm == pytest.approx(1000.0 * tr.plate_z_um + tr.cavity_drift_nm)
+    assert t.fringe_piston_nm == pytest.approx(1000.0 * tr.plate_z_um)
+    config.twin.cavity.in_fringes = True
+    on = ps.Twin(config, 3)
+    on.run([2.0, 2.0, 2.0], 500)
+    assert on.fringe_piston_nm == pytest.approx(on.truth().cavity_path_nm)
+    config.twin.cavity.gap_m = 20.0
+    assert (ps.twin_params_problem(config.design, config.twin)
+            == "twin.cavity.gap_m = 20 must be in [0, 10]")
+
+
 def test_converter_status(config):
     t = ps.Twin(config, 1)
     assert t.write_ao([11.0, 0.0, 0.0]) == ps.AoStatus.CLAMPED

@@ -55,6 +55,8 @@ void read_twin_sections(const io::ConfigFile& file, const design::DesignInputs& 
           fmt::format("{}: twin.sgs.nonlinearity_shape: '{}' is not one of bow, s_curve, wave",
                       file.source(), shape));
   }
+  // A switch, not a quantity: read apart from the ranges list.
+  file.section("twin.cavity").read("in_fringes", t.cavity.in_fringes);
 
   // What one key's bounds cannot say (rates that must divide, the contact identification, A).
   if (const std::string problem = plant::twin_params_problem(design, t); !problem.empty())

@@ -71,7 +71,7 @@ class Runner {
     if (twin_ == nullptr)
       return {now_s(), 0.0, 0.0, 0.0};
     const plant::TwinTruth& t = twin_->truth();
-    return {now_s(), 1000.0 * t.plate_z_um, t.theta_x_urad, t.theta_y_urad};
+    return {now_s(), twin_->fringe_piston_nm(), t.theta_x_urad, t.theta_y_urad};
   }
 
   camera::PlatePose pose() const {

@@ -14,13 +14,18 @@
 namespace piezoshift::plant {
 
 Twin::Twin(const design::DesignInputs& design, const TwinParams& params, std::uint64_t seed)
-    : model_(make_twin_model(design, params)), seed_(seed), rng_(seed) {
+    : model_(make_twin_model(design, params)),
+      seed_(seed),
+      rng_(seed),
+      cavity_rng_(cavity_seed(seed)) {
   const TwinParams& p = model_.params;
   // The run's draws at construction, in this order: the lab's start (2 deviates), the
   // interferometer's scale error, the excitation drift's terms, each channel's zero flicker terms
   // (all stationary starts).
   lab_ = LabEnvironment(p.lab, model_.control_period_s);
   lab_.start(lab_state_, rng_);
+  cavity_ = FizeauCavity(p.cavity, model_.control_period_s);
+  cavity_.start(cavity_state_, lab_, lab_state_, cavity_rng_);
   ifm_scale_ = 1.0 + p.interferometer.accuracy_ppm * 1e-6 * (2.0 * rng_.uniform() - 1.0);
   model_.sgs_excitation_drift.start(excitation_, rng_);
   for (std::size_t i = 0; i < 3; ++i)
@@ -167,6 +172,7 @@ void Twin::advance() noexcept {
   // Per tick, in this order: the lab (1 deviate), the interferometer (3 per sample), the
   // excitation drift and each channel's zero flicker (the terms due), the AI (3).
   lab_.update(lab_state_, rng_);
+  cavity_.update(cavity_state_, lab_, lab_state_, cavity_rng_);
   const double drift_um = lab_.drift_um(lab_state_);
   if (pending_end_sample)
     sample_interferometer(x, t, drift_um);
@@ -278,6 +284,9 @@ void Twin::update_truth(const Vec3& x_um) noexcept {
   t.points_um = control::multiply(m.geometry.barycentric, x_um);
   t.air_temperature_C = lab_.air_C(lab_state_);
   t.structure_temperature_C = lab_.structure_C(lab_state_);
+  t.air_pressure_Pa = cavity_.pressure_Pa(cavity_state_);
+  t.cavity_drift_nm = cavity_state_.drift_nm;
+  t.cavity_path_nm = 1000.0 * t.plate_z_um + t.cavity_drift_nm;
 }
 
 void Twin::set_fault(std::size_t channel, const ChannelFault& fault) {

@@ -18,7 +18,8 @@ BenchStage::BenchStage(rig::Bench& bench, double base_um, double settle_s)
 
 PoseSample BenchStage::pose() const {
   const plant::TwinTruth& t = bench_.twin().truth();
-  return {t.time_s, 1000.0 * t.plate_z_um - origin_.piston_nm,
+  // the piston the fringes see: the plate's, and the cavity's drift when it is switched on
+  return {t.time_s, bench_.twin().fringe_piston_nm() - origin_.piston_nm,
           t.theta_x_urad - origin_.theta_x_urad, t.theta_y_urad - origin_.theta_y_urad};
 }
 

@@ -117,8 +117,9 @@ TEST(TwinConfig, TheRangesListCoversTheDefaultsAndChecksStructsBuiltInCode) {
   int values = 0;
   plant::TwinParams t;
   plant::visit_twin_values(t, [&](const char*, const char*, auto&, core::Bounds) { ++values; });
-  // every key of configs/paper.toml's twin sections but nonlinearity_shape (a name, read apart)
-  EXPECT_EQ(values, 58);
+  // every key of configs/paper.toml's twin sections but nonlinearity_shape (a name) and
+  // in_fringes (a switch), both read apart
+  EXPECT_EQ(values, 66);
   t.sgs.offset_V[2] = 200.0;
   EXPECT_EQ(plant::twin_ranges_problem(t), "twin.sgs.offset_V[2] = 200 must be in [-100, 100]");
   EXPECT_NE(plant::twin_params_problem({}, t).find("twin.sgs.offset_V[2]"), std::string::npos);

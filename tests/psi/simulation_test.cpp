@@ -36,6 +36,27 @@ TEST(PsiAcquisitionTest, BenchStageStepsByLambdaOverEightAndComesOnTarget) {
   EXPECT_FALSE(stage.log().empty());
 }
 
+// With twin.cavity.in_fringes the poses the renderer gets carry the cavity's drift since the
+// stage's reference pose (plant/fizeau_cavity.hpp); the plate moves the same (the cavity draws
+// from its own stream), so the two runs' pistons differ by exactly that drift.
+TEST(PsiAcquisitionTest, BenchStagePosesCarryTheCavityDriftOnlyWhenItIsInTheFringes) {
+  const config::ProjectConfig off;
+  config::ProjectConfig on = off;
+  on.twin.cavity.in_fringes = true;
+  rig::Bench bench_off(off, paper_controller(off), 3), bench_on(on, paper_controller(on), 3);
+  BenchStage stage_off(bench_off), stage_on(bench_on);
+  const double drift0_nm = bench_on.twin().truth().cavity_drift_nm;
+  stage_off.move(79.1);
+  stage_on.move(79.1);
+  const std::vector<PoseSample> a = stage_off.expose(0.05), b = stage_on.expose(0.05);
+  ASSERT_EQ(a.size(), b.size());
+  const plant::TwinTruth& t = bench_on.twin().truth();
+  EXPECT_EQ(bench_off.twin().truth().plate_z_um, t.plate_z_um);
+  const double drift_nm = t.cavity_drift_nm - drift0_nm;
+  EXPECT_NEAR(b.back().piston_nm - a.back().piston_nm, drift_nm, 1e-9);
+  EXPECT_GT(std::fabs(drift_nm), 1e-4);
+}
+
 TEST(PsiSimulationTest, TwinMeasurementErrorIsSmallAndSplitsIntoStageAndCamera) {
   SimulationParams p;
   p.fizeau.width_px = p.fizeau.height_px = 96;

@@ -15,8 +15,10 @@
 // DAQ backend (runtime/sim_backend.hpp), which orders them by the one timing contract every
 // backend keeps (runtime/daq_backend.hpp).
 // Truth (plate pose, point displacements, internal signals) and the interferometer's readings
-// are exposed alongside. Every random number comes from one Rng seeded at construction, drawn in
-// a fixed order, so the same seed and inputs give the same outputs bit for bit.
+// are exposed alongside, and the Fizeau cavity's optical path (fizeau_cavity.hpp). Every random
+// number comes from one Rng seeded at construction, drawn in a fixed order, so the same seed and
+// inputs give the same outputs bit for bit; the cavity's barometric drift alone draws from a
+// second Rng seeded from the same seed (cavity_seed), so it changes no other draw.
 //
 // Faults: a per-channel ChannelFault (set_fault) covers what the later fault-injection work
 // needs: amplifier off, SGS open or stuck, ADC NaN or spike, a cracked stack (stiffness loss).
@@ -30,6 +32,7 @@
 #include "piezoshift/control/vec3.hpp"
 #include "piezoshift/design/design_inputs.hpp"
 #include "piezoshift/plant/creep.hpp"
+#include "piezoshift/plant/fizeau_cavity.hpp"
 #include "piezoshift/plant/flicker.hpp"
 #include "piezoshift/plant/hysteresis.hpp"
 #include "piezoshift/plant/lab_environment.hpp"
@@ -76,6 +79,10 @@ struct TwinTruth {
   double interferometer_drift_nm = 0.0;   //!< d(t), the lab's drift of every reading
   Vec3 contact_force_N{};                 //!< F0 + f, the ball contact's force (contact.hpp)
   Vec3 contact_residual_um{};             //!< r(f): Hertz beyond its linearization
+  // The Fizeau cavity (fizeau_cavity.hpp), since the start; a positive value is a longer cavity:
+  double air_pressure_Pa = 0.0;  //!< p, the barometric pressure
+  double cavity_drift_nm = 0.0;  //!< d_c: the air's index over the gap and the mount
+  double cavity_path_nm = 0.0;   //!< 1000 plate_z_um + d_c: what a fringe lock holds
 };
 
 struct InterferometerReading {
@@ -114,6 +121,11 @@ class Twin {
   const TwinTruth& truth() const noexcept { return truth_; }
   const InterferometerReading& interferometer() const noexcept { return ifm_; }
   const TwinModel& model() const noexcept { return model_; }
+  //! The piston the Fizeau's fringes see [nm]: the plate's Z, plus the cavity's drift when
+  //! twin.cavity.in_fringes (the renderers' pose sources read this, not plate_z_um).
+  double fringe_piston_nm() const noexcept {
+    return model_.params.cavity.in_fringes ? truth_.cavity_path_nm : 1000.0 * truth_.plate_z_um;
+  }
   double time_s() const noexcept { return truth_.time_s; }
   std::uint64_t ticks() const noexcept { return tick_; }
   std::uint64_t seed() const noexcept { return seed_; }
@@ -136,6 +148,10 @@ class Twin {
   Rng rng_;
   LabEnvironment lab_;
   LabState lab_state_{};
+  // The cavity draws from its own stream, so the draws above stay as they were without it.
+  Rng cavity_rng_;
+  FizeauCavity cavity_;
+  CavityState cavity_state_{};
   double ifm_scale_ = 1.0;  // 1 + eps
 
   // Per-channel constants (copied from the model for locality; changed by faults)

@@ -10,6 +10,7 @@
 #include "piezoshift/plant/amplifier.hpp"
 #include "piezoshift/plant/contact.hpp"
 #include "piezoshift/plant/daq.hpp"
+#include "piezoshift/plant/fizeau_cavity.hpp"
 #include "piezoshift/plant/geometry.hpp"
 #include "piezoshift/plant/interferometer.hpp"
 #include "piezoshift/plant/lab_environment.hpp"
@@ -34,6 +35,7 @@ struct TwinParams {
   SgsParams sgs{};
   InterferometerParams interferometer{};
   LabParams lab{};
+  CavityParams cavity{};
 
   bool operator==(const TwinParams&) const = default;
 };

@@ -117,6 +117,21 @@ void visit_twin_values(Twin& t, Visit&& visit) {
         B::closed(-1e-3, 1e-3));
   visit("twin.lab", "dead_path_m", t.lab.dead_path_m, B::closed(0.0, 1000.0));
   visit("twin.lab", "air_index_per_K", t.lab.air_index_per_K, B::closed(-1e-3, 1e-3));
+
+  visit("twin.cavity", "gap_m", t.cavity.gap_m, B::closed(0.0, 10.0));
+  // Edlen's dispersion term has poles below 160 nm; NIST's calculators take 300 to 1700 nm.
+  visit("twin.cavity", "wavelength_nm", t.cavity.wavelength_nm, B::closed(300.0, 1700.0));
+  // From a high-altitude lab to a pressurized room: Birch and Downs fitted near 100 kPa.
+  visit("twin.cavity", "pressure_Pa", t.cavity.pressure_Pa, B::closed(5e4, 1.2e5));
+  visit("twin.cavity", "pressure_rate_rms_Pa_per_s", t.cavity.pressure_rate_rms_Pa_per_s,
+        B::closed(0.0, 100.0));
+  visit("twin.cavity", "pressure_rate_correlation_time_s",
+        t.cavity.pressure_rate_correlation_time_s, B::above(0.0, 1e9));
+  // Up to the saturation pressure at 40 degC (7.4 kPa).
+  visit("twin.cavity", "water_vapour_pressure_Pa", t.cavity.water_vapour_pressure_Pa,
+        B::closed(0.0, 7400.0));
+  visit("twin.cavity", "mount_path_length_m", t.cavity.mount_path_length_m, B::closed(-10.0, 10.0));
+  visit("twin.cavity", "mount_cte_per_K", t.cavity.mount_cte_per_K, B::closed(-1e-3, 1e-3));
 }
 
 //! The first value of twin outside its range ("twin.daq.sample_time_s = 1000000 must be in

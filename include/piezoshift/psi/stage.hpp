@@ -12,8 +12,10 @@
 //                            flag would: judged on what the hardware sees, never on the twin's
 //                            truth (averaged, because single samples carry the gauges' noise)
 //   expose(T)                runs the ticks of the exposure and returns the TRUE plate pose
-//                            (twin().truth(): plate_z_um, theta_x_urad, theta_y_urad, relative to
-//                            the pose at construction) at its start and after every tick
+//                            (twin().fringe_piston_nm(): plate_z_um, plus the cavity's drift
+//                            when twin.cavity.in_fringes; truth() theta_x_urad, theta_y_urad;
+//                            relative to the pose at construction) at its start and after
+//                            every tick
 // Every tick is also appended to log() (time, commanded piston, mean gauge error, true pose).
 #include <vector>
 
