@@ -111,10 +111,8 @@ const char* experiment_set_name(ExperimentSet e) {
 }
 
 const std::vector<Compensator>& compensators() {
-  static const std::vector<Compensator> c{
-      {"A11", "A11"}, {"A12", "A12"}, {"A13", "A13"}, {"A21", "A21"}, {"A22", "A22"},
-      {"A23", "A23"}, {"A31", "A31"}, {"A32", "A32"}, {"A33", "A33"}, {"p_6um_um", "p(6 µm) [µm]"},
-  };
+  static const std::vector<Compensator> c{{"A11"}, {"A12"}, {"A13"}, {"A21"}, {"A22"},
+                                          {"A23"}, {"A31"}, {"A32"}, {"A33"}, {"p_6um_um"}};
   return c;
 }
 

@@ -44,11 +44,10 @@ struct StudyOptions {
 };
 
 //! What the calibration set to absorb the sample's deviations (the lens designer's compensators):
-//! the transmission matrix A (Eq. 8, row-major) and the polynomial's command for 6 um of gauge
-//! reading p(6 um) (mid-travel), in this order. NaN when the calibration failed.
+//! the transmission matrix A (Eq. 8, row-major) and p(6 um), the command Z_S the polynomial gives
+//! for a desired 6 um (mid-travel), in this order. NaN when the calibration failed.
 struct Compensator {
-  const char* key;  //!< "A11", ..., "A33", "p_6um_um"
-  const char* label;
+  const char* key;  //!< "A11", ..., "A33", "p_6um_um": the sample record's `calibration` keys
 };
 const std::vector<Compensator>& compensators();
 
