@@ -37,14 +37,18 @@ CalibrationOutcome calibrate(const config::ProjectConfig& config,
                              const control::SemiClosedLoopParams& base, std::uint64_t seed,
                              const CalibrationOptions& options, const rig::Progress& progress) {
   CalibrationOutcome out;
-  // Stage 1: the inner loops.
-  PidTuningOptions pid_tuning = options.pid_tuning;
-  pid_tuning.limits = options.limits;
-  out.pid = tune_pid(config, base, seed, pid_tuning, progress);
+  // Stage 1: the inner loops, unless gains were chosen on the identified plant.
   out.controller = base;
   out.controller.gains_sample_time_s = base.sample_time_s;
-  out.controller.gains =
-      options.pid == PidChoice::kPaper ? out.pid.paper.gains : out.pid.best.gains;
+  if (options.holding_gains) {
+    out.controller.gains = *options.holding_gains;
+  } else {
+    PidTuningOptions pid_tuning = options.pid_tuning;
+    pid_tuning.limits = options.limits;
+    out.pid = tune_pid(config, base, seed, pid_tuning, progress);
+    out.controller.gains =
+        options.pid == PidChoice::kPaper ? out.pid.paper.gains : out.pid.best.gains;
+  }
   // Stage 2: A, identity feedforward not involved (inner loops only).
   out.controller.polynomial = control::CubicPolynomial::identity();
   out.controller.matrix = control::TransmissionMatrix::identity();

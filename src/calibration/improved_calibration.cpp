@@ -127,7 +127,13 @@ ImprovedCalibrationOutcome calibrate_improved(const config::ProjectConfig& confi
                                               const ImprovedCalibrationOptions& options,
                                               const rig::Progress& progress) {
   ImprovedCalibrationOutcome out;
-  out.static_map = calibrate(config, base, seed, options.paper, progress);
+  // Stage 0: the gains the static map's stages hold with, chosen before they excite the plant.
+  out.holding = holding_gains(config, base, seed + 6, options.holding,
+                              "improved calibration, stage 0 (the inner loop)");
+  CalibrationOptions static_map = options.paper;
+  if (out.holding.scale < 1.0)
+    static_map.holding_gains = out.holding.gains;
+  out.static_map = calibrate(config, base, seed, static_map, progress);
   const control::SemiClosedLoopParams& paper = out.static_map.controller;
 
   // Stage 4: the channel models from an open-loop excitation.

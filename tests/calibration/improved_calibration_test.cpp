@@ -5,13 +5,16 @@
 #include <gtest/gtest.h>
 
 #include "piezoshift/calibration/calibration_file.hpp"
+#include "piezoshift/calibration/holding_gains.hpp"
 #include "piezoshift/calibration/improved_calibration.hpp"
 #include "piezoshift/calibration/loop_identification.hpp"
+#include "piezoshift/config/project_config.hpp"
 #include "piezoshift/core/input_error.hpp"
 #include "piezoshift/experiments/paper_experiments.hpp"
 #include "piezoshift/experiments/phase_step.hpp"
 #include "piezoshift/io/config_file.hpp"
 #include "piezoshift/runtime/control_cycle.hpp"
+#include "test_paths.hpp"
 
 namespace piezoshift::calibration {
 namespace {
@@ -101,6 +104,55 @@ TEST(ImprovedController, TheSameProcedureWorksOnOtherPlants) {
     EXPECT_LE(p.improved.hold_jitter_nm_rms, 0.35);
     EXPECT_LT(p.improved.hold_jitter_nm_rms, 0.7 * p.paper.hold_jitter_nm_rms);
   }
+}
+
+// Issue 31: configs/plants/ at compare's 10 kHz (the DAQ at 0.1 ms, the interferometer's dynamic
+// samples at 10 kHz).
+config::ProjectConfig plant_at_10kHz(const std::string& name) {
+  config::ProjectConfig c =
+      config::load_project_config(testing::source_dir() + "/configs/plants/" + name + ".toml");
+  c.twin.daq.sample_time_s = 1e-4;
+  c.twin.interferometer.dynamic_sample_rate_Hz = 1e4;
+  return c;
+}
+
+// The diagnosis: the paper's gains re-expressed at 10 kHz ring up at a 20 mm plate's mode (the
+// calibration's stage 2 then tripped the supervisor); on the default plate the ring decays.
+TEST(ImprovedController, ThePapersGainsAt10kHzRingUpOnAThickerPlate) {
+  control::SemiClosedLoopParams paper;
+  paper.sample_time_s = 1e-4;
+  const RingTest thick = ring_test(plant_at_10kHz("thick-plate"), paper, 7);
+  EXPECT_FALSE(thick.holds);
+  EXPECT_TRUE(thick.aborted || thick.late_ring_um > thick.early_ring_um)
+      << thick.early_ring_um << " " << thick.late_ring_um;
+  config::ProjectConfig fast;
+  fast.twin.daq.sample_time_s = 1e-4;
+  fast.twin.interferometer.dynamic_sample_rate_Hz = 1e4;
+  // Stable, its ring decaying (0.016 -> 0.012 um over 30 ms), if not by the 0.7 a margin needs.
+  const RingTest nominal = ring_test(fast, paper, 7);
+  EXPECT_FALSE(nominal.aborted);
+  EXPECT_LT(nominal.late_ring_um, 0.9 * nominal.early_ring_um) << nominal.early_ring_um;
+}
+
+// The fix: the improved calibration at 10 kHz chooses its holding gains on the plant first
+// (stage 0) and completes on the plants where it tripped the supervisor; its 10 kHz lambda/8 step
+// is then valid. At 1 kHz on the default twin stage 0 keeps the paper's gains (one test).
+TEST(ImprovedController, At10kHzStageZeroHoldsThickerAndHeavierPlates) {
+  for (const char* name : {"thick-plate", "payload"}) {
+    SCOPED_TRACE(name);
+    const config::ProjectConfig config = plant_at_10kHz(name);
+    const ImprovedCalibrationOutcome c = calibrated(config, 1);
+    EXPECT_LT(c.holding.scale, 0.75);  // the paper's gains, tested at 2 x, did not hold
+    EXPECT_GE(c.holding.scale, 0.05);
+    EXPECT_TRUE(c.holding.test.holds);
+    const experiments::PhaseStepResult p =
+        experiments::run_phase_step(config, c.controller, 86, experiments::PhaseStepOptions{});
+    ASSERT_TRUE(p.validity.valid) << p.validity.reason;
+    EXPECT_LE(p.hold_jitter_nm_rms, 0.35);
+  }
+  const ImprovedCalibrationOutcome nominal = calibrated(config::ProjectConfig{}, 1);
+  EXPECT_EQ(nominal.holding.scale, 1.0);
+  EXPECT_EQ(nominal.holding.tests, 1);
 }
 
 TEST(ImprovedController, CalibrationFileRoundTripsAndRefusesAnotherRate) {

@@ -6,6 +6,7 @@
 // Each stage runs on its own fresh bench (seed, seed + 1, seed + 2: the same unit, new
 // sessions). The result is the controller to load (SemiClosedLoopParams) and every stage's data.
 #include <cstdint>
+#include <optional>
 
 #include "piezoshift/calibration/matrix_identification.hpp"
 #include "piezoshift/calibration/pid_tuning.hpp"
@@ -30,6 +31,9 @@ struct CalibrationOptions {
   //! The supervisor's limits on every stage's bench and the travel's (the installation's
   //! [safety], as `run` uses them); they replace pid_tuning.limits and travel.bench.limits.
   runtime::SafetyLimits limits{};
+  //! Gains (per sample at the base's rate) chosen on the identified plant before stage 1 would
+  //! excite it (holding_gains.hpp): stage 1 is then not run and stages 2 and 3 hold with these.
+  std::optional<control::PidGains> holding_gains;
 
   //! The paper's gains, scored alone (no grid): the quickest calibration, for `run` and `serve`
   //! on the twin without a calibration file.

@@ -2,6 +2,10 @@
 // Calibration of the improved controller (control/semi_closed_loop.hpp, kind = kImproved; issue
 // 12), on the twin through the shipping loop (rig/bench.hpp), each step on a bench of its
 // own:
+//   0.   the inner loop identified open loop at the loop's rate, and the PID gains stages 1 to 3
+//        hold with chosen on it: the paper's when their margins there suffice, else scaled down
+//        (holding_gains.hpp; issue 31: at 10 kHz a thicker plate's mode made the paper's
+//        re-expressed gains unstable and stage 2 tripped the supervisor)       seed + 6
 //   1-3. the paper's procedure (calibration_procedure.hpp): A and p, the gauge-to-plate map the
 //        improved controller keeps as its feedforward          seeds seed .. seed + 2
 //   4.   the channel models: an open-loop excitation (a major loop, reversal curves, steps held
@@ -15,6 +19,7 @@
 #include <vector>
 
 #include "piezoshift/calibration/calibration_procedure.hpp"
+#include "piezoshift/calibration/holding_gains.hpp"
 #include "piezoshift/calibration/hysteresis_identification.hpp"
 #include "piezoshift/calibration/mode_identification.hpp"
 
@@ -33,10 +38,12 @@ struct ImprovedCalibrationOptions {
   double mode_step_from_um = 5.0;  //!< stage 5: open-loop command held, then
   double mode_step_um = 0.3;       //!< stepped by this
   double mode_record_s = 0.03;     //!< and the interferometer recorded this long
+  HoldingGainsOptions holding{};   //!< stage 0
 };
 
 struct ImprovedCalibrationOutcome {
   control::SemiClosedLoopParams controller;  //!< the improved controller to load
+  HoldingGains holding;                      //!< stage 0: what stages 1 to 3 held with
   CalibrationOutcome static_map;             //!< stages 1 to 3 as the paper's procedure ran them
   std::array<HysteresisFit, 3> model{};
   //! The plate's mode as the interferometer's dynamic samples show it, and whether the shaper
@@ -56,7 +63,8 @@ struct ImprovedDesign {
 };
 
 //! base supplies the sample time, limits and scaling. Throws rig::ProcedureFailed when a
-//! stage trips the supervisor, FitError when a fit fails.
+//! stage trips the supervisor or stage 0 finds no gains that hold the plant, FitError when a fit
+//! fails.
 ImprovedCalibrationOutcome calibrate_improved(const config::ProjectConfig& config,
                                               const control::SemiClosedLoopParams& base,
                                               std::uint64_t seed,
