@@ -63,15 +63,6 @@ std::optional<std::pair<std::uint64_t, std::uint64_t>> parse_shard(const std::st
   return std::pair{i, n};
 }
 
-nlohmann::json read_json(const std::string& path) {
-  const std::string text = io::read_input_file(path, io::kMaxDataFileBytes);
-  try {
-    return nlohmann::json::parse(text);
-  } catch (const nlohmann::json::exception& e) {
-    throw core::InputError(fmt::format("{}: not JSON: {}", path, e.what()));
-  }
-}
-
 tolerance::Study load_study(const Options& o) {
   tolerance::StudyInputs in;
   in.tolerances = o.tolerances;
@@ -79,10 +70,14 @@ tolerance::Study load_study(const Options& o) {
   in.spec = o.spec;
   in.samples = o.samples;
   in.options.seed = o.seed;
-  in.options.procedure =
-      o.procedure == "improved" ? tolerance::Procedure::kImproved : tolerance::Procedure::kPaper;
-  in.options.experiments = o.experiments == "table4" ? tolerance::ExperimentSet::kTable4
-                                                     : tolerance::ExperimentSet::kQuick;
+  // Both checked by their options' IsMember, and read back from a shard's header by merge.
+  const auto procedure = tolerance::procedure_named(o.procedure);
+  const auto experiments = tolerance::experiment_set_named(o.experiments);
+  if (!procedure || !experiments)
+    throw core::InputError(fmt::format("tolerance: procedure {} or experiments {} unknown",
+                                       o.procedure, o.experiments));
+  in.options.procedure = *procedure;
+  in.options.experiments = *experiments;
   return tolerance::load_study(in);
 }
 
@@ -198,7 +193,7 @@ int run(const Options& o) {
 int run_merge(const Options& given) {
   Options o = given;
   {
-    const nlohmann::json first = read_json(o.shard_files.at(0));
+    const nlohmann::json first = tolerance::read_study_json(o.shard_files.at(0));
     try {
       const nlohmann::json& h = first.at("study");
       o.tolerances = h.at("tolerance_file").get<std::string>();
@@ -216,7 +211,7 @@ int run_merge(const Options& given) {
   const tolerance::Study s = load_study(o);
   std::vector<std::optional<SampleResult>> by_index(o.samples);
   for (const std::string& path : o.shard_files) {
-    const nlohmann::json j = read_json(path);
+    const nlohmann::json j = tolerance::read_study_json(path);
     if (!j.contains("study") || j.at("study") != s.header)
       throw core::InputError(fmt::format(
           "{}: a shard of another study (tolerances, config, seed, procedure or --samples differ)",

@@ -31,34 +31,17 @@ def _run_sensitivity(description, k):
     return _ext.tolerance_run_sensitivity(description, k)
 
 
-class _Progress:
-    """"piezoshift: tolerance: 3/16 done, 2.10/s, 6 s left" on stderr, at most once a second."""
-
-    def __init__(self, what, total, enabled):
-        self.what, self.total, self.enabled = what, total, enabled
-        self.done, self.start, self.last = 0, time.monotonic(), 0.0
-
-    def one_done(self):
-        self.done += 1
-        t = time.monotonic() - self.start
-        if not self.enabled or (self.done != self.total and t - self.last < 1.0):
-            return
-        self.last = t
-        rate = self.done / t if t > 0 else 0.0
-        left = (self.total - self.done) / rate if rate > 0 else 0.0
-        print(f"piezoshift: {self.what}: {self.done}/{self.total} done, {rate:.2f}/s, "
-              f"{left:.0f} s left", file=sys.stderr, flush=True)
-
-
 def _on_cluster(client, function, description, indices, what, progress, on_result):
     """function(description, i) for each i on the cluster; on_result(i, text) as each arrives."""
     from distributed import as_completed
 
     futures = {client.submit(function, description, i, pure=False): i for i in indices}
-    meter = _Progress(what, len(futures), progress)
-    for future in as_completed(futures):
+    lines = _ext.tolerance_progress_lines(what) if progress else None
+    start = time.monotonic()
+    for done, future in enumerate(as_completed(futures), start=1):
         on_result(futures[future], future.result())
-        meter.one_done()
+        if lines is not None:
+            lines(done, len(futures), time.monotonic() - start)
 
 
 def run_study(tolerances, *, samples=100, seed=1, config=None, spec=None, procedure="paper",
@@ -73,18 +56,19 @@ def run_study(tolerances, *, samples=100, seed=1, config=None, spec=None, proced
     """
     study = _ext.load_tolerance_study(tolerances, config or "", spec or "", samples, seed,
                                       procedure, experiments)
-    results = {}
-    for i in range(samples):
-        text = study.resumed(out, i)
-        if text is not None:
-            results[i] = text
-    todo = [i for i in range(samples) if i not in results]
-    if len(todo) < samples and progress:
-        print(f"piezoshift: tolerance: {samples - len(todo)} sample(s) resumed from {out}/samples",
-              file=sys.stderr)
-    if client is None:
-        results.update(zip(todo, study.run_local(out, todo, jobs)))
+    if client is None:  # resumes, runs and records as `piezoshift tolerance` does
+        results = dict(enumerate(study.run_local(out, list(range(samples)), jobs)))
     else:
+        results = {}
+        for i in range(samples):
+            text = study.resumed(out, i)
+            if text is not None:
+                results[i] = text
+        todo = [i for i in range(samples) if i not in results]
+        if len(todo) < samples and progress:
+            print(f"piezoshift: tolerance: {samples - len(todo)} sample(s) resumed from "
+                  f"{out}/samples", file=sys.stderr)
+
         def keep(i, text):
             study.record(out, text)
             results[i] = text

@@ -3,6 +3,7 @@
 // (python/piezoshift/tolerance.py drives both; docs/tolerance.md). Samples cross as the JSON
 // text of their records, which reads back bit for bit, so a study run on workers writes the same
 // bytes as one run on local threads.
+#include <pybind11/functional.h>
 #include <pybind11/pybind11.h>
 #include <pybind11/stl.h>
 
@@ -27,9 +28,11 @@ namespace tol = ps::tolerance;
 tol::Study load(const std::string& tolerances, const std::string& config, const std::string& spec,
                 std::uint64_t samples, std::uint64_t seed, const std::string& procedure,
                 const std::string& experiments) {
-  if (procedure != "paper" && procedure != "improved")
+  const auto p = tol::procedure_named(procedure);
+  if (!p)
     throw ps::core::InputError(fmt::format("procedure: {} is not paper or improved", procedure));
-  if (experiments != "quick" && experiments != "table4")
+  const auto e = tol::experiment_set_named(experiments);
+  if (!e)
     throw ps::core::InputError(fmt::format("experiments: {} is not quick or table4", experiments));
   if (samples < 1)
     throw ps::core::InputError("samples: at least 1");
@@ -39,10 +42,8 @@ tol::Study load(const std::string& tolerances, const std::string& config, const 
   in.spec = spec;
   in.samples = samples;
   in.options.seed = seed;
-  in.options.procedure =
-      procedure == "improved" ? tol::Procedure::kImproved : tol::Procedure::kPaper;
-  in.options.experiments =
-      experiments == "table4" ? tol::ExperimentSet::kTable4 : tol::ExperimentSet::kQuick;
+  in.options.procedure = *p;
+  in.options.experiments = *e;
   return tol::load_study(in);
 }
 
@@ -151,6 +152,11 @@ void bind_tolerance(py::module_& m) {
         py::arg("spec") = "", py::arg("samples") = 100, py::arg("seed") = 1,
         py::arg("procedure") = "paper", py::arg("experiments") = "quick",
         "Reads and checks a tolerance study's files (InputError naming the file and key)");
+  m.def(
+      "tolerance_progress_lines",
+      [](std::string what) { return tol::progress_lines(std::move(what)); }, py::arg("what"),
+      "progress(done, total, elapsed_s): the progress lines `piezoshift tolerance` prints on "
+      "stderr, at most one a second");
   m.def("tolerance_run_sample", &run_sample, py::arg("description"), py::arg("index"),
         py::call_guard<py::gil_scoped_release>(),
         "Sample `index` of the study described (ToleranceStudy.description), as its record's "

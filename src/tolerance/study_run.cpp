@@ -39,15 +39,6 @@ Study build_study(const std::string& tolerance_name, std::string tolerance_text,
   return s;
 }
 
-nlohmann::json read_json(const fs::path& path) {
-  const std::string text = io::read_input_file(path.string(), io::kMaxDataFileBytes);
-  try {
-    return nlohmann::json::parse(text);
-  } catch (const nlohmann::json::exception& e) {
-    throw core::InputError(fmt::format("{}: not JSON: {}", path.string(), e.what()));
-  }
-}
-
 // A metric's distribution over the valid samples: its histogram and its cumulative curve, as the
 // change from the median in % (absolute values of a narrow spread, 0.03601 to 0.03605 s, make
 // tick labels that overlap); the caption gives the median and the range.
@@ -115,6 +106,15 @@ std::vector<ReportFigure> write_figures(const std::vector<SampleResult>& samples
 
 }  // namespace
 
+nlohmann::json read_study_json(const fs::path& path) {
+  const std::string text = io::read_input_file(path.string(), io::kMaxDataFileBytes);
+  try {
+    return nlohmann::json::parse(text);
+  } catch (const nlohmann::json::exception& e) {
+    throw core::InputError(fmt::format("{}: not JSON: {}", path.string(), e.what()));
+  }
+}
+
 Study load_study(const StudyInputs& in) {
   if (in.tolerances.empty())
     throw core::InputError("tolerance: --tolerances FILE is required");
@@ -143,10 +143,14 @@ Study study_from_description(const nlohmann::json& d) {
   try {
     StudyOptions o;
     o.seed = d.at("seed").get<std::uint64_t>();
-    o.procedure = d.at("procedure").get<std::string>() == "improved" ? Procedure::kImproved
-                                                                     : Procedure::kPaper;
-    o.experiments = d.at("experiments").get<std::string>() == "table4" ? ExperimentSet::kTable4
-                                                                       : ExperimentSet::kQuick;
+    const auto procedure = procedure_named(d.at("procedure").get<std::string>());
+    const auto experiments = experiment_set_named(d.at("experiments").get<std::string>());
+    if (!procedure || !experiments)
+      throw core::InputError(
+          "not a tolerance study's description: an unknown procedure or "
+          "experiment set");
+    o.procedure = *procedure;
+    o.experiments = *experiments;
     std::string config = d.at("config").get<std::string>();
     if (config == kBuiltIn)
       config.clear();
@@ -173,7 +177,7 @@ std::optional<SampleResult> resumed_sample(const Study& s, const fs::path& out,
   std::error_code ec;
   if (!fs::is_regular_file(path, ec))
     return std::nullopt;
-  const nlohmann::json j = read_json(path);
+  const nlohmann::json j = read_study_json(path);
   if (!j.contains("study") || j.at("study") != s.header || !j.contains("sample"))
     return std::nullopt;
   return sample_from_json(s.set, j.at("sample"), path.string());

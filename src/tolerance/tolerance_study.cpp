@@ -106,8 +106,22 @@ const char* procedure_name(Procedure p) {
   return p == Procedure::kImproved ? "improved" : "paper";
 }
 
+std::optional<Procedure> procedure_named(std::string_view name) {
+  for (const Procedure p : {Procedure::kPaper, Procedure::kImproved})
+    if (name == procedure_name(p))
+      return p;
+  return std::nullopt;
+}
+
 const char* experiment_set_name(ExperimentSet e) {
   return e == ExperimentSet::kTable4 ? "table4" : "quick";
+}
+
+std::optional<ExperimentSet> experiment_set_named(std::string_view name) {
+  for (const ExperimentSet e : {ExperimentSet::kQuick, ExperimentSet::kTable4})
+    if (name == experiment_set_name(e))
+      return e;
+  return std::nullopt;
 }
 
 const std::vector<Compensator>& compensators() {

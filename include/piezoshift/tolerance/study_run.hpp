@@ -49,6 +49,10 @@ Study study_from_description(const nlohmann::json& description);
 //! measured. The same bytes whichever thread, process or machine runs it.
 SampleResult run_study_sample(const Study& study, std::uint64_t index);
 
+//! A study's JSON file (a record, a shard), whole; core::InputError naming the file when it
+//! cannot be read or is not JSON.
+nlohmann::json read_study_json(const std::filesystem::path& path);
+
 //! <out>/samples/sample-NNNNNN.json
 std::filesystem::path record_path(const std::filesystem::path& out, std::uint64_t index);
 //! The record an earlier run of the same study wrote for `index`, or nothing (absent, or another

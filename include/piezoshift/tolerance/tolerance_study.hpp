@@ -12,7 +12,9 @@
 // is not valid, with its reason; its metrics that were not measured are NaN, and it fails any
 // spec (never dropped).
 #include <cstdint>
+#include <optional>
 #include <string>
+#include <string_view>
 #include <vector>
 
 #include "piezoshift/config/project_config.hpp"
@@ -23,11 +25,15 @@ namespace piezoshift::tolerance {
 
 enum class Procedure { kPaper, kImproved };
 const char* procedure_name(Procedure p);
+//! The procedure procedure_name() calls `name`; nothing for another name.
+std::optional<Procedure> procedure_named(std::string_view name);
 
 //! What each sample measures: the quick set (quick_schedule(), about 0.45 s of CPU a sample), or
 //! Table 4's (table4_schedule(): the paper's protocols whole, with repeatability at 10 um too).
 enum class ExperimentSet { kQuick, kTable4 };
 const char* experiment_set_name(ExperimentSet e);
+//! The set experiment_set_name() calls `name`; nothing for another name.
+std::optional<ExperimentSet> experiment_set_named(std::string_view name);
 
 //! The metrics every sample records, in this order.
 struct Metric {
