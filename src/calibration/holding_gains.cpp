@@ -1,7 +1,9 @@
 #include "piezoshift/calibration/holding_gains.hpp"
 
-#include <fmt/format.h>
+#include <array>
 #include <cmath>
+
+#include <fmt/format.h>
 
 #include "piezoshift/rig/bench.hpp"
 #include "piezoshift/rig/validity.hpp"
@@ -40,21 +42,23 @@ RingTest ring_test(const config::ProjectConfig& config,
     volts[i] = controller.scaling[i].um_to_dac(o.operating_um);
   bench.drive_open_loop(volts);
   std::array<double, 3> y1{}, y2{};  // the last two readings per gauge
-  const auto reading = [&](std::size_t i) {
-    return controller.scaling[i].sgs_to_um(bench.last_cycle().ai_V[i]);
-  };
-  RingWindow noise{ticks_of(0.5 * o.settle_s, T), ticks_of(o.settle_s, T) + 1};
-  const std::size_t settle_ticks = ticks_of(o.settle_s, T);
-  for (std::size_t k = 0; k < settle_ticks; ++k) {
+  // One tick, then per_gauge(i, reading, its second difference) for each gauge.
+  const auto tick = [&](const auto& per_gauge) {
     bench.run(T);
     for (std::size_t i = 0; i < 3; ++i) {
-      const double y = reading(i);
-      if (k >= 2)
-        noise.add(k, y - 2.0 * y1[i] + y2[i]);
+      const double y = controller.scaling[i].sgs_to_um(bench.last_cycle().ai_V[i]);
+      per_gauge(i, y, y - 2.0 * y1[i] + y2[i]);
       y2[i] = y1[i];
       y1[i] = y;
     }
-  }
+  };
+  RingWindow noise{ticks_of(0.5 * o.settle_s, T), ticks_of(o.settle_s, T) + 1};
+  const std::size_t settle_ticks = ticks_of(o.settle_s, T);
+  for (std::size_t k = 0; k < settle_ticks; ++k)
+    tick([&](std::size_t, double, double d2) {
+      if (k >= 2)
+        noise.add(k, d2);
+    });
   control::Vec3 target{};
   for (std::size_t i = 0; i < 3; ++i)
     target[i] = y1[i] + o.step_um;
@@ -63,16 +67,11 @@ RingTest ring_test(const config::ProjectConfig& config,
   RingWindow late{ticks_of(o.late_s, T), ticks_of(o.late_s + o.window_s, T)};
   RingTest r;
   for (std::size_t k = 0; k < late.to; ++k) {
-    bench.run(T);
-    for (std::size_t i = 0; i < 3; ++i) {
-      const double y = reading(i);
-      const double d2 = y - 2.0 * y1[i] + y2[i];
+    tick([&](std::size_t i, double y, double d2) {
       early.add(k, d2);
       late.add(k, d2);
-      y2[i] = y1[i];
-      y1[i] = y;
       r.aborted = r.aborted || std::fabs(y - target[i]) > o.abort_um;
-    }
+    });
     if (r.aborted || bench.faulted()) {
       r.aborted = true;
       bench.drive_open_loop(volts);  // opened by the procedure: nothing more is learned

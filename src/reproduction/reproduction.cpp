@@ -141,11 +141,20 @@ InnerLoopAnalysis analyze_inner_loop_at(const config::ProjectConfig& config,
 
 std::vector<InnerLoopAnalysis> analyze_inner_loop(const config::ProjectConfig& config,
                                                   const control::SemiClosedLoopParams& controller,
-                                                  std::uint64_t seed) {
+                                                  std::uint64_t seed,
+                                                  const std::string& not_at_10kHz) {
   const std::vector<double> rates = inner_loop_sample_times_s(config);
   std::vector<InnerLoopAnalysis> out;
-  for (std::size_t i = 0; i < rates.size(); ++i)
-    out.push_back(analyze_inner_loop_at(config, controller, rates[i], seed + 90 + i));
+  for (std::size_t i = 0; i < rates.size(); ++i) {
+    if (rates[i] == kFastSampleTime_s && !not_at_10kHz.empty()) {
+      InnerLoopAnalysis skipped;
+      skipped.sample_time_s = rates[i];
+      skipped.validity.fail(not_at_10kHz);
+      out.push_back(std::move(skipped));
+    } else {
+      out.push_back(analyze_inner_loop_at(config, controller, rates[i], seed + 90 + i));
+    }
+  }
   return out;
 }
 

@@ -121,10 +121,12 @@ std::vector<double> inner_loop_sample_times_s(const config::ProjectConfig& confi
 
 //! The controller's inner loop identified at each rate of inner_loop_sample_times_s (seeds
 //! seed + 90, seed + 91), with its PID's margins on it; the controller's gains re-expressed per
-//! sample at each rate. A rate the twin cannot run at is an analysis that is not valid.
+//! sample at each rate. A rate the twin cannot run at is an analysis that is not valid; so is the
+//! 10 kHz one, not run, when not_at_10kHz gives the reason (compare: gains that ring up there).
 std::vector<InnerLoopAnalysis> analyze_inner_loop(const config::ProjectConfig& config,
                                                   const control::SemiClosedLoopParams& controller,
-                                                  std::uint64_t seed);
+                                                  std::uint64_t seed,
+                                                  const std::string& not_at_10kHz = {});
 //! One rate of analyze_inner_loop: the twin's DAQ and the controller's sample time set to
 //! sample_time_s, identified on seed.
 InnerLoopAnalysis analyze_inner_loop_at(const config::ProjectConfig& config,
