@@ -4,12 +4,15 @@
 #include <unistd.h>
 
 #include <algorithm>
+#include <array>
 #include <chrono>
 #include <cmath>
+#include <cstdlib>
 #include <limits>
 #include <utility>
 
 #include <fmt/core.h>
+#include <fmt/ranges.h>
 #include <nlohmann/json.hpp>
 
 #include "piezoshift/core/input_error.hpp"
@@ -51,6 +54,25 @@ json number(double v) {
 double colour_top(const psi::Map& m) {
   const double top = psi::robust_max(m.v);
   return top > 0.0 ? top : 1.0;
+}
+
+// "" when MOV?'s answer (Z, U, V) is the pose (z_um, 0, 0) that the measurement commanded, to
+// MOV?'s six decimals; otherwise why not.
+std::string foreign_target(const std::string& answer, double z_um) {
+  const std::vector<std::string> lines = host::GcsClient::split_answer(answer);
+  const std::array<double, 3> expected{z_um, 0.0, 0.0};
+  bool same = lines.size() == expected.size();
+  for (std::size_t i = 0; same && i < lines.size(); ++i) {
+    const std::size_t eq = lines[i].find('=');
+    same = eq != std::string::npos &&
+           std::fabs(std::strtod(lines[i].c_str() + eq + 1, nullptr) - expected[i]) <= 2e-6;
+  }
+  if (same)
+    return {};
+  return fmt::format(
+      "the stage's targets are {} where this measurement left Z {:.6f} U 0 V 0: "
+      "another client's move (or a stop) since",
+      fmt::join(lines, " "), z_um);
 }
 
 }  // namespace
@@ -364,6 +386,14 @@ std::string ServeCamera::move(double z_um) {
     return fmt::format("`{}`: GCS error {}, {}", line, code,
                        host::describe(static_cast<host::GcsError>(code)));
   };
+  if (commanded_z_um_) {
+    // A target other than the one this measurement left is another client's move that the loop
+    // may never have shown (both applied in one tick): ours would silently undo it.
+    const std::string why = foreign_target(gcs_.on_line(kSession, "MOV? Z U V"), *commanded_z_um_);
+    if (!why.empty())
+      return why;
+  }
+  commanded_z_um_ = z_um;
   const std::vector<std::string> servo =
       host::GcsClient::split_answer(gcs_.on_line(kSession, "SVO?"));
   if (servo.empty() || servo.front() != "Z=1")
@@ -383,6 +413,7 @@ void ServeCamera::begin_measurement() {
   for (camera::Frame f; camera_->poll(f) != camera::FrameStatus::kNone;) {
   }
   const instrument::SequenceParams params = req.params;
+  commanded_z_um_.reset();
   running_ = std::make_unique<Running>(Running{
       std::move(req), instrument::SampleSequence(*camera_, params, options_.period_s,
                                                  [this](double z_um) { return move(z_um); })});

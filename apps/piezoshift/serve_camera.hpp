@@ -111,6 +111,7 @@ class ServeCamera final : public host::DashboardPanel {
 
   // The camera thread's own.
   std::unique_ptr<Running> running_;
+  std::optional<double> commanded_z_um_;  //!< the running measurement's last move
   camera::PlatePose origin_{};
   bool have_origin_ = false;
   bool preview_pending_ = false;

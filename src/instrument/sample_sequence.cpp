@@ -46,6 +46,8 @@ void SampleSequence::fail(const std::string& why) {
 }
 
 void SampleSequence::command(double z_um) {
+  previous_um_ = target_um_;
+  has_previous_ = phase_ != Phase::kStart;
   target_um_ = z_um;
   applied_ = false;
   if (const std::string why = move_(z_um); !why.empty()) {
@@ -62,6 +64,13 @@ camera::PlatePose SampleSequence::relative(const LoopSample& s) const {
           s.pose.theta_y_urad - origin_.theta_y_urad};
 }
 
+std::string SampleSequence::moved_away(const LoopSample& s) const {
+  return fmt::format(
+      "the stage was moved away from the measurement's Z_d = {:.4f} um at {:.3f} s "
+      "(Z_d {:.4f}, {:.4f}, {:.4f} um: another client's move, a wave generator or a stop)",
+      target_um_, s.t_s, s.zd_um[0], s.zd_um[1], s.zd_um[2]);
+}
+
 // The checks every sample passes once the first move is applied; false when the sequence ends.
 bool SampleSequence::watch(const LoopSample& s) {
   if (s.faulted) {
@@ -72,6 +81,16 @@ bool SampleSequence::watch(const LoopSample& s) {
   for (double z : s.zd_um)
     at_target = at_target && std::fabs(z - target_um_) <= kAppliedTolerance_um;
   if (!applied_) {
+    // Until this move shows, Z_d is the last target's: any other value is a move not ours (one
+    // whose own samples we had not yet read when we moved, or one made after ours).
+    bool ours = true;
+    for (double z : s.zd_um)
+      ours = ours && (std::fabs(z - target_um_) <= kAppliedTolerance_um || !has_previous_ ||
+                      std::fabs(z - previous_um_) <= kAppliedTolerance_um);
+    if (!ours) {
+      fail(moved_away(s));
+      return false;
+    }
     applied_ = at_target && s.closed_loop;
     if (!applied_ && s.t_s - phase_t0_s_ > p_.on_target.timeout_s)
       fail(fmt::format("the loop did not apply the move to Z_d = {:.4f} um within {} s", target_um_,
@@ -83,11 +102,7 @@ bool SampleSequence::watch(const LoopSample& s) {
     return false;
   }
   if (!at_target) {
-    fail(
-        fmt::format("the stage was moved away from the measurement's Z_d = {:.4f} um at {:.3f} s "
-                    "(Z_d {:.4f}, {:.4f}, {:.4f} um: another client's move, a wave generator "
-                    "or a stop)",
-                    target_um_, s.t_s, s.zd_um[0], s.zd_um[1], s.zd_um[2]));
+    fail(moved_away(s));
     return false;
   }
   return true;

@@ -118,6 +118,31 @@ TEST(SampleSequenceTest, AnotherClientsMoveEndsItWithThatReason) {
       << r.validity.reason;
 }
 
+// The same move while the sequence's own is on its way: seen between ours and the loop (the
+// sequence read its samples late), or made after ours so that ours never shows. Either is
+// another client's, not "not applied yet" (which before ended valid, or at the apply timeout
+// with another reason).
+TEST(SampleSequenceTest, AnotherClientsMoveWhileOursIsPendingEndsItWithThatReason) {
+  for (const bool after_ours : {false, true}) {
+    ScriptedCamera cam;
+    cam.configure({});
+    SyntheticLoop loop;
+    SampleSequence seq(cam, five_steps(), kPeriod_s, [&](double z) { return loop.move(z); });
+    const SequenceResult r = run(seq, loop, 20000, [&](SyntheticLoop& l, const SampleSequence& s) {
+      if (s.frames_taken() == 2 && l.pending_um && l.pending_ticks == 2) {
+        if (after_ours)
+          l.pending_um = 3.0;  // replaces ours before the loop applies it
+        else
+          l.zd_um = 3.0;  // in force one tick before ours
+      }
+    });
+    EXPECT_FALSE(r.validity.valid) << after_ours;
+    EXPECT_EQ(r.exposures.size(), 2u) << after_ours;
+    EXPECT_NE(r.validity.reason.find("another client's move"), std::string::npos)
+        << r.validity.reason;
+  }
+}
+
 TEST(SampleSequenceTest, ARefusedMoveEndsItNamingTheRefusal) {
   ScriptedCamera cam;
   cam.configure({});

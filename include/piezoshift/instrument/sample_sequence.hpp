@@ -75,6 +75,7 @@ class SampleSequence {
   void fail(const std::string& why);
   void command(double z_um);
   bool watch(const LoopSample& s);
+  std::string moved_away(const LoopSample& s) const;
   void on_settled(const LoopSample& s);
   void next_frame(const LoopSample& s);
   void finish_exposure(const LoopSample& s);
@@ -91,6 +92,8 @@ class SampleSequence {
   Phase phase_ = Phase::kStart;
   bool based_ = false;  //!< the base has settled: frames from here on
   double target_um_ = 0.0;
+  double previous_um_ = 0.0;   //!< the target before target_um_ (has_previous_)
+  bool has_previous_ = false;  //!< false for the first move: the stage was anywhere before it
   bool applied_ = false;
   double phase_t0_s_ = 0.0;
   std::uint64_t last_tick_ = 0;
