@@ -220,7 +220,8 @@ void ServeCamera::on_sample(const runtime::HostSample& s, const host::RecorderIn
   ls.has_truth = s.has_truth != 0;
   if (ls.has_truth) {
     const host::AxisValues pose = gcs_.model().pose_from_points(s.truth_um);
-    ls.pose = {s.t_s, 1000.0 * pose[0], pose[1], pose[2]};
+    // The fringes' piston: the plate's, plus the cavity's drift when the twin puts it there.
+    ls.pose = {s.t_s, 1000.0 * pose[0] + s.fringe_drift_nm, pose[1], pose[2]};
   }
   const std::lock_guard lock(mutex_);
   if (incoming_.size() >= kMaxIncoming) {

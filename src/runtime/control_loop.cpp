@@ -369,6 +369,7 @@ void ControlLoop::push_host_sample(const CycleSample& cs, const Vec3& zd, const 
   h.sgs_V = cs.ai_V;
   h.ao_V = cs.supervisor.ao_V;
   h.has_truth = daq_.truth(h.truth_um, h.interferometer_um) ? 1 : 0;
+  h.fringe_drift_nm = daq_.fringe_drift_nm();
   h.wake_latency_us = static_cast<double>(wake_ns - deadline_ns_) * 1e-3;
   h.overrun = previous_overran_ ? 1 : 0;
   h.closed_loop = closed_loop && !supervisor.faulted() ? 1 : 0;

@@ -104,6 +104,10 @@ bool SimBackend::truth(Vec3& z_um, Vec3& interferometer_um) const noexcept {
   return true;
 }
 
+double SimBackend::fringe_drift_nm() const noexcept {
+  return twin_ ? twin_->fringe_piston_nm() - 1000.0 * twin_->truth().plate_z_um : 0.0;
+}
+
 bool SimBackend::inject(FaultKind kind, std::size_t channel,
                         const FaultInjectionParams& params) noexcept {
   if (!twin_ || channel >= 3)

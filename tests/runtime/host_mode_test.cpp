@@ -10,6 +10,7 @@
 #include "allocation_counter.hpp"
 #include "fake_backend.hpp"
 #include "piezoshift/runtime/control_loop.hpp"
+#include "piezoshift/runtime/sim_backend.hpp"
 
 namespace piezoshift::runtime {
 namespace {
@@ -367,6 +368,42 @@ TEST(HostMode, CommandsAndSamplesMakeNoHeapAllocation) {
   EXPECT_EQ(r.host_commands_applied, 6u);
   EXPECT_EQ(r.host_samples_dropped, r.ticks - HostLink::kSampleCapacity)
       << "a full ring drops, never blocks";
+}
+
+// The twin's cavity drift reaches serve's samples (the dashboard camera renders the fringes from
+// them): each sample's fringe_drift_nm is the twin's d_c at that tick when twin.cavity.in_fringes,
+// and 0 otherwise (as on hardware).
+TEST(HostMode, TheTwinsCavityDriftReachesEverySampleWhenItIsInTheFringes) {
+  for (const bool in_fringes : {true, false}) {
+    SimOptions o;
+    o.twin.cavity.in_fringes = in_fringes;
+    SimBackend sim(o);
+    sim.configure();
+    sim.activate();
+    SimulatedClock clock;
+    HostLink link;
+    LoopConfig cfg;
+    cfg.rate_Hz = 1000.0;
+    cfg.duration_s = 0.2;
+    cfg.host = &link;
+    ControlLoop loop(cfg, control::SemiClosedLoopParams{}, SafetyLimits{}, sim, clock,
+                     SetpointProfile::step(0.0));
+    loop.start();
+    double worst_nm = 0.0, largest_nm = 0.0;
+    for (int k = 0; k < 200; ++k) {
+      ASSERT_TRUE(loop.tick());
+      HostSample s{};
+      ASSERT_TRUE(link.samples.try_pop(s));
+      const double d_c_nm = in_fringes ? sim.twin().truth().cavity_drift_nm : 0.0;
+      worst_nm = std::max(worst_nm, std::fabs(s.fringe_drift_nm - d_c_nm));
+      largest_nm = std::max(largest_nm, std::fabs(s.fringe_drift_nm));
+    }
+    EXPECT_LT(worst_nm, 1e-9) << in_fringes;  // the plate's piston cancels to rounding
+    if (in_fringes)
+      EXPECT_GT(largest_nm, 0.0);  // the air and the mount move from the first tick
+    else
+      EXPECT_EQ(largest_nm, 0.0);
+  }
 }
 
 }  // namespace

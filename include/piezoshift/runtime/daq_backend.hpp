@@ -80,6 +80,9 @@ class DaqBackend {
   //! Real-time safe. Ground truth at the measurement points P1..P3 (um), where the backend knows
   //! it (the twin: true displacement and the interferometer's reading). False on hardware.
   virtual bool truth(Vec3& /*z_um*/, Vec3& /*interferometer_um*/) const noexcept { return false; }
+  //! Real-time safe. What the Fizeau's fringes see beyond the plate's piston [nm]: the twin's
+  //! cavity drift when twin.cavity.in_fringes (plant/fizeau_cavity.hpp), else 0; 0 on hardware.
+  virtual double fringe_drift_nm() const noexcept { return 0.0; }
 
   //! Set-up: the backend drives a digital trigger output (default: none).
   virtual bool has_trigger_line() const noexcept { return false; }

@@ -100,6 +100,7 @@ class FaultInjectingBackend final : public DaqBackend {
   bool truth(Vec3& z_um, Vec3& interferometer_um) const noexcept override {
     return inner_.truth(z_um, interferometer_um);
   }
+  double fringe_drift_nm() const noexcept override { return inner_.fringe_drift_nm(); }
   bool has_trigger_line() const noexcept override { return inner_.has_trigger_line(); }
   void stage_trigger_line(bool high) noexcept override { inner_.stage_trigger_line(high); }
   bool take_trigger_edge(TriggerEdge& edge) noexcept override {

@@ -65,6 +65,7 @@ struct HostSample {
   Vec3 ao_V{};                         //!< the outputs sent to the DAQ
   Vec3 interferometer_um{};            //!< the twin's interferometer at P1..P3 (has_truth)
   Vec3 truth_um{};                     //!< the twin's true displacement of P1..P3 (has_truth)
+  double fringe_drift_nm = 0.0;        //!< the fringes' piston beyond the plate's (DaqBackend's)
   double wake_latency_us = 0.0;        //!< wake-up - deadline of this tick
   std::uint8_t overrun = 0;            //!< this tick's work ended after the next deadline
   std::uint8_t closed_loop = 0;        //!< servo on

@@ -68,6 +68,7 @@ class SimBackend final : public DaqBackend, public PlantFaultHooks {
   DaqStatus write(const CycleTime& t, const Vec3& ao_V) noexcept override;
   std::string name() const override { return "sim"; }
   bool truth(Vec3& z_um, Vec3& interferometer_um) const noexcept override;
+  double fringe_drift_nm() const noexcept override;
 
   bool has_trigger_line() const noexcept override { return true; }
   void stage_trigger_line(bool high) noexcept override { line_staged_ = high; }
