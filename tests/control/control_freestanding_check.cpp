@@ -1,5 +1,6 @@
 // Built with -fno-exceptions -fno-rtti: proves the controller core needs neither, and that a full
 // controller tick is usable in a constant expression (so it cannot allocate).
+#include "piezoshift/control/fringe_lock.hpp"
 #include "piezoshift/control/parameter_check.hpp"
 #include "piezoshift/control/semi_closed_loop.hpp"
 
@@ -38,6 +39,16 @@ static_assert(piezoshift::control::params_problem(piezoshift::control::SemiClose
               piezoshift::control::ParamsProblem::kNone);
 static_assert(noexcept(
     piezoshift::control::params_problem(piezoshift::control::SemiClosedLoopParams{}, 1e-3)));
+
+// The fringe lock's frame, in a constant expression: g = 0.5 takes half of a 10 nm offset.
+constexpr double fringe_lock_first_correction_nm() {
+  piezoshift::control::FringeLock lock(piezoshift::control::FringeLockParams{});
+  lock.start({0.0, 0.0, 0.0});
+  return lock.update({10.0, 0.0, 0.0}, true)[0];
+}
+static_assert(fringe_lock_first_correction_nm() == -5.0);
+static_assert(
+    piezoshift::control::fringe_lock_problem(piezoshift::control::FringeLockParams{})[0] == '\0');
 
 }  // namespace
 
