@@ -7,7 +7,10 @@
 #include <numbers>
 #include <vector>
 
+#include "piezoshift/plant/random.hpp"
 #include "piezoshift/psi/analysis.hpp"
+#include "piezoshift/psi/fizeau_simulation.hpp"
+#include "piezoshift/psi/frame_pose.hpp"
 
 namespace {
 
@@ -47,5 +50,27 @@ void BM_PsiAnalyze1024Frame13(benchmark::State& state) {
   }
 }
 BENCHMARK(BM_PsiAnalyze1024Frame13)->Unit(benchmark::kMillisecond);
+
+// One frame's pose for the fringe lock (frame_pose.hpp) on the twin's 256 px frames: the lock's
+// cost per camera frame (docs/psi.md).
+void BM_FramePoseFit256(benchmark::State& state) {
+  const FizeauParams fizeau;
+  const CameraParams camera;
+  const Mask mask = disk_mask(256, 256, 120.0);
+  piezoshift::plant::Rng rng(3);
+  const Map surface = make_surface_nm(SurfaceSpec{}, mask, rng);
+  const auto frame = [&](double piston_nm) {
+    const PoseSample pose{0.0, piston_nm, 0.3, -0.2};
+    return render_frame(surface, mask, fizeau, camera, std::span(&pose, 1), rng);
+  };
+  std::vector<Map> set;
+  for (int k = 0; k < 5; ++k)
+    set.push_back(frame(k * fizeau.wavelength_nm / 8.0));
+  const FramePoseReference ref = frame_pose_reference(set, mask);
+  const Map f = frame(20.0);
+  for (auto _ : state)
+    benchmark::DoNotOptimize(fit_frame_pose(f, ref, {}));
+}
+BENCHMARK(BM_FramePoseFit256)->Unit(benchmark::kMillisecond);
 
 }  // namespace
