@@ -314,7 +314,12 @@ FringeTracker::FrameFit FringeTracker::fit_frame(const Map& frame, const Plane& 
   const double white = pairs ? std::sqrt(d2 / (2.0 * static_cast<double>(pairs))) : rms;
   fit.noise = b > 0.0 ? white / b : std::numeric_limits<double>::infinity();
   const double misfit = std::sqrt(std::max(0.0, rms * rms - white * white)) / b;
-  if (!(fit.noise <= p_.max_noise_to_modulation))
+  if (!(b > 0.0))
+    fit.reason = fmt::format(
+        "the plane fit lost the fringes (modulation fitted at {:.3g}): the plate's tilt changed "
+        "beyond the fit's reach since the frames before, or the fringes vanished",
+        b);
+  else if (!(fit.noise <= p_.max_noise_to_modulation))
     fit.reason = fmt::format("modulation too low, noise {:.3f} of it (at most {:g})", fit.noise,
                              p_.max_noise_to_modulation);
   else if (it == kMaxIterations)

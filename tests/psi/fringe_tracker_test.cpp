@@ -217,6 +217,49 @@ TEST(FringeTrackerTest, AStepPastAQuarterWaveReadAsItsAliasIsRefused) {
       << run.poses[6].reason;
 }
 
+TEST(FringeTrackerTest, ADescentIsReadAsOneWhenTheFirstDirectionSaysSo) {
+  // Fringes alone cannot tell a descent from an ascent (phi -> -phi is the same data): told
+  // the first window's direction, the tracker gets the descent; told wrong, its mirror image.
+  const Scene s(9, 128);
+  std::vector<kinematics::PlatePose> truth;
+  for (int k = 0; k < 13; ++k)
+    truth.push_back({-1e-3 * 70.0 * k, 0.05 * k, 0.0});
+  FringeTrackerParams p = s.params();
+  p.first_direction = -1;
+  const Tracked down = track(s, truth, 29, p);
+  ASSERT_EQ(down.poses.size(), truth.size());
+  for (const FringePose& r : down.poses)
+    ASSERT_TRUE(r.valid) << r.frame << ": " << r.reason;
+  // 128 px: a quarter of the pixels, twice the noise of the 256 px band's estimate
+  EXPECT_LT(down.p_rms_nm, 2.0 * kBandRmsNm);
+  EXPECT_NEAR(down.poses.back().piston_nm, -840.0, 1.0);
+  p.first_direction = +1;
+  const Tracked up = track(s, truth, 29, p);
+  ASSERT_TRUE(up.poses.back().valid) << up.poses.back().reason;
+  EXPECT_NEAR(up.poses.back().piston_nm, 840.0, 1.0);
+  EXPECT_NEAR(up.poses.back().theta_x_urad, -0.6, 0.01);
+}
+
+TEST(FringeTrackerTest, ATiltJumpBeyondTheFitsReachIsRefused) {
+  // After the reference sequence the plate rests, then tips by 6 urad in one frame: 3.0 rad at
+  // the pupil edge, beyond what the fit started from the plate at rest reaches (4 urad, 2.0 rad
+  // at the edge, is followed: docs/fizeau.md).
+  const Scene s(10, 128);
+  std::vector<kinematics::PlatePose> truth;
+  for (int k = 0; k < 5; ++k)
+    truth.push_back({1e-3 * 79.1 * k, 0.0, 0.0});
+  for (int k = 5; k < 10; ++k)
+    truth.push_back({1e-3 * 79.1 * 4, k >= 8 ? 6.0 : 0.0, 0.0});
+  const Tracked run = track(s, truth, 30, s.params());
+  ASSERT_EQ(run.poses.size(), truth.size());
+  EXPECT_TRUE(run.poses[7].valid) << run.poses[7].reason;
+  EXPECT_NEAR(run.poses[7].piston_nm, 316.4, 1.0);
+  EXPECT_FALSE(run.poses[8].valid);
+  EXPECT_NE(run.poses[8].reason.find("frame 8: the "), std::string::npos) << run.poses[8].reason;
+  EXPECT_NE(run.poses[8].reason.find("tilt changed beyond the fit's reach"), std::string::npos)
+      << run.poses[8].reason;
+}
+
 TEST(FringeTrackerTest, FaintFringesAreRefusedAsLowModulation) {
   Scene s(5, 128);
   s.camera.visibility = 0.02;
