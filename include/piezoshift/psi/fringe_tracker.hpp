@@ -110,7 +110,8 @@ struct FringePose {
   double theta_x_urad = 0.0;                   //!< tip about x
   double theta_y_urad = 0.0;                   //!< tilt about y
   kinematics::PointDisplacements points_um{};  //!< P1, P2, P3
-  //! the window's white noise over its modulation (PhaseResult::noise_rms)
+  //! the fit's white noise over the modulation: the tilt-aia window's (PhaseResult::noise_rms)
+  //! for the frames it resolved, the frame's own fit's for a frame fitted alone
   double noise_to_modulation = 0.0;
 };
 
