@@ -66,12 +66,14 @@ std::optional<std::vector<std::uint64_t>> parse_seeds(const std::string& text) {
 }
 
 // A median as the terminal shows it, formatted as the report does: never a number when it is
-// not valid (the reasons follow on stderr).
+// not valid (the reasons follow on stderr) or not applicable (its reason under the tables).
 std::string cell(const reproduction::FigureValue& m, const std::string& unit, double resolution) {
   if (!m.measured)
     return "-";
   if (!m.validity.valid)
     return "NOT VALID";
+  if (!m.not_applicable.empty())
+    return "n/a";
   return reproduction::format_figure(m.value, unit, resolution);
 }
 
@@ -89,6 +91,8 @@ std::string summary_tables(const reproduction::ComparisonResult& result) {
   std::vector<std::vector<std::string>> targets{
       {"target (improved controller's median)", "bound", "median", "met"}};
   std::string not_judged;
+  for (const std::string& why : result.not_applicable_reasons())
+    not_judged += fmt::format("  n/a: {}\n", why);
   for (const auto& t : result.targets) {
     targets.push_back({t.text, t.bound_text, cell(t.improved, t.unit, t.resolution), t.verdict()});
     if (!t.not_applicable.empty())

@@ -35,7 +35,7 @@ std::size_t ticks_of(double t_s, double T) {
 RingTest ring_test(const config::ProjectConfig& config,
                    const control::SemiClosedLoopParams& controller, std::uint64_t seed,
                    const RingTestOptions& o) {
-  rig::Bench bench(config, controller, seed);
+  rig::Bench bench(config, controller, seed, o.bench);
   const double T = bench.sample_time_s();
   control::Vec3 volts{};
   for (std::size_t i = 0; i < 3; ++i)

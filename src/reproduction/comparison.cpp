@@ -17,6 +17,8 @@ namespace {
 
 using rig::Validity;
 
+constexpr double kFastSampleTime_s = 1e-4;  // 10 kHz, issue 12's second loop rate
+
 FigureValue figure(double value, const Validity& v) {
   FigureValue f;
   f.validity = v;
@@ -28,6 +30,12 @@ FigureValue figure(double value, const Validity& v) {
 FigureValue not_measured() {
   FigureValue f;
   f.measured = false;
+  return f;
+}
+
+FigureValue not_applicable(const std::string& why) {
+  FigureValue f;
+  f.not_applicable = why;
   return f;
 }
 
@@ -49,6 +57,8 @@ std::function<FigureValue(const VariantRun&)> at_10kHz(
       return figure(0.0, r.calibration);
     if (!r.ran_10kHz)
       return not_measured();
+    if (!r.not_applicable_10kHz.empty())
+      return not_applicable(r.not_applicable_10kHz);
     return figure(r.phase_step_10kHz.*member, r.phase_step_10kHz.validity);
   };
 }
@@ -64,6 +74,8 @@ std::function<FigureValue(const VariantRun&)> margin(std::size_t i, bool gain) {
       return f;
     }
     const InnerLoopAnalysis& a = r.inner_loop[i];
+    if (a.sample_time_s == kFastSampleTime_s && !r.not_applicable_10kHz.empty())
+      return not_applicable(r.not_applicable_10kHz);
     if (!a.validity.valid)
       return figure(0.0, a.validity);
     const calibration::StabilityMargins w = a.worst();
@@ -88,8 +100,6 @@ constexpr const char* kOracleExactOnThePapersLevels =
     "the oracle reads exactly 0 on the paper's whole-micron levels (its plate held on the levels "
     "the interferometer reads to 1 nm), so 1.2 × 0 would ask for exactly 0; judged on the 0.25 µm "
     "grid and downwards instead (issue 31)";
-
-constexpr double kFastSampleTime_s = 1e-4;  // 10 kHz, issue 12's second loop rate
 
 // The lambda/8 step with the loop at 10 kHz: the same controller re-expressed per sample.
 experiments::PhaseStepResult phase_step_at_10kHz(const config::ProjectConfig& config,
@@ -233,12 +243,17 @@ FigureValue median_over_seeds(const std::vector<FigureValue>& per_seed,
     }
     if (!f.validity.valid)
       m.validity.fail(fmt::format("seed {}: {}", seeds.at(i), f.validity.reason));
-    else
+    else if (!f.not_applicable.empty() && m.not_applicable.empty())
+      m.not_applicable = fmt::format("seed {}: {}", seeds.at(i), f.not_applicable);
+    else if (f.not_applicable.empty())
       v.push_back(f.value);
   }
-  if (!m.validity.valid || v.empty()) {
-    if (v.empty() && m.validity.valid)
-      m.validity.fail("no seed");
+  if (!m.validity.valid)
+    m.not_applicable.clear();  // a failure is never hidden behind a figure not judged
+  if (!m.validity.valid || !m.not_applicable.empty())
+    return m;
+  if (v.empty()) {
+    m.validity.fail("no seed");
     return m;
   }
   std::sort(v.begin(), v.end());
@@ -266,6 +281,18 @@ std::vector<std::string> ComparisonResult::invalid_reasons() const {
       const FigureValue& m = medians[i][static_cast<std::size_t>(k)];
       if (m.measured && !m.validity.valid)
         out.push_back(fmt::format("{}: {}: {}", variant_key(k), figures[i].key, m.validity.reason));
+    }
+  }
+  return out;
+}
+
+std::vector<std::string> ComparisonResult::not_applicable_reasons() const {
+  std::vector<std::string> out;
+  for (std::size_t i = 0; i < medians.size(); ++i) {
+    for (LoopVariant k : kLoopVariants) {
+      const FigureValue& m = medians[i][static_cast<std::size_t>(k)];
+      if (m.measured && m.validity.valid && !m.not_applicable.empty())
+        out.push_back(fmt::format("{}: {}: {}", variant_key(k), figures[i].key, m.not_applicable));
     }
   }
   return out;
@@ -365,6 +392,31 @@ void run_at_10kHz(const config::ProjectConfig& config, const control::SemiClosed
   run.simulated_time_s += run.phase_step_10kHz.simulated_time_s;
 }
 
+// Issue 31: the oracle closes the paper's gains around the plate's true position, which sees the
+// plate's mode with no stack in between, and at 1 kHz that loop rings up on plates lighter or
+// heavier than the default's. It chooses the gains it holds with as the improved calibration's
+// stage 0 does (holding_gains.hpp: the ring test, here on its own plate
+// feedback, scaled down by 0.7 a try until 1.5 x them holds; seed + 93), or the calibration
+// fails with that procedure's reason. Where the paper's gains hold, the oracle is what it was,
+// bit for bit.
+void choose_oracle_gains(const config::ProjectConfig& config, std::uint64_t seed,
+                         const Schedule& oracle_schedule, VariantRun& oracle) {
+  calibration::HoldingGainsOptions o;
+  o.ring.bench = oracle_schedule.phase_step.bench;  // the oracle's feedback and supervisor
+  // Tested at 1.5 x, not stage 0's 2 x: the default twin's oracle holds at 1.5 x and rings at 2 x
+  // (seed 1: the ring's rms 0.138 -> 0.016 um, and 0.41 -> 0.38 um), so 2 x would retune the
+  // oracle the comparison was built on; 1.5 x (3.5 dB) still covers the stack's slope at the end
+  // of a stroke (1.25, 1.9 dB), where the oracle's travel and 11 um step take it.
+  o.margin_factor = 1.5;
+  const calibration::HoldingGains h = calibration::holding_gains(
+      config, oracle.controller, seed + 93, o, "the oracle's holding gains (its plate feedback)");
+  oracle.holding_gains_scale = h.scale;
+  if (h.scale < 1.0) {
+    oracle.controller.gains = h.gains;  // per sample at its own rate
+    oracle.controller.gains_sample_time_s = oracle.controller.sample_time_s;
+  }
+}
+
 // The three variants on one seed: the paper's and the improved controller each calibrated by its
 // own procedure, the oracle feedback on the paper's calibration.
 SeedComparison compare_seed(const config::ProjectConfig& config, std::uint64_t seed,
@@ -407,6 +459,9 @@ SeedComparison compare_seed(const config::ProjectConfig& config, std::uint64_t s
   paper.simulated_time_s = paper_calibration_s;
 
   const Schedule oracle_schedule = with_feedback(s, rig::Feedback::kOracle);
+  if (oracle.calibration.valid)
+    calibrate_or_fail(oracle.calibration, "calibration",
+                      [&] { choose_oracle_gains(config, seed, oracle_schedule, oracle); });
   for (LoopVariant k : kLoopVariants) {
     VariantRun& run = sc.runs[static_cast<std::size_t>(k)];
     if (!run.calibration.valid)
@@ -426,9 +481,12 @@ SeedComparison compare_seed(const config::ProjectConfig& config, std::uint64_t s
       run_at_10kHz(config, base, seed, s, k, run, labelled(k));
       continue;
     }
+    // Issue 31's decision: a fixed design the issue does not judge, found unstable by the
+    // procedure: its 10 kHz figures are not applicable, not a failure of the comparison.
     run.inner_loop = analyze_inner_loop(config, run.controller, seed, unstable);
     run.ran_10kHz = true;
     run.phase_step_10kHz.validity.fail(unstable);
+    run.not_applicable_10kHz = unstable;
   }
   return sc;
 }

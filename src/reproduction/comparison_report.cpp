@@ -22,7 +22,8 @@ std::size_t idx(LoopVariant k) {
   return static_cast<std::size_t>(k);
 }
 
-// JSON has no infinity and no "not valid": both are null, the reason beside it.
+// JSON has no infinity, no "not valid" and no "not applicable": all are null, the reason beside
+// it.
 nlohmann::json number_or_null(const FigureValue& f) {
   return f.validity.valid && std::isfinite(f.value) ? nlohmann::json(f.value) : nlohmann::json();
 }
@@ -32,6 +33,7 @@ template <class Values>
 void prefixed(nlohmann::json& j, const ComparisonResult& r, LoopVariant k, Values values) {
   const std::string prefix = std::string(variant_key(k)) + "_";
   nlohmann::json not_valid = nlohmann::json::object();
+  nlohmann::json not_applicable = nlohmann::json::object();
   for (std::size_t i = 0; i < r.figures.size(); ++i) {
     const FigureValue f = values(i);
     if (!f.measured)
@@ -39,8 +41,11 @@ void prefixed(nlohmann::json& j, const ComparisonResult& r, LoopVariant k, Value
     j[prefix + r.figures[i].key] = number_or_null(f);
     if (!f.validity.valid)
       not_valid[r.figures[i].key] = f.validity.reason;
+    else if (!f.not_applicable.empty())
+      not_applicable[r.figures[i].key] = f.not_applicable;
   }
   j[prefix + "not_valid"] = not_valid;
+  j[prefix + "not_applicable"] = not_applicable;
 }
 
 // As reproduce's report prints it (figure_format.hpp).
@@ -49,6 +54,8 @@ std::string value_text(const FigureValue& f, const std::string& unit, double res
     return "-";
   if (!f.validity.valid)
     return "NOT VALID: " + f.validity.reason;
+  if (!f.not_applicable.empty())
+    return "n/a: " + f.not_applicable;
   return format_figure(f.value, unit, resolution);
 }
 
@@ -382,6 +389,7 @@ nlohmann::json comparison_json(const ComparisonResult& r) {
     o["seed"] = r.seeds[s].seed;
     for (LoopVariant k : kLoopVariants)
       prefixed(o, r, k, [&](std::size_t i) { return r.figures[i].of(r.seeds[s][k]); });
+    o["oracle_holding_gains_scale"] = r.seeds[s][LoopVariant::kOracleFeedback].holding_gains_scale;
     per.push_back(std::move(o));
   }
   j["per_seed"] = std::move(per);
@@ -401,6 +409,7 @@ nlohmann::json comparison_json(const ComparisonResult& r) {
   j["targets"] = std::move(targets);
   j["valid"] = r.valid();
   j["invalid_reasons"] = r.invalid_reasons();
+  j["not_applicable_reasons"] = r.not_applicable_reasons();
   j["simulated_time_s"] = r.simulated_time_s;
   j["wall_time_s"] = r.wall_time_s;
   return j;

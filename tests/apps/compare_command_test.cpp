@@ -1,4 +1,6 @@
 // `piezoshift compare` as a user runs it.
+#include <algorithm>
+
 #include <nlohmann/json.hpp>
 
 #include "../support/cli_test.hpp"
@@ -51,6 +53,48 @@ TEST_F(CompareCommand, ABadSeedListExitsWithStatusTwoNamingTheOption) {
   EXPECT_EQ(r.status, 2);
   EXPECT_NE(r.err.find("bad.toml"), std::string::npos) << r.err;
 }
+
+// Issue 31: configs/plants/, twins not used in development. A quick compare on each exits 0:
+// every figure of every controller valid, except that the paper's 10 kHz figures may be not
+// applicable, and then only with compare's ring test's reason (docs/compare.md). Not yet
+// contact-spread: its oracle holds only at 0.17 x the paper's gains, too slow for the
+// supervisor's tracking rule on its 10 and 11 um moves (docs/compare.md, what is left).
+class ComparePlants : public testing::CliTest, public ::testing::WithParamInterface<const char*> {};
+
+TEST_P(ComparePlants, QuickRunIsValid) {
+  const std::string cfg = testing::source_dir() + "/configs/plants/" + GetParam() + ".toml";
+  const testing::CliResult r = run("compare --quick --seeds 1 --json --config '" + cfg + "'");
+  EXPECT_EQ(r.status, 0) << r.err;
+  const auto j = nlohmann::json::parse(r.out);
+  EXPECT_TRUE(j["valid"].get<bool>());
+  EXPECT_TRUE(j["invalid_reasons"].empty()) << j["invalid_reasons"];
+  ASSERT_EQ(j["per_seed"].size(), 1U);
+  for (const nlohmann::json* o : {&j, &j["per_seed"][0]}) {
+    for (const char* v : {"paper", "improved", "oracle"}) {
+      EXPECT_TRUE((*o)[std::string(v) + "_not_valid"].empty())
+          << v << ": " << (*o)[std::string(v) + "_not_valid"];
+      for (const auto& [key, why] : (*o)[std::string(v) + "_not_applicable"].items()) {
+        EXPECT_EQ(std::string(v), "paper") << key;
+        EXPECT_NE(key.find("10kHz"), std::string::npos) << key;
+        EXPECT_NE(why.get<std::string>().find("re-expressed at 10 kHz are unstable on this plant"),
+                  std::string::npos)
+            << key << ": " << why;
+        EXPECT_TRUE((*o)["paper_" + key].is_null()) << key;
+      }
+    }
+  }
+  // The oracle ran its experiments: it reached the travel of the others (0 before, issue 31).
+  EXPECT_GT(j["oracle_travel_semi_closed_um"].get<double>(), 10.0);
+  EXPECT_GE(j["per_seed"][0]["oracle_holding_gains_scale"].get<double>(), 0.05);
+}
+
+INSTANTIATE_TEST_SUITE_P(Issue31, ComparePlants,
+                         ::testing::Values("thick-plate", "payload", "soft-hysteresis"),
+                         [](const auto& param_info) {
+                           std::string name = param_info.param;
+                           std::replace(name.begin(), name.end(), '-', '_');
+                           return name;
+                         });
 
 }  // namespace
 }  // namespace piezoshift

@@ -130,6 +130,98 @@ TEST(ComparisonSummary, AFigureNotValidIsNullWithItsReasonInTheJson) {
   EXPECT_EQ(j["per_seed"][1]["seed"], 9);
 }
 
+// Issue 31's decision: the paper's 10 kHz figures, where compare's ring test found its gains
+// unstable there, are not applicable with that reason: null in the JSON with the reason beside
+// it, "n/a" and the reason in the report, and not a reason for compare to exit 4.
+ComparisonResult papers_10kHz_not_applicable() {
+  CompareOptions o;
+  o.quick = true;
+  o.seeds = {3};
+  std::vector<SeedComparison> seeds(1);
+  seeds[0].seed = 3;
+  for (VariantRun& run : seeds[0].runs)
+    run.calibration.fail("calibration: made up for the test");
+  VariantRun& paper = seeds[0].runs[static_cast<std::size_t>(LoopVariant::kPaper)];
+  paper.calibration = rig::Validity{};
+  paper.ran_10kHz = true;
+  paper.not_applicable_10kHz = "made-up ring";
+  paper.phase_step_10kHz.validity.fail("made-up ring");
+  // A few made-up points, so that the report's figures have something to draw.
+  ExperimentSet& set = paper.set;
+  set.repeat_5um.measured_um = {5.0, 5.001, 4.999};
+  set.repeat_10um.measured_um = {10.0, 10.001, 9.999};
+  set.step.time_s = {0.0, 0.001};
+  set.step.measured_um = set.step.desired_um = {0.0, 11.0};
+  set.phase_step.time_s = {0.0, 0.001};
+  set.phase_step.exposure_mean_nm = {0.0, 79.1};
+  for (auto* lin : {&set.linearity, &set.linearity_grid}) {
+    lin->desired_um = {0.0, 1.0};
+    lin->metrics.deviation_zero_end_um = {0.0, 0.0};
+  }
+  for (const double ts : {1e-3, 1e-4}) {
+    InnerLoopAnalysis& a = paper.inner_loop.emplace_back();
+    a.sample_time_s = ts;
+    a.validity.fail("the inner loop: made up for the test");
+  }
+  return summarize_comparison(config::ProjectConfig{}, o, std::move(seeds));
+}
+
+TEST(ComparisonSummary, ThePapersFiguresAt10kHzCanBeNotApplicableWithTheRingTestsReason) {
+  const ComparisonResult r = papers_10kHz_not_applicable();
+  int not_applicable = 0;
+  for (std::size_t i = 0; i < r.figures.size(); ++i) {
+    const FigureValue& m = r.medians[i][static_cast<std::size_t>(LoopVariant::kPaper)];
+    const bool at_10kHz = r.figures[i].key.find("10kHz") != std::string::npos;
+    EXPECT_EQ(m.not_applicable, at_10kHz ? "seed 3: made-up ring" : "") << r.figures[i].key;
+    EXPECT_EQ(m.validity.valid, at_10kHz || r.figures[i].key.find("1kHz") == std::string::npos)
+        << r.figures[i].key;
+    not_applicable += at_10kHz ? 1 : 0;
+  }
+  EXPECT_EQ(not_applicable, 5);  // the step's three figures and the two margins
+  const std::vector<std::string> na = r.not_applicable_reasons();
+  ASSERT_EQ(na.size(), 5U);
+  EXPECT_EQ(na[0], "paper: phase_step_10kHz_hold_jitter_nm_rms: seed 3: made-up ring");
+  for (const std::string& why : r.invalid_reasons())
+    EXPECT_EQ(why.find("made-up ring"), std::string::npos) << why;
+
+  const nlohmann::json j = comparison_json(r);
+  EXPECT_TRUE(j["paper_phase_step_10kHz_settling_time_s"].is_null());
+  EXPECT_EQ(j["paper_not_applicable"]["pid_margins_10kHz_gain_margin_dB"], "seed 3: made-up ring");
+  EXPECT_FALSE(j["paper_not_valid"].contains("pid_margins_10kHz_gain_margin_dB"));
+  EXPECT_EQ(j["per_seed"][0]["paper_not_applicable"]["phase_step_10kHz_settling_time_s"],
+            "made-up ring");
+  EXPECT_EQ(j["not_applicable_reasons"].size(), 5U);
+}
+
+TEST(ComparisonSummary, ACompareWhoseOnlyGapsAreNotApplicableIsValid) {
+  // Every figure valid but the paper's at 10 kHz: valid (exit 0). A seed not valid beside a seed
+  // not applicable: not valid, named.
+  FigureValue na;
+  na.not_applicable = "made-up ring";
+  FigureValue bad;
+  bad.validity.fail("made-up trip");
+  const FigureValue m = median_over_seeds({value(1.0), na, bad}, {1, 2, 3});
+  EXPECT_FALSE(m.validity.valid);
+  EXPECT_EQ(m.validity.reason, "seed 3: made-up trip");
+  EXPECT_TRUE(m.not_applicable.empty());
+  const FigureValue n = median_over_seeds({value(1.0), na}, {1, 2});
+  EXPECT_TRUE(n.validity.valid);
+  EXPECT_EQ(n.not_applicable, "seed 2: made-up ring");
+  EXPECT_TRUE(std::isnan(n.value));
+}
+
+TEST(ComparisonSummary, TheReportSaysNotApplicableAndWhy) {
+  const std::filesystem::path dir =
+      std::filesystem::temp_directory_path() / "piezoshift_comparison_summary_na_test";
+  std::filesystem::remove_all(dir);
+  write_comparison_report(papers_10kHz_not_applicable(), dir, "made-up runs");
+  std::ifstream md(dir / "comparison.md");
+  const std::string text{std::istreambuf_iterator<char>(md), std::istreambuf_iterator<char>()};
+  EXPECT_NE(text.find("n/a: seed 3: made-up ring"), std::string::npos);  // the medians
+  EXPECT_NE(text.find("n/a: made-up ring"), std::string::npos);          // per seed
+  std::filesystem::remove_all(dir);
+}
+
 TEST(ComparisonSummary, OneSeedPerSeedOfTheOptionsOrItIsRefused) {
   CompareOptions o;
   o.seeds = {1, 2};

@@ -21,11 +21,14 @@
 //               hold, the three gains scaled by step_factor until it does;
 //   refusal     when no scale down to min_scale holds, the plant is outside what the procedure
 //               can hold: rig::ProcedureFailed saying so.
+// "Gauges" above are the loop's feedback: on an oracle bench (RingTestOptions::bench) the plate's
+// true position through A, in the gauges' volts.
 #include <cstdint>
 #include <string>
 
 #include "piezoshift/config/project_config.hpp"
 #include "piezoshift/control/semi_closed_loop.hpp"
+#include "piezoshift/rig/bench.hpp"
 
 namespace piezoshift::calibration {
 
@@ -41,6 +44,9 @@ struct RingTestOptions {
   //! while the open-loop hold settled.
   double noise_factor = 2.0;
   double abort_um = 1.0;  //!< a gauge this far from its target opens the loop at once
+  //! The bench's feedback and supervisor: the gauges, or the oracle's plate feedback, whose loop
+  //! sees the plate's mode with no stack in between (compare's oracle chooses its gains so).
+  rig::BenchOptions bench{};
 };
 
 struct RingTest {
