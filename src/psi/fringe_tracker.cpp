@@ -56,13 +56,7 @@ FringeTracker::FringeTracker(const Mask& mask, const FringeTrackerParams& params
     p_.hop_frames = p_.window_frames - 1;
   const Pupil pupil = pupil_of(mask_);  // throws for an empty mask
   pupil_radius_m_ = pupil.radius_px * p_.plate_m_per_px;
-  const auto w = static_cast<std::size_t>(mask_.width);
-  for (std::size_t q = 0; q < mask_.size(); ++q)
-    if (mask_.v[q]) {
-      pix_.push_back(q);
-      x_.push_back(pupil.x(static_cast<int>(q % w)));
-      y_.push_back(pupil.y(static_cast<int>(q / w)));
-    }
+  ref_ = phase_reference(mask_);
 }
 
 std::vector<FringePose> FringeTracker::push(const Map& frame) {
@@ -73,7 +67,7 @@ std::vector<FringePose> FringeTracker::push(const Map& frame) {
   ++seen_;
   if (!lost_.empty())
     return refuse_from(seen_ - 1, lost_);
-  if (p_.method == FringeMethod::kReference && !phi_ref_.empty())
+  if (p_.method == FringeMethod::kReference && have_phase_)
     return track_frame(frame);
   window_.push_back(frame);
   const auto nw = static_cast<std::size_t>(p_.window_frames);
@@ -106,11 +100,12 @@ std::string FringeTracker::anchor(const PhaseResult& r, int& sigma, Plane& w0) c
   using cd = std::complex<double>;
   std::array<cd, 2> mean{};
   std::size_t n = 0;
-  for (std::size_t q = 0; q < pix_.size(); ++q) {
-    const double phi = r.phase_rad.v[pix_[q]];
+  for (std::size_t q = 0; q < ref_.pixels.size(); ++q) {
+    const double phi = r.phase_rad.v[ref_.pixels[q]];
     if (!std::isfinite(phi))
       continue;
-    const double known = w0.piston_rad + w0.tip_rad * y_[q] + w0.tilt_rad * x_[q] + phi_ref_[q];
+    const double known =
+        w0.piston_rad + w0.tip_rad * ref_.y[q] + w0.tilt_rad * ref_.x[q] + ref_.phase_rad[q];
     mean[0] += std::polar(1.0, phi - known);
     mean[1] += std::polar(1.0, -phi - known);
     ++n;
@@ -134,13 +129,14 @@ std::string FringeTracker::anchor(const PhaseResult& r, int& sigma, Plane& w0) c
   const double offset = std::arg(mean[sigma > 0 ? 0 : 1]);
   Eigen::Matrix3d M = Eigen::Matrix3d::Zero();
   Eigen::Vector3d b = Eigen::Vector3d::Zero();
-  for (std::size_t q = 0; q < pix_.size(); ++q) {
-    const double phi = r.phase_rad.v[pix_[q]];
+  for (std::size_t q = 0; q < ref_.pixels.size(); ++q) {
+    const double phi = r.phase_rad.v[ref_.pixels[q]];
     if (!std::isfinite(phi))
       continue;
-    const double known = w0.piston_rad + w0.tip_rad * y_[q] + w0.tilt_rad * x_[q] + phi_ref_[q];
+    const double known =
+        w0.piston_rad + w0.tip_rad * ref_.y[q] + w0.tilt_rad * ref_.x[q] + ref_.phase_rad[q];
     const double res = offset + wrap(sigma * phi - known - offset);
-    const Eigen::Vector3d row(1.0, y_[q], x_[q]);
+    const Eigen::Vector3d row(1.0, ref_.y[q], ref_.x[q]);
     M += row * row.transpose();
     b += row * res;
   }
@@ -205,10 +201,11 @@ std::vector<FringePose> FringeTracker::process_window() {
     return refuse_from(next_, fmt::format("{}: {}", span, r.reason));
   int sigma = p_.first_direction;
   Plane w0;
-  if (phi_ref_.empty()) {
-    phi_ref_.resize(pix_.size());
-    for (std::size_t q = 0; q < pix_.size(); ++q)
-      phi_ref_[q] = sigma * r.phase_rad.v[pix_[q]];  // NaN where no modulation: skipped later
+  if (!have_phase_) {
+    have_phase_ = true;
+    for (std::size_t q = 0; q < ref_.pixels.size(); ++q)
+      ref_.phase_rad[q] =
+          sigma * r.phase_rad.v[ref_.pixels[q]];  // NaN where no modulation: skipped later
   } else {
     w0 = planes_[start];
     if (const std::string why = anchor(r, sigma, w0); !why.empty())
@@ -250,86 +247,27 @@ std::vector<FringePose> FringeTracker::process_window() {
 // its own, then Gauss-Newton on all five. Checked as tilt-aia checks its fits: the residual's
 // white part (adjacent-pixel differences) over b is the noise, the rest a misfit.
 FringeTracker::FrameFit FringeTracker::fit_frame(const Map& frame, const Plane& start) const {
-  using Vec5 = Eigen::Matrix<double, 5, 1>;
-  using Mat5 = Eigen::Matrix<double, 5, 5>;
   constexpr int kMaxIterations = 50;
-  constexpr double kTolerance_rad = 1e-7;
+  const PlaneFit f = fit_phase_plane(frame, ref_, start, kMaxIterations);
   FrameFit fit;
-  Eigen::Matrix3d M = Eigen::Matrix3d::Zero();
-  Eigen::Vector3d y3 = Eigen::Vector3d::Zero();
-  for (std::size_t q = 0; q < pix_.size(); ++q) {
-    if (!std::isfinite(phi_ref_[q]))
-      continue;
-    const double th = phi_ref_[q] + start.tip_rad * y_[q] + start.tilt_rad * x_[q];
-    const Eigen::Vector3d row(1.0, std::cos(th), -std::sin(th));
-    M += row * row.transpose();
-    y3 += row * frame.v[pix_[q]];
-  }
-  const Eigen::Vector3d u = M.ldlt().solve(y3);
-  double a = u(0), b = std::hypot(u(1), u(2));
-  fit.plane = {std::atan2(u(2), u(1)), start.tip_rad, start.tilt_rad};
-  int it = 0;
-  for (; it < kMaxIterations && b > 0.0; ++it) {
-    Mat5 JtJ = Mat5::Zero();
-    Vec5 Jtr = Vec5::Zero();
-    for (std::size_t q = 0; q < pix_.size(); ++q) {
-      if (!std::isfinite(phi_ref_[q]))
-        continue;
-      const double th = phi_ref_[q] + fit.plane.piston_rad + fit.plane.tip_rad * y_[q] +
-                        fit.plane.tilt_rad * x_[q];
-      const double c = std::cos(th), sn = std::sin(th);
-      Vec5 J;
-      J << 1.0, c, -b * sn, -b * sn * y_[q], -b * sn * x_[q];
-      JtJ.selfadjointView<Eigen::Lower>().rankUpdate(J);
-      Jtr += J * (frame.v[pix_[q]] - a - b * c);
-    }
-    JtJ.triangularView<Eigen::Upper>() = JtJ.transpose();
-    const Vec5 dx = JtJ.ldlt().solve(Jtr);
-    a += dx(0);
-    b += dx(1);
-    fit.plane = {fit.plane.piston_rad + dx(2), fit.plane.tip_rad + dx(3),
-                 fit.plane.tilt_rad + dx(4)};
-    if (std::max({std::fabs(dx(2)), std::fabs(dx(3)), std::fabs(dx(4))}) < kTolerance_rad)
-      break;
-  }
-  // the residual, its RMS and its white part, over b
-  std::vector<double> res(pix_.size(), kNaN);
-  double s2 = 0.0, d2 = 0.0;
-  std::size_t n = 0, pairs = 0;
-  for (std::size_t q = 0; q < pix_.size(); ++q) {
-    if (!std::isfinite(phi_ref_[q]))
-      continue;
-    const double th =
-        phi_ref_[q] + fit.plane.piston_rad + fit.plane.tip_rad * y_[q] + fit.plane.tilt_rad * x_[q];
-    res[q] = frame.v[pix_[q]] - a - b * std::cos(th);
-    s2 += res[q] * res[q];
-    ++n;
-    if (q > 0 && pix_[q] == pix_[q - 1] + 1 && std::isfinite(res[q - 1]) &&
-        pix_[q] % static_cast<std::size_t>(mask_.width) != 0) {
-      d2 += std::pow(res[q] - res[q - 1], 2);
-      ++pairs;
-    }
-  }
-  const double rms = n ? std::sqrt(s2 / static_cast<double>(n)) : kNaN;
-  const double white = pairs ? std::sqrt(d2 / (2.0 * static_cast<double>(pairs))) : rms;
-  fit.noise = b > 0.0 ? white / b : std::numeric_limits<double>::infinity();
-  const double misfit = std::sqrt(std::max(0.0, rms * rms - white * white)) / b;
-  if (!(b > 0.0))
+  fit.plane = f.plane;
+  fit.noise = f.noise;
+  if (!(f.contrast > 0.0))
     fit.reason = fmt::format(
         "the plane fit lost the fringes (modulation fitted at {:.3g}): the plate's tilt changed "
         "beyond the fit's reach since the frames before, or the fringes vanished",
-        b);
+        f.contrast);
   else if (!(fit.noise <= p_.max_noise_to_modulation))
     fit.reason = fmt::format("modulation too low, noise {:.3f} of it (at most {:g})", fit.noise,
                              p_.max_noise_to_modulation);
-  else if (it == kMaxIterations)
+  else if (!f.settled)
     fit.reason = fmt::format("the plane fit did not settle in {} iterations", kMaxIterations);
-  else if (!(misfit <= p_.phase.max_misfit))
+  else if (!(f.misfit <= p_.phase.max_misfit))
     fit.reason = fmt::format(
         "the frame differs from the reference phase and its fitted plane by {:.4f} of the "
         "modulation beyond its noise (at most {:g}): the plate's tilt changed beyond the fit's "
         "reach since the frames before, or the test surface moved",
-        misfit, p_.phase.max_misfit);
+        f.misfit, p_.phase.max_misfit);
   return fit;
 }
 

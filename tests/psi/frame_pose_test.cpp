@@ -36,23 +36,26 @@ struct Scene {
 };
 
 // The camera's noise is about 1 % of the modulation a pixel (shot noise of 9000 e against
-// 8100 e of modulation), so over the pupil's 45 000 pixels a frame's piston is known to a few
-// thousandths of a nm and its tilts to a few 1e-4 urad; the reference's own noise is of the same
-// order. 0.02 nm and 0.002 urad are several times that, and far below what a lock needs (0.2 nm).
+// 8100 e of modulation), so over the pupil's 45 000 pixels a frame's piston is known to about
+// 0.01 nm (measured: 0.009 nm RMS, 0.022 nm at worst over 24 frames) and its tilts to about
+// 5e-4 urad; the reference's own noise is of the same order. 0.05 nm and 0.002 urad are several
+// times that, and far below what a lock needs (0.2 nm).
 TEST(FramePoseTest, APoseWithinAQuarterWaveIsRecoveredToHundredthsOfANanometre) {
   Scene scene;
   const FramePoseReference ref = scene.reference();
-  EXPECT_GT(ref.median_modulation, 1000.0);
+  EXPECT_GT(ref.fringes.modulation_scale, 1000.0);
   const double cases[][3] = {
       {0.0, 0.0, 0.0}, {30.0, 0.5, -0.3}, {-40.0, -1.0, 0.8}, {12.5, 2.0, 1.5}};
   for (const auto& c : cases) {
     const FramePose p = fit_frame_pose(scene.frame(c[0], c[1], c[2]), ref, {});
     ASSERT_TRUE(p.valid) << p.reason;
-    EXPECT_NEAR(p.piston_nm, c[0], 0.02);
+    EXPECT_NEAR(p.piston_nm, c[0], 0.05);
     EXPECT_NEAR(p.theta_x_urad, c[1], 0.002);
     EXPECT_NEAR(p.theta_y_urad, c[2], 0.002);
     EXPECT_NEAR(p.contrast, 1.0, 0.01);
-    EXPECT_LT(p.misfit, 0.05);  // the noise: its band in frame_pose.hpp is 0.1
+    EXPECT_LT(p.misfit, 0.005);  // nothing beyond the noise (max_misfit 0.02)
+    EXPECT_GT(p.noise, 0.010);   // the camera's, about 0.012 of b a pixel, and the reference's
+    EXPECT_LT(p.noise, 0.025);
     EXPECT_LE(p.iterations, 10);
   }
 }
@@ -67,7 +70,7 @@ TEST(FramePoseTest, TrackedFromTheLastPoseTheFringeOrderIsCarried) {
     const double z = 50.0 * k;
     last = fit_frame_pose(scene.frame(z, 0.1 * k, 0.0), ref, last);
     ASSERT_TRUE(last.valid) << k << ": " << last.reason;
-    EXPECT_NEAR(last.piston_nm, z, 0.02) << k;
+    EXPECT_NEAR(last.piston_nm, z, 0.05) << k;  // the band above
   }
   // From the reference instead, 1 um is 3.16 half-waves away: the fit lands a whole number of
   // half-waves off, or is refused; never 1000 nm.

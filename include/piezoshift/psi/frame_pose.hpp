@@ -1,63 +1,104 @@
 #pragma once
-// The reference plate's pose from ONE frame, against a reference taken once with a phase-shifting
-// set: what the fringe lock (control/fringe_lock.hpp) reads at the camera's frame rate, where a
-// whole phase-shifting set per correction would divide the rate by its frame count.
+// One frame's phase plane against a known reference phase, and with it the reference plate's
+// pose from ONE frame: what the fringe lock (control/fringe_lock.hpp) reads at the camera's frame
+// rate, where a whole phase-shifting set per correction would divide the rate by its frame count,
+// and what the fringe tracker (fringe_tracker.hpp) fits each frame after its first window with.
 //
-// Reference (frame_pose_reference): from a set of frames at steps 0, pi/2, ... (hariharan5's five,
-// or any set wrapped_phase() takes with known pi/2 steps), per pupil pixel the bias a, the
-// modulation b and the phase phi of the frames' model I_k = a + b cos(phi + delta_k); a is the
-// mean of four consecutive frames (pi/2 apart, their cosines cancel).
+// fit_phase_plane(): over the reference's pixels q, the frame is fitted by
+//   I_q = alpha A_q + beta B_q cos(phi_q + piston + tip y_q + tilt x_q)
+// with A_q = B_q = 1 when the reference has no per-pixel bias and modulation (alpha, beta are then
+// the frame's own, as tilt-aware AIA's step (2) takes them uniform), else A_q = a_q and B_q = b_q
+// (alpha about 1, beta the fringes' contrast against the reference's). First the piston, alpha
+// and beta in closed form at the start's tip and tilt (linear in alpha, beta cos e, beta sin e:
+// no start needed for the piston, which comes back wrapped to (-pi, pi]), then Gauss-Newton on
+// all five. Its residual is split as tilt-aware AIA's is: the white part (adjacent pixels'
+// differences) over beta median(B) is the noise, the rest the misfit.
 //
-// A frame is then fitted, over the pupil, by the model of the Fizeau (fizeau_simulation.hpp):
-//   I(x, y) = a + k b cos(phi + (4 pi / lambda) d(x, y)),
-//   d = Z + theta_x y_m - theta_y x_m          (y_m = y R_pupil: the plate's rigid-body motion)
-// for (k, Z, theta_x, theta_y): k the fringes' contrast against the reference's, d the plate's
-// motion since the reference. Gauss-Newton from a start (the last frame's pose: the caller
-// tracks), which converges to the solution within a quarter wave of the start: the piston's
-// fringe order is the start's, so consecutive frames must differ by less than lambda / 8 of
-// piston at every pupil point (about 80 nm; FramePoseOptions::max_step_nm refuses more).
-// The fit checks itself (a failure is a result with valid = false and the reason, never a pose):
-//   k < min_contrast              the fringes are gone (a blocked beam, a stopped camera's dark
-//                                 frame, the test piece moved out)
+// The plate's pose (frame_pose_reference, fit_frame_pose): a reference set at steps 0, pi/2, ...
+// gives a_q, b_q and phi_q (hariharan5's five frames, or four); a frame's plane is then
+//   piston = (4 pi / lambda) Z,  tip = (4 pi / lambda) theta_x R,  tilt = -(4 pi / lambda) theta_y
+//   R
+// (fizeau_simulation.hpp, R the pupil's radius on the plate). The start is the pose the caller
+// expects (the last one plus any move it commanded since): the piston is taken within a quarter
+// wave of it, so the fringe order is the start's. A failure is a result with valid = false and
+// the reason, never a pose:
+//   beta < 0                      the fringes fit inverted: a quarter wave from the start
+//   beta < min_contrast           the fringes are gone (a blocked beam, a dark frame)
 //   not settled in max_iterations
-//   misfit > max_misfit           RMS residual over k median(b): not the surface the reference
-//                                 saw, or a pose beyond the start's basin
+//   misfit > max_misfit           not the surface the reference saw, or a tilt beyond the fit's
+//                                 reach from the start
 //   |d - start| > max_step_nm     at the pupil's edge: a step the fringe order cannot follow
-// What it assumes: the test surface and the illumination are the reference's (a changed surface
-// is a misfit), the plate moves rigidly, and the camera's pupil is the mask's.
+// What it assumes: the test surface and the illumination are the reference's, the plate moves
+// rigidly, and the camera's pupil is the mask's.
+#include <cstddef>
 #include <span>
 #include <string>
+#include <vector>
 
 #include "piezoshift/psi/grid.hpp"
 
 namespace piezoshift::psi {
 
-struct FramePoseReference {
-  Map bias;        //!< a [counts]
-  Map modulation;  //!< b [counts]
-  Map phase_rad;   //!< phi, wrapped
-  Mask mask;
-  Pupil pupil;
-  double median_modulation = 0.0;
+//! A frame's phase shift over the pupil [rad]: piston + tip y + tilt x (pupil coordinates).
+struct PhasePlane {
+  double piston_rad = 0.0;
+  double tip_rad = 0.0;
+  double tilt_rad = 0.0;
 };
 
-//! frames: at least four at steps 0, pi/2, pi, 3 pi/2 (more: the first five as hariharan5). Throws
-//! std::invalid_argument for fewer frames or sizes other than the mask's.
-FramePoseReference frame_pose_reference(std::span<const Map> frames, const Mask& mask);
+//! The fringes a frame is fitted against, over the pupil's pixels.
+struct PhaseReference {
+  std::vector<std::size_t> pixels;       //!< row-major indices of the mask's pixels
+  std::vector<double> x, y;              //!< their pupil coordinates (grid.hpp)
+  std::vector<double> phase_rad;         //!< phi_q; a NaN pixel is left out of the fits
+  std::vector<double> bias, modulation;  //!< a_q, b_q; both empty: uniform, fitted per frame
+  double modulation_scale = 1.0;         //!< median b_q (1 when uniform): the noise's unit
+  int width = 0, height = 0;
+};
+
+//! The mask's pixels and their coordinates, phase_rad NaN (to be filled), uniform. Throws
+//! std::invalid_argument for an empty mask.
+PhaseReference phase_reference(const Mask& mask);
+
+struct PlaneFit {
+  PhasePlane plane;
+  double bias = 0.0;      //!< alpha
+  double contrast = 0.0;  //!< beta
+  double noise = 0.0;     //!< white residual / (beta modulation_scale)
+  double misfit = 0.0;    //!< the residual beyond the white part, in the same unit
+  int iterations = 0;
+  bool settled = false;    //!< the last step moved no parameter of the plane by more than tolerance
+  std::size_t pixels = 0;  //!< fitted
+};
+
+//! The frame (the reference's size; std::invalid_argument otherwise) fitted from start.
+PlaneFit fit_phase_plane(const Map& frame, const PhaseReference& reference, const PhasePlane& start,
+                         int max_iterations = 50, double tolerance_rad = 1e-7);
+
+//! The plate's reference: a set at pi/2 steps, and the pupil's radius on the plate.
+struct FramePoseReference {
+  PhaseReference fringes;
+  double pupil_radius_m = 0.025;  //!< FizeauParams::pupil_radius_m
+};
+
+//! frames: at least four at steps 0, pi/2, pi, 3 pi/2 (five: Hariharan's formula, which cancels a
+//! step error to first order). Throws std::invalid_argument for fewer frames, sizes other than
+//! the mask's, or an empty mask.
+FramePoseReference frame_pose_reference(std::span<const Map> frames, const Mask& mask,
+                                        double pupil_radius_m = 0.025);
 
 struct FramePoseOptions {
   double wavelength_nm = 632.8;
-  double pupil_radius_m = 0.025;  //!< the pupil on the plate (FizeauParams::pupil_radius_m)
   int max_iterations = 20;
   double tolerance_nm = 1e-4;  //!< settled: no point of the pupil moved more in the last step
-  //! The least contrast k taken as fringes: assumed 0.3 (a third of the reference's; a camera's
+  //! The least contrast taken as fringes: assumed 0.3 (a third of the reference's; the camera's
   //! noise is about 1 % of b on the twin, so well above it)
   double min_contrast = 0.3;
-  //! The largest RMS residual over k median(b): assumed 0.1 (the twin's frames fit to about
-  //! 0.02, its shot and read noise and the 12-bit quantisation; tests/psi/frame_pose_test.cpp)
-  double max_misfit = 0.1;
-  //! The largest motion from the start at any pupil point: lambda / 8 (the basin's edge is a
-  //! quarter wave of phase; half of it leaves the noise a margin)
+  //! The residual beyond the noise: 0.02 of the modulation, tilt-aware AIA's bound
+  //! (PhaseOptions::max_misfit)
+  double max_misfit = 0.02;
+  //! The largest motion from the start at any pupil point: lambda / 8 (the closed form's edge is
+  //! a quarter wave; half of it leaves the noise a margin)
   double max_step_nm = 79.1;
 };
 
@@ -66,14 +107,15 @@ struct FramePose {
   double piston_nm = 0.0;
   double theta_x_urad = 0.0;
   double theta_y_urad = 0.0;
-  double contrast = 0.0;  //!< k
-  double misfit = 0.0;    //!< RMS residual / (k median b)
+  double contrast = 0.0;  //!< beta
+  double noise = 0.0;     //!< PlaneFit::noise
+  double misfit = 0.0;    //!< PlaneFit::misfit
   int iterations = 0;
   bool valid = false;
   std::string reason;  //!< why not valid, "" when valid
 };
 
-//! Fits frame from start (the previous pose; {} right after the reference). The frame must be the
+//! Fits frame from start (the expected pose; {} right after the reference). The frame must be the
 //! reference's size (std::invalid_argument otherwise).
 FramePose fit_frame_pose(const Map& frame, const FramePoseReference& reference,
                          const FramePose& start, const FramePoseOptions& options = {});

@@ -62,6 +62,7 @@
 #include <vector>
 
 #include "piezoshift/kinematics/tripod.hpp"
+#include "piezoshift/psi/frame_pose.hpp"
 #include "piezoshift/psi/grid.hpp"
 #include "piezoshift/psi/phase_algorithms.hpp"
 
@@ -130,9 +131,7 @@ class FringeTracker {
   const std::string& lost_reason() const noexcept { return lost_; }
 
  private:
-  struct Plane {
-    double piston_rad = 0.0, tip_rad = 0.0, tilt_rad = 0.0;
-  };
+  using Plane = PhasePlane;
   struct FrameFit {
     Plane plane;
     double noise = 0.0;  // white residual over the modulation
@@ -149,13 +148,13 @@ class FringeTracker {
   Mask mask_;
   FringeTrackerParams p_;
   kinematics::TripodGeometry tripod_;
-  std::vector<std::size_t> pix_;
-  std::vector<double> x_, y_;  // pupil coordinates of pix_
+  //! The pupil's pixels and, once the first window is resolved, Phi + D_0 over them
+  PhaseReference ref_;
+  bool have_phase_ = false;  //!< ref_.phase_rad holds the first window's phase
   double pupil_radius_m_ = 0.0;
   std::deque<Map> window_;
   std::size_t seen_ = 0;
   std::size_t next_ = 0;             // first frame not yet returned
-  std::vector<double> phi_ref_;      // Phi + D_0 over pix_ (empty before the first window)
   std::vector<Plane> planes_;        // D_k - D_0 of every frame returned
   std::optional<double> last_step_;  // the centre's last step [rad]
   std::string lost_;
