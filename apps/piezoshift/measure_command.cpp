@@ -32,6 +32,7 @@
 #include "piezoshift/instrument/measurement.hpp"
 #include "piezoshift/instrument/sequence.hpp"
 #include "piezoshift/instrument/twin_floor.hpp"
+#include "piezoshift/plant/geometry.hpp"
 #include "piezoshift/psi/analysis.hpp"
 #include "piezoshift/psi/fizeau_simulation.hpp"
 #include "piezoshift/rig/validity.hpp"
@@ -67,6 +68,7 @@ struct MeasureOptions {
   int cpu = -1;
   std::string out;
   bool json = false;
+  bool lock = false;
 };
 
 instrument::SequenceParams sequence_params(const MeasureOptions& o, psi::Algorithm alg,
@@ -159,6 +161,22 @@ void check_options(const MeasureOptions& o) {
         "--surface: the test surface of the twin camera (or of aravis:Fake_1 on --daq sim)");
 }
 
+// The fringe lock needs the pupil before the first frame: the twin's scene has it.
+instrument::LockSetup lock_setup(const MeasureOptions& o, const MeasureSetup& s) {
+  if (!s.scene)
+    throw core::InputError(fmt::format(
+        "--lock: the lock needs the pupil on the camera before the sequence; with camera {} "
+        "that is not built yet (--camera twin)",
+        o.camera));
+  instrument::LockSetup l;
+  l.mask = s.scene->mask;
+  l.pupil_radius_m = s.scene->fizeau.pupil_radius_m;
+  l.tripod.emplace(plant::make_twin_geometry(s.config.installation.project.twin.geometry).points);
+  if (const std::string why = instrument::lock_problem(l, s.params); !why.empty())
+    throw core::InputError("--lock: " + why);
+  return l;
+}
+
 void check_travel(const MeasureSetup& s) {
   if (const std::string why =
           instrument::travel_problem(s.params, s.calibration.travel_z_max_um, s.calibration.source);
@@ -233,6 +251,8 @@ int measure(const MeasureOptions& o) {
   work_begins();  // the twin's scene, the stage, the camera
   if (o.camera == "twin" || fed_by_twin(o))
     s.scene = twin_scene(o, s.config.camera, wavelength_nm);
+  if (o.lock)
+    s.params.lock = lock_setup(o, s);
   LoopStack stack(stack_options(o), s.config.installation.project);
   if (s.params.trigger == instrument::TriggerMode::kLine && !stack.daq().has_trigger_line())
     throw core::InputError(fmt::format("--trigger line: DAQ {} has no trigger line", stack.name()));
@@ -298,6 +318,11 @@ int measure(const MeasureOptions& o) {
         rec.error_rms_nm ? fmt::format(", measured - true {:.3f} nm RMS", *rec.error_rms_nm)
                          : std::string(),
         a.step_error_text(), r.wall_time_s, r.floor_s, r.overruns, o.out);
+    if (r.lock)
+      fmt::print(
+          "lock: {} frames locked, {} without a pose ({} lost){}\n", r.lock->locked,
+          r.lock->holding, r.lock->lost,
+          r.lock->first_refusal.empty() ? std::string() : "; first: " + r.lock->first_refusal);
   }
   return 0;
 }
@@ -356,6 +381,9 @@ void add_measure_command(CLI::App& app, Action& action) {
                 "sim only: simulated clock, as fast as possible (tests, benches)");
   cmd->add_option("--cpu", o->cpu, "CPU to pin the loop to (-1: the last one, -2: none)")
       ->capture_default_str();
+  cmd->add_flag("--lock", o->lock,
+                "hold the Fizeau cavity on the fringes (docs/fizeau.md): the first average's "
+                "first four frames are the reference; --camera twin");
   cmd->add_option("--out", o->out, "a new folder for the measurement")->required();
   cmd->add_flag("--json", o->json, "print the summary as JSON");
   cmd->callback([&action, o] { action = [o] { return measure(*o); }; });

@@ -52,6 +52,12 @@ Json exposures_json(const instrument::SequenceResult& s) {
            {"gauge_error_mean_nm", e.gauge_error_mean_nm},
            {"gauge_error_max_nm", e.gauge_error_max_nm},
            {"arrival_wall_s", e.arrival_wall_s}};
+    if (!e.lock_state.empty()) {
+      j["lock_state"] = e.lock_state;
+      j["lock_correction_nm"] = number_or_null(e.lock_correction_nm);
+      j["fringe_piston_nm"] = number_or_null(e.fringe_piston_nm);
+      j["lock_reason"] = e.lock_reason.empty() ? Json(nullptr) : Json(e.lock_reason);
+    }
     if (e.has_truth) {
       j["truth_piston_nm"] = e.truth_piston_nm;
       j["truth_blur_nm"] = e.truth_blur_nm;
@@ -187,6 +193,19 @@ std::string report_markdown(const MeasureRecord& r) {
         "| the same frames from an ideal stage (camera and algorithm floor, one average) | "
         "{:.3f} nm |\n",
         *r.ideal_error_rms_nm);
+  if (const std::optional<double> path =
+          instrument::path_error_rms_nm(s, r.params->steps_rad.size()))
+    md += fmt::format(
+        "| the cavity's path from its set point after the first average (twin), RMS | {:.3f} nm "
+        "|\n",
+        *path);
+  if (s.lock)
+    md += fmt::format(
+        "| fringe lock | {} frames locked, {} without a pose ({} lost){}; correction at the end "
+        "{:.3f} nm, {:.4f} / {:.4f} urad |\n",
+        s.lock->locked, s.lock->holding, s.lock->lost,
+        s.lock->first_refusal.empty() ? std::string() : "; first: " + s.lock->first_refusal,
+        s.lock->correction[0], s.lock->correction[1], s.lock->correction[2]);
   md +=
       "\n![surface](surface_nm.png)\n\n![Zernike](zernike.png)\n\n![steps](steps.png)\n\n"
       "![stage](stage.png)\n";
@@ -244,6 +263,20 @@ Json measure_json(const MeasureRecord& r) {
            {"ticks", s.ticks},
            {"overruns", s.overruns}}},
          {"exposures", exposures_json(s)}};
+  // The cavity's path from its set point after the first average (the lock's reference).
+  const std::optional<double> path = instrument::path_error_rms_nm(s, r.params->steps_rad.size());
+  j["path_error_rms_nm"] = path ? Json(*path) : Json(nullptr);
+  j["lock"] = nullptr;
+  if (s.lock)
+    j["lock"] = {{"reference_frames", s.lock->reference_frames},
+                 {"locked_frames", s.lock->locked},
+                 {"holding_frames", s.lock->holding},
+                 {"lost_frames", s.lock->lost},
+                 {"first_refusal",
+                  s.lock->first_refusal.empty() ? Json(nullptr) : Json(s.lock->first_refusal)},
+                 {"correction_piston_nm", s.lock->correction[0]},
+                 {"correction_theta_x_urad", s.lock->correction[1]},
+                 {"correction_theta_y_urad", s.lock->correction[2]}};
   Json averages = Json::array();
   for (const psi::SurfaceFigures& f : a.average_figures)
     averages.push_back({{"rms_nm", f.rms}, {"pv_nm", f.pv}, {"pvr_nm", f.pvr}});

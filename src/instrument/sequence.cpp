@@ -38,6 +38,8 @@ class Runner {
         window_(p.on_target, period_s_) {
     result_.frames.reserve(total_);
     result_.exposures.reserve(total_);
+    if (p.lock)
+      lock_.emplace(*p.lock, p);
   }
 
   SequenceResult run() {
@@ -57,6 +59,8 @@ class Runner {
       result_.wall_time_s = seconds_since(start_wall_);
     }
     finish_loop();
+    if (lock_)
+      result_.lock = lock_->summary();
     result_.floor_s = sequence_floor_s(p_, window_.length(), period_s_, camera_.settings());
     return std::move(result_);
   }
@@ -149,7 +153,9 @@ class Runner {
         static_cast<std::size_t>(average) * p_.steps_rad.size() + static_cast<std::size_t>(frame),
         now_s());
     const double z = p_.base_um + rec.commanded_piston_nm * 1e-3;
-    loop_.drive_points({z, z, z});
+    loop_.drive_points(lock_ ? lock_->points_um(p_.base_um, rec.commanded_piston_nm,
+                                                static_cast<std::size_t>(frame))
+                             : runtime::Vec3{z, z, z});
     if (!settle())
       return;
     rec.settled_time_s = now_s();
@@ -265,6 +271,10 @@ class Runner {
       fail(why);
       return false;
     }
+    if (lock_) {  // its correction is in force from the next move
+      const std::size_t n = result_.frames.size() - 1;
+      lock_->on_frame(result_.frames[n], result_.exposures[n]);
+    }
     return true;
   }
 
@@ -326,6 +336,7 @@ class Runner {
   std::uint64_t edges_forwarded_ = 0;
   double last_edge_s_ = 0.0;
   camera::PlatePose edge_pose_{};
+  std::optional<FringeLockSession> lock_;
   SequenceResult result_;
 };
 
@@ -432,6 +443,26 @@ std::string sequence_problem(const SequenceParams& p) {
   if (!(p.frame_timeout_s > 0.0 && p.frame_timeout_s <= 600.0))
     return fmt::format("frame timeout {} s: must be in (0, 600]", p.frame_timeout_s);
   return {};
+}
+
+std::optional<double> path_error_rms_nm(const SequenceResult& result, std::size_t first) {
+  if (result.exposures.empty() || !result.exposures.front().has_truth)
+    return std::nullopt;
+  const ExposureRecord& e0 = result.exposures.front();
+  const double offset_nm = e0.truth_piston_nm - e0.commanded_piston_nm;
+  double sum = 0.0;
+  std::size_t n = 0;
+  for (std::size_t i = first; i < result.exposures.size(); ++i) {
+    const ExposureRecord& e = result.exposures[i];
+    if (!e.has_truth)
+      return std::nullopt;
+    const double d = e.truth_piston_nm - e.commanded_piston_nm - offset_nm;
+    sum += d * d;
+    ++n;
+  }
+  if (n == 0)
+    return std::nullopt;
+  return std::sqrt(sum / static_cast<double>(n));
 }
 
 SequenceResult run_sequence(runtime::ControlLoop& loop, const plant::Twin* twin,

@@ -29,12 +29,14 @@
 // valid = false and the first reason; the loop still ramps to 0 V. The wall-time floor is
 // frames x (settle + exposure + readout), with settle the hold time the criterion needs.
 #include <cstdint>
+#include <limits>
 #include <optional>
 #include <string>
 #include <string_view>
 #include <vector>
 
 #include "piezoshift/camera/camera.hpp"
+#include "piezoshift/instrument/fringe_lock_session.hpp"
 #include "piezoshift/plant/twin.hpp"
 #include "piezoshift/psi/phase_algorithms.hpp"
 #include "piezoshift/psi/stage.hpp"
@@ -60,6 +62,8 @@ struct SequenceParams {
   double frame_timeout_s = 2.0;   //!< after its exposure, for a frame to arrive
   TriggerMode trigger = TriggerMode::kSoftware;
   std::uint32_t trigger_pulse_ticks = 1;  //!< kLine: the pulse's width, 1 to 1000 ticks
+  //! The fringe lock (fringe_lock_session.hpp); none: the semi-closed loop alone
+  std::optional<LockSetup> lock;
 };
 
 //! The commanded steps of a measurement with algorithm a: given, for lsq, aia and tilt-aia (the
@@ -100,6 +104,11 @@ struct ExposureRecord {
   double truth_tilt_urad = 0.0;  //!< mean theta_y
   std::uint64_t frame_id = 0;    //!< the frame that arrived for it
   double arrival_wall_s = 0.0;   //!< wall time from the sequence's start to its arrival
+  // The fringe lock (SequenceParams::lock), else NaN and "":
+  double lock_correction_nm = std::numeric_limits<double>::quiet_NaN();  //!< the move's piston
+  double fringe_piston_nm = std::numeric_limits<double>::quiet_NaN();    //!< from the frame
+  std::string lock_state;   //!< "reference", or FringeLockState's words after the frame
+  std::string lock_reason;  //!< why the frame gave no pose
 };
 
 struct SequenceResult {
@@ -111,6 +120,7 @@ struct SequenceResult {
   std::uint64_t overruns = 0;
   std::uint64_t ticks = 0;
   rig::Validity validity;
+  std::optional<LockSummary> lock;  //!< with SequenceParams::lock
 };
 
 //! The piston that makes frame k's phase step in reflection: steps_rad[k] lambda / (4 pi) [nm].
@@ -129,6 +139,12 @@ double sequence_floor_s(const SequenceParams& p, std::size_t hold_ticks, double 
 //! trigger asked for). Both drivers of a sequence use it (sample_sequence.hpp).
 std::string take_frame(camera::FrameStatus status, camera::Frame& frame,
                        const camera::Camera& camera, double arrival_wall_s, SequenceResult& result);
+
+//! The RMS of the cavity's optical path from its set point over exposures first.. (twin: the
+//! truth's piston, which carries the cavity's drift, minus the commanded piston, relative to
+//! the same at the first exposure: where a lock's reference holds it); nothing without truth or
+//! without an exposure from first on.
+std::optional<double> path_error_rms_nm(const SequenceResult& result, std::size_t first);
 
 //! Runs the sequence (see the header). twin: the twin whose true plate pose feeds the camera and
 //! the records (nullptr on hardware). loop must be in owner mode and not started; the DAQ
