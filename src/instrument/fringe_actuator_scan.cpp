@@ -111,9 +111,11 @@ class Scan {
     for (std::size_t i = 0; i < 3; ++i)
       pose.sgs_um[i] = sgs[i] / n;
     const camera::FrameStatus s = camera_.wait(frame_, p_.frame_timeout_s);
-    if (s != camera::FrameStatus::kOk)
-      r_.validity.fail(
-          fmt::format("frame {}: {}: {}", pose.frame, camera::to_string(s), camera_.message()));
+    if (s != camera::FrameStatus::kOk) {
+      const std::string why = camera_.message();
+      r_.validity.fail(fmt::format("frame {}: {}{}{}", pose.frame, camera::to_string(s),
+                                   why.empty() ? "" : ": ", why));
+    }
   }
 
   void track() {
@@ -186,6 +188,11 @@ FringeActuatorScanResult run_fringe_actuator_scan(
     const std::function<void(rig::Bench&, const FringeScanPose&)>& at_pose) {
   if (const std::string why = fringe_actuator_scan_problem(p); !why.empty())
     throw core::InputError("fringe actuator scan: " + why);
+  const camera::CameraSettings& cs = camera.settings();
+  if (cs.width_px != mask.width || cs.height_px != mask.height)
+    throw core::InputError(fmt::format(
+        "fringe actuator scan: camera {} gives {}x{} px frames, the pupil's mask is {}x{}",
+        camera.name(), cs.width_px, cs.height_px, mask.width, mask.height));
   const auto w0 = Clock::now();
   const double t0 = bench.time_s();
   Scan scan(bench, camera, mask, p, at_pose);

@@ -16,6 +16,7 @@
 #include "piezoshift/core/input_error.hpp"
 #include "piezoshift/instrument/fringe_actuator_scan.hpp"
 #include "piezoshift/plant/geometry.hpp"
+#include "scripted_camera.hpp"
 
 namespace piezoshift::instrument {
 namespace {
@@ -86,6 +87,39 @@ TEST(FringeActuatorScanTest, AStepPastTheTrackersLimitIsRefusedWithTheFrame) {
   EXPECT_NE(r.validity.reason.find("frame 5: the fringe tracker refused it"), std::string::npos)
       << r.validity.reason;
   EXPECT_EQ(r.poses.size(), 6u);
+}
+
+TEST(FringeActuatorScanTest, ALostFrameOrARefusedTriggerEndsTheScanWithTheReason) {
+  const config::ProjectConfig config;
+  const psi::Mask one(1, 1);
+  camera::CameraSettings s;
+  s.width_px = s.height_px = 1;
+  {
+    ScriptedCamera cam;
+    cam.configure(s);
+    cam.lose_frame = 2;
+    rig::Bench bench(config, control::SemiClosedLoopParams{}, 41);
+    const FringeActuatorScanResult r = run_fringe_actuator_scan(bench, cam, one, {});
+    EXPECT_FALSE(r.validity.valid);
+    EXPECT_EQ(r.validity.reason, "frame 2: lost");
+    EXPECT_EQ(r.poses.size(), 2u);
+  }
+  {
+    ScriptedCamera cam;
+    cam.configure(s);
+    cam.refuse = true;
+    rig::Bench bench(config, control::SemiClosedLoopParams{}, 42);
+    const FringeActuatorScanResult r = run_fringe_actuator_scan(bench, cam, one, {});
+    EXPECT_EQ(r.validity.reason, "frame 0: the camera refused the trigger: refusing");
+    EXPECT_TRUE(r.poses.empty());
+  }
+  {  // a camera whose frames are not the mask's size is refused before anything moves
+    ScriptedCamera cam;
+    cam.configure(camera::CameraSettings{});
+    rig::Bench bench(config, control::SemiClosedLoopParams{}, 43);
+    EXPECT_THROW(run_fringe_actuator_scan(bench, cam, one, {}), core::InputError);
+    EXPECT_EQ(bench.ticks(), 0u);
+  }
 }
 
 // The figures of docs/fizeau.md, "Calibration from fringes: one actuator".

@@ -82,7 +82,8 @@ double pupil_step_nm(const std::array<kinematics::PlatePoint, 3>& actuators, std
                      double leg_um, double pupil_radius_m);
 
 //! Runs the scan (see the header) on the bench with the camera (configured, not started; its
-//! size the mask's). Throws core::InputError for params fringe_actuator_scan_problem() refuses.
+//! size the mask's). Throws core::InputError for params fringe_actuator_scan_problem() refuses
+//! and for a camera whose frame size is not the mask's.
 FringeActuatorScanResult run_fringe_actuator_scan(
     rig::Bench& bench, camera::Camera& camera, const psi::Mask& mask,
     const FringeActuatorScanParams& params,
