@@ -5,6 +5,7 @@
 #include <chrono>
 #include <cmath>
 #include <limits>
+#include <stdexcept>
 
 #include "piezoshift/core/input_error.hpp"
 #include "piezoshift/instrument/measurement.hpp"
@@ -180,6 +181,20 @@ double pupil_step_nm(const std::array<kinematics::PlatePoint, 3>& actuators, std
   // z + theta . r over the pupil's disk peaks at its edge: |z| + R |theta| (urad x m = 1e3 nm)
   return 1000.0 * std::fabs(q.z_um) +
          1e3 * pupil_radius_m * std::hypot(q.theta_x_urad, q.theta_y_urad);
+}
+
+ScanMatrixPose matrix_pose(const FringeActuatorScanResult& scan) {
+  if (!scan.validity.valid || scan.poses.size() <= scan.base_pose + 1)
+    throw std::invalid_argument("matrix_pose: the scan is not valid or has no move: " +
+                                scan.validity.reason);
+  const FringeScanPose& b = scan.poses[scan.base_pose];
+  const FringeScanPose& e = scan.poses.back();
+  ScanMatrixPose m;
+  for (std::size_t j = 0; j < 3; ++j) {
+    m.ds_um[j] = e.sgs_um[j] - b.sgs_um[j];
+    m.dz_um[j] = e.points_um[j] - b.points_um[j];
+  }
+  return m;
 }
 
 FringeActuatorScanResult run_fringe_actuator_scan(

@@ -7,6 +7,7 @@
 #include <chrono>
 #include <cmath>
 #include <cstdio>
+#include <stdexcept>
 #include <vector>
 
 #include "piezoshift/calibration/matrix_identification.hpp"
@@ -103,6 +104,7 @@ TEST(FringeActuatorScanTest, ALostFrameOrARefusedTriggerEndsTheScanWithTheReason
     EXPECT_FALSE(r.validity.valid);
     EXPECT_EQ(r.validity.reason, "frame 2: lost");
     EXPECT_EQ(r.poses.size(), 2u);
+    EXPECT_THROW(matrix_pose(r), std::invalid_argument);
   }
   {
     ScriptedCamera cam;
@@ -263,8 +265,10 @@ TEST(FringeActuatorScanTest, ThreeScansGiveTheTransmissionMatrix) {
       ds_all.push_back(s);
       dz_all.push_back(z);
     }
-    ds_end.push_back(ds_all.back());
-    dz_end.push_back(dz_all.back());
+    const ScanMatrixPose m = matrix_pose(r);
+    ds_end.push_back(m.ds_um);
+    dz_end.push_back(m.dz_um);
+    EXPECT_EQ(m.dz_um[1], dz_all.back()[1]);
   }
   const calibration::MatrixFitResult f = calibration::fit_transmission_matrix(ds_end, dz_end);
   const calibration::MatrixFitResult fa = calibration::fit_transmission_matrix(ds_all, dz_all);

@@ -81,6 +81,16 @@ struct FringeActuatorScanResult {
 double pupil_step_nm(const std::array<kinematics::PlatePoint, 3>& actuators, std::size_t i,
                      double leg_um, double pupil_radius_m);
 
+//! Stage 2's pose (matrix_identification.hpp) from a scan: its last pose against its base, dS
+//! from the gauges over the two exposures, dZ from the fringes [um]. The three actuators' poses
+//! give A through calibration::fit_transmission_matrix. std::invalid_argument for a scan that
+//! is not valid or has no move.
+struct ScanMatrixPose {
+  control::Vec3 ds_um{};
+  control::Vec3 dz_um{};
+};
+ScanMatrixPose matrix_pose(const FringeActuatorScanResult& scan);
+
 //! Runs the scan (see the header) on the bench with the camera (configured, not started; its
 //! size the mask's). Throws core::InputError for params fringe_actuator_scan_problem() refuses
 //! and for a camera whose frame size is not the mask's.
