@@ -2,9 +2,11 @@
 
 #include <array>
 #include <cmath>
+#include <vector>
 
 #include <fmt/format.h>
 
+#include "piezoshift/calibration/mode_identification.hpp"
 #include "piezoshift/rig/bench.hpp"
 #include "piezoshift/rig/validity.hpp"
 
@@ -28,6 +30,22 @@ struct RingWindow {
 
 std::size_t ticks_of(double t_s, double T) {
   return static_cast<std::size_t>(std::llround(t_s / T));
+}
+
+// The loudest gauge's ring, identified as one sampled mode.
+double ring_frequency_Hz(const std::array<std::vector<double>, 3>& ring, double rate_Hz) {
+  std::size_t loudest = 0;
+  double most = -1.0;
+  for (std::size_t i = 0; i < ring.size(); ++i) {
+    double e = 0.0;
+    for (double d2 : ring[i])
+      e += d2 * d2;
+    if (e > most) {
+      most = e;
+      loudest = i;
+    }
+  }
+  return identify_plate_mode(ring[loudest], rate_Hz).mode_Hz;
 }
 
 }  // namespace
@@ -66,10 +84,12 @@ RingTest ring_test(const config::ProjectConfig& config,
   RingWindow early{ticks_of(o.early_s, T), ticks_of(o.early_s + o.window_s, T)};
   RingWindow late{ticks_of(o.late_s, T), ticks_of(o.late_s + o.window_s, T)};
   RingTest r;
+  std::array<std::vector<double>, 3> ring{};  // each gauge's second difference from the step on
   for (std::size_t k = 0; k < late.to; ++k) {
     tick([&](std::size_t i, double y, double d2) {
       early.add(k, d2);
       late.add(k, d2);
+      ring[i].push_back(d2);
       r.aborted = r.aborted || std::fabs(y - target[i]) > o.abort_um;
     });
     if (r.aborted || bench.faulted()) {
@@ -81,6 +101,7 @@ RingTest ring_test(const config::ProjectConfig& config,
   r.noise_ring_um = noise.rms();
   r.early_ring_um = early.rms();
   r.late_ring_um = late.rms();
+  r.ring_Hz = ring_frequency_Hz(ring, 1.0 / T);
   r.holds = !r.aborted && (r.late_ring_um <= o.decay_ratio * r.early_ring_um ||
                            r.late_ring_um <= o.noise_factor * r.noise_ring_um);
   return r;
@@ -97,6 +118,8 @@ HoldingGains holding_gains(const config::ProjectConfig& config,
     const double m = s * o.margin_factor;
     trial.gains = {m * asked.kp, m * asked.ki, m * asked.kd};
     h.test = ring_test(config, trial, seed, o.ring);
+    if (h.tests == 0)
+      h.first = h.test;
     ++h.tests;
     if (h.test.holds) {
       h.scale = s;

@@ -390,6 +390,8 @@ nlohmann::json comparison_json(const ComparisonResult& r) {
     for (LoopVariant k : kLoopVariants)
       prefixed(o, r, k, [&](std::size_t i) { return r.figures[i].of(r.seeds[s][k]); });
     o["oracle_holding_gains_scale"] = r.seeds[s][LoopVariant::kOracleFeedback].holding_gains_scale;
+    const auto& notch_Hz = r.seeds[s][LoopVariant::kOracleFeedback].feedback_notch_Hz;
+    o["oracle_feedback_notch_Hz"] = nlohmann::json::array({notch_Hz[0], notch_Hz[1]});
     per.push_back(std::move(o));
   }
   j["per_seed"] = std::move(per);

@@ -40,8 +40,8 @@ Bench::Bench(const config::ProjectConfig& config, const control::SemiClosedLoopP
   }
   daq_ = sim_.get();
   if (options.feedback == Feedback::kOracle) {
-    oracle_ =
-        std::make_unique<runtime::OracleBackend>(*sim_, controller.matrix, controller.scaling);
+    oracle_ = std::make_unique<runtime::OracleBackend>(*sim_, controller.matrix, controller.scaling,
+                                                       options.oracle_notch, sample_time_s_);
     daq_ = oracle_.get();
   }
   // Owner mode: the procedures drive it between ticks; it runs until the bench is destroyed and

@@ -54,6 +54,10 @@ struct RingTest {
   double early_ring_um = 0.0, late_ring_um = 0.0;  //!< rms of the second difference
   double noise_ring_um = 0.0;                      //!< the same over the open-loop hold
   bool aborted = false;                            //!< opened before the second window ended
+  //! The ring's frequency as the loop samples it (folded to [0, rate / 2]): Prony's one-mode fit
+  //! (mode_identification.hpp) of the loudest gauge's second difference from the step on; 0 when
+  //! no oscillation was found.
+  double ring_Hz = 0.0;
 };
 
 //! The ring test of controller (its gains, sample time, scaling) on a fresh bench (seed).
@@ -72,6 +76,7 @@ struct HoldingGains {
   control::PidGains gains;  //!< per sample at the controller's rate: what to hold with
   double scale = 1.0;       //!< gains / the gains asked for
   RingTest test;            //!< the last ring test (at margin_factor x gains)
+  RingTest first;           //!< the first (at margin_factor x the gains asked): how they rang
   int tests = 0;            //!< ring tests run
 };
 

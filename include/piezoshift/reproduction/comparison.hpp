@@ -79,6 +79,9 @@ struct VariantRun {
   std::string not_applicable_10kHz;
   //! The oracle: its holding gains over the paper's calibrated ones (1: the paper's held).
   double holding_gains_scale = 1.0;
+  //! The oracle: the modes its feedback's notches remove (folded at its rate), 0 for none: only
+  //! where its plain loop held below kOracleNotchBelowScale (comparison.cpp, docs/compare.md).
+  std::array<double, 2> feedback_notch_Hz{};
   double simulated_time_s = 0.0;  //!< its calibration and experiments
 };
 

@@ -25,6 +25,7 @@
 #include <memory>
 
 #include "piezoshift/config/project_config.hpp"
+#include "piezoshift/control/notch_filter.hpp"
 #include "piezoshift/control/semi_closed_loop.hpp"
 #include "piezoshift/plant/twin.hpp"
 #include "piezoshift/runtime/control_loop.hpp"
@@ -47,6 +48,8 @@ const char* to_string(Feedback feedback) noexcept;
 struct BenchOptions {
   Feedback feedback = Feedback::kGauges;
   runtime::SafetyLimits limits{};  //!< the supervisor's, as `run` and `serve` use by default
+  //! The oracle's feedback notches (runtime/oracle_backend.hpp); none by default. Not for kGauges.
+  control::OracleNotches oracle_notch{};
 };
 
 struct StaticMeasurement {

@@ -14,10 +14,15 @@
 // result. That is the floor no controller fed by the gauges can beat. Labelled impossible on
 // hardware wherever it is reported.
 //
+// notches (issue 31): where the PID closed on the plate rings at the plate's modes, compare's
+// oracle may take them out of its feedback (control/notch_filter.hpp, in series per channel, on
+// A z_true); by default there is none and the feedback is the plate's as above.
+//
 // read()/write()/truth() are real-time safe, like the twin's.
 #include <array>
 #include <string>
 
+#include "piezoshift/control/notch_filter.hpp"
 #include "piezoshift/control/signal_scaling.hpp"
 #include "piezoshift/control/transmission_matrix.hpp"
 #include "piezoshift/runtime/sim_backend.hpp"
@@ -27,8 +32,10 @@ namespace piezoshift::runtime {
 class OracleBackend final : public DaqBackend {
  public:
   //! sim is not owned and must outlive this backend.
+  //! sim is not owned and must outlive this backend. notches: none by default (mode_Hz 0).
   OracleBackend(SimBackend& sim, const control::TransmissionMatrix& matrix,
-                const std::array<control::SignalScaling, control::kChannels>& scaling);
+                const std::array<control::SignalScaling, control::kChannels>& scaling,
+                const control::OracleNotches& notches = {}, double sample_time_s = 1e-3);
 
   void configure() override { sim_.configure(); }
   void activate() override { sim_.activate(); }
@@ -52,6 +59,8 @@ class OracleBackend final : public DaqBackend {
   SimBackend& sim_;
   control::TransmissionMatrix matrix_;
   std::array<control::SignalScaling, control::kChannels> scaling_;
+  std::array<std::array<control::NotchFilter, control::kMaxOracleNotches>, control::kChannels>
+      notch_{};
 };
 
 }  // namespace piezoshift::runtime
