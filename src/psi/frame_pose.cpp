@@ -9,17 +9,11 @@
 #include <fmt/core.h>
 #include <Eigen/Dense>
 
+#include "piezoshift/psi/median.hpp"
+
 namespace piezoshift::psi {
 
 namespace {
-
-double median_of(std::vector<double> v) {
-  if (v.empty())
-    return 0.0;
-  const auto mid = v.begin() + static_cast<std::ptrdiff_t>(v.size() / 2);
-  std::nth_element(v.begin(), mid, v.end());
-  return *mid;
-}
 
 void require_size(const Map& frame, const PhaseReference& r, const char* who) {
   if (frame.width != r.width || frame.height != r.height || frame.size() != frame.v.size() ||

@@ -11,6 +11,7 @@
 #include <Eigen/Dense>
 
 #include "piezoshift/core/input_error.hpp"
+#include "piezoshift/psi/median.hpp"
 
 namespace piezoshift::psi {
 namespace {
@@ -489,15 +490,6 @@ void tilt_aia(std::span<const Map> frames, const PupilXY& xy, const std::vector<
   for (const FrameShift& s : best.shifts)
     r.steps_rad.push_back(s.piston_rad);
   r.shifts = best.shifts;
-}
-
-// The median of v (copied).
-double median_of(std::vector<double> v) {
-  if (v.empty())
-    return 0.0;
-  const auto mid = v.begin() + static_cast<std::ptrdiff_t>(v.size() / 2);
-  std::nth_element(v.begin(), mid, v.end());
-  return *mid;
 }
 
 // The frames' residual from the fitted model (per pixel A, B, phi; per frame its plane), as RMS
