@@ -42,7 +42,6 @@ std::string lock_problem(const LockSetup& setup, const SequenceParams& params) {
 FringeLockSession::FringeLockSession(const LockSetup& setup, const SequenceParams& params)
     : s_(setup),
       reference_count_(reference_frames(params)),
-      wavelength_nm_(params.wavelength_nm),
       locks_(params.steps_rad.size(), control::FringeLock(setup.lock)) {
   if (const std::string why = lock_problem(setup, params); !why.empty())
     throw std::invalid_argument(why);

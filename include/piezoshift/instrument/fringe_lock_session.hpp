@@ -76,7 +76,6 @@ class FringeLockSession {
  private:
   LockSetup s_;
   std::size_t reference_count_;
-  double wavelength_nm_;
   std::vector<psi::Map> reference_frames_;
   std::optional<psi::FramePoseReference> reference_;
   std::vector<control::FringeLock> locks_;            //!< one per frame of an average
