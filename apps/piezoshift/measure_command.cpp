@@ -168,6 +168,12 @@ instrument::LockSetup lock_setup(const MeasureOptions& o, const MeasureSetup& s)
         "--lock: the lock needs the pupil on the camera before the sequence; with camera {} "
         "that is not built yet (--camera twin)",
         o.camera));
+  // Each frame's fit (about 5 ms at 256 px) runs where the sequence takes its frames, which on
+  // a real-time clock is between the loop's ticks: it would make them overrun.
+  if (!o.free_run)
+    throw core::InputError(
+        "--lock: the lock's fit runs on the loop's thread, about 5 ms a frame, which a real-time "
+        "loop at 1 kHz cannot spare; use --free-run until it runs on a thread of its own");
   instrument::LockSetup l;
   l.mask = s.scene->mask;
   l.pupil_radius_m = s.scene->fizeau.pupil_radius_m;

@@ -153,6 +153,10 @@ TEST_F(MeasureCli, TheFringeLockHoldsTheDriftingCavityNearerItsSetPoint) {
   EXPECT_LT(locked, 0.8 * unlocked) << locked << " vs " << unlocked;
   // Refused before anything runs: steps the reference cannot be taken from.
   refused("--lock --algorithm lsq --steps-rad 0,1,2,3 --out '" + path("x") + "'", "--lock");
+  // On a real-time clock the fit would take the loop's time between ticks.
+  const testing::CliResult rt = run("measure --lock --out '" + path("y") + "'");
+  EXPECT_EQ(rt.status, 2) << rt.err;
+  EXPECT_NE(rt.err.find("--free-run"), std::string::npos) << rt.err;
 }
 
 // A step that never settles, or a frame that never arrives, is not a measurement: exit 4 and no
