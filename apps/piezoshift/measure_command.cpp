@@ -69,6 +69,8 @@ struct MeasureOptions {
   std::string out;
   bool json = false;
   bool lock = false;
+  double lock_retake_s = instrument::LockSetup{}.retake_s;
+  double hold_s = 0.0;
 };
 
 instrument::SequenceParams sequence_params(const MeasureOptions& o, psi::Algorithm alg,
@@ -82,6 +84,7 @@ instrument::SequenceParams sequence_params(const MeasureOptions& o, psi::Algorit
   p.on_target = o.on_target;
   p.averages = o.averages;
   p.frame_timeout_s = o.frame_timeout_s;
+  p.hold_s = o.hold_s;
   p.trigger =
       o.trigger == "line" ? instrument::TriggerMode::kLine : instrument::TriggerMode::kSoftware;
   if (const std::string why = instrument::sequence_problem(p); !why.empty())
@@ -178,6 +181,7 @@ instrument::LockSetup lock_setup(const MeasureOptions& o, const MeasureSetup& s)
   l.mask = s.scene->mask;
   l.pupil_radius_m = s.scene->fizeau.pupil_radius_m;
   l.tripod.emplace(plant::make_twin_geometry(s.config.installation.project.twin.geometry).points);
+  l.retake_s = o.lock_retake_s;
   if (const std::string why = instrument::lock_problem(l, s.params); !why.empty())
     throw core::InputError("--lock: " + why);
   return l;
@@ -324,10 +328,16 @@ int measure(const MeasureOptions& o) {
         rec.error_rms_nm ? fmt::format(", measured - true {:.3f} nm RMS", *rec.error_rms_nm)
                          : std::string(),
         a.step_error_text(), r.wall_time_s, r.floor_s, r.overruns, o.out);
+    if (!r.hold.empty()) {
+      const std::optional<double> rms = instrument::hold_path_error_rms_nm(r);
+      fmt::print("hold: {} frames over {:.1f} s{}\n", r.hold.size(), o.hold_s,
+                 rms ? fmt::format(", the cavity's path from its set point {:.3f} nm RMS", *rms)
+                     : std::string());
+    }
     if (r.lock)
       fmt::print(
-          "lock: {} frames locked, {} without a pose ({} lost){}\n", r.lock->locked,
-          r.lock->holding, r.lock->lost,
+          "lock: {} frames locked, {} without a pose ({} lost, {} taken again){}\n", r.lock->locked,
+          r.lock->holding, r.lock->lost, r.lock->retaken,
           r.lock->first_refusal.empty() ? std::string() : "; first: " + r.lock->first_refusal);
   }
   return 0;
@@ -390,6 +400,15 @@ void add_measure_command(CLI::App& app, Action& action) {
   cmd->add_flag("--lock", o->lock,
                 "hold the Fizeau cavity on the fringes (docs/fizeau.md): the first average's "
                 "first four frames are the reference; --camera twin");
+  cmd->add_option("--lock-retake-s", o->lock_retake_s,
+                  "with --lock: a frame whose fringes were lost is taken again until they come "
+                  "back, for at most this long (s, in (0, 60]); then the measurement fails")
+      ->capture_default_str();
+  cmd->add_option("--hold-s", o->hold_s,
+                  "after the measurement, hold the stage at frame 0 for this long while the "
+                  "camera exposes frame after frame (with --lock, the lock holds the cavity; "
+                  "hold.csv, hold.png), 0 to 3600 s")
+      ->capture_default_str();
   cmd->add_option("--out", o->out, "a new folder for the measurement")->required();
   cmd->add_flag("--json", o->json, "print the summary as JSON");
   cmd->callback([&action, o] { action = [o] { return measure(*o); }; });

@@ -9,6 +9,7 @@
 
 #include <fmt/core.h>
 
+#include "measure_hold.hpp"
 #include "piezoshift/core/input_error.hpp"
 #include "piezoshift/io/atomic_file.hpp"
 #include "piezoshift/io/csv_writer.hpp"
@@ -57,6 +58,7 @@ Json exposures_json(const instrument::SequenceResult& s) {
       j["lock_correction_nm"] = number_or_null(e.lock_correction_nm);
       j["fringe_piston_nm"] = number_or_null(e.fringe_piston_nm);
       j["lock_reason"] = e.lock_reason.empty() ? Json(nullptr) : Json(e.lock_reason);
+      j["retakes"] = e.retakes;
     }
     if (e.has_truth) {
       j["truth_piston_nm"] = e.truth_piston_nm;
@@ -201,14 +203,18 @@ std::string report_markdown(const MeasureRecord& r) {
         *path);
   if (s.lock)
     md += fmt::format(
-        "| fringe lock | {} frames locked, {} without a pose ({} lost){}; correction at the end "
-        "{:.3f} nm, {:.4f} / {:.4f} urad |\n",
-        s.lock->locked, s.lock->holding, s.lock->lost,
+        "| fringe lock | {} frames locked, {} without a pose ({} lost, {} taken again){}; "
+        "correction at the end {:.3f} nm, {:.4f} / {:.4f} urad |\n",
+        s.lock->locked, s.lock->holding, s.lock->lost, s.lock->retaken,
         s.lock->first_refusal.empty() ? std::string() : "; first: " + s.lock->first_refusal,
         s.lock->correction[0], s.lock->correction[1], s.lock->correction[2]);
+  if (!s.hold.empty())
+    md += hold_markdown(s);
   md +=
       "\n![surface](surface_nm.png)\n\n![Zernike](zernike.png)\n\n![steps](steps.png)\n\n"
       "![stage](stage.png)\n";
+  if (!s.hold.empty())
+    md += "\n![hold](hold.png)\n";
   return md;
 }
 
@@ -272,11 +278,13 @@ Json measure_json(const MeasureRecord& r) {
                  {"locked_frames", s.lock->locked},
                  {"holding_frames", s.lock->holding},
                  {"lost_frames", s.lock->lost},
+                 {"retaken_frames", s.lock->retaken},
                  {"first_refusal",
                   s.lock->first_refusal.empty() ? Json(nullptr) : Json(s.lock->first_refusal)},
                  {"correction_piston_nm", s.lock->correction[0]},
                  {"correction_theta_x_urad", s.lock->correction[1]},
                  {"correction_theta_y_urad", s.lock->correction[2]}};
+  j["hold"] = s.hold.empty() ? Json(nullptr) : hold_json(s);
   Json averages = Json::array();
   for (const psi::SurfaceFigures& f : a.average_figures)
     averages.push_back({{"rms_nm", f.rms}, {"pv_nm", f.pv}, {"pvr_nm", f.pvr}});
@@ -301,6 +309,8 @@ void write_measurement(const MeasureRecord& r, const std::string& out_name) {
     if (r.truth_nm != nullptr)
       psi::write_npy((tmp / "surface_truth_nm.npy").string(), *r.truth_nm);
     write_exposures_csv(*r.sequence, tmp / "exposures.csv");
+    if (!r.sequence->hold.empty())
+      write_hold(*r.sequence, tmp);
     io::write_file_atomically((tmp / "measurement.json").string(), measure_json(r).dump(2) + "\n");
     if (io::find_gnuplot()) {
       io::render(zernike_figure(*r.analysis), tmp / "zernike");

@@ -247,8 +247,12 @@ void TwinCamera::render(Slot& s) noexcept {
           s.frame_id, pose_capacity_, settings_.exposure_s, scene_.max_tick_rate_Hz);
     } else {
       plant::Rng rng(frame_seed(scene_.seed, s.frame_id));
+      psi::CameraParams sensor = sensor_;
+      if (scene_.fringe_loss_start_s >= 0.0 && s.trigger_time_s >= scene_.fringe_loss_start_s &&
+          s.trigger_time_s < scene_.fringe_loss_start_s + scene_.fringe_loss_s)
+        sensor.visibility = 0.0;
       const psi::Map m =
-          psi::render_frame(scene_.surface_nm, scene_.mask, scene_.fizeau, sensor_,
+          psi::render_frame(scene_.surface_nm, scene_.mask, scene_.fizeau, sensor,
                             std::span<const psi::PoseSample>(s.poses.data(), s.n_poses), rng);
       // Gain after quantisation, as a digital gain: 0 dB leaves render_frame's counts as they are.
       const double gain = std::pow(10.0, settings_.gain_dB / 20.0);

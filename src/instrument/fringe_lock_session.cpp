@@ -36,6 +36,8 @@ std::string lock_problem(const LockSetup& setup, const SequenceParams& params) {
     return "the fringe lock needs the tripod's points P1..P3";
   if (!(setup.pupil_radius_m > 0.0))
     return "the fringe lock needs the pupil's radius on the plate";
+  if (!(setup.retake_s > 0.0 && setup.retake_s <= 60.0))
+    return fmt::format("the fringe lock's retake time {} s: must be in (0, 60]", setup.retake_s);
   return {};
 }
 
@@ -51,9 +53,14 @@ FringeLockSession::FringeLockSession(const LockSetup& setup, const SequenceParam
 kinematics::PointDisplacements FringeLockSession::points_um(double base_um,
                                                             double commanded_piston_nm,
                                                             std::size_t step) {
-  const control::FringeAxes c = locks_.at(step).correction();
+  const control::FringeAxes c = locks_.at(holding_ ? 0 : step).correction();
   applied_by_move_.push_back(c);
   return s_.tripod->inverse({base_um + 1e-3 * (commanded_piston_nm + c[0]), c[1], c[2]});
+}
+
+void FringeLockSession::begin_hold() {
+  holding_ = true;
+  locks_.front().set_point(frame0_);
 }
 
 void FringeLockSession::on_frame(const camera::Frame& frame, ExposureRecord& rec) {
@@ -61,11 +68,18 @@ void FringeLockSession::on_frame(const camera::Frame& frame, ExposureRecord& rec
   const control::FringeAxes applied =
       n < applied_by_move_.size() ? applied_by_move_[n] : control::FringeAxes{};
   rec.lock_correction_nm = applied[0];
+  last_lost_fringes_ = false;
   if (n < reference_count_) {
     reference_frames_.push_back(frame_maps({frame}).front());
     rec.lock_state = "reference";
     if (reference_frames_.size() == reference_count_) {
       reference_ = psi::frame_pose_reference(reference_frames_, s_.mask, s_.pupil_radius_m);
+      // Frame 0's own pose: the reference's piston is a fit over its frames, which sets it
+      // apart from frame 0's by a fraction of a nanometre; the hold returns to frame 0.
+      const psi::FramePose f0 =
+          psi::fit_frame_pose(reference_frames_.front(), *reference_, {}, s_.pose);
+      if (f0.valid)
+        frame0_ = {f0.piston_nm, f0.theta_x_urad, f0.theta_y_urad};
       reference_frames_.clear();
       summary_.reference_frames = reference_count_;
       for (control::FringeLock& l : locks_)
@@ -84,8 +98,9 @@ void FringeLockSession::on_frame(const camera::Frame& frame, ExposureRecord& rec
   start.theta_y_urad += applied[2] - last_applied_[2];
   const psi::FramePose m =
       psi::fit_frame_pose(frame_maps({frame}).front(), *reference_, start, s_.pose);
-  control::FringeLock& lock = locks_[n % locks_.size()];
-  lock.set_point({rec.commanded_piston_nm, 0.0, 0.0});
+  control::FringeLock& lock = locks_.at(holding_ ? 0 : static_cast<std::size_t>(rec.frame));
+  if (!holding_)  // the hold's set point is frame 0's pose (begin_hold)
+    lock.set_point({rec.commanded_piston_nm, 0.0, 0.0});
   lock.update({m.piston_nm, m.theta_x_urad, m.theta_y_urad}, m.valid);
   rec.lock_state = control::to_string(lock.state());
   if (m.valid) {
@@ -96,6 +111,7 @@ void FringeLockSession::on_frame(const camera::Frame& frame, ExposureRecord& rec
     ++summary_.locked;
   } else {
     rec.lock_reason = m.reason;
+    last_lost_fringes_ = m.fringes_lost;
     ++summary_.holding;
     if (lock.state() == control::FringeLockState::kLost)
       ++summary_.lost;

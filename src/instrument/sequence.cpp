@@ -55,6 +55,8 @@ class Runner {
           take_frame(a, static_cast<int>(k));
       if (ok())
         collect_remaining_frames();
+      if (ok() && p_.hold_s > 0.0)
+        hold();
       result_.loop_time_s = now_s() - start_loop_s_;
       result_.wall_time_s = seconds_since(start_wall_);
     }
@@ -147,7 +149,66 @@ class Runner {
     return false;
   }
 
+  // The hold: frame 0's position, frame after frame, until hold_s of loop time has passed.
+  void hold() {
+    holding_ = true;
+    if (lock_)
+      lock_->begin_hold();
+    const double t0 = now_s();
+    while (ok() && now_s() - t0 < p_.hold_s) {
+      ExposureRecord rec = planned_exposure(p_, 0, now_s());
+      rec.average = p_.averages;  // after the last average
+      loop_.drive_points(lock_ ? lock_->points_um(p_.base_um, 0.0, 0)
+                               : runtime::Vec3{p_.base_um, p_.base_um, p_.base_um});
+      if (!settle())
+        return;
+      rec.settled_time_s = now_s();
+      if (!trigger_when_ready(rec))
+        return;
+      result_.hold.push_back(rec);
+      if (!expose(result_.hold.back()))
+        return;
+      if (!loop_.real_time())
+        wait_for_frames(result_.hold.size());
+      if (progress_)
+        progress_(std::min(now_s() - t0, p_.hold_s), p_.hold_s, "s of hold");
+    }
+    if (ok())
+      collect_remaining_frames();
+  }
+
+  // Frames in of the current phase (the sequence's, then the hold's) and frames asked for.
+  std::size_t received() const { return holding_ ? hold_frames_ : result_.frames.size(); }
+  std::size_t expected() const { return holding_ ? result_.hold.size() : total_; }
+  std::vector<ExposureRecord>& records() { return holding_ ? result_.hold : result_.exposures; }
+
+  // A frame of the sequence; with the lock, taken again while its fringes are lost (retake_s).
   void take_frame(int average, int frame) {
+    const double first_try_s = now_s();
+    for (int retakes = 0; take_frame_once(average, frame, retakes); ++retakes) {
+      if (!lock_ || loop_.real_time() || !lock_->last_frame_lost_fringes()) {
+        if (progress_)
+          progress_(static_cast<double>(result_.exposures.size()), static_cast<double>(total_),
+                    "frames");
+        return;
+      }
+      if (now_s() - first_try_s > p_.lock->retake_s) {
+        fail(
+            fmt::format("frame {} of average {}: the fringes did not come back within {} s "
+                        "(first tried at {:.3f} s): {}",
+                        frame, average + 1, p_.lock->retake_s, first_try_s,
+                        result_.exposures.back().lock_reason));
+        return;
+      }
+      result_.frames.pop_back();  // no fringes: dropped, and taken again
+      result_.exposures.pop_back();
+      lock_->note_retake();
+    }
+  }
+
+  // One try: move, settle, expose; off a real-time clock, its frame in (false: the sequence
+  // failed).
+  bool take_frame_once(int average, int frame, int retakes) {
     ExposureRecord rec = planned_exposure(
         p_,
         static_cast<std::size_t>(average) * p_.steps_rad.size() + static_cast<std::size_t>(frame),
@@ -156,20 +217,19 @@ class Runner {
     loop_.drive_points(lock_ ? lock_->points_um(p_.base_um, rec.commanded_piston_nm,
                                                 static_cast<std::size_t>(frame))
                              : runtime::Vec3{z, z, z});
+    rec.retakes = retakes;
     if (!settle())
-      return;
+      return false;
     rec.settled_time_s = now_s();
     if (!trigger_when_ready(rec))
-      return;
+      return false;
     // Recorded from the trigger on: the frame may arrive before the exposure's last tick ends.
     result_.exposures.push_back(rec);
     if (!expose(result_.exposures.back()))
-      return;
+      return false;
     if (!loop_.real_time())
       wait_for_frames(result_.exposures.size());
-    if (progress_)
-      progress_(static_cast<double>(result_.exposures.size()), static_cast<double>(total_),
-                "frames");
+    return ok();
   }
 
   // The camera refuses a trigger while it reads out the previous frame: tick until it takes one.
@@ -228,9 +288,9 @@ class Runner {
     // were skipped before it, when the scheduled time is later by them and a camera triggered
     // at it would wait for poses the sequence labels earlier, past its exposure's last tick.
     last_edge_s_ = static_cast<double>(edge.tick) * period_s_;
-    if (result_.exposures.empty())
+    if (records().empty())
       return;
-    result_.exposures.back().trigger_time_s = last_edge_s_;
+    records().back().trigger_time_s = last_edge_s_;
     if (!camera_.trigger(last_edge_s_)) {
       fail(fmt::format("camera {} took no trigger from the line's edge at {:.3f} s: {}",
                        camera_.name(), last_edge_s_, camera_.message()));
@@ -265,6 +325,8 @@ class Runner {
   }
 
   bool accept(camera::FrameStatus s, camera::Frame& f) {
+    if (holding_)
+      return accept_hold_frame(s, f);
     if (const std::string why =
             instrument::take_frame(s, f, camera_, seconds_since(start_wall_), result_);
         !why.empty()) {
@@ -278,14 +340,37 @@ class Runner {
     return true;
   }
 
+  // A hold's frame: to the lock, if any, then dropped.
+  bool accept_hold_frame(camera::FrameStatus s, camera::Frame& f) {
+    std::string why;
+    if (s == camera::FrameStatus::kLost)
+      why = fmt::format("camera {} lost frame {} of the hold", camera_.name(), f.frame_id);
+    else if (s != camera::FrameStatus::kOk)
+      why = fmt::format("camera {}: {} ({})", camera_.name(), camera::to_string(s),
+                        camera_.message());
+    else if (hold_frames_ >= result_.hold.size())
+      why = fmt::format("camera {} delivered frame {} that no trigger asked for", camera_.name(),
+                        f.frame_id);
+    if (!why.empty()) {
+      fail(why);
+      return false;
+    }
+    ExposureRecord& rec = result_.hold[hold_frames_++];
+    rec.frame_id = f.frame_id;
+    rec.arrival_wall_s = seconds_since(start_wall_);
+    if (lock_)
+      lock_->on_frame(f, rec);
+    return true;
+  }
+
   // Off a real-time clock only: the loop's time stands still while this thread waits.
   void wait_for_frames(std::size_t count) {
-    while (ok() && result_.frames.size() < count) {
+    while (ok() && received() < count) {
       camera::Frame f;
       const camera::FrameStatus s = camera_.wait(f, p_.frame_timeout_s);
       if (s == camera::FrameStatus::kTimeout) {
-        fail(fmt::format("camera {}: frame {} did not arrive within {} s", camera_.name(),
-                         result_.frames.size(), p_.frame_timeout_s));
+        fail(fmt::format("camera {}: frame {}{} did not arrive within {} s", camera_.name(),
+                         received(), holding_ ? " of the hold" : "", p_.frame_timeout_s));
         return;
       }
       accept(s, f);
@@ -295,14 +380,15 @@ class Runner {
   // On a real-time clock the loop keeps holding the last position while the frames come in.
   void collect_remaining_frames() {
     if (!loop_.real_time()) {
-      wait_for_frames(total_);
+      wait_for_frames(expected());
       return;
     }
     const auto t0 = Clock::now();
-    while (ok() && result_.frames.size() < total_) {
+    while (ok() && received() < expected()) {
       if (seconds_since(t0) > p_.frame_timeout_s) {
-        fail(fmt::format("camera {}: {} of {} frames arrived within {} s of the last exposure",
-                         camera_.name(), result_.frames.size(), total_, p_.frame_timeout_s));
+        fail(fmt::format("camera {}: {} of {} frames{} arrived within {} s of the last exposure",
+                         camera_.name(), received(), expected(), holding_ ? " of the hold" : "",
+                         p_.frame_timeout_s));
         return;
       }
       tick();
@@ -337,6 +423,8 @@ class Runner {
   double last_edge_s_ = 0.0;
   camera::PlatePose edge_pose_{};
   std::optional<FringeLockSession> lock_;
+  bool holding_ = false;         // the hold's frames are coming (hold())
+  std::size_t hold_frames_ = 0;  // ... of which arrived
   SequenceResult result_;
 };
 
@@ -442,27 +530,45 @@ std::string sequence_problem(const SequenceParams& p) {
     return fmt::format("{} averages: must be 1 to 100", p.averages);
   if (!(p.frame_timeout_s > 0.0 && p.frame_timeout_s <= 600.0))
     return fmt::format("frame timeout {} s: must be in (0, 600]", p.frame_timeout_s);
+  if (!(p.hold_s >= 0.0 && p.hold_s <= 3600.0))
+    return fmt::format("hold {} s: must be in [0, 3600]", p.hold_s);
   return {};
 }
 
-std::optional<double> path_error_rms_nm(const SequenceResult& result, std::size_t first) {
+std::vector<double> path_errors_nm(const SequenceResult& result,
+                                   const std::vector<ExposureRecord>& records) {
+  std::vector<double> d;
   if (result.exposures.empty() || !result.exposures.front().has_truth)
-    return std::nullopt;
+    return d;
   const ExposureRecord& e0 = result.exposures.front();
   const double offset_nm = e0.truth_piston_nm - e0.commanded_piston_nm;
-  double sum = 0.0;
-  std::size_t n = 0;
-  for (std::size_t i = first; i < result.exposures.size(); ++i) {
-    const ExposureRecord& e = result.exposures[i];
+  for (const ExposureRecord& e : records) {
     if (!e.has_truth)
-      return std::nullopt;
-    const double d = e.truth_piston_nm - e.commanded_piston_nm - offset_nm;
-    sum += d * d;
-    ++n;
+      return {};
+    d.push_back(e.truth_piston_nm - e.commanded_piston_nm - offset_nm);
   }
-  if (n == 0)
+  return d;
+}
+
+namespace {
+
+std::optional<double> rms_from(const std::vector<double>& d, std::size_t first) {
+  if (first >= d.size())
     return std::nullopt;
-  return std::sqrt(sum / static_cast<double>(n));
+  double sum = 0.0;
+  for (std::size_t i = first; i < d.size(); ++i)
+    sum += d[i] * d[i];
+  return std::sqrt(sum / static_cast<double>(d.size() - first));
+}
+
+}  // namespace
+
+std::optional<double> path_error_rms_nm(const SequenceResult& result, std::size_t first) {
+  return rms_from(path_errors_nm(result, result.exposures), first);
+}
+
+std::optional<double> hold_path_error_rms_nm(const SequenceResult& result, std::size_t first) {
+  return rms_from(path_errors_nm(result, result.hold), first);
 }
 
 SequenceResult run_sequence(runtime::ControlLoop& loop, const plant::Twin* twin,

@@ -198,7 +198,8 @@ FramePose fit_frame_pose(const Map& frame, const FramePoseReference& ref, const 
                     "quarter wave from where the fit started, so its fringe order is not "
                     "certain",
                     p.contrast));
-  if (!(p.contrast >= o.min_contrast))
+  p.fringes_lost = !(p.contrast >= o.min_contrast);
+  if (p.fringes_lost)
     return fail(
         fmt::format("the fringes' contrast is {:.3f} of the reference's, below {} (fringes "
                     "lost: a blocked beam, a dark frame, a moved test piece)",

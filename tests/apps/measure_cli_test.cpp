@@ -159,6 +159,77 @@ TEST_F(MeasureCli, TheFringeLockHoldsTheDriftingCavityNearerItsSetPoint) {
   EXPECT_NE(rt.err.find("--free-run"), std::string::npos) << rt.err;
 }
 
+// Issue 29: the fringes washed out mid-sequence (the twin camera's fringe loss, 60 ms from
+// 0.45 s: within the second average) lose the measurement no frame. Each frame without fringes is
+// taken again until they come back; the lock holds its correction meanwhile and locks again
+// without a jump; every frame kept has its fringes, so the surface is as good as without the loss
+// (same seed, 96 px: measured 0.272 against 0.298 nm; the retaken frames' noise differs). Fringes
+// that do not come back within
+// --lock-retake-s end the measurement (exit 4), never a surface from frames without fringes.
+TEST_F(MeasureCli, FringesLostMidSequenceAreTakenAgainAndNoFrameIsLost) {
+  const std::string clear = small_camera();
+  const std::string lossy = write("loss.toml",
+                                  "[camera]\nwidth_px = 96\nheight_px = 96\n"
+                                  "fringe_loss_start_s = 0.45\nfringe_loss_s = 0.06\n");
+  const Json base =
+      measure("--config '" + clear + "' --averages 4 --lock --out '" + path("clear") + "'");
+  const Json j =
+      measure("--config '" + lossy + "' --averages 4 --lock --out '" + path("loss") + "'");
+  ASSERT_TRUE(base.is_object() && j.is_object());
+  const Json& lock = j["lock"];
+  EXPECT_GE(lock["retaken_frames"].get<int>(), 2) << lock.dump();
+  EXPECT_EQ(base["lock"]["retaken_frames"], 0);
+  ASSERT_EQ(j["exposures"].size(), 20u);  // 4 x 5 frames, none lost
+  int retaken = 0;
+  for (std::size_t i = 5; i < 20; ++i) {
+    EXPECT_EQ(j["exposures"][i]["lock_state"], "locked") << i;  // every kept frame has fringes
+    retaken += j["exposures"][i]["retakes"].get<int>();
+  }
+  EXPECT_EQ(retaken, lock["retaken_frames"].get<int>());
+  EXPECT_LT(j["error_rms_nm"].get<double>(), 1.1 * base["error_rms_nm"].get<double>());
+  // The loss outlasts the retake time: a failure, and nothing written.
+  const std::string long_loss = write("long.toml",
+                                      "[camera]\nwidth_px = 96\nheight_px = 96\n"
+                                      "fringe_loss_start_s = 0.45\nfringe_loss_s = 5\n");
+  const testing::CliResult r =
+      run("measure --free-run --config '" + long_loss +
+          "' --averages 4 --lock --lock-retake-s 0.2 --out '" + path("long") + "'");
+  EXPECT_EQ(r.status, 4) << r.err;
+  EXPECT_NE(r.err.find("did not come back within 0.2 s"), std::string::npos) << r.err;
+  EXPECT_FALSE(fs::exists(path("long")));
+  refused("--lock --lock-retake-s 0 --out '" + path("x") + "'", "retake");
+}
+
+// Issue 29's hold: after the measurement the stage stays at frame 0 for a minute of loop time
+// while the camera exposes frame after frame (4286 frames), with the cavity's drift in the
+// fringes, the improved controller, seed 1. On the gauges alone the cavity's path is 2.04 nm RMS
+// from frame 0's (the return to frame 0 and the drift, which no gauge sees); the lock holds it
+// within 0.2 nm RMS of its set point (measured 0.177 nm), issue 29's bound. The paper's
+// controller cannot be held so close frame by frame: its own jitter from one 1 ms exposure to
+// the next is above the bound (0.54 nm locked; docs/fizeau.md).
+TEST_F(MeasureCli, TheLockHoldsTheCavityWithinAFifthOfANanometreOverAMinute) {
+  const testing::CliResult cal =
+      run("calibrate --controller improved --out '" + path("cal/improved.toml") + "'");
+  ASSERT_EQ(cal.status, 0) << cal.err;
+  const std::string cfg = write("drift.toml",
+                                "[camera]\nwidth_px = 96\nheight_px = 96\n"
+                                "[twin.cavity]\nin_fringes = true\n");
+  const std::string common =
+      "--calibration '" + path("cal/improved.toml") + "' --config '" + cfg + "' --hold-s 60 ";
+  const Json off = measure(common + "--out '" + path("off") + "'");
+  const Json on = measure(common + "--lock --out '" + path("on") + "'");
+  ASSERT_TRUE(off.is_object() && on.is_object());
+  const Json &h_off = off["hold"], &h_on = on["hold"];
+  EXPECT_GE(h_on["span_s"].get<double>(), 59.9);
+  EXPECT_GT(h_on["frames"].get<int>(), 2000);  // the camera's rate: ~19 ms a frame
+  EXPECT_EQ(h_on["lock_states"]["locked"], h_on["frames"]);
+  const double unlocked = h_off["path_error_rms_nm"], locked = h_on["path_error_rms_nm"];
+  EXPECT_LT(locked, 0.2) << locked;
+  EXPECT_GT(unlocked, 5.0 * locked) << unlocked;
+  EXPECT_LT(h_on["path_error_1s_means_rms_nm"].get<double>(), 0.1);  // measured 0.057
+  EXPECT_TRUE(fs::exists(path("on") + "/hold.csv"));
+}
+
 // A step that never settles, or a frame that never arrives, is not a measurement: exit 4 and no
 // folder at all.
 TEST_F(MeasureCli, AFailedSequenceWritesNothing) {

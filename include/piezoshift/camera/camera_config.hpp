@@ -54,6 +54,11 @@ struct CameraConfig {
       .shot_noise = true,
       .bit_depth = 12,
   };
+  //! The twin only: the fringes washed out (the air in the cavity stirred, a vibration through
+  //! the exposure) for frames triggered from this loop time for fringe_loss_s, rendered with
+  //! visibility 0; a negative start: never. A test of the fringe lock losing its fringes.
+  double fringe_loss_start_s = -1.0;
+  double fringe_loss_s = 0.0;
 };
 
 //! Calls visit(section, key, value, bounds) for each numeric value of [camera] (const or not);
@@ -74,6 +79,8 @@ void visit_camera_values(Config& c, Visit&& visit) {
   visit("camera", "read_noise_e", c.sensor.read_noise_e, B::closed(0.0, 1000.0));
   visit("camera", "mean_fill", c.sensor.mean_fill, B::open(0.0, 1.0));
   visit("camera", "visibility", c.sensor.visibility, B::above(0.0, 1.0));
+  visit("camera", "fringe_loss_start_s", c.fringe_loss_start_s, B::closed(-1.0, 1e6));
+  visit("camera", "fringe_loss_s", c.fringe_loss_s, B::closed(0.0, 3600.0));
 }
 
 //! The first value outside its range ("camera.exposure_s = 2 must be in (0, 1]"); "" when valid.

@@ -10,7 +10,8 @@
 //                        max_tick_rate_Hz + 2 poses); the first pose at or past t + exposure_s
 //                        completes the exposure, which is handed to the worker thread (so is an
 //                        unfinished exposure when the next trigger comes)
-//   worker thread        frame k = psi::render_frame(surface, mask, fizeau, sensor, poses,
+//   worker thread        (a frame triggered in the scene's fringe loss: visibility 0)
+//                        frame k = psi::render_frame(surface, mask, fizeau, sensor, poses,
 //                        Rng(frame_seed(seed, k))), then counts x 10^(gain_dB / 20), rounded and
 //                        clipped to 2^bits - 1 (bits of the pixel format); an exposure that saw
 //                        no pose, or more than the buffer holds, is a kError frame, never blank
@@ -53,6 +54,10 @@ struct TwinScene {
   psi::FizeauParams fizeau;
   std::uint64_t seed = 1;
   double max_tick_rate_Hz = kTwinMaxTickRate_Hz;
+  //! Frames triggered in [fringe_loss_start_s, + fringe_loss_s) are rendered without fringes
+  //! (visibility 0: CameraConfig's fringe loss); a negative start: never.
+  double fringe_loss_start_s = -1.0;
+  double fringe_loss_s = 0.0;
 };
 
 //! The scene `psi simulate` renders for the same surface, optics and seed: the centred disk of

@@ -16,6 +16,8 @@
 // step's lock alone, and no correction changes between two frames of a set for the frame
 // before's sake (one lock chasing each step's error in turn made the steps worse: on the twin
 // with the cavity's drift, measured 0.29 nm of surface error against 0.22 nm unlocked).
+// A hold after the sequence (SequenceParams::hold_s) is frame 0 again and again: step 0's lock,
+// which the averages have taught, holds the cavity frame by frame.
 // A frame whose pose is not valid (fringes lost, a misfit, a step the fringe order cannot
 // follow) leaves its step's correction where it is: the stage stays on its gauges without a
 // jump (FringeLock's holding, then lost), and each exposure records the lock's state and why.
@@ -43,10 +45,15 @@ struct LockSetup {
   psi::Mask mask;                 //!< the pupil on the camera
   //! P1..P3 on the plate: the correction's tilt to the points' set-points
   std::optional<kinematics::TripodGeometry> tripod;
+  //! A frame of the sequence whose fringes were lost (psi::FramePose::fringes_lost) is taken
+  //! again, until they come back, for at most this long of loop time from its first try; then
+  //! the sequence fails. The hold's frames are not taken again.
+  double retake_s = 1.0;
 };
 
 //! "" when a sequence with these steps can be locked, else why not: the steps begin 0, pi/2, pi,
-//! 3 pi/2 (to 1e-9), the lock's parameters are in range, the mask is not empty, the tripod set.
+//! 3 pi/2 (to 1e-9), the lock's parameters are in range (retake_s in (0, 60]), the mask is not
+//! empty, the tripod set.
 std::string lock_problem(const LockSetup& setup, const SequenceParams& params);
 
 //! What the lock did over a sequence.
@@ -55,6 +62,7 @@ struct LockSummary {
   std::size_t locked = 0;            //!< frames whose pose corrected the stage
   std::size_t holding = 0;           //!< frames without a valid pose, the correction held
   std::size_t lost = 0;              //!< ... of which beyond max_lost_frames in a row
+  std::size_t retaken = 0;           //!< frames taken again because their fringes were lost
   std::string first_refusal;         //!< the first frame's reason for no pose ("" if none)
   control::FringeAxes correction{};  //!< the last frame's step's, at the end [nm, urad, urad]
 };
@@ -68,10 +76,18 @@ class FringeLockSession {
   //! average.
   kinematics::PointDisplacements points_um(double base_um, double commanded_piston_nm,
                                            std::size_t step);
-  //! The frame of exposure `rec` (in order); records the lock's doing in rec.
+  //! The frame of exposure `rec` (in order, one per move); it feeds the lock of rec.frame's step
+  //! (a hold's frames: frame 0's). Records the lock's doing in rec.
   void on_frame(const camera::Frame& frame, ExposureRecord& rec);
 
   const LockSummary& summary() const noexcept { return summary_; }
+  //! The last frame on_frame() saw had lost its fringes (after the reference).
+  bool last_frame_lost_fringes() const noexcept { return last_lost_fringes_; }
+  //! The sequence takes the last frame again.
+  void note_retake() noexcept { ++summary_.retaken; }
+  //! The hold begins: from here every move and frame is step 0's lock's, which holds the cavity
+  //! where frame 0 of the first average found it (that frame's pose against the reference).
+  void begin_hold();
 
  private:
   LockSetup s_;
@@ -79,12 +95,15 @@ class FringeLockSession {
   std::vector<psi::Map> reference_frames_;
   std::optional<psi::FramePoseReference> reference_;
   std::vector<control::FringeLock> locks_;            //!< one per frame of an average
+  bool holding_ = false;                              //!< from begin_hold()
+  control::FringeAxes frame0_{};                      //!< frame 0's pose: the hold's set point
   psi::FramePose last_{};                             //!< the last valid pose
   double last_commanded_nm_ = 0.0;                    //!< its frame's commanded piston
   control::FringeAxes last_applied_{};                //!< the correction its frame was taken with
   control::FringeAxes applied_{};                     //!< the correction of the last move
   std::vector<control::FringeAxes> applied_by_move_;  //!< per move, in order
   std::size_t frames_ = 0;
+  bool last_lost_fringes_ = false;
   LockSummary summary_;
 };
 

@@ -22,6 +22,10 @@
 //       hardware from the loop's report (a line-triggered camera stamps its frame with t_e).
 //       Same ticks, same poses, same times as kSoftware.)
 //   tick, holding the last position, until every frame has arrived (frame_timeout_s)
+//   hold_s > 0: the hold. Z_d back to frame 0's; then frame after frame, for hold_s of loop time,
+//     as above (settle, expose, the frame): the cavity held where frame 0 of the first average
+//     found it, by the lock when there is one, else by the semi-closed loop alone. The hold's
+//     frames feed the lock and are not kept (a minute is thousands of frames); their records are.
 //   the loop's controlled part ends; tick through its ramp to 0 V
 //
 // Frames are polled between ticks (lock-free: camera.hpp). A fault the supervisor latches, a
@@ -64,6 +68,9 @@ struct SequenceParams {
   std::uint32_t trigger_pulse_ticks = 1;  //!< kLine: the pulse's width, 1 to 1000 ticks
   //! The fringe lock (fringe_lock_session.hpp); none: the semi-closed loop alone
   std::optional<LockSetup> lock;
+  //! After the averages, the stage held at frame 0's position while the camera exposes frame
+  //! after frame for this long [s of loop time]; 0: no hold.
+  double hold_s = 0.0;
 };
 
 //! The commanded steps of a measurement with algorithm a: given, for lsq, aia and tilt-aia (the
@@ -78,7 +85,7 @@ std::string travel_problem(const SequenceParams& p, std::optional<double> travel
                            std::string_view calibration_source);
 
 //! Why p cannot be run ("" when it can): 3 to 64 steps, finite, the first 0; wavelength, base,
-//! times, averages and pulse width in range.
+//! times (the hold 0 to 3600 s), averages and pulse width in range.
 std::string sequence_problem(const SequenceParams& p);
 
 //! One exposure: what was commanded, when, and where the stage was while the camera integrated.
@@ -109,6 +116,7 @@ struct ExposureRecord {
   double fringe_piston_nm = std::numeric_limits<double>::quiet_NaN();    //!< from the frame
   std::string lock_state;   //!< "reference", or FringeLockState's words after the frame
   std::string lock_reason;  //!< why the frame gave no pose
+  int retakes = 0;          //!< tries before this frame whose fringes were lost (LockSetup)
 };
 
 struct SequenceResult {
@@ -120,7 +128,8 @@ struct SequenceResult {
   std::uint64_t overruns = 0;
   std::uint64_t ticks = 0;
   rig::Validity validity;
-  std::optional<LockSummary> lock;  //!< with SequenceParams::lock
+  std::optional<LockSummary> lock;   //!< with SequenceParams::lock
+  std::vector<ExposureRecord> hold;  //!< the hold's exposures (SequenceParams::hold_s), in order
 };
 
 //! The piston that makes frame k's phase step in reflection: steps_rad[k] lambda / (4 pi) [nm].
@@ -145,6 +154,15 @@ std::string take_frame(camera::FrameStatus status, camera::Frame& frame,
 //! the same at the first exposure: where a lock's reference holds it); nothing without truth or
 //! without an exposure from first on.
 std::optional<double> path_error_rms_nm(const SequenceResult& result, std::size_t first);
+
+//! The cavity's path from its set point at each of records, as path_error_rms_nm takes it
+//! (relative to the sequence's first exposure); empty without truth.
+std::vector<double> path_errors_nm(const SequenceResult& result,
+                                   const std::vector<ExposureRecord>& records);
+
+//! The same over the hold's exposures, relative to the first exposure of the sequence (frame 0,
+//! where the hold returns): the hold's frames from first on.
+std::optional<double> hold_path_error_rms_nm(const SequenceResult& result, std::size_t first = 0);
 
 //! Runs the sequence (see the header). twin: the twin whose true plate pose feeds the camera and
 //! the records (nullptr on hardware). loop must be in owner mode and not started; the DAQ

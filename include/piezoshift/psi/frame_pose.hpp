@@ -112,7 +112,8 @@ struct FramePose {
   double misfit = 0.0;    //!< PlaneFit::misfit
   int iterations = 0;
   bool valid = false;
-  std::string reason;  //!< why not valid, "" when valid
+  bool fringes_lost = false;  //!< not valid because the contrast fell below min_contrast
+  std::string reason;         //!< why not valid, "" when valid
 };
 
 //! Fits frame from start (the expected pose; {} right after the reference). The frame must be the
