@@ -1,0 +1,160 @@
+// The paper's calibration with the Fizeau's fringes as the interferometer
+// (fringe_calibration.hpp), through the shipping loop on the simulated bench with the twin camera,
+// against the plant's own A and against the XL-80's calibration (calibration::calibrate) on the
+// same seed: issue 29's "calibration from fringes" done-when, on three plants.
+#include <gtest/gtest.h>
+
+#include <algorithm>
+#include <cmath>
+#include <cstdio>
+#include <string>
+
+#include "piezoshift/calibration/calibration_procedure.hpp"
+#include "piezoshift/camera/twin_camera.hpp"
+#include "piezoshift/config/project_config.hpp"
+#include "piezoshift/instrument/fringe_calibration.hpp"
+#include "scripted_camera.hpp"
+
+namespace piezoshift::instrument {
+namespace {
+
+double worst(const control::Mat3& a, const control::Mat3& b) {
+  double w = 0.0;
+  for (std::size_t i = 0; i < 3; ++i)
+    for (std::size_t j = 0; j < 3; ++j)
+      w = std::max(w, std::fabs(a[i][j] - b[i][j]));
+  return w;
+}
+
+// Stage 1 with the paper's gains alone (it reads no interferometer: the same in both paths).
+FringeCalibrationOptions paper_gains() {
+  FringeCalibrationOptions o;
+  o.stages = calibration::CalibrationOptions::paper_gains_only();
+  return o;
+}
+
+struct Plant {
+  std::string name;
+  config::ProjectConfig config;
+};
+
+// The done-when's three plants: the default twin; the gauges' gains a few per cent apart (A's
+// rows scaled: A = G W^-1, geometry.hpp, so g scales and the points stay); unequal legs (the
+// stacks' strokes of configs/plants/thick-plate.toml, 1.05 / 0.95 / 1.0: A unchanged, the
+// volts a move takes are not).
+Plant plant(int k) {
+  Plant p{"default twin", {}};
+  if (k == 1) {
+    p.name = "gauge gains 1.03 / 0.97 / 1.00";
+    const std::array<double, 3> scale{1.03, 0.97, 1.0};
+    for (std::size_t i = 0; i < 3; ++i)
+      for (double& v : p.config.twin.geometry.transmission_matrix[i])
+        v *= scale[i];
+  } else if (k == 2) {
+    p.name = "unequal legs 1.05 / 0.95 / 1.00";
+    p.config.twin.piezo.free_stroke_scale = {1.05, 0.95, 1.0};
+  }
+  return p;
+}
+
+class FringeCalibrationPlants : public ::testing::TestWithParam<int> {};
+
+TEST_P(FringeCalibrationPlants, AWithinTheBandOfThePlantsOwnInLessTimeThanTheXl80) {
+  const Plant pl = plant(GetParam());
+  const std::uint64_t seed = 1;
+  camera::CameraSettings settings;
+  settings.width_px = settings.height_px = 256;
+  const camera::TwinScene scene = camera::make_twin_scene(
+      psi::SurfaceSpec{}, camera::measurement_optics(settings, 632.8), seed);
+  camera::TwinCamera cam(scene, psi::CameraParams{});
+  cam.configure(settings);
+  const FringeOptics optics{scene.mask, scene.fizeau.pupil_radius_m,
+                            scene.fizeau.pupil_radius_m / scene.fizeau.pupil_radius_px};
+  control::SemiClosedLoopParams base;
+  base.sample_time_s = pl.config.twin.daq.sample_time_s;
+  const FringeCalibrationOutcome f =
+      calibrate_from_fringes(pl.config, base, seed, cam, optics, paper_gains());
+  ASSERT_TRUE(f.validity.valid) << f.validity.reason;
+  const calibration::CalibrationOutcome x = calibration::calibrate(
+      pl.config, base, seed, calibration::CalibrationOptions::paper_gains_only());
+
+  const control::Mat3& own = pl.config.twin.geometry.transmission_matrix;
+  const double f_err = worst(f.controller.matrix.a, own);
+  const double x_err = worst(x.controller.matrix.a, own);
+  // the XL-80's stage 2 and 3 bench times (each stage's bench starts at 0)
+  const double x_s = x.matrix.simulated_time_s + x.polynomial.simulated_time_s;
+  const double f_s = f.stage2_simulated_s + f.stage3_simulated_s;
+  // the two p's largest difference over stage 3's span [nm of command]
+  double p_nm = 0.0;
+  for (int k = 0; k <= 110; ++k) {
+    const double z = 0.1 * k;
+    p_nm =
+        std::max(p_nm, 1000.0 * std::fabs(f.controller.polynomial(z) - x.controller.polynomial(z)));
+  }
+  const auto& fp = f.controller.polynomial;
+  const auto& xp = x.controller.polynomial;
+  std::printf(
+      "%s, seed 1: A from fringes worst element %.5f from the plant's (the XL-80's %.5f); stages "
+      "2+3 %.1f + %.1f s simulated against the XL-80's %.1f + %.1f s; %.1f s wall\n"
+      "p from fringes %.4e %.4e %.5f %.4f (%zu points, rms %.2f nm); XL-80 %.4e %.4e %.5f %.4f "
+      "(rms %.2f nm); largest difference over 0..11 um %.2f nm; left out %zu / %zu\n",
+      pl.name.c_str(), f_err, x_err, f.stage2_simulated_s, f.stage3_simulated_s,
+      x.matrix.simulated_time_s, x.polynomial.simulated_time_s, f.wall_time_s, fp.p3, fp.p2, fp.p1,
+      fp.p0, f.polynomial.command_um.size(), 1000.0 * f.polynomial.fit.rms_residual_um, xp.p3,
+      xp.p2, xp.p1, xp.p0, 1000.0 * x.polynomial.fit.rms_residual_um, p_nm,
+      f.polynomial.saturated_points, x.polynomial.saturated_points);
+  // issue 29's done-when: A within 0.002 of the plant's own, in no more time than the XL-80's
+  EXPECT_LT(f_err, 0.002);
+  EXPECT_LE(f_s, x_s);
+  // the command 0 is left out of both fits: the PIDs sit at their lower limit there (the
+  // gauges' zero a few nm below the stacks' 0 V position, docs/calibration.md)
+  EXPECT_EQ(f.polynomial.saturated_points, 1u);
+  EXPECT_EQ(x.polynomial.saturated_points, 1u);
+  // p: the same curve as the XL-80's within 15 nm over the 11 um span (0.14 %, about the
+  // XL-80's own spread between sessions; measured, see docs/fizeau.md)
+  EXPECT_LT(p_nm, 15.0);
+}
+
+INSTANTIATE_TEST_SUITE_P(Issue29, FringeCalibrationPlants, ::testing::Values(0, 1, 2),
+                         [](const ::testing::TestParamInfo<int>& i) {
+                           return std::string(i.param == 0   ? "DefaultTwin"
+                                              : i.param == 1 ? "GaugeGains"
+                                                             : "UnequalLegs");
+                         });
+
+// A scan whose frames are lost ends the calibration with the stage, the actuator and the frame,
+// and no controller to use; stage 1 skipped (holding gains) so that nothing else runs.
+TEST(FringeCalibrationTest, ALostFrameEndsItWithTheStageAndTheReason) {
+  ScriptedCamera cam;
+  camera::CameraSettings s;
+  s.width_px = s.height_px = 1;
+  cam.configure(s);
+  cam.lose_frame = 2;
+  FringeOptics optics{psi::Mask(1, 1), 0.025, 0.025 / 120.0};
+  FringeCalibrationOptions o;
+  o.stages.holding_gains = control::PidGains{};
+  const config::ProjectConfig config;
+  control::SemiClosedLoopParams base;
+  base.sample_time_s = config.twin.daq.sample_time_s;
+  const FringeCalibrationOutcome r = calibrate_from_fringes(config, base, 1, cam, optics, o);
+  EXPECT_FALSE(r.validity.valid);
+  EXPECT_EQ(r.validity.reason, "stage 2 (matrix A), actuator 1's scan: frame 2: lost");
+  EXPECT_TRUE(r.matrix.ds_um.empty());
+  EXPECT_TRUE(r.piston_scan.poses.empty());
+}
+
+TEST(FringeCalibrationTest, PistonScanParamsAreRefusedByName) {
+  FringePistonScanParams p;
+  EXPECT_EQ(fringe_piston_scan_problem(p), "");
+  p.max_um = 0.2;  // below the reference's last pose (4 lambda/8 = 0.316 um)
+  EXPECT_NE(fringe_piston_scan_problem(p).find("max_um"), std::string::npos);
+  p = {};
+  p.max_pupil_step_nm = 200.0;
+  EXPECT_NE(fringe_piston_scan_problem(p).find("max_pupil_step_nm"), std::string::npos);
+  p = {};
+  p.reference_frames = 2;
+  EXPECT_NE(fringe_piston_scan_problem(p).find("reference_frames"), std::string::npos);
+}
+
+}  // namespace
+}  // namespace piezoshift::instrument
