@@ -13,6 +13,8 @@
 #include "piezoshift/camera/twin_camera.hpp"
 #include "piezoshift/config/project_config.hpp"
 #include "piezoshift/instrument/fringe_calibration.hpp"
+#include "piezoshift/reproduction/paper_bands.hpp"
+#include "piezoshift/reproduction/reproduction.hpp"
 #include "scripted_camera.hpp"
 
 namespace piezoshift::instrument {
@@ -121,6 +123,78 @@ INSTANTIATE_TEST_SUITE_P(Issue29, FringeCalibrationPlants, ::testing::Values(0, 
                                               : i.param == 1 ? "GaugeGains"
                                                              : "UnequalLegs");
                          });
+
+// Table 4 with the paper's controller calibrated from fringes against the same controller
+// calibrated with the XL-80 (issue 29's done-when): default twin, seeds 1 to 8, the quick
+// schedule (reproduce --quick's: every Table 4 experiment, the 230 repeatability moves kept),
+// each experiment on the same seed for both. The fringe calibration's median of each figure
+// must lie within the XL-80 calibration's spread over the same seeds (its smallest to largest).
+struct Table4Figures {
+  std::array<double, 4> v{};  // step settling [s], linearity [%], repeatability 5 / 10 um [nm]
+  bool valid = true;
+};
+
+Table4Figures table4(const reproduction::ExperimentSet& e) {
+  return {{e.step.metrics.settling_time_pct_s, e.linearity.metrics.linearity_zero_end_pct,
+           e.repeat_5um.metrics.repeatability_nm, e.repeat_10um.metrics.repeatability_nm},
+          e.table4_valid()};
+}
+
+double median(std::vector<double> v) {
+  std::sort(v.begin(), v.end());
+  const std::size_t n = v.size();
+  return n % 2 == 1 ? v[n / 2] : 0.5 * (v[n / 2 - 1] + v[n / 2]);
+}
+
+TEST(FringeCalibrationTable4, TheFringeCalibratedControllerScoresTable4WithinTheXl80sSpread) {
+  const config::ProjectConfig config;
+  camera::CameraSettings settings;
+  settings.width_px = settings.height_px = 256;
+  control::SemiClosedLoopParams base;
+  base.sample_time_s = config.twin.daq.sample_time_s;
+  const reproduction::Schedule schedule = reproduction::Schedule::quick();
+  std::array<std::vector<double>, 4> fv, xv;
+  double worst_a = 0.0;
+  for (std::uint64_t seed = 1; seed <= 8; ++seed) {
+    const camera::TwinScene scene = camera::make_twin_scene(
+        psi::SurfaceSpec{}, camera::measurement_optics(settings, 632.8), seed);
+    camera::TwinCamera cam(scene, psi::CameraParams{});
+    cam.configure(settings);
+    const FringeOptics optics{scene.mask, scene.fizeau.pupil_radius_m,
+                              scene.fizeau.pupil_radius_m / scene.fizeau.pupil_radius_px};
+    const FringeCalibrationOutcome f =
+        calibrate_from_fringes(config, base, seed, cam, optics, paper_gains());
+    ASSERT_TRUE(f.validity.valid) << "seed " << seed << ": " << f.validity.reason;
+    worst_a = std::max(worst_a, worst(f.controller.matrix.a, control::TransmissionMatrix{}.a));
+    const calibration::CalibrationOutcome x = calibration::calibrate(
+        config, base, seed, calibration::CalibrationOptions::paper_gains_only());
+    const Table4Figures tf =
+        table4(reproduction::run_experiment_set(config, f.controller, seed, schedule));
+    const Table4Figures tx =
+        table4(reproduction::run_experiment_set(config, x.controller, seed, schedule));
+    ASSERT_TRUE(tf.valid && tx.valid) << "seed " << seed;
+    for (std::size_t k = 0; k < 4; ++k) {
+      fv[k].push_back(tf.v[k]);
+      xv[k].push_back(tx.v[k]);
+    }
+    std::printf("seed %d: fringes %.4f s %.4f %% %.3f %.3f nm; XL-80 %.4f s %.4f %% %.3f %.3f nm\n",
+                static_cast<int>(seed), tf.v[0], tf.v[1], tf.v[2], tf.v[3], tx.v[0], tx.v[1],
+                tx.v[2], tx.v[3]);
+  }
+  const char* names[4] = {"11 um step settling [s]", "linearity, zero-end [%]",
+                          "repeatability at 5 um [nm]", "repeatability at 10 um [nm]"};
+  std::printf("A from fringes, seeds 1 to 8: worst element %.5f from the plant's\n", worst_a);
+  EXPECT_LT(worst_a, 0.002);
+  for (std::size_t k = 0; k < 4; ++k) {
+    const double mf = median(fv[k]);
+    const auto [lo, hi] = std::minmax_element(xv[k].begin(), xv[k].end());
+    std::printf("%-28s fringes median %.4f (%.4f to %.4f); XL-80 median %.4f (%.4f to %.4f)\n",
+                names[k], mf, *std::min_element(fv[k].begin(), fv[k].end()),
+                *std::max_element(fv[k].begin(), fv[k].end()), median(xv[k]), *lo, *hi);
+    EXPECT_GE(mf, *lo) << names[k];
+    EXPECT_LE(mf, *hi) << names[k];
+  }
+}
 
 // A scan whose frames are lost ends the calibration with the stage, the actuator and the frame,
 // and no controller to use; stage 1 skipped (holding gains) so that nothing else runs.
