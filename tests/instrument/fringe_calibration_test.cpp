@@ -7,6 +7,7 @@
 #include <algorithm>
 #include <cmath>
 #include <cstdio>
+#include <optional>
 #include <string>
 
 #include "piezoshift/calibration/calibration_procedure.hpp"
@@ -59,11 +60,22 @@ Plant plant(int k) {
   return p;
 }
 
-class FringeCalibrationPlants : public ::testing::TestWithParam<int> {};
+double median(std::vector<double> v) {
+  std::sort(v.begin(), v.end());
+  const std::size_t n = v.size();
+  return n % 2 == 1 ? v[n / 2] : 0.5 * (v[n / 2 - 1] + v[n / 2]);
+}
 
-TEST_P(FringeCalibrationPlants, AWithinTheBandOfThePlantsOwnInLessTimeThanTheXl80) {
-  const Plant pl = plant(GetParam());
-  const std::uint64_t seed = 1;
+// One seed of one plant: the calibration from fringes against the plant's own A and against
+// the XL-80 calibration on the same seed.
+struct SeedFigures {
+  double f_err = 0.0, x_err = 0.0;  // worst element of A from the plant's own
+  double f_s = 0.0, x_s = 0.0;      // stages 2 + 3, simulated (each stage's bench from 0)
+  double p_nm = 0.0;                // the two p's largest difference over 0..11 um [nm]
+  std::size_t f_left_out = 0, x_left_out = 0;
+};
+
+std::optional<SeedFigures> one_seed(const Plant& pl, std::uint64_t seed) {
   camera::CameraSettings settings;
   settings.width_px = settings.height_px = 256;
   const camera::TwinScene scene = camera::make_twin_scene(
@@ -76,45 +88,72 @@ TEST_P(FringeCalibrationPlants, AWithinTheBandOfThePlantsOwnInLessTimeThanTheXl8
   base.sample_time_s = pl.config.twin.daq.sample_time_s;
   const FringeCalibrationOutcome f =
       calibrate_from_fringes(pl.config, base, seed, cam, optics, paper_gains());
-  ASSERT_TRUE(f.validity.valid) << f.validity.reason;
+  if (!f.validity.valid) {
+    ADD_FAILURE() << pl.name << ", seed " << seed << ": " << f.validity.reason;
+    return std::nullopt;
+  }
   const calibration::CalibrationOutcome x = calibration::calibrate(
       pl.config, base, seed, calibration::CalibrationOptions::paper_gains_only());
-
   const control::Mat3& own = pl.config.twin.geometry.transmission_matrix;
-  const double f_err = worst(f.controller.matrix.a, own);
-  const double x_err = worst(x.controller.matrix.a, own);
-  // the XL-80's stage 2 and 3 bench times (each stage's bench starts at 0)
-  const double x_s = x.matrix.simulated_time_s + x.polynomial.simulated_time_s;
-  const double f_s = f.stage2_simulated_s + f.stage3_simulated_s;
-  // the two p's largest difference over stage 3's span [nm of command]
-  double p_nm = 0.0;
+  SeedFigures r;
+  r.f_err = worst(f.controller.matrix.a, own);
+  r.x_err = worst(x.controller.matrix.a, own);
+  r.x_s = x.matrix.simulated_time_s + x.polynomial.simulated_time_s;
+  r.f_s = f.stage2_simulated_s + f.stage3_simulated_s;
   for (int k = 0; k <= 110; ++k) {
     const double z = 0.1 * k;
-    p_nm =
-        std::max(p_nm, 1000.0 * std::fabs(f.controller.polynomial(z) - x.controller.polynomial(z)));
+    r.p_nm = std::max(r.p_nm,
+                      1000.0 * std::fabs(f.controller.polynomial(z) - x.controller.polynomial(z)));
   }
+  r.f_left_out = f.polynomial.saturated_points;
+  r.x_left_out = x.polynomial.saturated_points;
   const auto& fp = f.controller.polynomial;
   const auto& xp = x.controller.polynomial;
   std::printf(
-      "%s, seed 1: A from fringes worst element %.5f from the plant's (the XL-80's %.5f); stages "
-      "2+3 %.1f + %.1f s simulated against the XL-80's %.1f + %.1f s; %.1f s wall\n"
-      "p from fringes %.4e %.4e %.5f %.4f (%zu points, rms %.2f nm); XL-80 %.4e %.4e %.5f %.4f "
+      "%s, seed %d: A from fringes worst element %.5f from the plant's (the XL-80's %.5f); "
+      "stages 2+3 %.1f + %.1f s simulated against the XL-80's %.1f + %.1f s; %.1f s wall\n"
+      "  p from fringes %.4e %.4e %.5f %.4f (%zu points, rms %.2f nm); XL-80 %.4e %.4e %.5f %.4f "
       "(rms %.2f nm); largest difference over 0..11 um %.2f nm; left out %zu / %zu\n",
-      pl.name.c_str(), f_err, x_err, f.stage2_simulated_s, f.stage3_simulated_s,
-      x.matrix.simulated_time_s, x.polynomial.simulated_time_s, f.wall_time_s, fp.p3, fp.p2, fp.p1,
-      fp.p0, f.polynomial.command_um.size(), 1000.0 * f.polynomial.fit.rms_residual_um, xp.p3,
-      xp.p2, xp.p1, xp.p0, 1000.0 * x.polynomial.fit.rms_residual_um, p_nm,
-      f.polynomial.saturated_points, x.polynomial.saturated_points);
-  // issue 29's done-when: A within 0.002 of the plant's own, in no more time than the XL-80's
-  EXPECT_LT(f_err, 0.002);
-  EXPECT_LE(f_s, x_s);
-  // the command 0 is left out of both fits: the PIDs sit at their lower limit there (the
-  // gauges' zero a few nm below the stacks' 0 V position, docs/calibration.md)
-  EXPECT_EQ(f.polynomial.saturated_points, 1u);
-  EXPECT_EQ(x.polynomial.saturated_points, 1u);
-  // p: the same curve as the XL-80's within 15 nm over the 11 um span (0.14 %, about the
-  // XL-80's own spread between sessions; measured, see docs/fizeau.md)
-  EXPECT_LT(p_nm, 15.0);
+      pl.name.c_str(), static_cast<int>(seed), r.f_err, r.x_err, f.stage2_simulated_s,
+      f.stage3_simulated_s, x.matrix.simulated_time_s, x.polynomial.simulated_time_s, f.wall_time_s,
+      fp.p3, fp.p2, fp.p1, fp.p0, f.polynomial.command_um.size(),
+      1000.0 * f.polynomial.fit.rms_residual_um, xp.p3, xp.p2, xp.p1, xp.p0,
+      1000.0 * x.polynomial.fit.rms_residual_um, r.p_nm, r.f_left_out, r.x_left_out);
+  return r;
+}
+
+class FringeCalibrationPlants : public ::testing::TestWithParam<int> {};
+
+// Seeds 1 to 8 (issue 29's medians), seed 1 held to the band on its own too.
+TEST_P(FringeCalibrationPlants, AWithinTheBandOfThePlantsOwnInLessTimeThanTheXl80) {
+  const Plant pl = plant(GetParam());
+  std::vector<double> f_err, x_err, p_nm;
+  for (std::uint64_t seed = 1; seed <= 8; ++seed) {
+    const std::optional<SeedFigures> got = one_seed(pl, seed);
+    ASSERT_TRUE(got.has_value()) << "seed " << seed;
+    const SeedFigures& r = *got;
+    f_err.push_back(r.f_err);
+    x_err.push_back(r.x_err);
+    p_nm.push_back(r.p_nm);
+    // no more time than the XL-80's, every seed (the scans' poses are fixed: 45.9 s)
+    EXPECT_LE(r.f_s, r.x_s) << "seed " << seed;
+    // at most the command 0 is left out (a PID at its lower limit: the gauges' zero a few nm
+    // below the stacks' 0 V position, docs/calibration.md), as the XL-80's fit leaves it out
+    EXPECT_LE(r.f_left_out, 1u) << "seed " << seed;
+    if (seed == 1) {
+      EXPECT_LT(r.f_err, 0.002);  // issue 29's band, on seed 1 alone
+      // p: the XL-80's curve within 15 nm over the 11 um span (0.14 %; measured 3.4 to 4.8 nm
+      // on seed 1, docs/fizeau.md)
+      EXPECT_LT(r.p_nm, 15.0);
+    }
+  }
+  std::printf(
+      "%s, seeds 1 to 8: A from fringes median %.5f, worst %.5f from the plant's (the XL-80's "
+      "median %.5f, worst %.5f); p from the XL-80's median %.2f, worst %.2f nm\n",
+      pl.name.c_str(), median(f_err), *std::max_element(f_err.begin(), f_err.end()), median(x_err),
+      *std::max_element(x_err.begin(), x_err.end()), median(p_nm),
+      *std::max_element(p_nm.begin(), p_nm.end()));
+  EXPECT_LT(median(f_err), 0.002);  // issue 29's done-when: the median over seeds 1 to 8
 }
 
 INSTANTIATE_TEST_SUITE_P(Issue29, FringeCalibrationPlants, ::testing::Values(0, 1, 2),
@@ -138,12 +177,6 @@ Table4Figures table4(const reproduction::ExperimentSet& e) {
   return {{e.step.metrics.settling_time_pct_s, e.linearity.metrics.linearity_zero_end_pct,
            e.repeat_5um.metrics.repeatability_nm, e.repeat_10um.metrics.repeatability_nm},
           e.table4_valid()};
-}
-
-double median(std::vector<double> v) {
-  std::sort(v.begin(), v.end());
-  const std::size_t n = v.size();
-  return n % 2 == 1 ? v[n / 2] : 0.5 * (v[n / 2 - 1] + v[n / 2]);
 }
 
 TEST(FringeCalibrationTable4, TheFringeCalibratedControllerScoresTable4WithinTheXl80sSpread) {
