@@ -1,6 +1,7 @@
 // `piezoshift calibrate`: the paper's three calibration stages on the twin, or guided on a bench
-// (--daq, --interferometer: calibration/guided_calibration.hpp), written as a calibration file
-// that `piezoshift run --calibration` loads.
+// (--daq, --interferometer: calibration/guided_calibration.hpp), or on the twin with the Fizeau's
+// fringes as the interferometer (--interferometer fizeau: calibrate_fizeau.hpp), written as a
+// calibration file that `piezoshift run --calibration` loads.
 #include <algorithm>
 #include <cstdio>
 #include <filesystem>
