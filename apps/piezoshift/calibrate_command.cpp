@@ -1,6 +1,7 @@
 // `piezoshift calibrate`: the paper's three calibration stages on the twin, or guided on a bench
-// (--daq, --interferometer: calibration/guided_calibration.hpp), written as a calibration file
-// that `piezoshift run --calibration` loads.
+// (--daq, --interferometer: calibration/guided_calibration.hpp), or on the twin with the Fizeau's
+// fringes as the interferometer (--interferometer fizeau: calibrate_fizeau.hpp), written as a
+// calibration file that `piezoshift run --calibration` loads.
 #include <algorithm>
 #include <cstdio>
 #include <filesystem>
@@ -13,6 +14,7 @@
 #include <fmt/core.h>
 #include <nlohmann/json.hpp>
 
+#include "calibrate_fizeau.hpp"
 #include "command.hpp"
 #include "improved_summary.hpp"
 #include "loop_setup.hpp"
@@ -48,7 +50,9 @@ struct Options {
   std::string controller = "paper";
   bool json = false;
   std::string daq;             //!< guided: sim or comedi[:DEVICE]
-  std::string interferometer;  //!< guided: prompt, file:PATH or sim
+  std::string interferometer;  //!< guided: prompt, file:PATH or sim; or fizeau (the fringes)
+  std::string camera;          //!< --interferometer fizeau: twin
+  std::string surface;         //!< --interferometer fizeau: the twin camera's test surface
   bool free_run = false;       //!< guided, sim-rt: the loop paced by the procedure
   bool restart = false;
   double max_zero_drift_um = calibration::GuidedOptions{}.max_zero_drift_um;
@@ -393,7 +397,33 @@ int run_improved(const Options& o, const runtime::InstallationConfig& installati
   return 0;
 }
 
+// --interferometer fizeau: what it cannot do is refused before anything runs.
+int run_fizeau(const Options& o) {
+  if (!o.daq.empty())
+    throw core::InputError(fmt::format(
+        "--interferometer fizeau with --daq {}: the calibration from fringes runs on the twin's "
+        "bench (no --daq); a guided or hardware loop with a camera is not built",
+        o.daq));
+  if (o.controller != "paper")
+    throw core::InputError(
+        "--controller improved: the calibration from fringes identifies the paper's controller "
+        "only (the improved controller's identification from fringes is not built)");
+  return calibrate_from_fringes_command({.out = o.out,
+                                         .config = o.config,
+                                         .pid = o.pid,
+                                         .camera = o.camera,
+                                         .surface = o.surface,
+                                         .seed = o.seed,
+                                         .json = o.json,
+                                         .max_physics_steps = o.max_physics_steps});
+}
+
 int run(const Options& o) {
+  if (o.interferometer == "fizeau")
+    return run_fizeau(o);
+  if (!o.camera.empty() || !o.surface.empty())
+    throw core::InputError(fmt::format("{}: the Fizeau's camera, for --interferometer fizeau only",
+                                       o.camera.empty() ? "--surface" : "--camera"));
   if (!o.daq.empty()) {
     if (o.controller != "paper")
       throw core::InputError(
@@ -402,7 +432,9 @@ int run(const Options& o) {
     return run_guided(o);
   }
   if (!o.interferometer.empty())
-    throw core::InputError("--interferometer needs --daq (the guided calibration)");
+    throw core::InputError(fmt::format(
+        "--interferometer {} needs --daq (the guided calibration); only fizeau runs without it",
+        o.interferometer));
   // [safety] too: every bench of the calibration is supervised as `run`'s loop is.
   const runtime::InstallationConfig installation =
       o.config.empty() ? runtime::InstallationConfig{}
@@ -490,7 +522,14 @@ void add_calibrate_command(CLI::App& app, Action& action) {
                   "the real-time loop)");
   cmd->add_option("--interferometer", o->interferometer,
                   "guided: prompt (readings typed on stdin), file:PATH (the interferometer "
-                  "software's CSV log, t_s,displacement_um) or sim (the twin's; not on comedi)");
+                  "software's CSV log, t_s,displacement_um) or sim (the twin's; not on comedi); "
+                  "or fizeau: stages 2 and 3 from the Fizeau's fringes on the twin (no --daq)");
+  cmd->add_option("--camera", o->camera,
+                  "--interferometer fizeau: the camera whose fringes are read (twin; "
+                  "docs/fizeau.md)");
+  cmd->add_option("--surface", o->surface,
+                  "--interferometer fizeau: the twin camera's test surface, as `psi simulate` "
+                  "takes it (Z4=40,rough=0.5)");
   cmd->add_flag("--free-run", o->free_run,
                 "guided, --daq sim-rt: the loop runs as fast as the CPU allows, paced by the "
                 "procedure (deterministic), instead of in real time");

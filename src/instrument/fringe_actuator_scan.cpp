@@ -1,5 +1,7 @@
 #include "piezoshift/instrument/fringe_actuator_scan.hpp"
 
+#include "piezoshift/instrument/fringe_piston_scan.hpp"
+
 #include <fmt/core.h>
 
 #include <chrono>
@@ -40,9 +42,14 @@ class Scan {
     camera_.start();
   }
 
-  // One pose: drive, settle, expose, track.
-  void take(const control::Vec3& target_um, bool reference, double settle_s) {
-    bench_.drive_actuators(target_um);
+  // One pose: drive (the inner loops alone, or the full controller to the points), settle,
+  // expose, track.
+  void take(const control::Vec3& target_um, bool reference, double settle_s,
+            bool drive_points = false) {
+    if (drive_points)
+      bench_.drive_points(target_um);
+    else
+      bench_.drive_actuators(target_um);
     bench_.run(settle_s);
     if (bench_.faulted()) {
       r_.validity.fail(fmt::format("the safety supervisor tripped ({}, channel {})",
@@ -54,6 +61,7 @@ class Scan {
     pose.frame = r_.poses.size();
     pose.reference = reference;
     pose.target_um = target_um;
+    pose.saturated_mask = bench_.last_output().saturated_mask;
     expose(pose);
     if (!ok())
       return;
@@ -148,6 +156,14 @@ class Scan {
   FringeActuatorScanResult r_;
 };
 
+void check_frame_size(const camera::Camera& camera, const psi::Mask& mask, const char* what) {
+  const camera::CameraSettings& cs = camera.settings();
+  if (cs.width_px != mask.width || cs.height_px != mask.height)
+    throw core::InputError(
+        fmt::format("{}: camera {} gives {}x{} px frames, the pupil's mask is {}x{}", what,
+                    camera.name(), cs.width_px, cs.height_px, mask.width, mask.height));
+}
+
 }  // namespace
 
 std::string fringe_actuator_scan_problem(const FringeActuatorScanParams& p) {
@@ -203,11 +219,7 @@ FringeActuatorScanResult run_fringe_actuator_scan(
     const std::function<void(rig::Bench&, const FringeScanPose&)>& at_pose) {
   if (const std::string why = fringe_actuator_scan_problem(p); !why.empty())
     throw core::InputError("fringe actuator scan: " + why);
-  const camera::CameraSettings& cs = camera.settings();
-  if (cs.width_px != mask.width || cs.height_px != mask.height)
-    throw core::InputError(fmt::format(
-        "fringe actuator scan: camera {} gives {}x{} px frames, the pupil's mask is {}x{}",
-        camera.name(), cs.width_px, cs.height_px, mask.width, mask.height));
+  check_frame_size(camera, mask, "fringe actuator scan");
   const auto w0 = Clock::now();
   const double t0 = bench.time_s();
   Scan scan(bench, camera, mask, p, at_pose);
@@ -242,6 +254,67 @@ FringeActuatorScanResult run_fringe_actuator_scan(
   r.simulated_time_s = bench.time_s() - t0;
   r.wall_time_s = seconds_since(w0);
   return std::move(r);
+}
+
+std::string fringe_piston_scan_problem(const FringePistonScanParams& p) {
+  const auto pos = [](double v) { return std::isfinite(v) && v > 0.0; };
+  if (p.reference_frames < 3)
+    return "reference_frames must be at least 3";
+  if (!pos(p.wavelength_nm) || !pos(p.reference_step_um) || !pos(p.frame_timeout_s))
+    return "wavelength_nm, reference_step_um and frame_timeout_s must be > 0";
+  if (!pos(p.max_pupil_step_nm) || p.max_pupil_step_nm > p.wavelength_nm / 4.0)
+    return "max_pupil_step_nm must be > 0 and below a quarter wave";
+  if (!std::isfinite(p.settle_s) || p.settle_s < 0.0 || !std::isfinite(p.initial_settle_s) ||
+      p.initial_settle_s < 0.0)
+    return "settle_s and initial_settle_s must be finite and >= 0";
+  if (!pos(p.max_um) || p.max_um <= (p.reference_frames - 1) * p.reference_step_um)
+    return "max_um must be finite and beyond the reference's last pose";
+  return "";
+}
+
+FringePistonScanResult run_fringe_piston_scan(rig::Bench& bench, camera::Camera& camera,
+                                              const psi::Mask& mask,
+                                              const FringePistonScanParams& p) {
+  if (const std::string why = fringe_piston_scan_problem(p); !why.empty())
+    throw core::InputError("fringe piston scan: " + why);
+  check_frame_size(camera, mask, "fringe piston scan");
+  const auto w0 = Clock::now();
+  const double t0 = bench.time_s();
+  // the actuator scan's machinery, with the fields a piston scan shares
+  FringeActuatorScanParams sp;
+  sp.reference_frames = p.reference_frames;
+  sp.wavelength_nm = p.wavelength_nm;
+  sp.frame_timeout_s = p.frame_timeout_s;
+  sp.tracker = p.tracker;
+  const std::function<void(rig::Bench&, const FringeScanPose&)> no_callback;  // Scan keeps a ref
+  Scan scan(bench, camera, mask, sp, no_callback);
+  const int w = p.reference_frames;
+  const double top_ref_um = (w - 1) * p.reference_step_um;
+  FringePistonScanResult r;
+  r.moves = static_cast<int>(std::ceil(1000.0 * (p.max_um - top_ref_um) / p.max_pupil_step_nm));
+  r.step_um = (p.max_um - top_ref_um) / r.moves;
+  const auto common = [](double z_um) { return control::Vec3{z_um, z_um, z_um}; };
+  bench.drive_points(common(0.0));
+  bench.run(p.initial_settle_s);
+  scan.start();
+  for (int k = 0; k < w && scan.ok(); ++k)
+    scan.take(common(k * p.reference_step_um), true, k == 0 ? 0.0 : p.settle_s, true);
+  for (int m = 1; m <= r.moves && scan.ok(); ++m)
+    scan.take(common(top_ref_um + r.step_um * m), false, p.settle_s, true);
+  camera.stop();
+  FringeActuatorScanResult& got = scan.result();
+  r.poses = std::move(got.poses);
+  r.tracker_wall_s = got.tracker_wall_s;
+  r.validity = got.validity;
+  if (!r.poses.empty()) {  // the truth relative to frame 0, as the fringes are
+    const control::Vec3 z0 = r.poses[0].truth_points_um;
+    for (FringeScanPose& q : r.poses)
+      for (std::size_t j = 0; j < 3; ++j)
+        q.truth_points_um[j] -= z0[j];
+  }
+  r.simulated_time_s = bench.time_s() - t0;
+  r.wall_time_s = seconds_since(w0);
+  return r;
 }
 
 }  // namespace piezoshift::instrument

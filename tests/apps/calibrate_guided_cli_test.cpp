@@ -158,7 +158,7 @@ TEST_F(GuidedCalibrateCli, BadOptionsExitTwoNamingTheOption) {
   EXPECT_NE(a.err.find("--interferometer laser"), std::string::npos) << a.err;
   const CliResult b = run("calibrate --interferometer sim --out '" + path("b.toml") + "'");
   EXPECT_EQ(b.status, 2);
-  EXPECT_NE(b.err.find("--interferometer needs --daq"), std::string::npos) << b.err;
+  EXPECT_NE(b.err.find("--interferometer sim needs --daq"), std::string::npos) << b.err;
   const CliResult c = run("calibrate --daq sim --interferometer 'file:" + path("none.csv") +
                           "' --out '" + path("c.toml") + "'");
   EXPECT_EQ(c.status, 2);

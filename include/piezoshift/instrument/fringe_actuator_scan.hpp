@@ -19,6 +19,7 @@
 // with valid = false and the first reason; the poses taken so far are kept.
 #include <array>
 #include <cstddef>
+#include <cstdint>
 #include <functional>
 #include <string>
 #include <vector>
@@ -54,10 +55,11 @@ std::string fringe_actuator_scan_problem(const FringeActuatorScanParams& p);
 
 struct FringeScanPose {
   std::size_t frame = 0;
-  bool reference = false;     //!< one of the first window's frames
-  control::Vec3 target_um{};  //!< S commanded
-  control::Vec3 sgs_um{};     //!< mean SGS feedback over the exposure
-  bool valid = false;         //!< the tracker resolved it (else points NaN, reason why)
+  bool reference = false;           //!< one of the first window's frames
+  control::Vec3 target_um{};        //!< S commanded (Z_d on a piston scan)
+  std::uint8_t saturated_mask = 0;  //!< the PIDs at their limits when the exposure began
+  control::Vec3 sgs_um{};           //!< mean SGS feedback over the exposure
+  bool valid = false;               //!< the tracker resolved it (else points NaN, reason why)
   std::string reason;
   control::Vec3 points_um{};        //!< P1..P3 from the fringes, relative to frame 0
   control::Vec3 truth_points_um{};  //!< the twin's P1..P3, mean over the exposure, from frame 0's

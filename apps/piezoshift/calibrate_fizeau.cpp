@@ -1,0 +1,136 @@
+#include "calibrate_fizeau.hpp"
+
+#include <fmt/core.h>
+
+#include <nlohmann/json.hpp>
+
+#include "command.hpp"
+#include "physics_budget.hpp"
+#include "piezoshift/calibration/calibration_cost.hpp"
+#include "piezoshift/calibration/calibration_file.hpp"
+#include "piezoshift/camera/instrument_config.hpp"
+#include "piezoshift/camera/make_camera.hpp"
+#include "piezoshift/camera/twin_camera.hpp"
+#include "piezoshift/core/input_error.hpp"
+#include "piezoshift/instrument/fringe_calibration.hpp"
+#include "piezoshift/psi/fizeau_simulation.hpp"
+#include "piezoshift/rig/validity.hpp"
+#include "progress_bar.hpp"
+
+namespace piezoshift::app {
+
+namespace {
+
+nlohmann::json rows(const control::Mat3& a) {
+  nlohmann::json j = nlohmann::json::array();
+  for (const auto& row : a)
+    j.push_back({row[0], row[1], row[2]});
+  return j;
+}
+
+std::size_t frames(const instrument::FringeCalibrationOutcome& r) {
+  std::size_t n = r.piston_scan.poses.size();
+  for (const auto& s : r.actuator_scans)
+    n += s.poses.size();
+  return n;
+}
+
+nlohmann::json outcome_json(const FizeauCalibrateRequest& q,
+                            const instrument::FringeCalibrationOutcome& r) {
+  nlohmann::json j;
+  j["calibration_file"] = q.out;
+  j["interferometer"] = "fizeau";
+  j["camera"] = "twin";
+  const auto& g = r.controller.gains;
+  const auto& p = r.controller.polynomial;
+  j["pid_gains"] = {{"kp", g.kp}, {"ki", g.ki}, {"kd", g.kd}};
+  j["A"] = rows(r.controller.matrix.a);
+  j["p"] = {p.p3, p.p2, p.p1, p.p0};
+  j["A_rms_residual_um"] = r.matrix.fit.rms_residual_um;
+  j["condition_number"] = r.matrix.fit.condition_number;
+  j["p_rms_residual_um"] = r.polynomial.fit.rms_residual_um;
+  j["p_points"] = r.polynomial.command_um.size();
+  j["p_skipped_commands"] = r.polynomial.saturated_points;
+  j["frames"] = frames(r);
+  j["stage2_simulated_s"] = r.stage2_simulated_s;
+  j["stage3_simulated_s"] = r.stage3_simulated_s;
+  j["wall_s"] = r.wall_time_s;
+  return j;
+}
+
+}  // namespace
+
+int calibrate_from_fringes_command(const FizeauCalibrateRequest& q) {
+  if (!q.camera.empty() && q.camera != "twin")
+    throw core::InputError(fmt::format(
+        "--camera {}: the calibration from fringes runs on the twin's bench with the twin camera "
+        "only (--camera twin); aravis:ID and files:DIR need the scans on a hardware loop, which "
+        "is not built",
+        q.camera));
+  const camera::InstrumentConfig ic =
+      q.config.empty() ? camera::InstrumentConfig{} : camera::load_instrument_config(q.config);
+  const psi::SurfaceSpec surface =
+      q.surface.empty() ? psi::SurfaceSpec{} : psi::parse_surface_spec(q.surface);
+  const config::ProjectConfig& config = ic.installation.project;
+  instrument::FringeCalibrationOptions fo;
+  // Stage 1 reads no interferometer: --pid paper keeps the paper's gains, scored alone (as `run`
+  // calibrates the twin; the XL-80 path's grid would keep the same gains); search runs the grid.
+  if (q.pid == "paper")
+    fo.stages = calibration::CalibrationOptions::paper_gains_only();
+  else
+    fo.stages.pid = calibration::PidChoice::kSearch;
+  fo.stages.limits = ic.installation.safety;
+  // The XL-80's stages bound the scans' (docs/fizeau.md) and the travel it adds is not run
+  // here: the check errs on the safe side.
+  check_procedure_cost("calibrate --interferometer fizeau",
+                       calibration::calibration_cost(fo.stages, config.twin.daq.sample_time_s),
+                       config.twin, q.max_physics_steps);
+  work_begins();  // the twin's scene, the stage, the camera
+  const double wavelength_nm = fo.wavelength_nm;
+  const camera::TwinScene scene = camera::make_twin_scene(
+      surface, camera::measurement_optics(ic.camera.settings, wavelength_nm), q.seed);
+  const std::unique_ptr<camera::Camera> cam = camera::make_camera("twin", ic.camera, &scene);
+  const instrument::FringeOptics optics{scene.mask, scene.fizeau.pupil_radius_m,
+                                        scene.fizeau.pupil_radius_m / scene.fizeau.pupil_radius_px};
+  control::SemiClosedLoopParams base;
+  base.sample_time_s = config.twin.daq.sample_time_s;
+  instrument::FringeCalibrationOutcome r;
+  {
+    ProgressBar bar(3);
+    r = instrument::calibrate_from_fringes(config, base, q.seed, *cam, optics, fo, bar.callback());
+  }
+  if (!r.validity.valid)
+    throw rig::ProcedureFailed("calibrate --interferometer fizeau: " + r.validity.reason +
+                               "; no calibration file written");
+  // No [travel]: Section 4.1's travel search reads the XL-80; `run` and `serve` then take the
+  // paper's travel (calibration_file.hpp).
+  calibration::write_calibration_file(
+      q.out, r.controller,
+      fmt::format("piezoshift calibration, identified on the digital twin by `piezoshift "
+                  "calibrate --interferometer fizeau --camera twin`\ninterferometer: the Fizeau's "
+                  "fringes (psi::FringeTracker, {} frames), not the XL-80; no optics moved\n"
+                  "seed {}, configuration: {}, PID gains: {}",
+                  frames(r), q.seed, q.config.empty() ? "built-in defaults" : q.config,
+                  q.pid == "paper" ? "the paper's" : "searched"));
+  if (q.json) {
+    fmt::print("{}\n", outcome_json(q, r).dump(2));
+    return 0;
+  }
+  const auto& g = r.controller.gains;
+  const auto& p = r.controller.polynomial;
+  fmt::print("stage 1  PID gains  kp {:g}, ki {:g}, kd {:g}\n", g.kp, g.ki, g.kd);
+  fmt::print(
+      "stage 2  matrix A from fringes (3 actuator scans, {:.1f} s simulated), cond(A) {:.3f}\n",
+      r.stage2_simulated_s, r.matrix.fit.condition_number);
+  for (const auto& row : r.controller.matrix.a)
+    fmt::print("           [{:8.4f} {:8.4f} {:8.4f}]\n", row[0], row[1], row[2]);
+  fmt::print(
+      "stage 3  cubic p from fringes ({} frames, {:.1f} s simulated)  p3 {:.4e}, p2 {:.4e}, p1 "
+      "{:.5f}, p0 {:.4f} um (rms {:.4f} um)\n",
+      r.polynomial.command_um.size(), r.stage3_simulated_s, p.p3, p.p2, p.p1, p.p0,
+      r.polynomial.fit.rms_residual_um);
+  fmt::print("written: {} (no [travel]: its search reads the XL-80)\n", q.out);
+  return 0;
+}
+
+}  // namespace piezoshift::app

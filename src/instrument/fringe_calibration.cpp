@@ -1,0 +1,148 @@
+#include "piezoshift/instrument/fringe_calibration.hpp"
+
+#include <fmt/core.h>
+
+#include <chrono>
+
+#include "piezoshift/calibration/fit_error.hpp"
+#include "piezoshift/calibration/matrix_fit.hpp"
+#include "piezoshift/calibration/pid_tuning.hpp"
+#include "piezoshift/calibration/poly_fit.hpp"
+
+namespace piezoshift::instrument {
+
+namespace {
+
+psi::FringeTrackerParams tracker(const FringeOptics& optics) {
+  psi::FringeTrackerParams t;
+  t.plate_m_per_px = optics.plate_m_per_px;
+  return t;
+}
+
+// Stage 2: the three actuators' scans on one bench, their ends stage 2's poses. False (and the
+// reason in out.validity) when a scan or the fit fails.
+bool stage2(rig::Bench& bench, camera::Camera& camera, const FringeOptics& optics,
+            const FringeCalibrationOptions& o, const rig::Progress& progress,
+            FringeCalibrationOutcome& out) {
+  const double t0 = bench.time_s();
+  for (std::size_t i = 0; i < 3; ++i) {
+    FringeActuatorScanParams p;
+    p.actuator = i;
+    p.base_um = o.stages.matrix.base_um;
+    p.move_um = o.stages.matrix.move_um;
+    p.wavelength_nm = o.wavelength_nm;
+    p.reference_step_um = 1e-3 * o.wavelength_nm / 8.0;
+    p.max_pupil_step_nm = o.max_pupil_step_nm;
+    p.settle_s = o.settle_s;
+    p.pupil_radius_m = optics.pupil_radius_m;
+    p.tracker = tracker(optics);
+    FringeActuatorScanResult& r = out.actuator_scans[i];
+    r = run_fringe_actuator_scan(bench, camera, optics.mask, p);
+    if (!r.validity.valid) {
+      out.validity.fail(
+          fmt::format("stage 2 (matrix A), actuator {}'s scan: {}", i + 1, r.validity.reason));
+      return false;
+    }
+    const ScanMatrixPose m = matrix_pose(r);
+    out.matrix.ds_um.push_back(m.ds_um);
+    out.matrix.dz_um.push_back(m.dz_um);
+    if (progress)
+      progress(static_cast<double>(i + 1), 3.0, "matrix A from fringes");
+  }
+  out.stage2_simulated_s = bench.time_s() - t0;
+  out.matrix.simulated_time_s = bench.time_s();
+  try {
+    out.matrix.fit = calibration::fit_transmission_matrix(out.matrix.ds_um, out.matrix.dz_um);
+  } catch (const calibration::FitError& e) {
+    out.validity.fail(fmt::format("stage 2 (matrix A): the scans cannot give A: {}", e.what()));
+    return false;
+  }
+  return true;
+}
+
+// Stage 3: the common scan with the gains and A in place, p the identity; every frame a point.
+bool stage3(rig::Bench& bench, camera::Camera& camera, const FringeOptics& optics,
+            const FringeCalibrationOptions& o, const rig::Progress& progress,
+            FringeCalibrationOutcome& out) {
+  control::SemiClosedLoopParams params = bench.controller_params();
+  params.polynomial = control::CubicPolynomial::identity();
+  bench.set_controller(params);
+  const double t0 = bench.time_s();
+  FringePistonScanParams p;
+  p.max_um = o.stages.polynomial.max_um;
+  p.wavelength_nm = o.wavelength_nm;
+  p.reference_step_um = 1e-3 * o.wavelength_nm / 8.0;
+  p.max_pupil_step_nm = o.max_pupil_step_nm;
+  p.settle_s = o.settle_s;
+  p.tracker = tracker(optics);
+  out.piston_scan = run_fringe_piston_scan(bench, camera, optics.mask, p);
+  const FringePistonScanResult& r = out.piston_scan;
+  out.stage3_simulated_s = bench.time_s() - t0;
+  if (!r.validity.valid) {
+    out.validity.fail(
+        fmt::format("stage 3 (polynomial p), the common scan: {}", r.validity.reason));
+    return false;
+  }
+  calibration::PolynomialIdentificationResult& poly = out.polynomial;
+  for (const FringeScanPose& q : r.poses) {
+    if (q.saturated_mask != 0) {
+      ++poly.saturated_points;
+      continue;
+    }
+    poly.command_um.push_back(q.target_um[0]);
+    poly.measured_um.push_back((q.points_um[0] + q.points_um[1] + q.points_um[2]) / 3.0);
+  }
+  poly.simulated_time_s = bench.time_s();
+  if (progress)
+    progress(1.0, 1.0, "polynomial p from fringes");
+  try {
+    poly.fit = calibration::fit_cubic_polynomial(poly.measured_um, poly.command_um);
+  } catch (const calibration::FitError& e) {
+    out.validity.fail(fmt::format("stage 3 (polynomial p): the scan cannot give p: {}", e.what()));
+    return false;
+  }
+  return true;
+}
+
+}  // namespace
+
+FringeCalibrationOutcome calibrate_from_fringes(const config::ProjectConfig& config,
+                                                const control::SemiClosedLoopParams& base,
+                                                std::uint64_t seed, camera::Camera& camera,
+                                                const FringeOptics& optics,
+                                                const FringeCalibrationOptions& o,
+                                                const rig::Progress& progress) {
+  const auto w0 = std::chrono::steady_clock::now();
+  FringeCalibrationOutcome out;
+  // Stage 1 as calibration::calibrate() runs it: no interferometer in it.
+  out.controller = base;
+  out.controller.gains_sample_time_s = base.sample_time_s;
+  if (o.stages.holding_gains) {
+    out.controller.gains = *o.stages.holding_gains;
+  } else {
+    calibration::PidTuningOptions pid_tuning = o.stages.pid_tuning;
+    pid_tuning.limits = o.stages.limits;
+    out.pid = calibration::tune_pid(config, base, seed, pid_tuning, progress);
+    out.controller.gains =
+        o.stages.pid == calibration::PidChoice::kPaper ? out.pid.paper.gains : out.pid.best.gains;
+  }
+  out.controller.polynomial = control::CubicPolynomial::identity();
+  out.controller.matrix = control::TransmissionMatrix::identity();
+  const rig::BenchOptions bo{rig::Feedback::kGauges, o.stages.limits};
+  bool ok = false;
+  {
+    rig::Bench bench(config, out.controller, seed + 1, bo);
+    ok = stage2(bench, camera, optics, o, progress, out);
+  }
+  if (ok) {
+    out.controller.matrix = out.matrix.fit.a;
+    rig::Bench bench(config, out.controller, seed + 2, bo);
+    ok = stage3(bench, camera, optics, o, progress, out);
+  }
+  if (ok)
+    out.controller.polynomial = out.polynomial.fit.p;
+  out.wall_time_s = std::chrono::duration<double>(std::chrono::steady_clock::now() - w0).count();
+  return out;
+}
+
+}  // namespace piezoshift::instrument
