@@ -304,12 +304,17 @@ int measure(const MeasureOptions& o) {
                     .mask = &mask,
                     .truth_nm = s.scene ? &s.scene->surface_nm : nullptr,
                     .error_rms_nm = std::nullopt,
-                    .ideal_error_rms_nm = std::nullopt};
+                    .ideal_error_rms_nm = std::nullopt,
+                    .floor_error_rms_nm = std::nullopt};
   if (s.scene) {
     rec.error_rms_nm = psi::surface_error_rms_nm(a.surface_nm, s.scene->surface_nm, a.valid);
     rec.ideal_error_rms_nm =
         instrument::ideal_stage_error_rms_nm(*s.scene, s.config.camera, s.params, ao);
   }
+  // The twin camera's frame ids are its noise draws' (the fed Aravis camera's are Aravis's).
+  if (s.scene && o.camera == "twin")
+    rec.floor_error_rms_nm =
+        instrument::ideal_measurement_error_rms_nm(*s.scene, s.config.camera, s.params, r, ao);
   if (!a.converged) {
     if (o.json)
       fmt::print("{}\n", measure_json(rec).dump(2));

@@ -34,6 +34,11 @@ io::Panel panel(std::string title, std::string x_label, std::string y_label) {
   return p;
 }
 
+// What the stage added to the floor, in quadrature; 0 when the measurement is at its floor.
+double stage_error_nm(double measured_nm, double floor_nm) {
+  return std::sqrt(std::max(0.0, measured_nm * measured_nm - floor_nm * floor_nm));
+}
+
 Json number_or_null(double v) {
   return std::isfinite(v) ? Json(v) : Json(nullptr);
 }
@@ -195,6 +200,11 @@ std::string report_markdown(const MeasureRecord& r) {
         "| the same frames from an ideal stage (camera and algorithm floor, one average) | "
         "{:.3f} nm |\n",
         *r.ideal_error_rms_nm);
+  if (r.floor_error_rms_nm && r.error_rms_nm)
+    md += fmt::format(
+        "| the whole measurement from an ideal stage (its floor) / what the stage added, "
+        "sqrt(measured^2 - floor^2) | {:.3f} / {:.3f} nm |\n",
+        *r.floor_error_rms_nm, stage_error_nm(*r.error_rms_nm, *r.floor_error_rms_nm));
   if (const std::optional<double> path =
           instrument::path_error_rms_nm(s, r.params->steps_rad.size()))
     md += fmt::format(
@@ -260,6 +270,10 @@ Json measure_json(const MeasureRecord& r) {
          {"zernike_nm", a.zernike_nm},
          {"error_rms_nm", r.error_rms_nm ? Json(*r.error_rms_nm) : Json(nullptr)},
          {"ideal_error_rms_nm", r.ideal_error_rms_nm ? Json(*r.ideal_error_rms_nm) : Json(nullptr)},
+         {"floor_error_rms_nm", r.floor_error_rms_nm ? Json(*r.floor_error_rms_nm) : Json(nullptr)},
+         {"stage_error_rms_nm", r.floor_error_rms_nm && r.error_rms_nm
+                                    ? Json(stage_error_nm(*r.error_rms_nm, *r.floor_error_rms_nm))
+                                    : Json(nullptr)},
          {"timing",
           {{"wall_time_s", s.wall_time_s},
            {"floor_s", s.floor_s},

@@ -27,6 +27,9 @@ struct MeasureRecord {
   std::optional<double> error_rms_nm;  //!< measured - truth, piston and tilt removed
   //! The same frames from an ideal stage (the camera's and the algorithm's floor, one average).
   std::optional<double> ideal_error_rms_nm;
+  //! The same over the whole measurement, every exposure with its own frame's noise draws
+  //! (twin camera): the floor the stage's error adds to.
+  std::optional<double> floor_error_rms_nm;
 };
 
 //! The summary measure prints with --json and writes as measurement.json.
