@@ -58,13 +58,6 @@ struct Options {
   double max_zero_drift_um = calibration::GuidedOptions{}.max_zero_drift_um;
 };
 
-nlohmann::json matrix_json(const control::Mat3& a) {
-  nlohmann::json rows = nlohmann::json::array();
-  for (const auto& row : a)
-    rows.push_back({row[0], row[1], row[2]});
-  return rows;
-}
-
 std::string session_path(const std::string& out) {
   return std::filesystem::path(out).replace_extension(".session.json").string();
 }

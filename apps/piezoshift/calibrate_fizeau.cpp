@@ -21,13 +21,6 @@ namespace piezoshift::app {
 
 namespace {
 
-nlohmann::json rows(const control::Mat3& a) {
-  nlohmann::json j = nlohmann::json::array();
-  for (const auto& row : a)
-    j.push_back({row[0], row[1], row[2]});
-  return j;
-}
-
 std::size_t frames(const instrument::FringeCalibrationOutcome& r) {
   std::size_t n = r.piston_scan.poses.size();
   for (const auto& s : r.actuator_scans)
@@ -44,7 +37,7 @@ nlohmann::json outcome_json(const FizeauCalibrateRequest& q,
   const auto& g = r.controller.gains;
   const auto& p = r.controller.polynomial;
   j["pid_gains"] = {{"kp", g.kp}, {"ki", g.ki}, {"kd", g.kd}};
-  j["A"] = rows(r.controller.matrix.a);
+  j["A"] = matrix_json(r.controller.matrix.a);
   j["p"] = {p.p3, p.p2, p.p1, p.p0};
   j["A_rms_residual_um"] = r.matrix.fit.rms_residual_um;
   j["condition_number"] = r.matrix.fit.condition_number;
@@ -59,6 +52,13 @@ nlohmann::json outcome_json(const FizeauCalibrateRequest& q,
 }
 
 }  // namespace
+
+nlohmann::json matrix_json(const control::Mat3& a) {
+  nlohmann::json rows = nlohmann::json::array();
+  for (const auto& row : a)
+    rows.push_back({row[0], row[1], row[2]});
+  return rows;
+}
 
 int calibrate_from_fringes_command(const FizeauCalibrateRequest& q) {
   if (!q.camera.empty() && q.camera != "twin")

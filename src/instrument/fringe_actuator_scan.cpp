@@ -18,6 +18,16 @@ namespace {
 
 using Clock = std::chrono::steady_clock;
 
+// The truth relative to frame 0, as the fringes are.
+void truth_from_first_frame(std::vector<FringeScanPose>& poses) {
+  if (poses.empty())
+    return;
+  const control::Vec3 z0 = poses.front().truth_points_um;
+  for (FringeScanPose& q : poses)
+    for (std::size_t j = 0; j < 3; ++j)
+      q.truth_points_um[j] -= z0[j];
+}
+
 double seconds_since(Clock::time_point t0) {
   return std::chrono::duration<double>(Clock::now() - t0).count();
 }
@@ -245,12 +255,7 @@ FringeActuatorScanResult run_fringe_actuator_scan(
     scan.take(s, false, p.settle_s);
   }
   camera.stop();
-  if (!r.poses.empty()) {  // the truth relative to frame 0, as the fringes are
-    const control::Vec3 z0 = r.poses[0].truth_points_um;
-    for (FringeScanPose& q : r.poses)
-      for (std::size_t j = 0; j < 3; ++j)
-        q.truth_points_um[j] -= z0[j];
-  }
+  truth_from_first_frame(r.poses);
   r.simulated_time_s = bench.time_s() - t0;
   r.wall_time_s = seconds_since(w0);
   return std::move(r);
@@ -306,12 +311,7 @@ FringePistonScanResult run_fringe_piston_scan(rig::Bench& bench, camera::Camera&
   r.poses = std::move(got.poses);
   r.tracker_wall_s = got.tracker_wall_s;
   r.validity = got.validity;
-  if (!r.poses.empty()) {  // the truth relative to frame 0, as the fringes are
-    const control::Vec3 z0 = r.poses[0].truth_points_um;
-    for (FringeScanPose& q : r.poses)
-      for (std::size_t j = 0; j < 3; ++j)
-        q.truth_points_um[j] -= z0[j];
-  }
+  truth_from_first_frame(r.poses);
   r.simulated_time_s = bench.time_s() - t0;
   r.wall_time_s = seconds_since(w0);
   return r;

@@ -67,6 +67,17 @@ class MeasureCli : public testing::CliTest {
     EXPECT_EQ(r.err.find("internal error"), std::string::npos) << r.err;
     return r.out.empty() ? Json() : Json::parse(r.out, nullptr, false);
   }
+  // The improved controller calibrated on the twin, and a 96 px camera with the cavity's drift in
+  // the fringes: the options of a measurement with both.
+  std::string improved_with_drift() {
+    const testing::CliResult cal =
+        run("calibrate --controller improved --out '" + path("cal/improved.toml") + "'");
+    EXPECT_EQ(cal.status, 0) << cal.err;
+    const std::string cfg = write("drift.toml",
+                                  "[camera]\nwidth_px = 96\nheight_px = 96\n"
+                                  "[twin.cavity]\nin_fringes = true\n");
+    return "--calibration '" + path("cal/improved.toml") + "' --config '" + cfg + "' ";
+  }
   void refused(const std::string& args, const std::string& piece) {
     const testing::CliResult r = run("measure --free-run " + args);
     EXPECT_EQ(r.status, 2) << args << "\n" << r.err;
@@ -206,14 +217,7 @@ TEST_F(MeasureCli, FringesLostMidSequenceAreTakenAgainAndNoFrameIsLost) {
 // own noise draws (floor_error_rms_nm). Measured: 0.0865 nm unlocked, 0.0140 nm locked (seeds 1
 // to 8: 0.09 to 0.44 of the unlocked; docs/fizeau.md).
 TEST_F(MeasureCli, TheLockHalvesWhatTheDriftingStageAddsToTheSurface) {
-  const testing::CliResult cal =
-      run("calibrate --controller improved --out '" + path("cal/improved.toml") + "'");
-  ASSERT_EQ(cal.status, 0) << cal.err;
-  const std::string cfg = write("drift.toml",
-                                "[camera]\nwidth_px = 96\nheight_px = 96\n"
-                                "[twin.cavity]\nin_fringes = true\n");
-  const std::string common =
-      "--calibration '" + path("cal/improved.toml") + "' --config '" + cfg + "' --averages 20 ";
+  const std::string common = improved_with_drift() + "--averages 20 ";
   const Json off = measure(common + "--out '" + path("off") + "'");
   const Json on = measure(common + "--lock --out '" + path("on") + "'");
   ASSERT_TRUE(off.is_object() && on.is_object());
@@ -237,14 +241,7 @@ TEST_F(MeasureCli, TheLockHalvesWhatTheDriftingStageAddsToTheSurface) {
 // controller cannot be held so close frame by frame: its own jitter from one 1 ms exposure to
 // the next is above the bound (0.54 nm locked; docs/fizeau.md).
 TEST_F(MeasureCli, TheLockHoldsTheCavityWithinAFifthOfANanometreOverAMinute) {
-  const testing::CliResult cal =
-      run("calibrate --controller improved --out '" + path("cal/improved.toml") + "'");
-  ASSERT_EQ(cal.status, 0) << cal.err;
-  const std::string cfg = write("drift.toml",
-                                "[camera]\nwidth_px = 96\nheight_px = 96\n"
-                                "[twin.cavity]\nin_fringes = true\n");
-  const std::string common =
-      "--calibration '" + path("cal/improved.toml") + "' --config '" + cfg + "' --hold-s 60 ";
+  const std::string common = improved_with_drift() + "--hold-s 60 ";
   const Json off = measure(common + "--out '" + path("off") + "'");
   const Json on = measure(common + "--lock --out '" + path("on") + "'");
   ASSERT_TRUE(off.is_object() && on.is_object());
