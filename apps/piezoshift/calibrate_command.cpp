@@ -19,6 +19,7 @@
 #include "improved_summary.hpp"
 #include "loop_setup.hpp"
 #include "loop_stack.hpp"
+#include "paper_summary.hpp"
 #include "physics_budget.hpp"
 #include "piezoshift/calibration/calibration_cost.hpp"
 #include "piezoshift/calibration/calibration_file.hpp"
@@ -231,21 +232,13 @@ FitDataFiles write_fit_data(const std::string& out, const calibration::GuidedOut
 nlohmann::json guided_json(const Options& o, const calibration::GuidedOutcome& r,
                            const FitDataFiles& files, const std::string& session_file,
                            std::size_t steps) {
-  nlohmann::json j;
+  nlohmann::json j = paper_calibration_json(r.controller, r.matrix, r.polynomial);
   j["calibration_file"] = o.out;
   j["session_file"] = session_file;
   j["matrix_poses_file"] = files.poses;
   j["polynomial_points_file"] = files.points;
   j["readings_taken"] = r.taken;
   j["steps"] = steps;
-  const auto& g = r.controller.gains;
-  const auto& p = r.controller.polynomial;
-  j["pid_gains"] = {{"kp", g.kp}, {"ki", g.ki}, {"kd", g.kd}};
-  j["A"] = matrix_json(r.controller.matrix.a);
-  j["p"] = {p.p3, p.p2, p.p1, p.p0};
-  j["A_rms_residual_um"] = r.matrix.fit.rms_residual_um;
-  j["condition_number"] = r.matrix.fit.condition_number;
-  j["p_rms_residual_um"] = r.polynomial.fit.rms_residual_um;
   j["p_skipped_commands"] = r.polynomial.saturated_points;
   return j;
 }
@@ -457,18 +450,11 @@ int run(const Options& o) {
                   o.pid == "paper" ? "the paper's" : "searched"),
       travel.single_move_um, travel.single_move_min_um);
   const auto& g = c.controller.gains;
-  const auto& p = c.controller.polynomial;
   if (o.json) {
-    nlohmann::json j;
+    nlohmann::json j = paper_calibration_json(c.controller, c.matrix, c.polynomial);
     j["calibration_file"] = o.out;
-    j["pid_gains"] = {{"kp", g.kp}, {"ki", g.ki}, {"kd", g.kd}};
     j["pid_worst_overshoot_pct"] =
         (o.pid == "paper" ? c.pid.paper : c.pid.best).worst.overshoot_pct;
-    j["A"] = matrix_json(c.controller.matrix.a);
-    j["p"] = {p.p3, p.p2, p.p1, p.p0};
-    j["A_rms_residual_um"] = c.matrix.fit.rms_residual_um;
-    j["condition_number"] = c.matrix.fit.condition_number;
-    j["p_rms_residual_um"] = c.polynomial.fit.rms_residual_um;
     j["travel_z_max_um"] = travel.single_move_um;
     j["travel_semi_closed_um"] = travel.semi_closed_um;
     j["travel_z_min_um"] = travel.single_move_min_um;

@@ -5,6 +5,7 @@
 #include <nlohmann/json.hpp>
 
 #include "command.hpp"
+#include "paper_summary.hpp"
 #include "physics_budget.hpp"
 #include "piezoshift/calibration/calibration_cost.hpp"
 #include "piezoshift/calibration/calibration_file.hpp"
@@ -30,18 +31,10 @@ std::size_t frames(const instrument::FringeCalibrationOutcome& r) {
 
 nlohmann::json outcome_json(const FizeauCalibrateRequest& q,
                             const instrument::FringeCalibrationOutcome& r) {
-  nlohmann::json j;
+  nlohmann::json j = paper_calibration_json(r.controller, r.matrix, r.polynomial);
   j["calibration_file"] = q.out;
   j["interferometer"] = "fizeau";
   j["camera"] = "twin";
-  const auto& g = r.controller.gains;
-  const auto& p = r.controller.polynomial;
-  j["pid_gains"] = {{"kp", g.kp}, {"ki", g.ki}, {"kd", g.kd}};
-  j["A"] = matrix_json(r.controller.matrix.a);
-  j["p"] = {p.p3, p.p2, p.p1, p.p0};
-  j["A_rms_residual_um"] = r.matrix.fit.rms_residual_um;
-  j["condition_number"] = r.matrix.fit.condition_number;
-  j["p_rms_residual_um"] = r.polynomial.fit.rms_residual_um;
   j["p_points"] = r.polynomial.command_um.size();
   j["p_skipped_commands"] = r.polynomial.saturated_points;
   j["frames"] = frames(r);
@@ -52,13 +45,6 @@ nlohmann::json outcome_json(const FizeauCalibrateRequest& q,
 }
 
 }  // namespace
-
-nlohmann::json matrix_json(const control::Mat3& a) {
-  nlohmann::json rows = nlohmann::json::array();
-  for (const auto& row : a)
-    rows.push_back({row[0], row[1], row[2]});
-  return rows;
-}
 
 int calibrate_from_fringes_command(const FizeauCalibrateRequest& q) {
   if (!q.camera.empty() && q.camera != "twin")
@@ -90,8 +76,7 @@ int calibrate_from_fringes_command(const FizeauCalibrateRequest& q) {
   const camera::TwinScene scene = camera::make_twin_scene(
       surface, camera::measurement_optics(ic.camera.settings, wavelength_nm), q.seed);
   const std::unique_ptr<camera::Camera> cam = camera::make_camera("twin", ic.camera, &scene);
-  const instrument::FringeOptics optics{scene.mask, scene.fizeau.pupil_radius_m,
-                                        scene.fizeau.pupil_radius_m / scene.fizeau.pupil_radius_px};
+  const instrument::FringeOptics optics = instrument::twin_optics(scene);
   control::SemiClosedLoopParams base;
   base.sample_time_s = config.twin.daq.sample_time_s;
   instrument::FringeCalibrationOutcome r;

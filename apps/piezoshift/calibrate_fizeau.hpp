@@ -5,10 +5,6 @@
 #include <cstdint>
 #include <string>
 
-#include <nlohmann/json.hpp>
-
-#include "piezoshift/control/vec3.hpp"
-
 namespace piezoshift::app {
 
 struct FizeauCalibrateRequest {
@@ -21,9 +17,6 @@ struct FizeauCalibrateRequest {
   bool json = false;
   double max_physics_steps = 0.0;
 };
-
-//! A's rows as a JSON array of arrays (every `calibrate` summary prints A so).
-nlohmann::json matrix_json(const control::Mat3& a);
 
 //! Throws core::InputError for what it cannot do (a camera other than the twin), and
 //! rig::ProcedureFailed, naming the stage and the frame, when a scan fails.

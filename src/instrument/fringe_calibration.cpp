@@ -106,6 +106,11 @@ bool stage3(rig::Bench& bench, camera::Camera& camera, const FringeOptics& optic
 
 }  // namespace
 
+FringeOptics twin_optics(const camera::TwinScene& scene) {
+  return {scene.mask, scene.fizeau.pupil_radius_m,
+          scene.fizeau.pupil_radius_m / scene.fizeau.pupil_radius_px};
+}
+
 FringeCalibrationOutcome calibrate_from_fringes(const config::ProjectConfig& config,
                                                 const control::SemiClosedLoopParams& base,
                                                 std::uint64_t seed, camera::Camera& camera,

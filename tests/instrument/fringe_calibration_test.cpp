@@ -99,8 +99,7 @@ std::optional<SeedFigures> one_seed(const Plant& pl, std::uint64_t seed) {
       psi::SurfaceSpec{}, camera::measurement_optics(settings, 632.8), seed);
   camera::TwinCamera cam(scene, psi::CameraParams{});
   cam.configure(settings);
-  const FringeOptics optics{scene.mask, scene.fizeau.pupil_radius_m,
-                            scene.fizeau.pupil_radius_m / scene.fizeau.pupil_radius_px};
+  const FringeOptics optics = twin_optics(scene);
   control::SemiClosedLoopParams base;
   base.sample_time_s = pl.config.twin.daq.sample_time_s;
   const FringeCalibrationOutcome f =
@@ -215,8 +214,7 @@ TEST(FringeCalibrationTable4, TheFringeCalibratedControllerScoresTable4WithinThe
         psi::SurfaceSpec{}, camera::measurement_optics(settings, 632.8), seed);
     camera::TwinCamera cam(scene, psi::CameraParams{});
     cam.configure(settings);
-    const FringeOptics optics{scene.mask, scene.fizeau.pupil_radius_m,
-                              scene.fizeau.pupil_radius_m / scene.fizeau.pupil_radius_px};
+    const FringeOptics optics = twin_optics(scene);
     const FringeCalibrationOutcome f =
         calibrate_from_fringes(config, base, seed, cam, optics, paper_gains());
     ASSERT_TRUE(f.validity.valid) << "seed " << seed << ": " << f.validity.reason;

@@ -21,6 +21,7 @@
 
 #include "piezoshift/calibration/calibration_procedure.hpp"
 #include "piezoshift/camera/camera.hpp"
+#include "piezoshift/camera/twin_camera.hpp"
 #include "piezoshift/config/project_config.hpp"
 #include "piezoshift/instrument/fringe_actuator_scan.hpp"
 #include "piezoshift/instrument/fringe_piston_scan.hpp"
@@ -36,6 +37,9 @@ struct FringeOptics {
   double pupil_radius_m = 0.025;          //!< FizeauParams::pupil_radius_m
   double plate_m_per_px = 0.025 / 120.0;  //!< pupil_radius_m / FizeauParams::pupil_radius_px
 };
+
+//! The twin camera's: its scene's mask and Fizeau optics.
+FringeOptics twin_optics(const camera::TwinScene& scene);
 
 struct FringeCalibrationOptions {
   //! Stage 1's choice and grid, the supervisor's limits, stage 2's base and move and stage 3's

@@ -1,0 +1,26 @@
+#include "paper_summary.hpp"
+
+namespace piezoshift::app {
+
+nlohmann::json matrix_json(const control::Mat3& a) {
+  nlohmann::json rows = nlohmann::json::array();
+  for (const auto& row : a)
+    rows.push_back({row[0], row[1], row[2]});
+  return rows;
+}
+
+nlohmann::json paper_calibration_json(
+    const control::SemiClosedLoopParams& controller,
+    const calibration::MatrixIdentificationResult& matrix,
+    const calibration::PolynomialIdentificationResult& polynomial) {
+  const auto& g = controller.gains;
+  const auto& p = controller.polynomial;
+  return {{"pid_gains", {{"kp", g.kp}, {"ki", g.ki}, {"kd", g.kd}}},
+          {"A", matrix_json(controller.matrix.a)},
+          {"p", {p.p3, p.p2, p.p1, p.p0}},
+          {"A_rms_residual_um", matrix.fit.rms_residual_um},
+          {"condition_number", matrix.fit.condition_number},
+          {"p_rms_residual_um", polynomial.fit.rms_residual_um}};
+}
+
+}  // namespace piezoshift::app
