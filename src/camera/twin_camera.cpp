@@ -53,6 +53,20 @@ struct TwinCamera::Slot {
   std::int64_t system_timestamp_ns = 0;
 };
 
+void render_twin_counts(const TwinScene& scene, const psi::CameraParams& sensor, double gain_dB,
+                        std::span<const psi::PoseSample> poses, std::uint64_t frame_id,
+                        std::vector<std::uint16_t>& counts) {
+  plant::Rng rng(frame_seed(scene.seed, frame_id));
+  const psi::Map m =
+      psi::render_frame(scene.surface_nm, scene.mask, scene.fizeau, sensor, poses, rng);
+  // Gain after quantisation, as a digital gain.
+  const double gain = std::pow(10.0, gain_dB / 20.0);
+  const double top = std::ldexp(1.0, sensor.bit_depth) - 1.0;
+  counts.resize(m.size());
+  for (std::size_t p = 0; p < m.size(); ++p)
+    counts[p] = static_cast<std::uint16_t>(std::min(top, std::round(m.v[p] * gain)));
+}
+
 std::uint64_t frame_seed(std::uint64_t seed, std::uint64_t frame_id) noexcept {
   // splitmix64 of the seed, then of that xor the frame id: neighbouring seeds and ids give
   // unrelated streams
@@ -246,20 +260,13 @@ void TwinCamera::render(Slot& s) noexcept {
           "buffer holds exposure_s x {} Hz + 2): ticks faster than the twin camera allows",
           s.frame_id, pose_capacity_, settings_.exposure_s, scene_.max_tick_rate_Hz);
     } else {
-      plant::Rng rng(frame_seed(scene_.seed, s.frame_id));
       psi::CameraParams sensor = sensor_;
       if (scene_.fringe_loss_start_s >= 0.0 && s.trigger_time_s >= scene_.fringe_loss_start_s &&
           s.trigger_time_s < scene_.fringe_loss_start_s + scene_.fringe_loss_s)
         sensor.visibility = 0.0;
-      const psi::Map m =
-          psi::render_frame(scene_.surface_nm, scene_.mask, scene_.fizeau, sensor,
-                            std::span<const psi::PoseSample>(s.poses.data(), s.n_poses), rng);
-      // Gain after quantisation, as a digital gain: 0 dB leaves render_frame's counts as they are.
-      const double gain = std::pow(10.0, settings_.gain_dB / 20.0);
-      const double top = std::ldexp(1.0, sensor_.bit_depth) - 1.0;
-      s.counts.resize(m.size());
-      for (std::size_t p = 0; p < m.size(); ++p)
-        s.counts[p] = static_cast<std::uint16_t>(std::min(top, std::round(m.v[p] * gain)));
+      render_twin_counts(scene_, sensor, settings_.gain_dB,
+                         std::span<const psi::PoseSample>(s.poses.data(), s.n_poses), s.frame_id,
+                         s.counts);
       s.status = FrameStatus::kOk;
     }
   } catch (const std::exception& e) {

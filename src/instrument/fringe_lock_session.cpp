@@ -53,7 +53,7 @@ FringeLockSession::FringeLockSession(const LockSetup& setup, const SequenceParam
 kinematics::PointDisplacements FringeLockSession::points_um(double base_um,
                                                             double commanded_piston_nm,
                                                             std::size_t step) {
-  const control::FringeAxes c = locks_.at(holding_ ? 0 : step).correction();
+  const control::FringeAxes c = locks_.at(step).correction();
   applied_by_move_.push_back(c);
   return s_.tripod->inverse({base_um + 1e-3 * (commanded_piston_nm + c[0]), c[1], c[2]});
 }
@@ -98,7 +98,7 @@ void FringeLockSession::on_frame(const camera::Frame& frame, ExposureRecord& rec
   start.theta_y_urad += applied[2] - last_applied_[2];
   const psi::FramePose m =
       psi::fit_frame_pose(frame_maps({frame}).front(), *reference_, start, s_.pose);
-  control::FringeLock& lock = locks_.at(holding_ ? 0 : static_cast<std::size_t>(rec.frame));
+  control::FringeLock& lock = locks_.at(static_cast<std::size_t>(rec.frame));
   if (!holding_)  // the hold's set point is frame 0's pose (begin_hold)
     lock.set_point({rec.commanded_piston_nm, 0.0, 0.0});
   lock.update({m.piston_nm, m.theta_x_urad, m.theta_y_urad}, m.valid);

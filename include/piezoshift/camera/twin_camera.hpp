@@ -30,6 +30,7 @@
 #include <atomic>
 #include <cstdint>
 #include <memory>
+#include <span>
 #include <string>
 #include <thread>
 #include <vector>
@@ -66,6 +67,14 @@ struct TwinScene {
 //! core::InputError for optics out of range (psi::fizeau_problem).
 TwinScene make_twin_scene(const psi::SurfaceSpec& surface, const psi::FizeauParams& fizeau,
                           std::uint64_t seed);
+
+//! Frame frame_id of the scene seen from poses, as the twin camera counts it: psi::render_frame
+//! with the frame's noise draws (frame_seed(scene.seed, frame_id)), then the digital gain after
+//! quantisation (0 dB leaves the counts as they are), rounded and clipped to 2^bit_depth - 1.
+//! The twin camera's frames and the floor of a measurement (instrument/twin_floor.hpp) both.
+void render_twin_counts(const TwinScene& scene, const psi::CameraParams& sensor, double gain_dB,
+                        std::span<const psi::PoseSample> poses, std::uint64_t frame_id,
+                        std::vector<std::uint16_t>& counts);
 
 //! The optics a measurement renders a camera's frames with: the frame's size, a pupil of 0.47 of
 //! its shorter side (`psi simulate`'s proportion), wavelength_nm; the rest psi's defaults.
