@@ -22,7 +22,9 @@ void config_input(std::string_view data) {
 void calibration_input(std::string_view data) {
   try {
     std::optional<double> z_max, z_min;
-    calibration::load_calibration_file(scratch_file("calibration.toml", data), &z_max, &z_min);
+    std::optional<control::FringeLockParams> lock;  // the [fringe_lock] reader too
+    calibration::load_calibration_file(scratch_file("calibration.toml", data), &z_max, &z_min,
+                                       &lock);
   } catch (const core::InputError&) {
   }
 }

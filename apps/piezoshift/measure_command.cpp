@@ -164,26 +164,33 @@ void check_options(const MeasureOptions& o) {
         "--surface: the test surface of the twin camera (or of aravis:Fake_1 on --daq sim)");
 }
 
-// The fringe lock needs the pupil before the first frame: the twin's scene has it.
+// The fringe lock (--lock, or the calibration's [controller] outer = "fringes" with its
+// [fringe_lock] parameters) needs the pupil before the first frame: the twin's scene has it.
 instrument::LockSetup lock_setup(const MeasureOptions& o, const MeasureSetup& s) {
+  const std::string who =
+      o.lock ? std::string("--lock")
+             : fmt::format("{}: [controller] outer = \"fringes\"", s.calibration.source);
   if (!s.scene)
     throw core::InputError(fmt::format(
-        "--lock: the lock needs the pupil on the camera before the sequence; with camera {} "
+        "{}: the lock needs the pupil on the camera before the sequence; with camera {} "
         "that is not built yet (--camera twin)",
-        o.camera));
+        who, o.camera));
   // Each frame's fit (about 5 ms at 256 px) runs where the sequence takes its frames, which on
   // a real-time clock is between the loop's ticks: it would make them overrun.
   if (!o.free_run)
     throw core::InputError(
-        "--lock: the lock's fit runs on the loop's thread, about 5 ms a frame, which a real-time "
+        who +
+        ": the lock's fit runs on the loop's thread, about 5 ms a frame, which a real-time "
         "loop at 1 kHz cannot spare; use --free-run until it runs on a thread of its own");
   instrument::LockSetup l;
+  if (s.calibration.fringe_lock)
+    l.lock = *s.calibration.fringe_lock;
   l.mask = s.scene->mask;
   l.pupil_radius_m = s.scene->fizeau.pupil_radius_m;
   l.tripod.emplace(plant::make_twin_geometry(s.config.installation.project.twin.geometry).points);
   l.retake_s = o.lock_retake_s;
   if (const std::string why = instrument::lock_problem(l, s.params); !why.empty())
-    throw core::InputError("--lock: " + why);
+    throw core::InputError(who + ": " + why);
   return l;
 }
 
@@ -261,13 +268,13 @@ int measure(const MeasureOptions& o) {
   work_begins();  // the twin's scene, the stage, the camera
   if (o.camera == "twin" || fed_by_twin(o))
     s.scene = twin_scene(o, s.config.camera, wavelength_nm);
-  if (o.lock)
-    s.params.lock = lock_setup(o, s);
   LoopStack stack(stack_options(o), s.config.installation.project);
   if (s.params.trigger == instrument::TriggerMode::kLine && !stack.daq().has_trigger_line())
     throw core::InputError(fmt::format("--trigger line: DAQ {} has no trigger line", stack.name()));
   s.calibration = resolve_calibration(o.calibration, o.daq, s.config.installation.project, o.seed,
                                       1.0 / o.rate_Hz, o.max_physics_steps);
+  if (o.lock || s.calibration.fringe_lock)
+    s.params.lock = lock_setup(o, s);
   check_travel(s);
 
   const Outcome acquired = acquire(o, s, stack);
@@ -404,7 +411,8 @@ void add_measure_command(CLI::App& app, Action& action) {
       ->capture_default_str();
   cmd->add_flag("--lock", o->lock,
                 "hold the Fizeau cavity on the fringes (docs/fizeau.md): the first average's "
-                "first four frames are the reference; --camera twin");
+                "first four frames are the reference; --camera twin (a calibration file's "
+                "[controller] outer = \"fringes\" asks for it too, with its [fringe_lock])");
   cmd->add_option("--lock-retake-s", o->lock_retake_s,
                   "with --lock: a frame whose fringes were lost is taken again until they come "
                   "back, for at most this long (s, in (0, 60]); then the measurement fails")

@@ -288,7 +288,9 @@ Json measure_json(const MeasureRecord& r) {
   j["path_error_rms_nm"] = path ? Json(*path) : Json(nullptr);
   j["lock"] = nullptr;
   if (s.lock)
-    j["lock"] = {{"reference_frames", s.lock->reference_frames},
+    j["lock"] = {{"gain_per_frame",
+                  r.params->lock ? Json(r.params->lock->lock.gain_per_frame) : Json(nullptr)},
+                 {"reference_frames", s.lock->reference_frames},
                  {"locked_frames", s.lock->locked},
                  {"holding_frames", s.lock->holding},
                  {"lost_frames", s.lock->lost},

@@ -333,6 +333,7 @@ int run(const RunOptions& o) {
   LoopStack stack(stack_options(o), project);
   const LoopCalibration cal = resolve_calibration(o.calibration, o.daq, project, o.seed,
                                                   1.0 / o.rate_Hz, o.max_physics_steps);
+  calibration::refuse_fringe_lock(cal, "run");
   if (o.step_um && cal.travel_z_max_um && *o.step_um > *cal.travel_z_max_um)
     throw core::InputError(
         fmt::format("--step-um {}: beyond the calibrated semi-closed-loop "

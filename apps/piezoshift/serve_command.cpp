@@ -419,6 +419,7 @@ int serve(const ServeOptions& o) {
   const runtime::SafetyLimits safety = resolve_overrun_trip(limits, stack.sim() != nullptr);
   const LoopCalibration cal = resolve_calibration(o.calibration, o.daq, config, o.seed,
                                                   1.0 / o.rate_Hz, o.max_physics_steps);
+  calibration::refuse_fringe_lock(cal, "serve");
   const host::StageModel model = make_stage_model(o, config, cal.params, cal, safety);
 
   CameraSetup camera_setup;

@@ -291,6 +291,7 @@ int run_simulate(const SimulateOptions& opt) {
   if (closed_loop) {
     const LoopCalibration lc = resolve_calibration(opt.calibration, "sim", config, opt.seed,
                                                    period_s, opt.max_physics_steps);
+    calibration::refuse_fringe_lock(lc, "simulate");
     cp = lc.params;
     run.calibration = lc.source;
   }

@@ -4,6 +4,7 @@
 #include <cmath>
 #include <sstream>
 #include <string>
+#include <type_traits>
 #include <vector>
 
 #include <fmt/core.h>
@@ -20,6 +21,8 @@ namespace {
 
 [[noreturn]] void fail(const io::ConfigFile& file, std::string_view section, std::string_view key,
                        const std::string& why) {
+  if (key.empty())  // a rule over the whole section
+    throw core::InputError(fmt::format("{}: [{}]: {}", file.source(), section, why));
   throw core::InputError(fmt::format("{}: [{}] {}: {}", file.source(), section, key, why));
 }
 
@@ -34,11 +37,13 @@ class FieldReader {
     if (!file_.section(section).read(key, v, b) && note.starts_with("required"))
       fail(file_, section, key, fmt::format("missing ({})", note));
   }
-  void operator()(std::string_view section, std::string_view key, std::size_t& v,
-                  const core::Bounds& b, std::string_view) const {
+  template <class Whole>
+  requires std::is_unsigned_v<Whole>
+  void operator()(std::string_view section, std::string_view key, Whole& v, const core::Bounds& b,
+                  std::string_view) const {
     auto whole = static_cast<std::int64_t>(v);
     if (file_.section(section).read(key, whole, b))
-      v = static_cast<std::size_t>(whole);
+      v = static_cast<Whole>(whole);
   }
   template <class Count>
   void operator()(std::string_view section, std::string_view key, const ListField<double, Count>& f,
@@ -69,6 +74,28 @@ void read_improved(const io::ConfigFile& file, control::ImprovedParams& im) {
     fail(file, "improved", "shaper_taps", fmt::format("must sum to 1 (they sum to {})", sum));
   for (std::size_t i = 0; i < control::kChannels; ++i)
     visit_model_fields(im.model[i], model_section(i), reader);
+}
+
+// [controller] outer and [fringe_lock]: the lock's parameters when outer = "fringes".
+std::optional<control::FringeLockParams> read_outer_loop(const io::ConfigFile& file) {
+  std::string outer = "none";
+  file.section("controller").read("outer", outer);
+  if (outer != "none" && outer != "fringes")
+    fail(file, "controller", "outer", "expected \"none\" or \"fringes\"");
+  if (outer == "none") {
+    control::FringeLockParams unused;
+    visit_fringe_lock_fields(unused, [&](std::string_view section, std::string_view key, auto&,
+                                         const core::Bounds&, std::string_view) {
+      if (file.section(section).has(key))
+        fail(file, section, key, "needs [controller] outer = \"fringes\"");
+    });
+    return std::nullopt;
+  }
+  control::FringeLockParams lock;
+  visit_fringe_lock_fields(lock, FieldReader(file));
+  if (const char* why = control::fringe_lock_problem(lock); *why != '\0')
+    fail(file, "fringe_lock", "", why);  // e.g. a total below one frame's step
+  return lock;
 }
 
 std::string number_list(const double* v, std::size_t n) {
@@ -138,12 +165,20 @@ void read_controller_section(const io::ConfigFile& file, control::SemiClosedLoop
     read_improved(file, params.improved);
 }
 
-control::SemiClosedLoopParams load_calibration_file(const std::string& path,
-                                                    std::optional<double>* travel_z_max_um,
-                                                    std::optional<double>* travel_z_min_um) {
+control::SemiClosedLoopParams load_calibration_file(
+    const std::string& path, std::optional<double>* travel_z_max_um,
+    std::optional<double>* travel_z_min_um, std::optional<control::FringeLockParams>* fringe_lock) {
   const io::ConfigFile file = io::ConfigFile::load(path);
   control::SemiClosedLoopParams params;
   read_controller_section(file, params);
+  const std::optional<control::FringeLockParams> lock = read_outer_loop(file);
+  if (lock && fringe_lock == nullptr)
+    throw core::InputError(fmt::format(
+        "{}: [controller] outer = \"fringes\": the fringe lock runs in `piezoshift measure` only "
+        "(this command runs the semi-closed loop alone)",
+        path));
+  if (fringe_lock != nullptr)
+    *fringe_lock = lock;
   double z_max_um = 0.0, z_min_um = 0.0;
   const bool has_max = file.section("travel").read("z_max_um", z_max_um, core::Bounds::positive());
   const bool has_min =

@@ -31,10 +31,19 @@ void check_at_loop_rate(const control::SemiClosedLoopParams& params, double loop
 
 LoopCalibration load_loop_calibration(const std::string& path, double loop_sample_time_s) {
   LoopCalibration c;
-  c.params = load_calibration_file(path, &c.travel_z_max_um, &c.travel_z_min_um);
+  c.params = load_calibration_file(path, &c.travel_z_max_um, &c.travel_z_min_um, &c.fringe_lock);
   check_at_loop_rate(c.params, loop_sample_time_s, path);
   c.source = path;
   return c;
+}
+
+void refuse_fringe_lock(const LoopCalibration& c, const std::string& command) {
+  if (c.fringe_lock)
+    throw core::InputError(fmt::format(
+        "{}: [controller] outer = \"fringes\": `piezoshift {}` runs the semi-closed loop alone; "
+        "the fringe lock runs in `piezoshift measure` (on the loop's real-time clock it is not "
+        "built: docs/fizeau.md)",
+        c.source, command));
 }
 
 LoopCalibration startup_calibration(const config::ProjectConfig& config, std::uint64_t seed,

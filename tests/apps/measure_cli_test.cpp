@@ -4,6 +4,7 @@
 #include <cmath>
 #include <filesystem>
 #include <fstream>
+#include <iterator>
 #include <sstream>
 #include <string>
 #include <vector>
@@ -168,6 +169,45 @@ TEST_F(MeasureCli, TheFringeLockHoldsTheDriftingCavityNearerItsSetPoint) {
   const testing::CliResult rt = run("measure --lock --out '" + path("y") + "'");
   EXPECT_EQ(rt.status, 2) << rt.err;
   EXPECT_NE(rt.err.find("--free-run"), std::string::npos) << rt.err;
+}
+
+// Issue 29's `[controller] outer = "fringes"`: a calibration file that asks for the fringe lock
+// locks `measure` exactly as --lock does (same seed: the same numbers, bit for bit), its
+// [fringe_lock] reaches the lock, and the commands that run no lock refuse the file by name.
+TEST_F(MeasureCli, ACalibrationThatAsksForTheFringeLockLocksAsTheFlagDoes) {
+  const testing::CliResult cal = run("calibrate --out '" + path("paper.toml") + "'");
+  ASSERT_EQ(cal.status, 0) << cal.err;
+  std::ifstream in(path("paper.toml"));
+  const std::string text((std::istreambuf_iterator<char>(in)), std::istreambuf_iterator<char>());
+  const auto with_outer = [&](const std::string& name, const std::string& lock_section) {
+    std::string t = text;
+    t.replace(t.find("[controller]\n"), 13, "[controller]\nouter = \"fringes\"\n");
+    return write(name, t + lock_section);
+  };
+  const std::string outer = with_outer("outer.toml", "");
+  const std::string slow = with_outer("slow.toml", "\n[fringe_lock]\ngain_per_frame = 0.25\n");
+  const std::string cfg = write("drift.toml",
+                                "[camera]\nwidth_px = 96\nheight_px = 96\n"
+                                "[twin.cavity]\nin_fringes = true\n");
+  const std::string common = "--config '" + cfg + "' --averages 10 ";
+  const Json flag = measure(common + "--calibration '" + path("paper.toml") + "' --lock --out '" +
+                            path("flag") + "'");
+  const Json file = measure(common + "--calibration '" + outer + "' --out '" + path("file") + "'");
+  const Json gain = measure(common + "--calibration '" + slow + "' --out '" + path("gain") + "'");
+  ASSERT_TRUE(flag.is_object() && file.is_object() && gain.is_object());
+  EXPECT_EQ(file["lock"], flag["lock"]);
+  EXPECT_EQ(file["path_error_rms_nm"], flag["path_error_rms_nm"]);
+  EXPECT_EQ(file["error_rms_nm"], flag["error_rms_nm"]);
+  EXPECT_EQ(flag["lock"]["gain_per_frame"], 0.5);
+  EXPECT_EQ(gain["lock"]["gain_per_frame"], 0.25);
+  EXPECT_EQ(gain["lock"]["locked_frames"], 45);
+  // Another gain corrects each frame by another amount: another path.
+  EXPECT_NE(gain["path_error_rms_nm"], flag["path_error_rms_nm"]);
+  for (const char* command : {"run --duration-s 0.1", "serve", "simulate --step-um 1"}) {
+    const testing::CliResult r = run(std::string(command) + " --calibration '" + outer + "'");
+    EXPECT_EQ(r.status, 2) << command << "\n" << r.err;
+    EXPECT_NE(r.err.find("outer = \"fringes\""), std::string::npos) << command << "\n" << r.err;
+  }
 }
 
 // Issue 29: the fringes washed out mid-sequence (the twin camera's fringe loss, 60 ms from

@@ -4,6 +4,7 @@
 #include <cmath>
 #include <cstring>
 #include <limits>
+#include <optional>
 #include <random>
 #include <string>
 #include <vector>
@@ -210,6 +211,56 @@ TEST_F(ControllerFile, GainsOutsideTheStableRegionAreRefusedAtLoad) {
   } catch (const core::InputError& e) {
     EXPECT_NE(std::string(e.what()).find("unstable.toml"), std::string::npos) << e.what();
     EXPECT_NE(std::string(e.what()).find("kp = 5, ki = 3, kd = 2"), std::string::npos) << e.what();
+  }
+}
+
+// [controller] outer = "fringes" and [fringe_lock] (issue 29): read into the lock's parameters
+// only when the file asks for it, refused by a caller that runs no lock, each bad value named.
+TEST_F(ControllerFile, TheFringeLockIsReadWhenTheFileAsksForItAndRefusedWhereNoneRuns) {
+  const std::string gains = "[controller]\nkp = 0.6\nki = 0.2\nkd = 0.001\n";
+  const std::string locked =
+      write("locked.toml", gains +
+                               "outer = \"fringes\"\n[fringe_lock]\ngain_per_frame = 0.25\n"
+                               "max_step_theta_y_urad = 4.5\nmax_lost_frames = 7\n");
+  std::optional<control::FringeLockParams> lock;
+  load_calibration_file(locked, nullptr, nullptr, &lock);
+  ASSERT_TRUE(lock.has_value());
+  EXPECT_EQ(lock->gain_per_frame, 0.25);
+  EXPECT_EQ(lock->max_step[2], 4.5);
+  EXPECT_EQ(lock->max_lost_frames, 7U);
+  // The keys the file does not give keep the lock's own defaults.
+  EXPECT_EQ(lock->max_step[0], control::FringeLockParams{}.max_step[0]);
+  EXPECT_EQ(lock->max_correction[1], control::FringeLockParams{}.max_correction[1]);
+  try {
+    load_calibration_file(locked);
+    ADD_FAILURE() << "a caller without a lock accepted outer = \"fringes\"";
+  } catch (const core::InputError& e) {
+    EXPECT_NE(std::string(e.what()).find("piezoshift measure"), std::string::npos) << e.what();
+  }
+  // Without outer: no lock, and the section alone is refused rather than ignored.
+  lock = control::FringeLockParams{};
+  load_calibration_file(write("plain.toml", gains), nullptr, nullptr, &lock);
+  EXPECT_FALSE(lock.has_value());
+  const struct {
+    const char* text;
+    const char* piece;
+  } bad[] = {
+      {"[fringe_lock]\ngain_per_frame = 0.3\n", "gain_per_frame: needs [controller] outer"},
+      {"outer = \"camera\"\n", "[controller] outer: expected"},
+      {"outer = \"fringes\"\n[fringe_lock]\ngain_per_frame = 1.5\n", "gain_per_frame"},
+      {"outer = \"fringes\"\n[fringe_lock]\nmax_correction_piston_nm = 100\n",
+       "[fringe_lock]: max_correction must be at least max_step"},
+      {"outer = \"fringes\"\n[fringe_lock]\nmax_lost_frames = 0\n", "max_lost_frames"},
+  };
+  for (const auto& b : bad) {
+    const std::string file = write("bad.toml", gains + b.text);
+    try {
+      load_calibration_file(file, nullptr, nullptr, &lock);
+      ADD_FAILURE() << b.text << " was accepted";
+    } catch (const core::InputError& e) {
+      EXPECT_NE(std::string(e.what()).find(b.piece), std::string::npos) << e.what();
+      EXPECT_NE(std::string(e.what()).find("bad.toml"), std::string::npos) << e.what();
+    }
   }
 }
 

@@ -19,6 +19,12 @@
 //   z_min_um = 0.1             # optional: the lowest Z a move from the top reaches (the stacks'
 //                              # hysteresis at 0 V); `serve`'s TMN? Z
 //
+//   [controller] outer = "fringes"   # optional ("none" by default): `measure` runs the fringe
+//                                    # lock around the loop (docs/fizeau.md), as with --lock
+//   [fringe_lock]              # optional with outer = "fringes": control/fringe_lock.hpp's
+//   gain_per_frame = 0.5       # parameters (controller_ranges.hpp lists them); absent keys keep
+//                              # its defaults
+//
 // Every key is optional (absent: the paper's value, Section 4); an unknown key or section, a
 // wrong type or a bad value throws core::InputError naming file, key and reason. The run's own
 // sample time is set by the loop, not here. Files are written whole to a temporary file and
@@ -27,6 +33,7 @@
 #include <optional>
 #include <string>
 
+#include "piezoshift/control/fringe_lock.hpp"
 #include "piezoshift/control/semi_closed_loop.hpp"
 
 namespace piezoshift::io {
@@ -37,11 +44,14 @@ namespace piezoshift::calibration {
 
 //! Reads [controller] from an already parsed file into params (does not reject unknown keys).
 void read_controller_section(const io::ConfigFile& file, control::SemiClosedLoopParams& params);
-//! Loads a file holding [controller] and optionally [travel]; rejects anything else. The travel
-//! (empty when the file has none) goes to travel_z_max_um when given.
+//! Loads a file holding [controller] and optionally [travel] and [fringe_lock]; rejects anything
+//! else. The travel (empty when the file has none) goes to travel_z_max_um when given; the fringe
+//! lock (empty with outer = "none") to fringe_lock, and a file asking for it is refused when
+//! fringe_lock is null (the caller runs no lock).
 control::SemiClosedLoopParams load_calibration_file(
     const std::string& path, std::optional<double>* travel_z_max_um = nullptr,
-    std::optional<double>* travel_z_min_um = nullptr);
+    std::optional<double>* travel_z_min_um = nullptr,
+    std::optional<control::FringeLockParams>* fringe_lock = nullptr);
 
 //! The file's text; header lines (each prefixed with "# ") describe where it came from.
 std::string format_calibration(const control::SemiClosedLoopParams& params,

@@ -11,6 +11,9 @@
 //                          shaper_taps (a list, summing to 1), shaper_rate_um_per_s
 //   [improved.channelN]    offset_um, linear_weight (required), thresholds_um, weights (a list
 //                          as long as thresholds_um), creep_time_constants_s, creep_gain
+//   [fringe_lock]          with [controller] outer = "fringes": gain_per_frame, max_step_* and
+//                          max_correction_* (piston_nm, theta_x_urad, theta_y_urad),
+//                          max_lost_frames; checked as a whole by control::fringe_lock_problem
 //
 // Beyond each number's range, controller_problem() refuses what would make the stage report
 // nonsense or the loop unstable (issue 27's findings):
@@ -32,6 +35,7 @@
 #include <string>
 #include <string_view>
 
+#include "piezoshift/control/fringe_lock.hpp"
 #include "piezoshift/control/semi_closed_loop.hpp"
 #include "piezoshift/core/bounds.hpp"
 #include "piezoshift/io/config_file.hpp"
@@ -107,6 +111,23 @@ void visit_model_fields(Model& m, std::string_view section, Visit&& visit) {
         ListField{m.creep_time_constant_s.data(), &m.creep_terms, control::kMaxCreepTerms},
         B::positive(), "");
   visit(section, "creep_gain", m.creep_gain, B::closed(-0.05, 0.05), "");
+}
+
+//! [fringe_lock]'s numbers (control/fringe_lock.hpp, whose defaults are the file's), as
+//! visit_controller_fields; the axes are piston [nm], theta_x and theta_y [urad].
+template <class Lock, class Visit>
+void visit_fringe_lock_fields(Lock& p, Visit&& visit) {
+  using B = core::Bounds;
+  visit("fringe_lock", "gain_per_frame", p.gain_per_frame, B::above(0.0, 1.0), "per camera frame");
+  static const std::string kStep[3] = {"max_step_piston_nm", "max_step_theta_x_urad",
+                                       "max_step_theta_y_urad"};
+  static const std::string kTotal[3] = {"max_correction_piston_nm", "max_correction_theta_x_urad",
+                                        "max_correction_theta_y_urad"};
+  for (std::size_t a = 0; a < 3; ++a)
+    visit("fringe_lock", kStep[a], p.max_step[a], B::above(0.0, 1e6), "one frame's largest");
+  for (std::size_t a = 0; a < 3; ++a)
+    visit("fringe_lock", kTotal[a], p.max_correction[a], B::above(0.0, 1e6), "");
+  visit("fringe_lock", "max_lost_frames", p.max_lost_frames, B::closed(1.0, 100000.0), "");
 }
 
 //! The section of channel i (0-based): "improved.channel1" ...

@@ -6,6 +6,7 @@
 #include <string>
 
 #include "piezoshift/config/project_config.hpp"
+#include "piezoshift/control/fringe_lock.hpp"
 #include "piezoshift/control/semi_closed_loop.hpp"
 
 namespace piezoshift::calibration {
@@ -15,7 +16,13 @@ struct LoopCalibration {
   std::optional<double> travel_z_max_um;  //!< the travel one move reaches, when known
   std::optional<double> travel_z_min_um;  //!< the lowest Z a move from the top reaches
   std::string source;                     //!< the file, or how it was obtained
+  //! The fringe lock the file asks for ([controller] outer = "fringes"); only `measure` runs it
+  std::optional<control::FringeLockParams> fringe_lock;
 };
+
+//! core::InputError naming the source and command when c asks for the fringe lock, which command
+//! does not run (it runs the semi-closed loop alone: say so rather than ignore the file's word).
+void refuse_fringe_lock(const LoopCalibration& c, const std::string& command);
 
 //! core::InputError naming source when params cannot run at the loop's rate: an improved
 //! controller designed at another rate (its shaper and correction hold at one rate only), or
