@@ -30,9 +30,9 @@
 #include "piezoshift/core/input_error.hpp"
 #include "piezoshift/instrument/acquisition.hpp"
 #include "piezoshift/instrument/measurement.hpp"
+#include "piezoshift/instrument/scene_lock.hpp"
 #include "piezoshift/instrument/sequence.hpp"
 #include "piezoshift/instrument/twin_floor.hpp"
-#include "piezoshift/plant/geometry.hpp"
 #include "piezoshift/psi/analysis.hpp"
 #include "piezoshift/psi/fizeau_simulation.hpp"
 #include "piezoshift/rig/validity.hpp"
@@ -170,28 +170,17 @@ instrument::LockSetup lock_setup(const MeasureOptions& o, const MeasureSetup& s)
   const std::string who =
       o.lock ? std::string("--lock")
              : fmt::format("{}: [controller] outer = \"fringes\"", s.calibration.source);
-  if (!s.scene)
-    throw core::InputError(fmt::format(
-        "{}: the lock needs the pupil on the camera before the sequence; with camera {} "
-        "that is not built yet (--camera twin)",
-        who, o.camera));
   // Each frame's fit (about 5 ms at 256 px) runs where the sequence takes its frames, which on
   // a real-time clock is between the loop's ticks: it would make them overrun.
-  if (!o.free_run)
+  if (s.scene && !o.free_run)
     throw core::InputError(
         who +
         ": the lock's fit runs on the loop's thread, about 5 ms a frame, which a real-time "
         "loop at 1 kHz cannot spare; use --free-run until it runs on a thread of its own");
-  instrument::LockSetup l;
-  if (s.calibration.fringe_lock)
-    l.lock = *s.calibration.fringe_lock;
-  l.mask = s.scene->mask;
-  l.pupil_radius_m = s.scene->fizeau.pupil_radius_m;
-  l.tripod.emplace(plant::make_twin_geometry(s.config.installation.project.twin.geometry).points);
-  l.retake_s = o.lock_retake_s;
-  if (const std::string why = instrument::lock_problem(l, s.params); !why.empty())
-    throw core::InputError(who + ": " + why);
-  return l;
+  return instrument::scene_lock_setup(
+      s.scene ? &*s.scene : nullptr, o.camera, s.config.installation.project.twin.geometry,
+      s.calibration.fringe_lock.value_or(control::FringeLockParams{}), o.lock_retake_s, s.params,
+      who);
 }
 
 void check_travel(const MeasureSetup& s) {

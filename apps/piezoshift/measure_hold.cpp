@@ -1,85 +1,45 @@
 #include "measure_hold.hpp"
 
-#include <algorithm>
 #include <cmath>
-#include <map>
 #include <optional>
 #include <vector>
 
 #include <fmt/core.h>
 
+#include "piezoshift/instrument/hold_summary.hpp"
 #include "piezoshift/io/csv_writer.hpp"
 #include "piezoshift/io/plot.hpp"
 
 namespace piezoshift::app {
 
-namespace {
-
 using Json = nlohmann::json;
 
-// The RMS of the path's means over whole seconds of the hold: the drift a lock at the frame rate
-// is there to hold, without the inner loop's jitter from exposure to exposure, which averages out.
-std::optional<double> second_means_rms_nm(const instrument::SequenceResult& s,
-                                          const std::vector<double>& path) {
-  if (path.empty())
-    return std::nullopt;
-  const double t0 = s.hold.front().trigger_time_s;
-  std::vector<double> sum, count;
-  for (std::size_t i = 0; i < path.size(); ++i) {
-    const auto k = static_cast<std::size_t>(s.hold[i].trigger_time_s - t0);
-    if (k >= sum.size()) {
-      sum.resize(k + 1, 0.0);
-      count.resize(k + 1, 0.0);
-    }
-    sum[k] += path[i];
-    count[k] += 1.0;
-  }
-  double sq = 0.0;
-  std::size_t n = 0;
-  for (std::size_t k = 0; k + 1 < sum.size(); ++k)  // the last second is not whole
-    if (count[k] > 0.0) {
-      sq += (sum[k] / count[k]) * (sum[k] / count[k]);
-      ++n;
-    }
-  if (n == 0)
-    return std::nullopt;
-  return std::sqrt(sq / static_cast<double>(n));
-}
+namespace {
 
-double hold_span_s(const instrument::SequenceResult& s) {
-  return s.hold.size() < 2 ? 0.0 : s.hold.back().trigger_time_s - s.hold.front().trigger_time_s;
+Json number_or_null(const std::optional<double>& v) {
+  return v ? Json(*v) : Json(nullptr);
 }
 
 }  // namespace
 
 Json hold_json(const instrument::SequenceResult& s) {
-  const std::vector<double> path = instrument::path_errors_nm(s, s.hold);
-  const std::optional<double> rms = instrument::hold_path_error_rms_nm(s);
-  double worst = 0.0;
-  for (double d : path)
-    worst = std::max(worst, std::fabs(d));
-  std::map<std::string, std::size_t> states;
-  for (const instrument::ExposureRecord& e : s.hold)
-    if (!e.lock_state.empty())
-      ++states[e.lock_state];
-  const double span = hold_span_s(s);
-  const std::optional<double> slow = second_means_rms_nm(s, path);
-  return {{"frames", s.hold.size()},
-          {"span_s", span},
-          {"frame_interval_s",
-           s.hold.size() < 2 ? Json(nullptr) : Json(span / static_cast<double>(s.hold.size() - 1))},
-          {"path_error_rms_nm", rms ? Json(*rms) : Json(nullptr)},
-          {"path_error_max_nm", path.empty() ? Json(nullptr) : Json(worst)},
-          {"path_error_1s_means_rms_nm", slow ? Json(*slow) : Json(nullptr)},
-          {"lock_states", states.empty() ? Json(nullptr) : Json(states)}};
+  const instrument::HoldSummary h = instrument::hold_summary(s);
+  return {{"frames", h.frames},
+          {"span_s", h.span_s},
+          {"frame_interval_s", number_or_null(h.frame_interval_s)},
+          {"path_error_rms_nm", number_or_null(h.path_error_rms_nm)},
+          {"path_error_max_nm", number_or_null(h.path_error_max_nm)},
+          {"path_error_1s_means_rms_nm", number_or_null(h.path_error_1s_means_rms_nm)},
+          {"lock_states", h.lock_states.empty() ? Json(nullptr) : Json(h.lock_states)}};
 }
 
 std::string hold_markdown(const instrument::SequenceResult& s) {
-  const std::optional<double> rms = instrument::hold_path_error_rms_nm(s);
+  const instrument::HoldSummary h = instrument::hold_summary(s);
   return fmt::format(
       "| hold at frame 0: {} frames over {:.1f} s; the cavity's path from its set point (twin), "
       "RMS | {} |\n",
-      s.hold.size(), hold_span_s(s), rms ? fmt::format("{:.3f} nm", *rms) : "(no truth)");
+      h.frames, h.span_s,
+      h.path_error_rms_nm ? fmt::format("{:.3f} nm", *h.path_error_rms_nm) : "(no truth)");
 }
 
 void write_hold(const instrument::SequenceResult& s, const std::filesystem::path& dir) {

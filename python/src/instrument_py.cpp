@@ -2,14 +2,18 @@
 // takes one phase-shifting measurement on the twin as `piezoshift measure --daq sim --free-run`
 // does (the shipping loop in owner mode on a simulated clock, the camera exposing once the stage
 // has settled, then the analysis) and returns its result as a dict with the JSON names of
-// `measure --json`, plus the maps and frames as numpy arrays. A measurement that is not valid or
-// whose fits did not converge raises ProcedureFailed (the CLI's exit status 4), the partial
+// `measure --json`, plus the maps and frames as numpy arrays. The fringe lock (`lock`) and the
+// hold after the measurement (`hold_s`) are the CLI's: the lock built and checked by
+// instrument::scene_lock_setup, the hold summed up by instrument::hold_summary, both shared with
+// `measure --lock --hold-s`, and its records as hold.csv's columns. A measurement that is not valid
+// or whose fits did not converge raises ProcedureFailed (the CLI's exit status 4), the partial
 // result in its `result` attribute.
 #include <pybind11/numpy.h>
 #include <pybind11/pybind11.h>
 #include <pybind11/stl.h>
 
 #include <cmath>
+#include <cstdint>
 #include <memory>
 #include <numbers>
 #include <optional>
@@ -25,7 +29,9 @@
 #include "piezoshift/camera/twin_camera.hpp"
 #include "piezoshift/core/input_error.hpp"
 #include "piezoshift/instrument/acquisition.hpp"
+#include "piezoshift/instrument/hold_summary.hpp"
 #include "piezoshift/instrument/measurement.hpp"
+#include "piezoshift/instrument/scene_lock.hpp"
 #include "piezoshift/instrument/twin_floor.hpp"
 #include "piezoshift/plant/simulation_cost.hpp"
 #include "piezoshift/psi/pupil_detection.hpp"
@@ -59,6 +65,9 @@ struct MeasureArgs {
   double frame_timeout_s = 2.0;
   py::object mask;
   std::string trigger = "software";
+  bool lock = false;
+  double lock_retake_s = ins::LockSetup{}.retake_s;
+  double hold_s = 0.0;
 };
 
 // Aravis's in-process fake camera shown the twin's fringes, as `measure --daq sim` does.
@@ -75,6 +84,7 @@ ins::SequenceParams sequence_params(const MeasureArgs& a, psi::Algorithm alg) {
   p.on_target = a.on_target;
   p.averages = a.averages;
   p.frame_timeout_s = a.frame_timeout_s;
+  p.hold_s = a.hold_s;
   p.trigger = a.trigger == "line" ? ins::TriggerMode::kLine : ins::TriggerMode::kSoftware;
   if (const std::string why = ins::sequence_problem(p); !why.empty())
     throw ps::core::InputError("measure: " + why);
@@ -125,6 +135,19 @@ std::unique_ptr<cam::Camera> open_camera(const MeasureArgs& a, const cam::Camera
   return c;
 }
 
+py::object number_or_none(std::optional<double> v) {
+  return v ? py::object(py::float_(*v)) : py::object(py::none());
+}
+
+// NaN (no lock, no pose) as None, as the CLI's JSON writes null.
+py::object finite_or_none(double v) {
+  return number_or_none(std::isfinite(v) ? std::optional<double>(v) : std::nullopt);
+}
+
+py::object text_or_none(const std::string& s) {
+  return s.empty() ? py::object(py::none()) : py::object(py::str(s));
+}
+
 py::list exposures_list(const ins::SequenceResult& s) {
   py::list out;
   for (const ins::ExposureRecord& e : s.exposures) {
@@ -141,6 +164,13 @@ py::list exposures_list(const ins::SequenceResult& s) {
     d["gauge_error_mean_nm"] = e.gauge_error_mean_nm;
     d["gauge_error_max_nm"] = e.gauge_error_max_nm;
     d["arrival_wall_s"] = e.arrival_wall_s;
+    if (!e.lock_state.empty()) {
+      d["lock_state"] = e.lock_state;
+      d["lock_correction_nm"] = finite_or_none(e.lock_correction_nm);
+      d["fringe_piston_nm"] = finite_or_none(e.fringe_piston_nm);
+      d["lock_reason"] = text_or_none(e.lock_reason);
+      d["retakes"] = e.retakes;
+    }
     if (e.has_truth) {
       d["truth_piston_nm"] = e.truth_piston_nm;
       d["truth_blur_nm"] = e.truth_blur_nm;
@@ -152,8 +182,66 @@ py::list exposures_list(const ins::SequenceResult& s) {
   return out;
 }
 
-py::object number_or_none(std::optional<double> v) {
-  return v ? py::object(py::float_(*v)) : py::object(py::none());
+py::object lock_dict(const ins::SequenceResult& s, const ins::SequenceParams& p) {
+  if (!s.lock)
+    return py::none();
+  const ins::LockSummary& l = *s.lock;
+  py::dict d;
+  d["gain_per_frame"] = p.lock ? py::object(py::float_(p.lock->lock.gain_per_frame)) : py::none();
+  d["reference_frames"] = l.reference_frames;
+  d["locked_frames"] = l.locked;
+  d["holding_frames"] = l.holding;
+  d["lost_frames"] = l.lost;
+  d["retaken_frames"] = l.retaken;
+  d["first_refusal"] = text_or_none(l.first_refusal);
+  d["correction_piston_nm"] = l.correction[0];
+  d["correction_theta_x_urad"] = l.correction[1];
+  d["correction_theta_y_urad"] = l.correction[2];
+  return d;
+}
+
+// The hold's records as hold.csv's columns, each an array over the hold's frames.
+py::dict hold_records(const ins::SequenceResult& s, const ins::HoldSummary& h) {
+  std::vector<double> t, settle, gauge, correction, fringe;
+  std::vector<std::uint64_t> ids;
+  py::list states;
+  for (const ins::ExposureRecord& e : s.hold) {
+    t.push_back(e.trigger_time_s);
+    ids.push_back(e.frame_id);
+    settle.push_back(e.settled_time_s - e.move_time_s);
+    gauge.push_back(e.gauge_error_mean_nm);
+    correction.push_back(e.lock_correction_nm);
+    fringe.push_back(e.fringe_piston_nm);
+    states.append(e.lock_state);
+  }
+  py::dict r;
+  r["trigger_time_s"] = to_numpy(t);
+  r["frame_id"] = py::array_t<std::uint64_t>(static_cast<py::ssize_t>(ids.size()), ids.data());
+  r["settle_s"] = to_numpy(settle);
+  r["gauge_error_mean_nm"] = to_numpy(gauge);
+  r["path_error_nm"] =
+      h.path_error_nm.empty() ? py::object(py::none()) : py::object(to_numpy(h.path_error_nm));
+  r["lock_correction_nm"] = to_numpy(correction);
+  r["fringe_piston_nm"] = to_numpy(fringe);
+  r["lock_state"] = states;
+  return r;
+}
+
+// measure --json's `hold`, and its records.
+py::object hold_dict(const ins::SequenceResult& s) {
+  if (s.hold.empty())
+    return py::none();
+  const ins::HoldSummary h = ins::hold_summary(s);
+  py::dict d;
+  d["frames"] = h.frames;
+  d["span_s"] = h.span_s;
+  d["frame_interval_s"] = number_or_none(h.frame_interval_s);
+  d["path_error_rms_nm"] = number_or_none(h.path_error_rms_nm);
+  d["path_error_max_nm"] = number_or_none(h.path_error_max_nm);
+  d["path_error_1s_means_rms_nm"] = number_or_none(h.path_error_1s_means_rms_nm);
+  d["lock_states"] = h.lock_states.empty() ? py::object(py::none()) : py::cast(h.lock_states);
+  d["records"] = hold_records(s, h);
+  return d;
 }
 
 // The acquisition's part of the result: frames, exposures, timing, validity.
@@ -178,6 +266,10 @@ py::dict sequence_dict(const ins::SequenceResult& s, const ins::SequenceParams& 
     frames.append(counts_to_numpy(f));
   d["frames"] = frames;
   d["exposures"] = exposures_list(s);
+  // The cavity's path from its set point after the first average (the lock's reference).
+  d["path_error_rms_nm"] = number_or_none(ins::path_error_rms_nm(s, p.steps_rad.size()));
+  d["lock"] = lock_dict(s, p);
+  d["hold"] = hold_dict(s);
   py::dict t;
   t["wall_time_s"] = s.wall_time_s;
   t["floor_s"] = s.floor_s;
@@ -271,6 +363,14 @@ py::dict measure(const MeasureArgs& a) {
   {
     py::gil_scoped_release release;
     s.calibration = resolve(a, project);
+    // lock=True, or a calibration file's [controller] outer = "fringes" (its [fringe_lock] too)
+    if (a.lock || s.calibration.fringe_lock)
+      s.params.lock = ins::scene_lock_setup(
+          s.scene ? &*s.scene : nullptr, a.camera, project.twin.geometry,
+          s.calibration.fringe_lock.value_or(ps::control::FringeLockParams{}), a.lock_retake_s,
+          s.params,
+          a.lock ? std::string("lock")
+                 : s.calibration.source + ": [controller] outer = \"fringes\"");
     if (const std::string why =
             ins::travel_problem(s.params, s.calibration.travel_z_max_um, s.calibration.source);
         !why.empty())
@@ -338,7 +438,8 @@ void bind_instrument(py::module_& m) {
          const std::string& algorithm, const std::vector<double>& steps_rad, int averages,
          const std::string& surface, std::uint64_t seed, double rate_Hz, double base_um,
          double settle_band_nm, double settle_hold_s, double settle_timeout_s,
-         double frame_timeout_s, const py::object& mask, const std::string& trigger) {
+         double frame_timeout_s, const py::object& mask, const std::string& trigger, bool lock,
+         double lock_retake_s, double hold_s) {
         MeasureArgs a;
         if (!config.is_none())
           a.config = py::str(config).cast<std::string>();  // str or os.PathLike
@@ -358,6 +459,9 @@ void bind_instrument(py::module_& m) {
         a.frame_timeout_s = frame_timeout_s;
         a.mask = mask;
         a.trigger = trigger;
+        a.lock = lock;
+        a.lock_retake_s = lock_retake_s;
+        a.hold_s = hold_s;
         return measure(a);
       },
       py::arg("config") = py::none(), py::arg("calibration") = py::none(),
@@ -368,10 +472,13 @@ void bind_instrument(py::module_& m) {
       py::arg("settle_hold_s") = defaults.on_target.hold_s,
       py::arg("settle_timeout_s") = defaults.on_target.timeout_s,
       py::arg("frame_timeout_s") = defaults.frame_timeout_s, py::arg("mask") = py::none(),
-      py::arg("trigger") = "software",
+      py::arg("trigger") = "software", py::arg("lock") = false,
+      py::arg("lock_retake_s") = ins::LockSetup{}.retake_s, py::arg("hold_s") = defaults.hold_s,
       "One phase-shifting measurement on the twin (free-running simulated clock), as "
       "`piezoshift measure --daq sim --free-run` takes it; a dict with the names of "
-      "`measure --json`, maps and frames as numpy arrays (docs/python.md)");
+      "`measure --json`, maps and frames as numpy arrays; lock=True holds the cavity on the "
+      "fringes, "
+      "hold_s holds the stage at frame 0 afterwards (docs/python.md)");
 }
 
 }  // namespace piezoshift::python

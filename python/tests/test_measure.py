@@ -177,3 +177,78 @@ def test_the_docs_example_runs():
     blocks = section.split("```python\n")[1:]
     assert len(blocks) == 1
     exec(compile(blocks[0].split("```", 1)[0], "docs/python.md", "exec"), {})
+
+
+def drifting_cavity_toml(tmp_path):
+    path = tmp_path / "drift.toml"
+    path.write_text("[camera]\nwidth_px = 96\nheight_px = 96\n[twin.cavity]\nin_fringes = true\n")
+    return str(path)
+
+
+def test_the_fringe_lock_holds_the_drifting_cavity_over_the_hold(tmp_path):
+    # Issue 29's hold (docs/fizeau.md) from Python, as `measure --lock --hold-s 5`: after the
+    # measurement the stage stays at frame 0 for 5 s of loop time, the cavity's drift in the
+    # fringes, the paper's controller, seed 1 (the same figures as the CLI's, to the last digit).
+    # Measured: unlocked 2.233 nm RMS from the set point (1 s means 2.031 nm: the drift no gauge
+    # sees), locked 0.554 nm (1 s means 0.072 nm); seeds 2 to 4 gave 1.66 to 2.03 unlocked and
+    # 0.53 to 0.59 locked. What the lock leaves is the paper's controller's jitter from one 1 ms
+    # exposure to the next (0.54 nm over 60 s, docs/fizeau.md), which a lock one frame late
+    # cannot remove but which averages out over a second. The bands: locked within 0.7 nm and
+    # under 0.4 x unlocked (a lock that did nothing gives the unlocked figure), its 1 s means
+    # within 0.15 nm against more than 1 nm unlocked.
+    config = drifting_cavity_toml(tmp_path)
+    off = ps.measure(config=config, hold_s=5.0, seed=1)
+    on = ps.measure(config=config, hold_s=5.0, seed=1, lock=True)
+    assert off["lock"] is None and off["hold"]["lock_states"] is None
+    h_off, h_on = off["hold"], on["hold"]
+    assert h_on["span_s"] >= 4.9 and h_on["frames"] == h_off["frames"] > 300  # ~14 ms a frame
+    assert h_on["lock_states"] == {"locked": h_on["frames"]}
+    unlocked, locked = h_off["path_error_rms_nm"], h_on["path_error_rms_nm"]
+    assert unlocked > 1.5, unlocked
+    assert locked < 0.7 and locked < 0.4 * unlocked, (locked, unlocked)
+    assert h_on["path_error_1s_means_rms_nm"] < 0.15 < 1.0 < h_off["path_error_1s_means_rms_nm"]
+    # The records: hold.csv's columns, the RMS theirs.
+    rec = h_on["records"]
+    assert len(rec["trigger_time_s"]) == len(rec["lock_state"]) == h_on["frames"]
+    assert np.sqrt(np.mean(rec["path_error_nm"] ** 2)) == pytest.approx(locked, rel=1e-12)
+    assert np.abs(rec["path_error_nm"]).max() == pytest.approx(h_on["path_error_max_nm"])
+    assert np.all(np.isnan(h_off["records"]["lock_correction_nm"]))
+    # The lock's summary and each exposure's: the first average (0 to 2 pi) is the reference.
+    lock = on["lock"]
+    assert lock["reference_frames"] == 5 and lock["holding_frames"] == 0
+    assert lock["first_refusal"] is None
+    assert [e["lock_state"] for e in on["exposures"]] == ["reference"] * 5
+    assert "lock_state" not in off["exposures"][0]
+
+
+def test_a_calibration_file_that_asks_for_the_fringe_lock_locks_as_lock_true(tmp_path):
+    # `[controller] outer = "fringes"` (docs/calibration.md): measure() locks as with lock=True
+    # (same seed: the same numbers to the last digit), and [fringe_lock]'s gain reaches the lock.
+    config = drifting_cavity_toml(tmp_path)
+    plain = tmp_path / "paper.toml"
+    ps.write_calibration_file(str(plain), ps.SemiClosedLoopParams(), "test")
+    text = plain.read_text()
+    outer = tmp_path / "outer.toml"
+    outer.write_text(text.replace("[controller]\n", '[controller]\nouter = "fringes"\n', 1))
+    slow = tmp_path / "slow.toml"
+    slow.write_text(outer.read_text() + "\n[fringe_lock]\ngain_per_frame = 0.25\n")
+    flag = ps.measure(config=config, calibration=str(plain), averages=4, lock=True)
+    file = ps.measure(config=config, calibration=str(outer), averages=4)
+    gain = ps.measure(config=config, calibration=str(slow), averages=4)
+    assert file["lock"] == flag["lock"] and flag["lock"]["gain_per_frame"] == 0.5
+    assert file["path_error_rms_nm"] == flag["path_error_rms_nm"]
+    assert gain["lock"]["gain_per_frame"] == 0.25 and gain["lock"]["locked_frames"] == 15
+    assert gain["path_error_rms_nm"] != flag["path_error_rms_nm"]
+
+
+def test_bad_lock_and_hold_values_are_refused_by_name(tmp_path):
+    config = drifting_cavity_toml(tmp_path)
+    with pytest.raises(ps.InputError, match=r"measure: hold -1 s: must be in \[0, 3600\]"):
+        ps.measure(config=config, hold_s=-1.0)
+    # The lock needs the pupil before the first frame: only the twin's scene has it.
+    with pytest.raises(ps.InputError, match="lock: the lock needs the pupil on the camera"):
+        ps.measure(config=config, camera="files:" + str(tmp_path), lock=True)
+    with pytest.raises(ps.InputError, match=r"lock: the fringe lock's retake time 0 s"):
+        ps.measure(config=config, lock=True, lock_retake_s=0.0)
+    with pytest.raises(ps.InputError, match="lock: the fringe lock takes its reference"):
+        ps.measure(config=config, lock=True, algorithm="lsq", steps_rad=[0, 1, 2, 3])
