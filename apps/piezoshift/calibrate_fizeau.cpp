@@ -10,8 +10,6 @@
 #include "piezoshift/calibration/calibration_cost.hpp"
 #include "piezoshift/calibration/calibration_file.hpp"
 #include "piezoshift/camera/instrument_config.hpp"
-#include "piezoshift/camera/make_camera.hpp"
-#include "piezoshift/camera/twin_camera.hpp"
 #include "piezoshift/core/input_error.hpp"
 #include "piezoshift/instrument/fringe_calibration.hpp"
 #include "piezoshift/psi/fizeau_simulation.hpp"
@@ -22,13 +20,6 @@ namespace piezoshift::app {
 
 namespace {
 
-std::size_t frames(const instrument::FringeCalibrationOutcome& r) {
-  std::size_t n = r.piston_scan.poses.size();
-  for (const auto& s : r.actuator_scans)
-    n += s.poses.size();
-  return n;
-}
-
 nlohmann::json outcome_json(const FizeauCalibrateRequest& q,
                             const instrument::FringeCalibrationOutcome& r) {
   nlohmann::json j = paper_calibration_json(r.controller, r.matrix, r.polynomial);
@@ -37,7 +28,7 @@ nlohmann::json outcome_json(const FizeauCalibrateRequest& q,
   j["camera"] = "twin";
   j["p_points"] = r.polynomial.command_um.size();
   j["p_skipped_commands"] = r.polynomial.saturated_points;
-  j["frames"] = frames(r);
+  j["frames"] = instrument::frames_read(r);
   j["stage2_simulated_s"] = r.stage2_simulated_s;
   j["stage3_simulated_s"] = r.stage3_simulated_s;
   j["wall_s"] = r.wall_time_s;
@@ -72,17 +63,10 @@ int calibrate_from_fringes_command(const FizeauCalibrateRequest& q) {
                        calibration::calibration_cost(fo.stages, config.twin.daq.sample_time_s),
                        config.twin, q.max_physics_steps);
   work_begins();  // the twin's scene, the stage, the camera
-  const double wavelength_nm = fo.wavelength_nm;
-  const camera::TwinScene scene = camera::make_twin_scene(
-      surface, camera::measurement_optics(ic.camera.settings, wavelength_nm), q.seed);
-  const std::unique_ptr<camera::Camera> cam = camera::make_camera("twin", ic.camera, &scene);
-  const instrument::FringeOptics optics = instrument::twin_optics(scene);
-  control::SemiClosedLoopParams base;
-  base.sample_time_s = config.twin.daq.sample_time_s;
   instrument::FringeCalibrationOutcome r;
   {
     ProgressBar bar(3);
-    r = instrument::calibrate_from_fringes(config, base, q.seed, *cam, optics, fo, bar.callback());
+    r = instrument::calibrate_twin_from_fringes(ic, q.seed, surface, fo, bar.callback());
   }
   if (!r.validity.valid)
     throw rig::ProcedureFailed("calibrate --interferometer fizeau: " + r.validity.reason +
@@ -95,7 +79,8 @@ int calibrate_from_fringes_command(const FizeauCalibrateRequest& q) {
                   "calibrate --interferometer fizeau --camera twin`\ninterferometer: the Fizeau's "
                   "fringes (psi::FringeTracker, {} frames), not the XL-80; no optics moved\n"
                   "seed {}, configuration: {}, PID gains: {}",
-                  frames(r), q.seed, q.config.empty() ? "built-in defaults" : q.config,
+                  instrument::frames_read(r), q.seed,
+                  q.config.empty() ? "built-in defaults" : q.config,
                   q.pid == "paper" ? "the paper's" : "searched"));
   if (q.json) {
     fmt::print("{}\n", outcome_json(q, r).dump(2));

@@ -23,18 +23,21 @@
 
 #include "bindings.hpp"
 #include "images.hpp"
+#include "piezoshift/calibration/calibration_cost.hpp"
 #include "piezoshift/calibration/loop_calibration.hpp"
 #include "piezoshift/camera/instrument_config.hpp"
 #include "piezoshift/camera/make_camera.hpp"
 #include "piezoshift/camera/twin_camera.hpp"
 #include "piezoshift/core/input_error.hpp"
 #include "piezoshift/instrument/acquisition.hpp"
+#include "piezoshift/instrument/fringe_calibration.hpp"
 #include "piezoshift/instrument/hold_summary.hpp"
 #include "piezoshift/instrument/measurement.hpp"
 #include "piezoshift/instrument/scene_lock.hpp"
 #include "piezoshift/instrument/twin_floor.hpp"
 #include "piezoshift/plant/simulation_cost.hpp"
 #include "piezoshift/psi/pupil_detection.hpp"
+#include "piezoshift/rig/procedure_cost.hpp"
 #include "piezoshift/rig/validity.hpp"
 #include "piezoshift/runtime/loop_clock.hpp"
 #include "piezoshift/runtime/sim_backend.hpp"
@@ -428,6 +431,60 @@ py::dict measure(const MeasureArgs& a) {
   return d;
 }
 
+// `calibrate --interferometer fizeau --camera twin` (docs/fizeau.md) from Python: the paper's
+// three stages with the twin's fringes as the interferometer, the CLI's --json names.
+py::dict fringe_calibration(const py::object& config, std::uint64_t seed,
+                            const std::string& surface, const std::string& pid) {
+  if (pid != "paper" && pid != "search")
+    throw ps::core::InputError("calibrate_from_fringes: pid '" + pid +
+                               "': expected 'paper' (the paper's gains) or 'search'");
+  const cam::InstrumentConfig ic =
+      config.is_none() ? cam::InstrumentConfig{} : cam::load_instrument_config(py::str(config));
+  const psi::SurfaceSpec spec =
+      surface.empty() ? psi::SurfaceSpec{} : psi::parse_surface_spec(surface);
+  ins::FringeCalibrationOptions fo;
+  if (pid == "paper")
+    fo.stages = ps::calibration::CalibrationOptions::paper_gains_only();
+  else
+    fo.stages.pid = ps::calibration::PidChoice::kSearch;
+  fo.stages.limits = ic.installation.safety;
+  const ps::plant::TwinParams& twin = ic.installation.project.twin;
+  ps::rig::check_procedure_budget(
+      "calibrate_from_fringes",
+      ps::calibration::calibration_cost(fo.stages, twin.daq.sample_time_s), twin,
+      ps::plant::kDefaultPhysicsStepBudget, "a twin with fewer physics steps");
+  ins::FringeCalibrationOutcome r;
+  {
+    py::gil_scoped_release release;
+    r = ins::calibrate_twin_from_fringes(ic, seed, spec, fo);
+  }
+  py::dict d;
+  d["valid"] = r.validity.valid;
+  d["reason"] = r.validity.reason.empty() ? py::object(py::none()) : py::str(r.validity.reason);
+  d["controller"] = r.controller;
+  const auto& g = r.controller.gains;
+  py::dict gains;
+  gains["kp"] = g.kp;
+  gains["ki"] = g.ki;
+  gains["kd"] = g.kd;
+  d["pid_gains"] = gains;
+  d["A"] = r.controller.matrix.a;
+  const auto& p = r.controller.polynomial;
+  d["p"] = std::vector<double>{p.p3, p.p2, p.p1, p.p0};
+  d["A_rms_residual_um"] = r.matrix.fit.rms_residual_um;
+  d["condition_number"] = r.matrix.fit.condition_number;
+  d["p_rms_residual_um"] = r.polynomial.fit.rms_residual_um;
+  d["p_points"] = r.polynomial.command_um.size();
+  d["p_skipped_commands"] = r.polynomial.saturated_points;
+  d["frames"] = ins::frames_read(r);
+  d["stage2_simulated_s"] = r.stage2_simulated_s;
+  d["stage3_simulated_s"] = r.stage3_simulated_s;
+  d["wall_s"] = r.wall_time_s;
+  if (!r.validity.valid)
+    fail("calibrate_from_fringes: " + r.validity.reason, d);
+  return d;
+}
+
 }  // namespace
 
 void bind_instrument(py::module_& m) {
@@ -479,6 +536,12 @@ void bind_instrument(py::module_& m) {
       "`measure --json`, maps and frames as numpy arrays; lock=True holds the cavity on the "
       "fringes, "
       "hold_s holds the stage at frame 0 afterwards (docs/python.md)");
+  m.def("calibrate_from_fringes", &fringe_calibration, py::arg("config") = py::none(),
+        py::arg("seed") = 1, py::arg("surface") = "", py::arg("pid") = "paper",
+        "The paper's calibration on the twin with the Fizeau's fringes as its interferometer, as "
+        "`piezoshift calibrate --interferometer fizeau --camera twin --json`: a dict with its "
+        "names and `controller`, a SemiClosedLoopParams (docs/fizeau.md); ProcedureFailed when "
+        "a scan or a fit fails");
 }
 
 }  // namespace piezoshift::python

@@ -8,6 +8,7 @@
 #include "piezoshift/calibration/matrix_fit.hpp"
 #include "piezoshift/calibration/pid_tuning.hpp"
 #include "piezoshift/calibration/poly_fit.hpp"
+#include "piezoshift/camera/make_camera.hpp"
 
 namespace piezoshift::instrument {
 
@@ -148,6 +149,27 @@ FringeCalibrationOutcome calibrate_from_fringes(const config::ProjectConfig& con
     out.controller.polynomial = out.polynomial.fit.p;
   out.wall_time_s = std::chrono::duration<double>(std::chrono::steady_clock::now() - w0).count();
   return out;
+}
+
+std::size_t frames_read(const FringeCalibrationOutcome& r) {
+  std::size_t n = r.piston_scan.poses.size();
+  for (const FringeActuatorScanResult& s : r.actuator_scans)
+    n += s.poses.size();
+  return n;
+}
+
+FringeCalibrationOutcome calibrate_twin_from_fringes(const camera::InstrumentConfig& config,
+                                                     std::uint64_t seed,
+                                                     const psi::SurfaceSpec& surface,
+                                                     const FringeCalibrationOptions& options,
+                                                     const rig::Progress& progress) {
+  const camera::TwinScene scene = camera::make_twin_scene(
+      surface, camera::measurement_optics(config.camera.settings, options.wavelength_nm), seed);
+  const std::unique_ptr<camera::Camera> cam = camera::make_camera("twin", config.camera, &scene);
+  control::SemiClosedLoopParams base;
+  base.sample_time_s = config.installation.project.twin.daq.sample_time_s;
+  return calibrate_from_fringes(config.installation.project, base, seed, *cam, twin_optics(scene),
+                                options, progress);
 }
 
 }  // namespace piezoshift::instrument

@@ -21,10 +21,12 @@
 
 #include "piezoshift/calibration/calibration_procedure.hpp"
 #include "piezoshift/camera/camera.hpp"
+#include "piezoshift/camera/instrument_config.hpp"
 #include "piezoshift/camera/twin_camera.hpp"
 #include "piezoshift/config/project_config.hpp"
 #include "piezoshift/instrument/fringe_actuator_scan.hpp"
 #include "piezoshift/instrument/fringe_piston_scan.hpp"
+#include "piezoshift/psi/fizeau_simulation.hpp"
 #include "piezoshift/psi/grid.hpp"
 #include "piezoshift/rig/progress.hpp"
 #include "piezoshift/rig/validity.hpp"
@@ -74,5 +76,17 @@ FringeCalibrationOutcome calibrate_from_fringes(const config::ProjectConfig& con
                                                 const FringeOptics& optics,
                                                 const FringeCalibrationOptions& options = {},
                                                 const rig::Progress& progress = {});
+
+//! Frames the scans read (the three actuator scans' and the piston scan's).
+std::size_t frames_read(const FringeCalibrationOutcome& r);
+
+//! The same on the twin's bench with the twin camera, as `calibrate --interferometer fizeau
+//! --camera twin` and Python's calibrate_from_fringes() run it: the camera on config's settings
+//! showing surface drawn from seed, the controller at the twin DAQ's rate.
+FringeCalibrationOutcome calibrate_twin_from_fringes(const camera::InstrumentConfig& config,
+                                                     std::uint64_t seed,
+                                                     const psi::SurfaceSpec& surface,
+                                                     const FringeCalibrationOptions& options,
+                                                     const rig::Progress& progress = {});
 
 }  // namespace piezoshift::instrument
