@@ -65,8 +65,13 @@ void FringeLockSession::begin_hold() {
 
 void FringeLockSession::on_frame(const camera::Frame& frame, ExposureRecord& rec) {
   const std::size_t n = frames_++;
-  const control::FringeAxes applied =
-      n < applied_by_move_.size() ? applied_by_move_[n] : control::FringeAxes{};
+  // Each frame takes its move's correction off the queue: a minute's hold of 4300 frames keeps
+  // one or two, not one per move of the whole run.
+  control::FringeAxes applied{};
+  if (!applied_by_move_.empty()) {
+    applied = applied_by_move_.front();
+    applied_by_move_.pop_front();
+  }
   rec.lock_correction_nm = applied[0];
   last_lost_fringes_ = false;
   if (n < reference_count_) {

@@ -23,6 +23,7 @@
 // jump (FringeLock's holding, then lost), and each exposure records the lock's state and why.
 #include <cstddef>
 #include <cstdint>
+#include <deque>
 #include <optional>
 #include <string>
 #include <vector>
@@ -94,14 +95,15 @@ class FringeLockSession {
   std::size_t reference_count_;
   std::vector<psi::Map> reference_frames_;
   std::optional<psi::FramePoseReference> reference_;
-  std::vector<control::FringeLock> locks_;            //!< one per frame of an average
-  bool holding_ = false;                              //!< from begin_hold()
-  control::FringeAxes frame0_{};                      //!< frame 0's pose: the hold's set point
-  psi::FramePose last_{};                             //!< the last valid pose
-  double last_commanded_nm_ = 0.0;                    //!< its frame's commanded piston
-  control::FringeAxes last_applied_{};                //!< the correction its frame was taken with
-  control::FringeAxes applied_{};                     //!< the correction of the last move
-  std::vector<control::FringeAxes> applied_by_move_;  //!< per move, in order
+  std::vector<control::FringeLock> locks_;  //!< one per frame of an average
+  bool holding_ = false;                    //!< from begin_hold()
+  control::FringeAxes frame0_{};            //!< frame 0's pose: the hold's set point
+  psi::FramePose last_{};                   //!< the last valid pose
+  double last_commanded_nm_ = 0.0;          //!< its frame's commanded piston
+  control::FringeAxes last_applied_{};      //!< the correction its frame was taken with
+  control::FringeAxes applied_{};           //!< the correction of the last move
+  //! per move whose frame has not come yet, in order (frames come one per move, in order)
+  std::deque<control::FringeAxes> applied_by_move_;
   std::size_t frames_ = 0;
   bool last_lost_fringes_ = false;
   LockSummary summary_;
