@@ -31,6 +31,8 @@ nlohmann::json improved_json(const ImprovedSummary& s) {
   j["shaper_taps"] = std::vector<double>(sh.weight.begin(),
                                          sh.weight.begin() + static_cast<std::ptrdiff_t>(sh.taps));
   j["shaper_rate_um_per_s"] = sh.rate_um_per_s;
+  j["command_slew_um_per_s"] = s.controller.command_slew_um_per_s;
+  j["slew_approach_um"] = s.controller.slew_approach_um;
   j["correction_ki"] = s.controller.correction_ki;
   j["sample_time_s"] = s.controller.sample_time_s;
   return j;

@@ -176,7 +176,9 @@ void bind_improved(py::module_& m) {
       .PS_RW(c::ImprovedParams, correction_boost_error_um)
       .PS_RW(c::ImprovedParams, correction_limit_um)
       .PS_RW(c::ImprovedParams, reference_delay_ticks)
-      .PS_RW(c::ImprovedParams, headroom_fraction);
+      .PS_RW(c::ImprovedParams, headroom_fraction)
+      .PS_RW(c::ImprovedParams, command_slew_um_per_s)
+      .PS_RW(c::ImprovedParams, slew_approach_um);
 }
 
 }  // namespace

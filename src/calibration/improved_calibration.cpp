@@ -231,6 +231,13 @@ ImprovedDesign design_improved_controller(const config::ProjectConfig& config,
   c.improved.shaper =
       control::design_mode_shaper(out.shaped ? mode.mode_Hz : 0.0, c.sample_time_s,
                                   options.slew_margin * rate_command_um_per_s * min_slope);
+  // Large moves at the slew the supervisor passes (it clamps each DAQ step to max_slew T), in
+  // command um: the amplifier's own current limit is above it (25.9 against 22.5 V/ms).
+  const double passed_V_per_s =
+      std::min(options.paper.limits.max_slew_V_per_s, slew_V_per_s / config.twin.amplifier.gain);
+  c.improved.command_slew_um_per_s =
+      options.large_move_slew_fraction * passed_V_per_s / paper.scaling[0].drive_V_per_um;
+  c.improved.slew_approach_um = options.large_move_approach_um;
   c.improved.correction_ki =
       2.0 * std::numbers::pi * options.correction_bandwidth_Hz * c.sample_time_s;
   c.improved.correction_ki_max =

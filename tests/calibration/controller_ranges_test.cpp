@@ -75,6 +75,8 @@ SemiClosedLoopParams awkward_improved(std::uint64_t seed) {
   im.shaper.weight[1] = 0.5;
   im.shaper.weight[2] = 0.25;
   im.shaper.rate_um_per_s = 1e3 * (1.0 + u(rng));
+  im.command_slew_um_per_s = 2e3 * (1.0 + u(rng));
+  im.slew_approach_um = 0.5 + u(rng);
   for (control::HysteresisCreepParams& m : im.model) {
     m.offset_um = u(rng) - 0.5;
     m.linear_weight = 0.8 + 0.4 * u(rng);
@@ -101,8 +103,8 @@ TEST_F(ControllerFile, EveryNumberOfTheListReadsBackBitForBit) {
     write_calibration_file(file, p, "test");
     const SemiClosedLoopParams q = load_calibration_file(file);
     const auto a = all_numbers(p), b = all_numbers(q);
-    // 4 controller numbers, 8 improved ones (3 taps), per channel 2 + 5 + 5 + 4 + 1.
-    ASSERT_EQ(a.size(), 4U + 7U + 3U + 3U * 17U);
+    // 4 controller numbers, 9 improved ones and 3 taps, per channel 2 + 5 + 5 + 4 + 1.
+    ASSERT_EQ(a.size(), 4U + 9U + 3U + 3U * 17U);
     ASSERT_EQ(a.size(), b.size());
     for (std::size_t i = 0; i < a.size(); ++i) {
       EXPECT_EQ(a[i].first, b[i].first);

@@ -136,5 +136,50 @@ TEST(ImprovedController, TracksAPlantThatIsItsModelWithABias) {
   EXPECT_EQ(out.saturated_mask, 0);
 }
 
+// A large move (issue 31): the command steps by the slew limit each tick, the reference follows
+// what the model reads (so the correction does not wind up on the move), the slew stops
+// slew_approach_um before the target and the shaper makes the rest; a small move never slews.
+TEST(ImprovedController, LargeMoveSlewsThenTheShaperFinishes) {
+  SemiClosedLoopParams params;
+  params.kind = ControllerKind::kImproved;
+  params.polynomial = CubicPolynomial::identity();
+  params.matrix = TransmissionMatrix::identity();
+  for (auto& m : params.improved.model)
+    m = example_model();
+  params.improved.shaper = design_mode_shaper(1419.0, 1e-3, 1000.0);
+  params.improved.reference_delay_ticks = 2;
+  params.improved.correction_ki = 0.05;
+  params.improved.command_slew_um_per_s = 2000.0;  // 2 um of command per tick
+  params.improved.slew_approach_um = 1.0;
+  SemiClosedLoopController c(params);
+  HysteresisCreepModel plant;
+  plant.configure(example_model(), 1e-3);
+  double y1 = plant.output(), y2 = y1, previous = 0.0;
+  int full_steps = 0;
+  ControllerOutput out{};
+  for (int k = 0; k < 400; ++k) {
+    out = c.update(Vec3{10.0, 10.0, 10.0}, filled(y2 / 1.6));
+    const double du = out.command_um[0] - previous;
+    EXPECT_LE(du, 2.0 + 1e-9);
+    full_steps += du > 2.0 - 1e-9 ? 1 : 0;
+    if (k < full_steps) {  // while slewing: the model's reading, the target at least 1 um away
+      EXPECT_LE(c.model(0).output(), 10.0 - 1.0 + 1e-9);
+    }
+    previous = out.command_um[0];
+    plant.commit(out.command_um[0]);
+    y2 = y1;
+    y1 = plant.output();
+  }
+  EXPECT_GE(full_steps, 3);
+  EXPECT_NEAR(y1, 10.0, 1e-6);
+  // A move of less than twice the approach is the shaper's alone: its rate limit, 1 um a tick.
+  previous = c.model(0).output();
+  for (int k = 0; k < 20; ++k) {
+    out = c.update(Vec3{11.5, 11.5, 11.5}, filled(c.model(0).output() / 1.6));
+    EXPECT_LE(c.model(0).output() - previous, 1.0 + 1e-9);
+    previous = c.model(0).output();
+  }
+}
+
 }  // namespace
 }  // namespace piezoshift::control

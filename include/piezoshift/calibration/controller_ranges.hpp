@@ -93,6 +93,9 @@ void visit_improved_fields(Improved& im, Visit&& visit) {
         ListField{im.shaper.weight.data(), &im.shaper.taps, control::kMaxShaperTaps},
         B::closed(0.0, 1.0), "");
   visit("improved", "shaper_rate_um_per_s", im.shaper.rate_um_per_s, B::positive(), "");
+  visit("improved", "command_slew_um_per_s", im.command_slew_um_per_s, B::non_negative(),
+        "0: large moves shaped like small ones");
+  visit("improved", "slew_approach_um", im.slew_approach_um, B::non_negative(), "");
 }
 
 //! One [improved.channelN]'s numbers (section: its name), as visit_controller_fields.

@@ -34,7 +34,14 @@ struct ImprovedCalibrationOptions {
   //! The boost's ceiling (large model errors, e.g. after a long move), as a bandwidth: 50 Hz
   //! keeps 11 dB and 65 deg on the identified loop at 1 kHz.
   double boost_bandwidth_Hz = 50.0;
-  double slew_margin = 0.7;        //!< the rate limit as this fraction of the amplifier's slew
+  double slew_margin = 0.7;  //!< the rate limit as this fraction of the amplifier's slew
+  //! Large moves: the command's step per tick as this fraction of the slew the supervisor passes
+  //! (its max_slew_V_per_s, below the amplifier's), so the amplifier slews through most of each
+  //! tick (docs/control.md, "Large moves"); 0 turns the slew path off.
+  double large_move_slew_fraction = 0.98;
+  //! and the slew stops this far (SGS um) before the target: above the ring the stop leaves
+  //! (0.2 to 0.3 um of plate on the plants of docs/compare.md), so it stays below the target.
+  double large_move_approach_um = 1.0;
   double mode_step_from_um = 5.0;  //!< stage 5: open-loop command held, then
   double mode_step_um = 0.3;       //!< stepped by this
   double mode_record_s = 0.03;     //!< and the interferometer recorded this long

@@ -99,7 +99,7 @@ template <class T>
 constexpr bool model_finite(const BasicImprovedParams<T>& im) noexcept {
   bool ok = all_finite(im.sample_time_s, im.correction_ki, im.correction_ki_max,
                        im.correction_boost_error_um, im.correction_limit_um, im.headroom_fraction,
-                       im.shaper.rate_um_per_s);
+                       im.shaper.rate_um_per_s, im.command_slew_um_per_s, im.slew_approach_um);
   for (std::size_t k = 0; k < im.shaper.taps; ++k)
     ok = ok && finite(im.shaper.weight[k]);
   for (const BasicHysteresisCreepParams<T>& m : im.model) {

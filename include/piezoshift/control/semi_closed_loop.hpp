@@ -20,7 +20,12 @@
 //         the command just short of the rail, and the channel reports itself saturated)
 //   u   = model_i^-1(t)                inverse hysteresis-creep model (hysteresis_creep_model.hpp)
 // so a set-point change is made by the model at once and the gauges' noise enters only through
-// the slow correction (docs/control.md).
+// the slow correction (docs/control.md). A large move (more than 2 slew_approach_um away, when
+// command_slew_um_per_s > 0) is made instead by the command stepping by the slew limit each tick
+// towards model^-1(S_i + c), unshaped: a DAQ step of the full slew keeps the current-limited
+// amplifier slewing through the tick, where smaller shaped steps make it slew and pause every
+// tick, which rings the plate's mode; slew_approach_um before the target the shaper takes over
+// from where the slew left (issue 31).
 //
 // Real-time safe: no heap, no exceptions, no I/O; every member is noexcept. Templated on the
 // scalar type (see vec3.hpp): SemiClosedLoopController is the double one, the firmware runs
@@ -63,6 +68,12 @@ struct BasicImprovedParams {
   //! The command range kept in reserve at each end, as a fraction of the range: the governor
   //! holds the target within what the model reaches inside it.
   T headroom_fraction = T(0.001);
+  //! Large moves at the slew limit (0: off, the shaper makes every move): a move of more than
+  //! twice slew_approach_um is made by the command stepping this fast (um of command per second,
+  //! at most what the supervisor passes) until the target is slew_approach_um away, then the
+  //! shaper makes the rest (issue 31; docs/control.md, "Large moves").
+  T command_slew_um_per_s = T(0);
+  T slew_approach_um = T(1);  //!< SGS um
 };
 
 using ImprovedParams = BasicImprovedParams<double>;
@@ -80,6 +91,8 @@ constexpr BasicImprovedParams<To> convert(const BasicImprovedParams<From>& p) no
   q.correction_limit_um = static_cast<To>(p.correction_limit_um);
   q.reference_delay_ticks = p.reference_delay_ticks;
   q.headroom_fraction = static_cast<To>(p.headroom_fraction);
+  q.command_slew_um_per_s = static_cast<To>(p.command_slew_um_per_s);
+  q.slew_approach_um = static_cast<To>(p.slew_approach_um);
   return q;
 }
 
@@ -236,12 +249,16 @@ class BasicSemiClosedLoopController {
     for (std::size_t i = 0; i < kChannels; ++i) {
       const BasicSignalScaling<T>& s = params_.scaling[i];
       out.feedback_um[i] = s.sgs_to_um(sgs_V[i]);
-      const T r = shaper_[i].update(target_um[i]);
+      const BasicImprovedParams<T>& im = params_.improved;
+      const T slew = im.command_slew_um_per_s * params_.sample_time_s;
+      if (slew > T(0) && enabled_ && !slewing_[i] &&
+          shaper_[i].distance(target_um[i]) > T(2) * im.slew_approach_um)
+        slewing_[i] = true;
+      const T r = slewing_[i] ? shaper_[i].output() : shaper_[i].update(target_um[i]);
       auto& hist = reference_[i];
       for (std::size_t k = kMaxReferenceDelayTicks; k > 0; --k)
         hist[k] = hist[k - 1];
       hist[0] = r;
-      const BasicImprovedParams<T>& im = params_.improved;
       T e = hist[delay_] - out.feedback_um[i];
       if (!(e == e))
         e = T(0);  // a NaN reading never reaches the correction (the supervisor reports it)
@@ -270,7 +287,7 @@ class BasicSemiClosedLoopController {
       const T limit = im.correction_limit_um;
       const bool corr_limited = corr > limit || corr < -limit;
       corr = corr > limit ? limit : (corr < -limit ? -limit : corr);
-      T target = r + corr;
+      T target = (slewing_[i] ? target_um[i] : r) + corr;
       governed_[i] = 0;
       if (target > y_top) {
         target = y_top;
@@ -284,8 +301,11 @@ class BasicSemiClosedLoopController {
         if (at_rail && !(u > params_.output_min_um))
           governed_[i] = -1;
         clamped = clamped || at_rail;
+        if (slewing_[i])
+          u = slew_step(i, u, slew, target_um[i], corr, hist[0]);
       } else {
         corr = T(0);
+        slewing_[i] = false;
       }
       model_[i].commit(u);
       out.command_um[i] = u;
@@ -294,6 +314,26 @@ class BasicSemiClosedLoopController {
         out.saturated_mask |= static_cast<std::uint8_t>(1U << i);
     }
     return out;
+  }
+
+  // One tick of a large move: the command at most slew from the last one towards u (the command
+  // for the whole move). The reference (and the shaper's state) is what the model reads with the
+  // command sent, so the correction sees the model's error only, not the move. The slew ends once
+  // the model reads within slew_approach_um of the target (after a whole slew step: a partial one
+  // that stops at exactly that distance rang the plate more, docs/compare.md), or where the
+  // command arrives; the shaper goes on from there.
+  constexpr T slew_step(std::size_t i, T u, T slew, T target, T corr, T& reference) noexcept {
+    const T u0 = model_[i].command_um();
+    const T du = u - u0;
+    const bool limited = du > slew || du < -slew;
+    if (limited)
+      u = du > T(0) ? u0 + slew : u0 - slew;
+    const T r = limited ? model_[i].predict(u) - corr : target;
+    const T left = target - r;
+    slewing_[i] = limited && (left < T(0) ? -left : left) > params_.improved.slew_approach_um;
+    shaper_[i].reset(r);
+    reference = r;
+    return u;
   }
 
   // The models start from the commands held (history unknown: a rising branch), the shapers and
@@ -306,6 +346,7 @@ class BasicSemiClosedLoopController {
       reference_[i].fill(y);
       correction_[i] = T(0);
       governed_[i] = 0;
+      slewing_[i] = false;
     }
   }
 
@@ -316,6 +357,7 @@ class BasicSemiClosedLoopController {
   Vec correction_{};  //!< c per channel (SGS um)
   //! +1: the target held below the top by the governor; -1: the command at its lower rail.
   std::array<int, kChannels> governed_{};
+  std::array<bool, kChannels> slewing_{};  //!< a large move slewing (command_slew_um_per_s)
   bool enabled_ = true;
   bool correction_held_ = false;
   std::array<std::array<T, kMaxReferenceDelayTicks + 1>, kChannels> reference_{};

@@ -104,6 +104,11 @@ class BasicSetpointShaper {
     return r;
   }
   constexpr T output() const noexcept { return out_; }
+  //! How far target is from the rate limiter's present value.
+  constexpr T distance(T target) const noexcept {
+    const T d = target - q_[0];
+    return d < T(0) ? -d : d;
+  }
 
  private:
   BasicShaperParams<T> p_{};
