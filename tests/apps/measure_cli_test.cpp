@@ -1,7 +1,9 @@
 // `piezoshift measure` end to end (docs/measure.md): the stage stepped through the shipping loop,
 // the camera exposed once it settled, the surface found again; and every failure a clear exit
 // status with nothing half-written.
+#include <algorithm>
 #include <cmath>
+#include <cstdio>
 #include <filesystem>
 #include <fstream>
 #include <iterator>
@@ -252,25 +254,52 @@ TEST_F(MeasureCli, FringesLostMidSequenceAreTakenAgainAndNoFrameIsLost) {
 }
 
 // Issue 29: with the lab's drift in the fringes, the lock at most halves what the stage adds to
-// the surface error (improved controller, seed 1, 20 averages, 96 px). What the stage adds is
-// sqrt(error^2 - floor^2), the floor the whole measurement from an ideal stage with every frame's
-// own noise draws (floor_error_rms_nm). Measured: 0.0865 nm unlocked, 0.0140 nm locked (seeds 1
-// to 8: 0.09 to 0.44 of the unlocked; docs/fizeau.md).
+// the surface error (improved controller, 20 averages, 96 px), the median over seeds 1 to 8 as
+// the done-when asks, each seed calibrated on its own. What the stage adds is sqrt(error^2 -
+// floor^2), the floor the whole measurement from an ideal stage with every frame's own noise
+// draws (floor_error_rms_nm). One seed alone does not decide it: locked, the stage adds 0.01 to
+// 0.04 nm to a floor of 0.119 nm, so a change of 0.007 nm in a seed's error moves its ratio from
+// 0.12 to 0.57 (seed 1 after issue 31's large moves at the slew limit, which changed the move to
+// the base; seeds 2 to 5 stayed at 0.15 to 0.38). Measured: docs/fizeau.md.
 TEST_F(MeasureCli, TheLockHalvesWhatTheDriftingStageAddsToTheSurface) {
-  const std::string common = improved_with_drift() + "--averages 20 ";
-  const Json off = measure(common + "--out '" + path("off") + "'");
-  const Json on = measure(common + "--lock --out '" + path("on") + "'");
-  ASSERT_TRUE(off.is_object() && on.is_object());
-  const double floor_off = off["floor_error_rms_nm"], floor_on = on["floor_error_rms_nm"];
-  // The same frame draws when no frame was taken again: the same floor.
-  EXPECT_EQ(on["lock"]["retaken_frames"], 0);
-  EXPECT_NEAR(floor_on, floor_off, 1e-12);
-  EXPECT_NEAR(off["stage_error_rms_nm"].get<double>(),
-              std::sqrt(std::pow(off["error_rms_nm"].get<double>(), 2) - floor_off * floor_off),
-              1e-12);
-  const double stage_off = off["stage_error_rms_nm"], stage_on = on["stage_error_rms_nm"];
-  EXPECT_GT(stage_off, 0.0);
-  EXPECT_LE(stage_on, 0.5 * stage_off) << stage_on << " vs " << stage_off;
+  const std::string cfg = write("drift.toml",
+                                "[camera]\nwidth_px = 96\nheight_px = 96\n"
+                                "[twin.cavity]\nin_fringes = true\n");
+  std::vector<double> ratio, off_nm, on_nm;
+  for (int seed = 1; seed <= 8; ++seed) {
+    const std::string seed_s = std::to_string(seed);
+    const std::string cal = path("cal" + seed_s + ".toml");
+    const testing::CliResult c =
+        run("calibrate --controller improved --seed " + seed_s + " --out '" + cal + "'");
+    ASSERT_EQ(c.status, 0) << c.err;
+    const std::string common =
+        "--calibration '" + cal + "' --config '" + cfg + "' --seed " + seed_s + " --averages 20 ";
+    const Json off = measure(common + "--out '" + path("off" + seed_s) + "'");
+    const Json on = measure(common + "--lock --out '" + path("on" + seed_s) + "'");
+    ASSERT_TRUE(off.is_object() && on.is_object());
+    const double floor_off = off["floor_error_rms_nm"], floor_on = on["floor_error_rms_nm"];
+    // The same frame draws when no frame was taken again: the same floor.
+    EXPECT_EQ(on["lock"]["retaken_frames"], 0);
+    EXPECT_NEAR(floor_on, floor_off, 1e-12);
+    EXPECT_NEAR(off["stage_error_rms_nm"].get<double>(),
+                std::sqrt(std::pow(off["error_rms_nm"].get<double>(), 2) - floor_off * floor_off),
+                1e-12);
+    const double stage_off = off["stage_error_rms_nm"], stage_on = on["stage_error_rms_nm"];
+    EXPECT_GT(stage_off, 0.0);
+    off_nm.push_back(stage_off);
+    on_nm.push_back(stage_on);
+    ratio.push_back(stage_on / stage_off);
+    std::printf("seed %d: the stage adds %.4f nm unlocked, %.4f nm locked (%.2f)\n", seed,
+                stage_off, stage_on, stage_on / stage_off);
+  }
+  const auto median = [](std::vector<double> v) {
+    std::sort(v.begin(), v.end());
+    return 0.5 * (v[v.size() / 2 - 1] + v[v.size() / 2]);
+  };
+  std::printf("medians: %.4f nm unlocked, %.4f nm locked; ratio %.2f\n", median(off_nm),
+              median(on_nm), median(ratio));
+  EXPECT_LE(median(on_nm), 0.5 * median(off_nm));
+  EXPECT_LE(median(ratio), 0.5);
 }
 
 // Issue 29's hold: after the measurement the stage stays at frame 0 for a minute of loop time
