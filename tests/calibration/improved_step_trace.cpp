@@ -23,17 +23,14 @@
 #include "piezoshift/experiments/phase_step.hpp"
 #include "piezoshift/reproduction/reproduction.hpp"
 #include "piezoshift/rig/bench.hpp"
-#include "test_paths.hpp"
+#include "plant_by_name.hpp"
 
 namespace piezoshift::calibration {
 namespace {
 
 void trace(const std::string& name, std::uint64_t seed) {
   {
-    config::ProjectConfig config;
-    if (name != "default")
-      config =
-          config::load_project_config(testing::source_dir() + "/configs/plants/" + name + ".toml");
+    config::ProjectConfig config = testing::plant_by_name(name);
     if (const char* d = std::getenv("DIAG_DAMPING"))
       config.twin.mechanics.modal_damping_ratio = std::strtod(d, nullptr);
     if (const char* r = std::getenv("DIAG_IFM_HZ"))

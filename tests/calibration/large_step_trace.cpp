@@ -20,7 +20,7 @@
 #include "piezoshift/experiments/paper_experiments.hpp"
 #include "piezoshift/reproduction/reproduction.hpp"
 #include "piezoshift/rig/bench.hpp"
-#include "test_paths.hpp"
+#include "plant_by_name.hpp"
 
 namespace piezoshift::calibration {
 namespace {
@@ -31,12 +31,7 @@ double env(const char* name, double fallback) {
 }
 
 void trace(const std::string& name, std::uint64_t seed) {
-  config::ProjectConfig config;
-  if (!name.empty() && name[0] == '/')
-    config = config::load_project_config(name);
-  else if (name != "default")
-    config =
-        config::load_project_config(testing::source_dir() + "/configs/plants/" + name + ".toml");
+  config::ProjectConfig config = testing::plant_by_name(name);
   ImprovedCalibrationOptions o;
   o.paper = reproduction::Schedule::quick().calibration;
   control::SemiClosedLoopParams base;

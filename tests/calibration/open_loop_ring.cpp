@@ -10,17 +10,12 @@
 
 #include "piezoshift/config/project_config.hpp"
 #include "piezoshift/rig/bench.hpp"
-#include "test_paths.hpp"
+#include "plant_by_name.hpp"
 
 int main(int argc, char** argv) {
   using namespace piezoshift;
   const std::string name = argc > 1 ? argv[1] : "default";
-  config::ProjectConfig config;
-  if (!name.empty() && name[0] == '/')
-    config = config::load_project_config(name);
-  else if (name != "default")
-    config =
-        config::load_project_config(testing::source_dir() + "/configs/plants/" + name + ".toml");
+  config::ProjectConfig config = testing::plant_by_name(name);
   config.twin.daq.sample_time_s = 1e-4;
   if (const char* p = std::getenv("DIAG_AMP_POWER_SCALE"))
     config.twin.amplifier.average_power_W *= std::strtod(p, nullptr);
@@ -29,9 +24,14 @@ int main(int argc, char** argv) {
   control::SemiClosedLoopParams c;
   c.sample_time_s = 1e-4;
   std::vector<double> seq;
-  std::ifstream in(std::getenv("DIAG_SEQ_FILE"));
+  const char* seq_file = std::getenv("DIAG_SEQ_FILE");
+  std::ifstream in(seq_file != nullptr ? seq_file : "");
   for (double v; in >> v;)
     seq.push_back(v);
+  if (seq.empty()) {
+    std::fprintf(stderr, "open_loop_ring: DIAG_SEQ_FILE must name a file of commands (um)\n");
+    return 2;
+  }
   rig::BenchOptions bo;
   if (const char* p = std::getenv("DIAG_SUPERVISOR_SLEW"))
     bo.limits.max_slew_V_per_s = std::strtod(p, nullptr);
