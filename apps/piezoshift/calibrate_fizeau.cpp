@@ -49,14 +49,8 @@ int calibrate_from_fringes_command(const FizeauCalibrateRequest& q) {
   const psi::SurfaceSpec surface =
       q.surface.empty() ? psi::SurfaceSpec{} : psi::parse_surface_spec(q.surface);
   const config::ProjectConfig& config = ic.installation.project;
-  instrument::FringeCalibrationOptions fo;
-  // Stage 1 reads no interferometer: --pid paper keeps the paper's gains, scored alone (as `run`
-  // calibrates the twin; the XL-80 path's grid would keep the same gains); search runs the grid.
-  if (q.pid == "paper")
-    fo.stages = calibration::CalibrationOptions::paper_gains_only();
-  else
-    fo.stages.pid = calibration::PidChoice::kSearch;
-  fo.stages.limits = ic.installation.safety;
+  const instrument::FringeCalibrationOptions fo =
+      instrument::fringe_calibration_options(q.pid == "search", ic.installation.safety);
   // The XL-80's stages bound the scans' (docs/fizeau.md) and the travel it adds is not run
   // here: the check errs on the safe side.
   check_procedure_cost("calibrate --interferometer fizeau",

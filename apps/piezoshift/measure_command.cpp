@@ -29,6 +29,7 @@
 #include "piezoshift/camera/twin_camera.hpp"
 #include "piezoshift/core/input_error.hpp"
 #include "piezoshift/instrument/acquisition.hpp"
+#include "piezoshift/instrument/hold_summary.hpp"
 #include "piezoshift/instrument/measurement.hpp"
 #include "piezoshift/instrument/scene_lock.hpp"
 #include "piezoshift/instrument/sequence.hpp"
@@ -164,12 +165,10 @@ void check_options(const MeasureOptions& o) {
         "--surface: the test surface of the twin camera (or of aravis:Fake_1 on --daq sim)");
 }
 
-// The fringe lock (--lock, or the calibration's [controller] outer = "fringes" with its
-// [fringe_lock] parameters) needs the pupil before the first frame: the twin's scene has it.
-instrument::LockSetup lock_setup(const MeasureOptions& o, const MeasureSetup& s) {
-  const std::string who =
-      o.lock ? std::string("--lock")
-             : fmt::format("{}: [controller] outer = \"fringes\"", s.calibration.source);
+// The fringe lock, asked for by `who` (instrument::lock_requested_by): it needs the pupil before
+// the first frame, which the twin's scene has.
+instrument::LockSetup lock_setup(const MeasureOptions& o, const MeasureSetup& s,
+                                 const std::string& who) {
   // Each frame's fit (about 5 ms at 256 px) runs where the sequence takes its frames, which on
   // a real-time clock is between the loop's ticks: it would make them overrun.
   if (s.scene && !o.free_run)
@@ -177,10 +176,9 @@ instrument::LockSetup lock_setup(const MeasureOptions& o, const MeasureSetup& s)
         who +
         ": the lock's fit runs on the loop's thread, about 5 ms a frame, which a real-time "
         "loop at 1 kHz cannot spare; use --free-run until it runs on a thread of its own");
-  return instrument::scene_lock_setup(
-      s.scene ? &*s.scene : nullptr, o.camera, s.config.installation.project.twin.geometry,
-      s.calibration.fringe_lock.value_or(control::FringeLockParams{}), o.lock_retake_s, s.params,
-      who);
+  return instrument::scene_lock_setup(s.scene ? &*s.scene : nullptr, o.camera,
+                                      s.config.installation.project.twin.geometry, s.calibration,
+                                      o.lock_retake_s, s.params, who);
 }
 
 void check_travel(const MeasureSetup& s) {
@@ -262,8 +260,9 @@ int measure(const MeasureOptions& o) {
     throw core::InputError(fmt::format("--trigger line: DAQ {} has no trigger line", stack.name()));
   s.calibration = resolve_calibration(o.calibration, o.daq, s.config.installation.project, o.seed,
                                       1.0 / o.rate_Hz, o.max_physics_steps);
-  if (o.lock || s.calibration.fringe_lock)
-    s.params.lock = lock_setup(o, s);
+  if (const std::optional<std::string> who =
+          instrument::lock_requested_by(o.lock, "--lock", s.calibration))
+    s.params.lock = lock_setup(o, s, *who);
   check_travel(s);
 
   const Outcome acquired = acquire(o, s, stack);
@@ -330,7 +329,7 @@ int measure(const MeasureOptions& o) {
                          : std::string(),
         a.step_error_text(), r.wall_time_s, r.floor_s, r.overruns, o.out);
     if (!r.hold.empty()) {
-      const std::optional<double> rms = instrument::hold_path_error_rms_nm(r);
+      const std::optional<double> rms = instrument::hold_summary(r).path_error_rms_nm;
       fmt::print("hold: {} frames over {:.1f} s{}\n", r.hold.size(), o.hold_s,
                  rms ? fmt::format(", the cavity's path from its set point {:.3f} nm RMS", *rms)
                      : std::string());

@@ -43,7 +43,8 @@ std::string hold_markdown(const instrument::SequenceResult& s) {
 }
 
 void write_hold(const instrument::SequenceResult& s, const std::filesystem::path& dir) {
-  const std::vector<double> path = instrument::path_errors_nm(s, s.hold);
+  const instrument::HoldSummary h = instrument::hold_summary(s);
+  const std::vector<double>& path = h.path_error_nm;
   const double nan = std::nan("");
   io::CsvWriter csv((dir / "hold.csv").string(),
                     {"trigger_time_s", "frame_id", "settle_s", "gauge_error_mean_nm",
@@ -64,10 +65,12 @@ void write_hold(const instrument::SequenceResult& s, const std::filesystem::path
   io::Figure f;
   f.width_px = 800;
   f.height_px = 520;
-  const std::optional<double> rms = instrument::hold_path_error_rms_nm(s);
   io::Panel p;
-  p.title = rms ? fmt::format("The hold: the cavity's path from its set point, RMS {:.3f} nm", *rms)
-                : "The hold";
+  p.title = h.path_error_rms_nm ? fmt::format(
+                                      "The hold: the cavity's path from its set point, "
+                                      "RMS {:.3f} nm",
+                                      *h.path_error_rms_nm)
+                                : "The hold";
   p.x_label = "loop time [s]";
   p.y_label = "[nm]";
   if (!path.empty())

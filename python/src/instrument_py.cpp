@@ -366,14 +366,11 @@ py::dict measure(const MeasureArgs& a) {
   {
     py::gil_scoped_release release;
     s.calibration = resolve(a, project);
-    // lock=True, or a calibration file's [controller] outer = "fringes" (its [fringe_lock] too)
-    if (a.lock || s.calibration.fringe_lock)
-      s.params.lock = ins::scene_lock_setup(
-          s.scene ? &*s.scene : nullptr, a.camera, project.twin.geometry,
-          s.calibration.fringe_lock.value_or(ps::control::FringeLockParams{}), a.lock_retake_s,
-          s.params,
-          a.lock ? std::string("lock")
-                 : s.calibration.source + ": [controller] outer = \"fringes\"");
+    if (const std::optional<std::string> who =
+            ins::lock_requested_by(a.lock, "lock", s.calibration))
+      s.params.lock =
+          ins::scene_lock_setup(s.scene ? &*s.scene : nullptr, a.camera, project.twin.geometry,
+                                s.calibration, a.lock_retake_s, s.params, *who);
     if (const std::string why =
             ins::travel_problem(s.params, s.calibration.travel_z_max_um, s.calibration.source);
         !why.empty())
@@ -442,12 +439,8 @@ py::dict fringe_calibration(const py::object& config, std::uint64_t seed,
       config.is_none() ? cam::InstrumentConfig{} : cam::load_instrument_config(py::str(config));
   const psi::SurfaceSpec spec =
       surface.empty() ? psi::SurfaceSpec{} : psi::parse_surface_spec(surface);
-  ins::FringeCalibrationOptions fo;
-  if (pid == "paper")
-    fo.stages = ps::calibration::CalibrationOptions::paper_gains_only();
-  else
-    fo.stages.pid = ps::calibration::PidChoice::kSearch;
-  fo.stages.limits = ic.installation.safety;
+  const ins::FringeCalibrationOptions fo =
+      ins::fringe_calibration_options(pid == "search", ic.installation.safety);
   const ps::plant::TwinParams& twin = ic.installation.project.twin;
   ps::rig::check_procedure_budget(
       "calibrate_from_fringes",

@@ -151,6 +151,19 @@ FringeCalibrationOutcome calibrate_from_fringes(const config::ProjectConfig& con
   return out;
 }
 
+FringeCalibrationOptions fringe_calibration_options(bool search_gains,
+                                                    const runtime::SafetyLimits& limits) {
+  FringeCalibrationOptions o;
+  // --pid paper keeps the paper's gains (as `run` calibrates the twin; the XL-80 path's grid
+  // would keep the same gains); search runs the grid.
+  if (search_gains)
+    o.stages.pid = calibration::PidChoice::kSearch;
+  else
+    o.stages = calibration::CalibrationOptions::paper_gains_only();
+  o.stages.limits = limits;
+  return o;
+}
+
 std::size_t frames_read(const FringeCalibrationOutcome& r) {
   std::size_t n = r.piston_scan.poses.size();
   for (const FringeActuatorScanResult& s : r.actuator_scans)

@@ -45,11 +45,13 @@ HoldSummary hold_summary(const SequenceResult& result) {
     s.frame_interval_s = s.span_s / static_cast<double>(hold.size() - 1);
   }
   s.path_error_nm = path_errors_nm(result, hold);
-  s.path_error_rms_nm = hold_path_error_rms_nm(result);
   if (!s.path_error_nm.empty()) {
-    double worst = 0.0;
-    for (double d : s.path_error_nm)
+    double sum = 0.0, worst = 0.0;
+    for (double d : s.path_error_nm) {
+      sum += d * d;
       worst = std::max(worst, std::fabs(d));
+    }
+    s.path_error_rms_nm = std::sqrt(sum / static_cast<double>(s.path_error_nm.size()));
     s.path_error_max_nm = worst;
   }
   s.path_error_1s_means_rms_nm = second_means_rms_nm(hold, s.path_error_nm);

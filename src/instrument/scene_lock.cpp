@@ -8,9 +8,18 @@
 
 namespace piezoshift::instrument {
 
+std::optional<std::string> lock_requested_by(bool flag, std::string_view flag_name,
+                                             const calibration::LoopCalibration& calibration) {
+  if (flag)
+    return std::string(flag_name);
+  if (calibration.fringe_lock)
+    return fmt::format("{}: [controller] outer = \"fringes\"", calibration.source);
+  return std::nullopt;
+}
+
 LockSetup scene_lock_setup(const camera::TwinScene* scene, std::string_view camera_spec,
                            const plant::GeometryParams& geometry,
-                           const control::FringeLockParams& lock, double retake_s,
+                           const calibration::LoopCalibration& calibration, double retake_s,
                            const SequenceParams& params, std::string_view option) {
   if (scene == nullptr)
     throw core::InputError(
@@ -18,7 +27,7 @@ LockSetup scene_lock_setup(const camera::TwinScene* scene, std::string_view came
                     "{} that is not built yet (camera twin has it)",
                     option, camera_spec));
   LockSetup l;
-  l.lock = lock;
+  l.lock = calibration.fringe_lock.value_or(control::FringeLockParams{});
   l.mask = scene->mask;
   l.pupil_radius_m = scene->fizeau.pupil_radius_m;
   l.tripod.emplace(plant::make_twin_geometry(geometry).points);

@@ -567,10 +567,6 @@ std::optional<double> path_error_rms_nm(const SequenceResult& result, std::size_
   return rms_from(path_errors_nm(result, result.exposures), first);
 }
 
-std::optional<double> hold_path_error_rms_nm(const SequenceResult& result) {
-  return rms_from(path_errors_nm(result, result.hold), 0);
-}
-
 SequenceResult run_sequence(runtime::ControlLoop& loop, const plant::Twin* twin,
                             camera::Camera& camera, const SequenceParams& params,
                             const rig::Progress& progress) {

@@ -246,11 +246,11 @@ class BasicSemiClosedLoopController {
   constexpr Output update_improved(const Vec& target_um, const Vec& sgs_V) noexcept {
     Output out{};
     out.target_um = target_um;
+    const BasicImprovedParams<T>& im = params_.improved;
+    const T slew = im.command_slew_um_per_s * params_.sample_time_s;
     for (std::size_t i = 0; i < kChannels; ++i) {
       const BasicSignalScaling<T>& s = params_.scaling[i];
       out.feedback_um[i] = s.sgs_to_um(sgs_V[i]);
-      const BasicImprovedParams<T>& im = params_.improved;
-      const T slew = im.command_slew_um_per_s * params_.sample_time_s;
       if (slew > T(0) && enabled_ && !slewing_[i] &&
           shaper_[i].distance(target_um[i]) > T(2) * im.slew_approach_um)
         slewing_[i] = true;

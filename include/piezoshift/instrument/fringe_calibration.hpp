@@ -77,6 +77,12 @@ FringeCalibrationOutcome calibrate_from_fringes(const config::ProjectConfig& con
                                                 const FringeCalibrationOptions& options = {},
                                                 const rig::Progress& progress = {});
 
+//! The options `calibrate --interferometer fizeau` and Python's calibrate_from_fringes() run
+//! with: stage 1 (which reads no interferometer) keeps the paper's gains, scored alone, or
+//! searches the grid (search_gains); the supervisor's limits are the installation's.
+FringeCalibrationOptions fringe_calibration_options(bool search_gains,
+                                                    const runtime::SafetyLimits& limits);
+
 //! Frames the scans read (the three actuator scans' and the piston scan's).
 std::size_t frames_read(const FringeCalibrationOutcome& r);
 

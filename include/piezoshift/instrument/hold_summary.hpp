@@ -19,7 +19,8 @@ struct HoldSummary {
   std::optional<double> frame_interval_s;  //!< span_s / (frames - 1); none under two frames
   //! The cavity's path from its set point at each hold record [nm]; empty without truth
   std::vector<double> path_error_nm;
-  std::optional<double> path_error_rms_nm;  //!< hold_path_error_rms_nm()
+  //! Their RMS: relative to the sequence's first exposure (frame 0, where the hold returns)
+  std::optional<double> path_error_rms_nm;
   std::optional<double> path_error_max_nm;  //!< the largest |path_error_nm|
   //! The RMS of the path's means over the hold's whole seconds (the last, partial second left
   //! out): the drift a lock at the frame rate is there to hold, without the exposure-to-exposure

@@ -160,10 +160,6 @@ std::optional<double> path_error_rms_nm(const SequenceResult& result, std::size_
 std::vector<double> path_errors_nm(const SequenceResult& result,
                                    const std::vector<ExposureRecord>& records);
 
-//! The same over the hold's exposures, relative to the first exposure of the sequence (frame 0,
-//! where the hold returns).
-std::optional<double> hold_path_error_rms_nm(const SequenceResult& result);
-
 //! Runs the sequence (see the header). twin: the twin whose true plate pose feeds the camera and
 //! the records (nullptr on hardware). loop must be in owner mode and not started; the DAQ
 //! backend must be active. Throws core::InputError for parameters sequence_problem() refuses, and
