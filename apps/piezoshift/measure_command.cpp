@@ -31,11 +31,12 @@
 #include "piezoshift/instrument/acquisition.hpp"
 #include "piezoshift/instrument/hold_summary.hpp"
 #include "piezoshift/instrument/measurement.hpp"
-#include "piezoshift/instrument/scene_lock.hpp"
+#include "piezoshift/instrument/measurement_lock.hpp"
 #include "piezoshift/instrument/sequence.hpp"
 #include "piezoshift/instrument/twin_floor.hpp"
 #include "piezoshift/psi/analysis.hpp"
 #include "piezoshift/psi/fizeau_simulation.hpp"
+#include "piezoshift/psi/png_image.hpp"
 #include "piezoshift/rig/validity.hpp"
 #include "piezoshift/runtime/control_loop.hpp"
 #include "piezoshift/runtime/safety_ranges.hpp"
@@ -110,8 +111,8 @@ camera::TwinScene twin_scene(const MeasureOptions& o, const camera::CameraConfig
                              double wavelength_nm) {
   const psi::SurfaceSpec spec =
       o.surface.empty() ? psi::SurfaceSpec{} : psi::parse_surface_spec(o.surface);
-  return camera::make_twin_scene(spec, camera::measurement_optics(cc.settings, wavelength_nm),
-                                 o.seed);
+  return camera::make_twin_scene(
+      spec, camera::measurement_optics(cc.settings, cc.pupil_radius_m, wavelength_nm), o.seed);
 }
 
 // Everything a measurement needs before the loop starts, checked in this order so that bad input
@@ -165,20 +166,25 @@ void check_options(const MeasureOptions& o) {
         "--surface: the test surface of the twin camera (or of aravis:Fake_1 on --daq sim)");
 }
 
-// The fringe lock, asked for by `who` (instrument::lock_requested_by): it needs the pupil before
-// the first frame, which the twin's scene has.
+// The fringe lock, asked for by `who` (instrument::lock_requested_by). Its pupil: the twin
+// camera's scene's; --mask; else found from the lock's reference frames (Aravis's fake camera
+// fed the twin too: a real camera knows no scene).
 instrument::LockSetup lock_setup(const MeasureOptions& o, const MeasureSetup& s,
                                  const std::string& who) {
-  // Each frame's fit (about 5 ms at 256 px) runs where the sequence takes its frames, which on
-  // a real-time clock is between the loop's ticks: it would make them overrun.
-  if (s.scene && !o.free_run)
-    throw core::InputError(
-        who +
-        ": the lock's fit runs on the loop's thread, about 5 ms a frame, which a real-time "
-        "loop at 1 kHz cannot spare; use --free-run until it runs on a thread of its own");
-  return instrument::scene_lock_setup(s.scene ? &*s.scene : nullptr, o.camera,
-                                      s.config.installation.project.twin.geometry, s.calibration,
-                                      o.lock_retake_s, s.params, who);
+  psi::Mask mask;
+  if (s.scene && o.camera == "twin") {
+    mask = s.scene->mask;
+  } else if (!o.mask.empty()) {
+    mask = psi::read_mask_png(o.mask);
+    const camera::CameraSettings& cs = s.config.camera.settings;
+    if (mask.width != cs.width_px || mask.height != cs.height_px)
+      throw core::InputError(fmt::format("{}: mask is {} x {} pixels, the camera's frames {} x {}",
+                                         o.mask, mask.width, mask.height, cs.width_px,
+                                         cs.height_px));
+  }
+  return instrument::measurement_lock_setup(std::move(mask), s.config.camera.pupil_radius_m,
+                                            s.config.installation.project.twin.geometry,
+                                            s.calibration, o.lock_retake_s, s.params, who);
 }
 
 void check_travel(const MeasureSetup& s) {
@@ -370,7 +376,7 @@ void add_measure_command(CLI::App& app, Action& action) {
       ->check(whole_number(1, 100));
   cmd->add_option("--surface", o->surface,
                   "the twin camera's test surface, as `psi simulate` takes it (Z4=40,rough=0.5)");
-  cmd->add_option("--mask", o->mask, "the pupil as a PNG (cameras other than the twin)");
+  cmd->add_option("--mask", o->mask, "the pupil as a PNG (cameras other than the twin; the lock's too)");
   cmd->add_option("--base-um", o->base_um, "Z_d of P1..P3 at frame 0 (um)")->capture_default_str();
   cmd->add_option("--settle-band-nm", o->on_target.band_nm,
                   "settled: mean S - feedback within this on every channel (nm)")
@@ -399,8 +405,9 @@ void add_measure_command(CLI::App& app, Action& action) {
       ->capture_default_str();
   cmd->add_flag("--lock", o->lock,
                 "hold the Fizeau cavity on the fringes (docs/fizeau.md): the first average's "
-                "first four frames are the reference; --camera twin (a calibration file's "
-                "[controller] outer = \"fringes\" asks for it too, with its [fringe_lock])");
+                "first four frames are the reference; the pupil: the twin camera's, --mask, "
+                "else found in them (a calibration file's [controller] outer = \"fringes\" "
+                "asks for it too, with its [fringe_lock])");
   cmd->add_option("--lock-retake-s", o->lock_retake_s,
                   "with --lock: a frame whose fringes were lost is taken again until they come "
                   "back, for at most this long (s, in (0, 60]); then the measurement fails")

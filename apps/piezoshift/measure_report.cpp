@@ -295,6 +295,8 @@ Json measure_json(const MeasureRecord& r) {
                  {"holding_frames", s.lock->holding},
                  {"lost_frames", s.lock->lost},
                  {"retaken_frames", s.lock->retaken},
+                 {"pupil_source", s.lock->pupil_from_modulation ? "modulation" : "given"},
+                 {"pupil_pixels", s.lock->pupil_pixels},
                  {"first_refusal",
                   s.lock->first_refusal.empty() ? Json(nullptr) : Json(s.lock->first_refusal)},
                  {"correction_piston_nm", s.lock->correction[0]},

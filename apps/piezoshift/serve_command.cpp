@@ -197,7 +197,7 @@ CameraSetup open_camera(const ServeOptions& o, const camera::CameraConfig& cc,
   if (o.camera == "twin" || (o.camera.starts_with("aravis:Fake") && o.daq == "sim"))
     c.scene = camera::make_twin_scene(
         o.surface.empty() ? psi::SurfaceSpec{} : psi::parse_surface_spec(o.surface),
-        camera::measurement_optics(cc.settings, wavelength_nm), o.seed);
+        camera::measurement_optics(cc.settings, cc.pupil_radius_m, wavelength_nm), o.seed);
   c.camera = camera::make_camera(o.camera, cc, c.scene ? &*c.scene : nullptr);
   c.options.period_s = 1.0 / o.rate_Hz;
   // A replay's frames are the measurements' own: a live view would use them up.

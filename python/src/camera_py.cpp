@@ -112,8 +112,10 @@ void bind_twin_scene(py::module_& m) {
         const ps::psi::SurfaceSpec spec =
             surface.empty() ? ps::psi::SurfaceSpec{} : ps::psi::parse_surface_spec(surface);
         const cam::CameraConfig cc = config.value_or(cam::CameraConfig{});
-        return cam::make_twin_scene(
-            spec, fizeau.value_or(cam::measurement_optics(cc.settings, kWavelength_nm)), seed);
+        return cam::make_twin_scene(spec,
+                                    fizeau.value_or(cam::measurement_optics(
+                                        cc.settings, cc.pupil_radius_m, kWavelength_nm)),
+                                    seed);
       },
       py::arg("surface") = "", py::arg("config") = py::none(), py::arg("seed") = 1,
       py::arg("fizeau") = py::none(),

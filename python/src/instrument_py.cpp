@@ -4,10 +4,10 @@
 // has settled, then the analysis) and returns its result as a dict with the JSON names of
 // `measure --json`, plus the maps and frames as numpy arrays. The fringe lock (`lock`) and the
 // hold after the measurement (`hold_s`) are the CLI's: the lock built and checked by
-// instrument::scene_lock_setup, the hold summed up by instrument::hold_summary, both shared with
-// `measure --lock --hold-s`, and its records as hold.csv's columns. A measurement that is not valid
-// or whose fits did not converge raises ProcedureFailed (the CLI's exit status 4), the partial
-// result in its `result` attribute.
+// instrument::measurement_lock_setup, the hold summed up by instrument::hold_summary, both shared
+// with `measure --lock --hold-s`, and its records as hold.csv's columns. A measurement that is not
+// valid or whose fits did not converge raises ProcedureFailed (the CLI's exit status 4), the
+// partial result in its `result` attribute.
 #include <pybind11/numpy.h>
 #include <pybind11/pybind11.h>
 #include <pybind11/stl.h>
@@ -33,7 +33,7 @@
 #include "piezoshift/instrument/fringe_calibration.hpp"
 #include "piezoshift/instrument/hold_summary.hpp"
 #include "piezoshift/instrument/measurement.hpp"
-#include "piezoshift/instrument/scene_lock.hpp"
+#include "piezoshift/instrument/measurement_lock.hpp"
 #include "piezoshift/instrument/twin_floor.hpp"
 #include "piezoshift/plant/simulation_cost.hpp"
 #include "piezoshift/psi/pupil_detection.hpp"
@@ -196,6 +196,8 @@ py::object lock_dict(const ins::SequenceResult& s, const ins::SequenceParams& p)
   d["holding_frames"] = l.holding;
   d["lost_frames"] = l.lost;
   d["retaken_frames"] = l.retaken;
+  d["pupil_source"] = l.pupil_from_modulation ? "modulation" : "given";
+  d["pupil_pixels"] = l.pupil_pixels;
   d["first_refusal"] = text_or_none(l.first_refusal);
   d["correction_piston_nm"] = l.correction[0];
   d["correction_theta_x_urad"] = l.correction[1];
@@ -343,9 +345,23 @@ Setup prepare(const MeasureArgs& a) {
     const psi::SurfaceSpec spec =
         a.surface.empty() ? psi::SurfaceSpec{} : psi::parse_surface_spec(a.surface);
     s.scene = cam::make_twin_scene(
-        spec, cam::measurement_optics(s.config.camera.settings, kWavelength_nm), a.seed);
+        spec,
+        cam::measurement_optics(s.config.camera.settings, s.config.camera.pupil_radius_m,
+                                kWavelength_nm),
+        a.seed);
   }
   return s;
+}
+
+// The lock's pupil, as the CLI's: the twin camera's scene's, the mask given, else none (the lock
+// finds it in its reference frames).
+psi::Mask lock_mask(const MeasureArgs& a, const Setup& s) {
+  if (s.scene && a.camera == "twin")
+    return s.scene->mask;
+  if (!a.mask.is_none())
+    return mask_from_numpy(a.mask, s.config.camera.settings.width_px,
+                           s.config.camera.settings.height_px, "mask");
+  return {};
 }
 
 py::dict measure(const MeasureArgs& a) {
@@ -363,14 +379,15 @@ py::dict measure(const MeasureArgs& a) {
   ps::runtime::SimulatedClock clock;
   ins::SequenceResult r;
   std::string camera_name;
+  psi::Mask pupil = lock_mask(a, s);  // with the GIL: it may read a numpy array
   {
     py::gil_scoped_release release;
     s.calibration = resolve(a, project);
     if (const std::optional<std::string> who =
             ins::lock_requested_by(a.lock, "lock", s.calibration))
-      s.params.lock =
-          ins::scene_lock_setup(s.scene ? &*s.scene : nullptr, a.camera, project.twin.geometry,
-                                s.calibration, a.lock_retake_s, s.params, *who);
+      s.params.lock = ins::measurement_lock_setup(std::move(pupil), s.config.camera.pupil_radius_m,
+                                                  project.twin.geometry, s.calibration,
+                                                  a.lock_retake_s, s.params, *who);
     if (const std::string why =
             ins::travel_problem(s.params, s.calibration.travel_z_max_um, s.calibration.source);
         !why.empty())

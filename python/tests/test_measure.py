@@ -241,13 +241,31 @@ def test_a_calibration_file_that_asks_for_the_fringe_lock_locks_as_lock_true(tmp
     assert gain["path_error_rms_nm"] != flag["path_error_rms_nm"]
 
 
+def test_the_lock_finds_the_pupil_of_a_camera_that_does_not_show_the_scene(tmp_path):
+    # Aravis's fake camera fed the twin (Mono16: the fake has no Mono12), as `measure --lock
+    # --camera aravis:Fake_1`: the lock finds the pupil in its reference frames' modulation, the
+    # scene's own 6400 pixels there, so it locks as the twin camera's does.
+    path = tmp_path / "drift16.toml"
+    path.write_text(
+        '[camera]\nwidth_px = 96\nheight_px = 96\npixel_format = "Mono16"\n'
+        "[twin.cavity]\nin_fringes = true\n"
+    )
+    twin = ps.measure(config=str(path), averages=4, lock=True)
+    fake = ps.measure(config=str(path), camera="aravis:Fake_1", averages=4, lock=True)
+    assert twin["lock"]["pupil_source"] == "given"
+    assert fake["lock"]["pupil_source"] == "modulation"
+    assert fake["lock"]["pupil_pixels"] == twin["lock"]["pupil_pixels"]
+    assert fake["lock"]["locked_frames"] == 15
+    assert fake["path_error_rms_nm"] == pytest.approx(twin["path_error_rms_nm"], abs=0.01)
+
+
 def test_bad_lock_and_hold_values_are_refused_by_name(tmp_path):
     config = drifting_cavity_toml(tmp_path)
     with pytest.raises(ps.InputError, match=r"measure: hold -1 s: must be in \[0, 3600\]"):
         ps.measure(config=config, hold_s=-1.0)
-    # The lock needs the pupil before the first frame: only the twin's scene has it.
-    with pytest.raises(ps.InputError, match="lock: the lock needs the pupil on the camera"):
-        ps.measure(config=config, camera="files:" + str(tmp_path), lock=True)
+    # A pupil given for the lock must be the camera's size (the config's 96 x 96).
+    with pytest.raises(ps.InputError, match="mask"):
+        ps.measure(config=config, camera="aravis:Fake_1", lock=True, mask=np.ones((10, 10)))
     with pytest.raises(ps.InputError, match=r"lock: the fringe lock's retake time 0 s"):
         ps.measure(config=config, lock=True, lock_retake_s=0.0)
     with pytest.raises(ps.InputError, match="lock: the fringe lock takes its reference"):

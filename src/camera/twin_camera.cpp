@@ -92,8 +92,10 @@ TwinScene make_twin_scene(const psi::SurfaceSpec& surface, const psi::FizeauPara
   return s;
 }
 
-psi::FizeauParams measurement_optics(const CameraSettings& settings, double wavelength_nm) {
+psi::FizeauParams measurement_optics(const CameraSettings& settings, double pupil_radius_m,
+                                     double wavelength_nm) {
   psi::FizeauParams fizeau;
+  fizeau.pupil_radius_m = pupil_radius_m;
   fizeau.width_px = settings.width_px;
   fizeau.height_px = settings.height_px;
   fizeau.pupil_radius_px = 0.47 * std::min(settings.width_px, settings.height_px);

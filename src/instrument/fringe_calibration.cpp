@@ -177,7 +177,10 @@ FringeCalibrationOutcome calibrate_twin_from_fringes(const camera::InstrumentCon
                                                      const FringeCalibrationOptions& options,
                                                      const rig::Progress& progress) {
   const camera::TwinScene scene = camera::make_twin_scene(
-      surface, camera::measurement_optics(config.camera.settings, options.wavelength_nm), seed);
+      surface,
+      camera::measurement_optics(config.camera.settings, config.camera.pupil_radius_m,
+                                 options.wavelength_nm),
+      seed);
   const std::unique_ptr<camera::Camera> cam = camera::make_camera("twin", config.camera, &scene);
   control::SemiClosedLoopParams base;
   base.sample_time_s = config.installation.project.twin.daq.sample_time_s;

@@ -8,6 +8,7 @@
 
 #include "piezoshift/instrument/measurement.hpp"
 #include "piezoshift/instrument/sequence.hpp"
+#include "piezoshift/psi/pupil_detection.hpp"
 
 namespace piezoshift::instrument {
 
@@ -30,7 +31,7 @@ std::string lock_problem(const LockSetup& setup, const SequenceParams& params) {
            "pi/2, pi and 3 pi/2 (hariharan5, 4step, or --steps-rad beginning so)";
   if (const char* why = control::fringe_lock_problem(setup.lock); why[0] != '\0')
     return fmt::format("the fringe lock: {}", why);
-  if (setup.mask.count() < 16)
+  if (setup.mask.size() > 0 && setup.mask.count() < 16)
     return "the fringe lock needs the pupil on the camera (a mask of 16 pixels or more)";
   if (!setup.tripod)
     return "the fringe lock needs the tripod's points P1..P3";
@@ -63,7 +64,31 @@ void FringeLockSession::begin_hold() {
   locks_.front().set_point(frame0_);
 }
 
+bool FringeLockSession::find_pupil() {
+  summary_.pupil_from_modulation = s_.mask.size() == 0;
+  if (summary_.pupil_from_modulation) {
+    try {
+      s_.mask = psi::pupil_from_modulation(reference_frames_).mask;
+    } catch (const std::invalid_argument& e) {
+      problem_ =
+          fmt::format("the fringe lock found no pupil in its reference frames: {}", e.what());
+      return false;
+    }
+    if (s_.mask.count() < 16) {
+      problem_ = fmt::format(
+          "the fringe lock found {} pixels of pupil in its reference frames' modulation (16 or "
+          "more needed)",
+          s_.mask.count());
+      return false;
+    }
+  }
+  summary_.pupil_pixels = s_.mask.count();
+  return true;
+}
+
 void FringeLockSession::on_frame(const camera::Frame& frame, ExposureRecord& rec) {
+  if (!problem_.empty())
+    return;
   const std::size_t n = frames_++;
   // Each frame takes its move's correction off the queue: a minute's hold of 4300 frames keeps
   // one or two, not one per move of the whole run.
@@ -78,6 +103,8 @@ void FringeLockSession::on_frame(const camera::Frame& frame, ExposureRecord& rec
     reference_frames_.push_back(frame_maps({frame}).front());
     rec.lock_state = "reference";
     if (reference_frames_.size() == reference_count_) {
+      if (!find_pupil())
+        return;
       reference_ = psi::frame_pose_reference(reference_frames_, s_.mask, s_.pupil_radius_m);
       // Frame 0's own pose: the reference's piston is a fit over its frames, which sets it
       // apart from frame 0's by a fraction of a nanometre; the hold returns to frame 0.

@@ -4,6 +4,7 @@
 #include <array>
 #include <chrono>
 #include <cmath>
+#include <functional>
 #include <numbers>
 #include <string>
 
@@ -11,6 +12,7 @@
 
 #include "piezoshift/core/input_error.hpp"
 #include "piezoshift/instrument/exposure_accumulator.hpp"
+#include "piezoshift/instrument/fit_thread.hpp"
 #include "piezoshift/instrument/settle_window.hpp"
 
 namespace piezoshift::instrument {
@@ -40,6 +42,8 @@ class Runner {
     result_.exposures.reserve(total_);
     if (p.lock)
       lock_.emplace(*p.lock, p);
+    if (p.lock && loop.real_time())
+      fit_thread_.emplace();
   }
 
   SequenceResult run() {
@@ -61,6 +65,8 @@ class Runner {
       result_.wall_time_s = seconds_since(start_wall_);
     }
     finish_loop();
+    if (fit_thread_)
+      fit_thread_->wait();  // a fit still running after a failure writes to result_
     if (lock_)
       result_.lock = lock_->summary();
     result_.floor_s = sequence_floor_s(p_, window_.length(), period_s_, camera_.settings());
@@ -168,8 +174,7 @@ class Runner {
       result_.hold.push_back(rec);
       if (!expose(result_.hold.back()))
         return;
-      if (!loop_.real_time())
-        wait_for_frames(result_.hold.size());
+      await_frames(result_.hold.size());
       if (progress_)
         progress_(std::min(now_s() - t0, p_.hold_s), p_.hold_s, "s of hold");
     }
@@ -186,7 +191,11 @@ class Runner {
   void take_frame(int average, int frame) {
     const double first_try_s = now_s();
     for (int retakes = 0; take_frame_once(average, frame, retakes); ++retakes) {
-      if (!lock_ || loop_.real_time() || !lock_->last_frame_lost_fringes()) {
+      if (lock_ && !lock_->problem().empty()) {
+        fail(lock_->problem());
+        return;
+      }
+      if (!lock_ || !lock_->last_frame_lost_fringes()) {
         if (progress_)
           progress_(static_cast<double>(result_.exposures.size()), static_cast<double>(total_),
                     "frames");
@@ -227,8 +236,7 @@ class Runner {
     result_.exposures.push_back(rec);
     if (!expose(result_.exposures.back()))
       return false;
-    if (!loop_.real_time())
-      wait_for_frames(result_.exposures.size());
+    await_frames(result_.exposures.size());
     return ok();
   }
 
@@ -335,7 +343,7 @@ class Runner {
     }
     if (lock_) {  // its correction is in force from the next move
       const std::size_t n = result_.frames.size() - 1;
-      lock_->on_frame(result_.frames[n], result_.exposures[n]);
+      feed_lock([this, n] { lock_->on_frame(result_.frames[n], result_.exposures[n]); });
     }
     return true;
   }
@@ -355,12 +363,43 @@ class Runner {
       fail(why);
       return false;
     }
-    ExposureRecord& rec = result_.hold[hold_frames_++];
-    rec.frame_id = f.frame_id;
-    rec.arrival_wall_s = seconds_since(start_wall_);
+    const std::size_t k = hold_frames_++;
+    result_.hold[k].frame_id = f.frame_id;
+    result_.hold[k].arrival_wall_s = seconds_since(start_wall_);
     if (lock_)
-      lock_->on_frame(f, rec);
+      feed_lock([this, k, frame = std::move(f)] { lock_->on_frame(frame, result_.hold[k]); });
     return true;
+  }
+
+  // A frame to the lock: here off a real-time clock (the loop's time stands still meanwhile),
+  // else on the fit thread while the loop ticks.
+  void feed_lock(std::function<void()> job) {
+    if (fit_thread_)
+      fit_thread_->run(std::move(job));
+    else
+      job();
+  }
+
+  // After an exposure: off a real-time clock, its frame in; on one with the lock, the loop
+  // holding until the frame is in and its fit done, so that the next move takes its correction
+  // and a frame whose fringes were lost can be taken again, as off a real-time clock. On a
+  // real-time clock without the lock the frames come in while the sequence moves on.
+  void await_frames(std::size_t count) {
+    if (!loop_.real_time()) {
+      wait_for_frames(count);
+      return;
+    }
+    if (!fit_thread_)
+      return;
+    const auto t0 = Clock::now();
+    while (ok() && (received() < count || !fit_thread_->idle())) {
+      if (seconds_since(t0) > p_.frame_timeout_s) {
+        fail(fmt::format("camera {}: frame {}{} and its fit not done within {} s", camera_.name(),
+                         count - 1, holding_ ? " of the hold" : "", p_.frame_timeout_s));
+        return;
+      }
+      tick();
+    }
   }
 
   // Off a real-time clock only: the loop's time stands still while this thread waits.
@@ -426,6 +465,8 @@ class Runner {
   bool holding_ = false;         // the hold's frames are coming (hold())
   std::size_t hold_frames_ = 0;  // ... of which arrived
   SequenceResult result_;
+  // Last, so that it is gone (its job done) before what its jobs touch: lock_, result_.
+  std::optional<FitThread> fit_thread_;  // the lock on a real-time clock
 };
 
 }  // namespace

@@ -25,8 +25,9 @@ instrument::SequenceParams sequence_params() {
 
 // `measure`'s twin scene for the default surface.
 camera::TwinScene twin_scene(const camera::CameraConfig& cc, std::uint64_t seed) {
-  return camera::make_twin_scene(psi::SurfaceSpec{},
-                                 camera::measurement_optics(cc.settings, kWavelength_nm), seed);
+  return camera::make_twin_scene(
+      psi::SurfaceSpec{},
+      camera::measurement_optics(cc.settings, cc.pupil_radius_m, kWavelength_nm), seed);
 }
 
 }  // namespace

@@ -71,4 +71,22 @@ bool keep_off_cpu(std::thread& thread, int cpu) {
   return ::pthread_setaffinity_np(thread.native_handle(), sizeof(set), &set) == 0;
 }
 
+bool leave_loop_scheduling() {
+  sched_param normal{};
+  bool ok = ::pthread_setschedparam(::pthread_self(), SCHED_OTHER, &normal) == 0;
+  cpu_set_t mine;
+  CPU_ZERO(&mine);
+  if (::pthread_getaffinity_np(::pthread_self(), sizeof(mine), &mine) != 0)
+    return false;
+  const long online = ::sysconf(_SC_NPROCESSORS_ONLN);
+  if (CPU_COUNT(&mine) != 1 || online < 2)
+    return ok;  // not pinned (the loop was not, or the worker has only the one CPU there is)
+  cpu_set_t others;
+  CPU_ZERO(&others);
+  for (int c = 0; c < online && c < CPU_SETSIZE; ++c)
+    if (!CPU_ISSET(c, &mine))
+      CPU_SET(c, &others);
+  return ::pthread_setaffinity_np(::pthread_self(), sizeof(others), &others) == 0 && ok;
+}
+
 }  // namespace piezoshift::runtime

@@ -167,10 +167,41 @@ TEST_F(MeasureCli, TheFringeLockHoldsTheDriftingCavityNearerItsSetPoint) {
   EXPECT_LT(locked, 0.8 * unlocked) << locked << " vs " << unlocked;
   // Refused before anything runs: steps the reference cannot be taken from.
   refused("--lock --algorithm lsq --steps-rad 0,1,2,3 --out '" + path("x") + "'", "--lock");
-  // On a real-time clock the fit would take the loop's time between ticks.
-  const testing::CliResult rt = run("measure --lock --out '" + path("y") + "'");
-  EXPECT_EQ(rt.status, 2) << rt.err;
-  EXPECT_NE(rt.err.find("--free-run"), std::string::npos) << rt.err;
+}
+
+// On a real-time clock (the twin paced by the wall clock, as on hardware) the lock's fit runs on
+// a thread of its own while the loop holds the stage (instrument/fit_thread.hpp); the next move
+// takes the frame's correction, as off a real-time clock. Every frame after the reference locks,
+// and the hold returns to frame 0's cavity: the semi-closed loop alone brings the plate back 1
+// to 3 nm off it (measured on this clock, the paper's controller, 1 s hold: -2.2 and -2.4 nm
+// over the hold's second half, against -0.20 and -0.12 nm locked). Real time is not repeatable
+// to the digit and its overruns are the machine's (the twin never trips on them): what is
+// asserted is what the lock must do on any run, the states and that offset removed.
+TEST_F(MeasureCli, TheLockRunsOnARealTimeClockWithItsFitBesideTheLoop) {
+  const std::string cfg = write("drift.toml",
+                                "[camera]\nwidth_px = 96\nheight_px = 96\n"
+                                "[twin.cavity]\nin_fringes = true\n");
+  const testing::CliResult r = run("measure --json --config '" + cfg +
+                                   "' --averages 4 --hold-s 1 --lock --out '" + path("rt") + "'");
+  ASSERT_EQ(r.status, 0) << r.err;
+  const Json on = Json::parse(r.out, nullptr, false);
+  ASSERT_TRUE(on.is_object());
+  EXPECT_EQ(on["clock"], "realtime");
+  const Json& lock = on["lock"];
+  EXPECT_EQ(lock["reference_frames"], 5);
+  const int hold_frames = on["hold"]["frames"];
+  EXPECT_GT(hold_frames, 40);  // 1 s, a frame every 14 to 20 ms
+  EXPECT_EQ(lock["locked_frames"].get<int>(), 15 + hold_frames);
+  EXPECT_EQ(lock["holding_frames"], 0);
+  EXPECT_EQ(on["exposures"][19]["lock_state"], "locked");
+  EXPECT_EQ(on["hold"]["lock_states"]["locked"], hold_frames);
+  const std::vector<double> e = csv_column(path("rt") + "/hold.csv", "path_error_nm");
+  ASSERT_EQ(e.size(), static_cast<std::size_t>(hold_frames));
+  double mean = 0.0;
+  for (std::size_t k = e.size() / 2; k < e.size(); ++k)
+    mean += e[k] / static_cast<double>(e.size() - e.size() / 2);
+  EXPECT_LT(std::fabs(mean), 0.5);
+  EXPECT_LT(on["hold"]["path_error_rms_nm"].get<double>(), 1.0);  // the PID's own 0.54 nm
 }
 
 // Issue 29's `[controller] outer = "fringes"`: a calibration file that asks for the fringe lock
@@ -412,6 +443,47 @@ TEST_F(MeasureCli, AravisFakeCameraFedTheTwinGivesTheTwinsSurface) {
   refused("--config '" + small_camera("Mono12") + "' --camera aravis:Fake_1 --out '" + path("m12") +
               "'",
           "Mono12");
+}
+
+// A camera that does not show the twin's scene (Aravis's fake, fed the twin here; a real one):
+// the lock finds the pupil in its reference frames' fringe modulation, or takes --mask. On the
+// twin's fringes the modulation finds the scene's own pupil, so the lock does as the twin
+// camera's (measured: the same 6400 pixels and the same path error to the last digit).
+TEST_F(MeasureCli, TheLockFindsThePupilOfACameraWithoutTheScenesInItsReferenceFrames) {
+  const std::string cfg = write("drift16.toml",
+                                "[camera]\nwidth_px = 96\nheight_px = 96\n"
+                                "pixel_format = \"Mono16\"\n[twin.cavity]\nin_fringes = true\n");
+  const std::string common = "--config '" + cfg + "' --averages 10 --lock ";
+  const Json twin = measure(common + "--out '" + path("twin") + "'");
+  const Json arv = measure(common + "--camera aravis:Fake_1 --out '" + path("arv") + "'");
+  const Json given = measure(common + "--camera aravis:Fake_1 --mask '" + path("twin") +
+                             "/mask.png' --out '" + path("given") + "'");
+  ASSERT_TRUE(twin.is_object() && arv.is_object() && given.is_object());
+  EXPECT_EQ(twin["lock"]["pupil_source"], "given");
+  EXPECT_EQ(arv["lock"]["pupil_source"], "modulation");
+  EXPECT_EQ(given["lock"]["pupil_source"], "given");
+  EXPECT_EQ(arv["lock"]["pupil_pixels"], twin["lock"]["pupil_pixels"]);
+  EXPECT_EQ(arv["lock"]["locked_frames"], 45);
+  EXPECT_NEAR(arv["path_error_rms_nm"].get<double>(), twin["path_error_rms_nm"].get<double>(),
+              0.01);
+  EXPECT_NEAR(given["path_error_rms_nm"].get<double>(), twin["path_error_rms_nm"].get<double>(),
+              0.01);
+  // Fringes too faint to find a pupil in: the lock cannot start, and says so (exit 4).
+  const std::string flat = write("flat.toml",
+                                 "[camera]\nwidth_px = 96\nheight_px = 96\n"
+                                 "pixel_format = \"Mono16\"\nvisibility = 0.0001\n");
+  const testing::CliResult r = run("measure --free-run --lock --camera aravis:Fake_1 --config '" +
+                                   flat + "' --out '" + path("flat") + "'");
+  EXPECT_EQ(r.status, 4) << r.err;
+  EXPECT_NE(r.err.find("the fringe lock found no pupil in its reference frames"), std::string::npos)
+      << r.err;
+  // A mask whose size is not the camera's: refused before anything runs.
+  const std::string wide = write("wide.toml",
+                                 "[camera]\nwidth_px = 128\nheight_px = 96\n"
+                                 "pixel_format = \"Mono16\"\n");
+  refused("--lock --camera aravis:Fake_1 --config '" + wide + "' --mask '" + path("twin") +
+              "/mask.png' --out '" + path("m") + "'",
+          "mask is 96 x 96 pixels, the camera's frames 128 x 96");
 }
 
 }  // namespace

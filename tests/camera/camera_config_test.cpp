@@ -1,4 +1,5 @@
 #include "piezoshift/camera/camera_config.hpp"
+#include "piezoshift/camera/twin_camera.hpp"
 
 #include <gtest/gtest.h>
 
@@ -108,10 +109,9 @@ TEST(CameraConfigTest, EveryBoundOfTheListPassesPsisOwnChecks) {
     });
     EXPECT_EQ(camera_config_problem(c), "") << "end " << end;
     EXPECT_EQ(psi::camera_problem(sensor_params(c)), "") << "end " << end;
-    psi::FizeauParams f;
-    f.width_px = c.settings.width_px;
-    f.height_px = c.settings.height_px;
-    EXPECT_EQ(psi::fizeau_problem(f), "") << "end " << end;
+    // the optics a measurement renders with: the size and the pupil's radius on the plate
+    EXPECT_EQ(psi::fizeau_problem(measurement_optics(c.settings, c.pupil_radius_m, 632.8)), "")
+        << "end " << end;
   }
 }
 

@@ -12,6 +12,7 @@
 
 #include "piezoshift/calibration/matrix_identification.hpp"
 #include "piezoshift/calibration/poly_fit.hpp"
+#include "piezoshift/camera/camera_config.hpp"
 #include "piezoshift/camera/twin_camera.hpp"
 #include "piezoshift/config/project_config.hpp"
 #include "piezoshift/core/input_error.hpp"
@@ -37,7 +38,7 @@ struct Rig {
   // count and then runs tilt-aia in a quarter of the time
   explicit Rig(std::uint64_t seed, int size_px = 256)
       : settings(sized(size_px)),
-        fizeau(camera::measurement_optics(settings, 632.8)),
+        fizeau(camera::measurement_optics(settings, camera::CameraConfig{}.pupil_radius_m, 632.8)),
         scene(camera::make_twin_scene(psi::SurfaceSpec{}, fizeau, seed)) {}
   FringeActuatorScanParams params(std::size_t actuator) const {
     FringeActuatorScanParams p;

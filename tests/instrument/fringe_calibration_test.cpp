@@ -12,6 +12,7 @@
 #include <string>
 
 #include "piezoshift/calibration/calibration_procedure.hpp"
+#include "piezoshift/camera/camera_config.hpp"
 #include "piezoshift/camera/twin_camera.hpp"
 #include "piezoshift/config/project_config.hpp"
 #include "piezoshift/instrument/fringe_calibration.hpp"
@@ -110,7 +111,8 @@ std::optional<SeedFigures> one_seed(const Plant& pl, std::uint64_t seed) {
   camera::CameraSettings settings;
   settings.width_px = settings.height_px = 256;
   const camera::TwinScene scene = camera::make_twin_scene(
-      psi::SurfaceSpec{}, camera::measurement_optics(settings, 632.8), seed);
+      psi::SurfaceSpec{},
+      camera::measurement_optics(settings, camera::CameraConfig{}.pupil_radius_m, 632.8), seed);
   camera::TwinCamera cam(scene, psi::CameraParams{});
   cam.configure(settings);
   const FringeOptics optics = twin_optics(scene);

@@ -1,6 +1,8 @@
 // The hold's summary (hold_summary.hpp) and the lock of a measurement on the twin's scene
-// (scene_lock.hpp), on records and scenes built by hand: every figure by hand from them.
+// (measurement_lock.hpp), on records and scenes built by hand: every figure by hand from them.
 #include "piezoshift/instrument/hold_summary.hpp"
+#include "piezoshift/camera/camera_config.hpp"
+#include "piezoshift/camera/twin_camera.hpp"
 
 #include <gtest/gtest.h>
 
@@ -9,7 +11,7 @@
 #include <vector>
 
 #include "piezoshift/core/input_error.hpp"
-#include "piezoshift/instrument/scene_lock.hpp"
+#include "piezoshift/instrument/measurement_lock.hpp"
 
 namespace piezoshift::instrument {
 namespace {
@@ -71,33 +73,42 @@ SequenceParams hariharan5() {
   return p;
 }
 
-TEST(SceneLockTest, TheLockTakesTheScenesPupilAndTheTwinsPoints) {
+// The lock takes the pupil the front end gives (the twin camera's scene's), or none (the session
+// finds it in the reference frames' modulation), with the config's radius on the plate.
+TEST(MeasurementLockTest, TheLockTakesThePupilGivenAndTheTwinsPoints) {
   camera::CameraSettings settings;
   settings.width_px = settings.height_px = 64;
-  const camera::TwinScene scene =
-      camera::make_twin_scene({}, camera::measurement_optics(settings, 632.8), 1);
+  const camera::TwinScene scene = camera::make_twin_scene(
+      {}, camera::measurement_optics(settings, camera::CameraConfig{}.pupil_radius_m, 632.8), 1);
   const plant::GeometryParams geometry;
-  const LockSetup l = scene_lock_setup(&scene, "twin", geometry, {}, 2.5, hariharan5(), "lock");
+  const LockSetup l =
+      measurement_lock_setup(scene.mask, 0.04, geometry, {}, 2.5, hariharan5(), "lock");
   EXPECT_EQ(l.mask.count(), scene.mask.count());
-  EXPECT_EQ(l.pupil_radius_m, scene.fizeau.pupil_radius_m);
+  EXPECT_EQ(l.pupil_radius_m, 0.04);
   ASSERT_TRUE(l.tripod);
   EXPECT_EQ(l.retake_s, 2.5);
-  // Refusals name the front end's option, and for a camera without the scene the camera.
-  const auto refused = [&](const camera::TwinScene* s, double retake_s, const SequenceParams& p,
+  const LockSetup other = measurement_lock_setup({}, 0.04, geometry, {}, 2.5, hariharan5(), "lock");
+  EXPECT_EQ(other.mask.size(), 0u);
+  EXPECT_EQ(other.pupil_radius_m, 0.04);
+  ASSERT_TRUE(other.tripod);
+  // Refusals name the front end's option.
+  const auto refused = [&](const psi::Mask& m, double retake_s, const SequenceParams& p,
                            const std::string& piece) {
     try {
-      (void)scene_lock_setup(s, "files:/x", geometry, {}, retake_s, p, "--lock");
+      (void)measurement_lock_setup(m, 0.025, geometry, {}, retake_s, p, "--lock");
       ADD_FAILURE() << piece;
     } catch (const core::InputError& e) {
       EXPECT_EQ(std::string(e.what()).rfind("--lock: ", 0), 0u) << e.what();
       EXPECT_NE(std::string(e.what()).find(piece), std::string::npos) << e.what();
     }
   };
-  refused(nullptr, 1.0, hariharan5(), "with camera files:/x that is not built yet");
-  refused(&scene, 0.0, hariharan5(), "retake time 0 s");
+  psi::Mask tiny(64, 64, 0);
+  tiny.v[32 * 64 + 32] = 1;
+  refused(tiny, 1.0, hariharan5(), "a mask of 16 pixels or more");
+  refused(scene.mask, 0.0, hariharan5(), "retake time 0 s");
   SequenceParams lsq;
   lsq.steps_rad = {0.0, 1.0, 2.0, 3.0};
-  refused(&scene, 1.0, lsq, "takes its reference from the first frames");
+  refused(scene.mask, 1.0, lsq, "takes its reference from the first frames");
 }
 
 }  // namespace

@@ -59,6 +59,10 @@ struct CameraConfig {
   //! visibility 0; a negative start: never. A test of the fringe lock losing its fringes.
   double fringe_loss_start_s = -1.0;
   double fringe_loss_s = 0.0;
+  //! The pupil's radius on the reference plate, which the camera images (the Fizeau's aperture):
+  //! the twin renders it, and the fringe lock turns fringes across it into the plate's tilt.
+  //! 25 mm, a 50 mm aperture, assumed (psi::FizeauParams; the paper gives none).
+  double pupil_radius_m = 0.025;
 };
 
 //! Calls visit(section, key, value, bounds) for each numeric value of [camera] (const or not);
@@ -81,6 +85,8 @@ void visit_camera_values(Config& c, Visit&& visit) {
   visit("camera", "visibility", c.sensor.visibility, B::above(0.0, 1.0));
   visit("camera", "fringe_loss_start_s", c.fringe_loss_start_s, B::closed(-1.0, 1e6));
   visit("camera", "fringe_loss_s", c.fringe_loss_s, B::closed(0.0, 3600.0));
+  // psi::fizeau_problem's range; a Fizeau's aperture is 25 to 300 mm across
+  visit("camera", "pupil_radius_m", c.pupil_radius_m, B::open(0.0, 1.0));
 }
 
 //! The first value outside its range ("camera.exposure_s = 2 must be in (0, 1]"); "" when valid.

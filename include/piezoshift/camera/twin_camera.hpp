@@ -77,8 +77,10 @@ void render_twin_counts(const TwinScene& scene, const psi::CameraParams& sensor,
                         std::vector<std::uint16_t>& counts);
 
 //! The optics a measurement renders a camera's frames with: the frame's size, a pupil of 0.47 of
-//! its shorter side (`psi simulate`'s proportion), wavelength_nm; the rest psi's defaults.
-psi::FizeauParams measurement_optics(const CameraSettings& settings, double wavelength_nm);
+//! its shorter side (`psi simulate`'s proportion) and pupil_radius_m on the plate
+//! (CameraConfig::pupil_radius_m), wavelength_nm; the rest psi's defaults.
+psi::FizeauParams measurement_optics(const CameraSettings& settings, double pupil_radius_m,
+                                     double wavelength_nm);
 
 class TwinCamera final : public Camera {
  public:

@@ -18,6 +18,9 @@
 // with the cavity's drift, measured 0.29 nm of surface error against 0.22 nm unlocked).
 // A hold after the sequence (SequenceParams::hold_s) is frame 0 again and again: step 0's lock,
 // which the averages have taught, holds the cavity frame by frame.
+// The pupil: the mask given (the twin camera's scene), else found from the reference frames'
+// fringe modulation (psi::pupil_from_modulation, as a measurement's own mask is), which any
+// camera has: none found there ends the sequence with the reason (problem()).
 // A frame whose pose is not valid (fringes lost, a misfit, a step the fringe order cannot
 // follow) leaves its step's correction where it is: the stage stays on its gauges without a
 // jump (FringeLock's holding, then lost), and each exposure records the lock's state and why.
@@ -42,8 +45,8 @@ struct ExposureRecord;
 struct LockSetup {
   control::FringeLockParams lock{};
   psi::FramePoseOptions pose{};
-  double pupil_radius_m = 0.025;  //!< the pupil on the plate (psi::FizeauParams)
-  psi::Mask mask;                 //!< the pupil on the camera
+  double pupil_radius_m = 0.025;  //!< the pupil on the plate (camera::CameraConfig)
+  psi::Mask mask;  //!< the pupil on the camera; empty: from the reference frames' modulation
   //! P1..P3 on the plate: the correction's tilt to the points' set-points
   std::optional<kinematics::TripodGeometry> tripod;
   //! A frame of the sequence whose fringes were lost (psi::FramePose::fringes_lost) is taken
@@ -53,19 +56,21 @@ struct LockSetup {
 };
 
 //! "" when a sequence with these steps can be locked, else why not: the steps begin 0, pi/2, pi,
-//! 3 pi/2 (to 1e-9), the lock's parameters are in range (retake_s in (0, 60]), the mask is not
-//! empty, the tripod set.
+//! 3 pi/2 (to 1e-9), the lock's parameters are in range (retake_s in (0, 60]), a mask given has
+//! 16 pixels or more, the tripod set.
 std::string lock_problem(const LockSetup& setup, const SequenceParams& params);
 
 //! What the lock did over a sequence.
 struct LockSummary {
   std::size_t reference_frames = 0;
-  std::size_t locked = 0;            //!< frames whose pose corrected the stage
-  std::size_t holding = 0;           //!< frames without a valid pose, the correction held
-  std::size_t lost = 0;              //!< ... of which beyond max_lost_frames in a row
-  std::size_t retaken = 0;           //!< frames taken again because their fringes were lost
-  std::string first_refusal;         //!< the first frame's reason for no pose ("" if none)
-  control::FringeAxes correction{};  //!< the last frame's step's, at the end [nm, urad, urad]
+  std::size_t locked = 0;              //!< frames whose pose corrected the stage
+  std::size_t holding = 0;             //!< frames without a valid pose, the correction held
+  std::size_t lost = 0;                //!< ... of which beyond max_lost_frames in a row
+  std::size_t retaken = 0;             //!< frames taken again because their fringes were lost
+  std::string first_refusal;           //!< the first frame's reason for no pose ("" if none)
+  control::FringeAxes correction{};    //!< the last frame's step's, at the end [nm, urad, urad]
+  bool pupil_from_modulation = false;  //!< the pupil found in the reference frames, not given
+  std::size_t pupil_pixels = 0;        //!< the pupil's pixels (0 before the reference)
 };
 
 class FringeLockSession {
@@ -84,6 +89,9 @@ class FringeLockSession {
   const LockSummary& summary() const noexcept { return summary_; }
   //! The last frame on_frame() saw had lost its fringes (after the reference).
   bool last_frame_lost_fringes() const noexcept { return last_lost_fringes_; }
+  //! Why the lock cannot go on ("": it can): no pupil in the reference frames' modulation. The
+  //! sequence then fails with it; later frames are ignored.
+  const std::string& problem() const noexcept { return problem_; }
   //! The sequence takes the last frame again.
   void note_retake() noexcept { ++summary_.retaken; }
   //! The hold begins: from here every move and frame is step 0's lock's, which holds the cavity
@@ -91,6 +99,8 @@ class FringeLockSession {
   void begin_hold();
 
  private:
+  bool find_pupil();  // at the reference's end: the mask given, else from its modulation
+
   LockSetup s_;
   std::size_t reference_count_;
   std::vector<psi::Map> reference_frames_;
@@ -106,6 +116,7 @@ class FringeLockSession {
   std::deque<control::FringeAxes> applied_by_move_;
   std::size_t frames_ = 0;
   bool last_lost_fringes_ = false;
+  std::string problem_;
   LockSummary summary_;
 };
 

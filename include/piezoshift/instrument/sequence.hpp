@@ -21,6 +21,9 @@
 //       tick's pose: on the twin from the sim backend's record of its line (the wire), on
 //       hardware from the loop's report (a line-triggered camera stamps its frame with t_e).
 //       Same ticks, same poses, same times as kSoftware.)
+//   (with the lock, after each exposure: its frame in and fed to the lock before the next move;
+//     on a real-time clock the loop ticks, holding, while the frame's fit runs on the
+//     FitThread, fit_thread.hpp)
 //   tick, holding the last position, until every frame has arrived (frame_timeout_s)
 //   hold_s > 0: the hold. Z_d back to frame 0's; then frame after frame, for hold_s of loop time,
 //     as above (settle, expose, the frame): the cavity held where frame 0 of the first average

@@ -34,4 +34,10 @@ RealtimeReport request_realtime(const RealtimeRequest& request);
 //! changed) when the thread has no other CPU or the kernel refuses.
 bool keep_off_cpu(std::thread& thread, int cpu);
 
+//! For a worker the loop's thread starts, called on the worker: it inherits the loop's
+//! SCHED_FIFO and, when the loop is pinned, its one CPU, where its work would delay ticks. Back
+//! to SCHED_OTHER, and off that CPU onto the others when there are any. False when the kernel
+//! refused either (the worker then runs on as it is).
+bool leave_loop_scheduling();
+
 }  // namespace piezoshift::runtime

@@ -1,6 +1,7 @@
-#include "piezoshift/instrument/scene_lock.hpp"
+#include "piezoshift/instrument/measurement_lock.hpp"
 
 #include <string>
+#include <utility>
 
 #include <fmt/core.h>
 
@@ -17,19 +18,14 @@ std::optional<std::string> lock_requested_by(bool flag, std::string_view flag_na
   return std::nullopt;
 }
 
-LockSetup scene_lock_setup(const camera::TwinScene* scene, std::string_view camera_spec,
-                           const plant::GeometryParams& geometry,
-                           const calibration::LoopCalibration& calibration, double retake_s,
-                           const SequenceParams& params, std::string_view option) {
-  if (scene == nullptr)
-    throw core::InputError(
-        fmt::format("{}: the lock needs the pupil on the camera before the sequence; with camera "
-                    "{} that is not built yet (camera twin has it)",
-                    option, camera_spec));
+LockSetup measurement_lock_setup(psi::Mask mask, double pupil_radius_m,
+                                 const plant::GeometryParams& geometry,
+                                 const calibration::LoopCalibration& calibration, double retake_s,
+                                 const SequenceParams& params, std::string_view option) {
   LockSetup l;
   l.lock = calibration.fringe_lock.value_or(control::FringeLockParams{});
-  l.mask = scene->mask;
-  l.pupil_radius_m = scene->fizeau.pupil_radius_m;
+  l.mask = std::move(mask);
+  l.pupil_radius_m = pupil_radius_m;
   l.tripod.emplace(plant::make_twin_geometry(geometry).points);
   l.retake_s = retake_s;
   if (const std::string why = lock_problem(l, params); !why.empty())
