@@ -376,7 +376,8 @@ void add_measure_command(CLI::App& app, Action& action) {
       ->check(whole_number(1, 100));
   cmd->add_option("--surface", o->surface,
                   "the twin camera's test surface, as `psi simulate` takes it (Z4=40,rough=0.5)");
-  cmd->add_option("--mask", o->mask, "the pupil as a PNG (cameras other than the twin; the lock's too)");
+  cmd->add_option("--mask", o->mask,
+                  "the pupil as a PNG (cameras other than the twin; the lock's too)");
   cmd->add_option("--base-um", o->base_um, "Z_d of P1..P3 at frame 0 (um)")->capture_default_str();
   cmd->add_option("--settle-band-nm", o->on_target.band_nm,
                   "settled: mean S - feedback within this on every channel (nm)")
