@@ -79,13 +79,15 @@ std::string cell(const reproduction::FigureValue& m, const std::string& unit, do
 
 // The medians and the targets as two aligned tables.
 std::string summary_tables(const reproduction::ComparisonResult& result) {
-  std::vector<std::vector<std::string>> medians{
-      {"median over seeds", "paper", "improved", "oracle"}};
+  std::vector<std::string> header{"median over seeds"};
+  for (const reproduction::LoopVariant k : result.variants())
+    header.push_back(reproduction::variant_key(k));
+  std::vector<std::vector<std::string>> medians{std::move(header)};
   for (std::size_t i = 0; i < result.figures.size(); ++i) {
     const auto& f = result.figures[i];
     std::vector<std::string> row{f.label};
-    for (const auto& m : result.medians[i])
-      row.push_back(cell(m, f.unit, f.resolution));
+    for (const reproduction::LoopVariant k : result.variants())
+      row.push_back(cell(result.medians[i][static_cast<std::size_t>(k)], f.unit, f.resolution));
     medians.push_back(std::move(row));
   }
   std::vector<std::vector<std::string>> targets{
@@ -98,7 +100,16 @@ std::string summary_tables(const reproduction::ComparisonResult& result) {
     if (!t.not_applicable.empty())
       not_judged += fmt::format("  n/a: {}: {}\n", t.text, t.not_applicable);
   }
-  return reproduction::text_table(medians) + "\n" + reproduction::text_table(targets) + not_judged;
+  std::string out =
+      reproduction::text_table(medians) + "\n" + reproduction::text_table(targets) + not_judged;
+  if (result.options.fringes) {
+    std::vector<std::vector<std::string>> spread{
+        {"Table 4 (issue 29)", "paper_fringes median", "paper's seed spread", "within"}};
+    for (const auto& c : result.fringes_within_spread)
+      spread.push_back(reproduction::spread_row(result, c));
+    out += "\n" + reproduction::text_table(spread);
+  }
+  return out;
 }
 
 struct Options {
@@ -107,6 +118,7 @@ struct Options {
   std::string out;
   bool quick = false;
   bool json = false;
+  bool fringes = false;
   double max_physics_steps = plant::kDefaultPhysicsStepBudget;  // per seed
 };
 
@@ -115,19 +127,29 @@ int run(const Options& o) {
                                            ? config::ProjectConfig{}
                                            : runtime::load_installation_config(o.config).project;
   // Per seed: the seeds run one after another, each a whole comparison of its own.
-  check_procedure_cost("compare, one seed", reproduction::compare_seed_cost(o.quick), config.twin,
-                       o.max_physics_steps);
+  rig::ProcedureCost per_seed_cost = reproduction::compare_seed_cost(o.quick);
+  if (o.fringes) {
+    const rig::ProcedureCost f = reproduction::compare_fringes_seed_cost(o.quick);
+    per_seed_cost.fixed_s += f.fixed_s;
+    per_seed_cost.window_s += f.window_s;
+  }
+  check_procedure_cost("compare, one seed", per_seed_cost, config.twin, o.max_physics_steps);
   reproduction::CompareOptions co;
   co.seeds = *parse_seeds(o.seeds);  // checked by the option's validator
   co.quick = o.quick;
+  co.fringes = o.fringes;
   work_begins();  // every seed's calibrations and experiments
   reproduction::ComparisonResult result;
   {
     // The bar counts changes of label. Per seed: two calibrations (3 labels each), three
     // experiment sets of 7 labels (the grid and downward linearity share one), and at 10 kHz the
     // improved controller's calibration (3) and phase step (1). Counted on `compare --quick
-    // --seeds 1`: the bar ran [1/31] to [31/31].
-    ProgressBar bar(static_cast<int>(co.seeds.size()) * (2 * 3 + 3 * 7 + 3 + 1));
+    // --seeds 1`: the bar ran [1/31] to [30/31] (the improved controller's 10 kHz calibration
+    // showed 2 labels). --fringes adds the calibration from fringes (3 labels) and its
+    // experiment set (7; its 10 kHz step shares the set's last label, as the paper's does):
+    // [1/41] to [40/41] on `compare --quick --fringes --seeds 1`.
+    const int per_seed = 2 * 3 + 3 * 7 + 3 + 1 + (co.fringes ? 3 + 7 : 0);
+    ProgressBar bar(static_cast<int>(co.seeds.size()) * per_seed);
     result = reproduction::compare(config, co, bar.callback());
   }
   const int status = result.valid() ? 0 : rig::kExitNotValid;
@@ -177,6 +199,10 @@ void add_compare_command(CLI::App& app, Action& action) {
   add_physics_budget_option(cmd, o->max_physics_steps);
   cmd->add_flag("--quick", o->quick, "shortened schedule (tests, a first look)");
   cmd->add_flag("--json", o->json, "print the JSON summary");
+  cmd->add_flag("--fringes", o->fringes,
+                "a fourth column: the paper's controller calibrated from the Fizeau's fringes, no "
+                "XL-80 (issue 29); costs its calibration (10 to 16 s of wall time a seed) and its "
+                "experiments (about as long as the paper's column)");
   cmd->add_option("--out", o->out,
                   "output folder for comparison.md, comparison.html, figures, CSVs");
   cmd->callback([o, &action] { action = [o] { return run(*o); }; });

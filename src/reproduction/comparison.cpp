@@ -12,6 +12,7 @@
 #include "piezoshift/calibration/holding_gains.hpp"
 #include "piezoshift/calibration/improved_calibration.hpp"
 #include "piezoshift/control/notch_filter.hpp"
+#include "piezoshift/instrument/fringe_calibration.hpp"
 #include "piezoshift/reproduction/figure_format.hpp"
 
 namespace piezoshift::reproduction {
@@ -131,6 +132,13 @@ const char* Target::verdict() const noexcept {
   return met ? "yes" : "no";
 }
 
+std::vector<LoopVariant> loop_variants(const CompareOptions& options) {
+  std::vector<LoopVariant> v(kLoopVariants.begin(), kLoopVariants.end());
+  if (options.fringes)
+    v.push_back(LoopVariant::kPaperFringes);
+  return v;
+}
+
 const char* variant_key(LoopVariant k) {
   switch (k) {
     case LoopVariant::kPaper:
@@ -139,6 +147,8 @@ const char* variant_key(LoopVariant k) {
       return "improved";
     case LoopVariant::kOracleFeedback:
       return "oracle";
+    case LoopVariant::kPaperFringes:
+      return "paper_fringes";
   }
   return "";
 }
@@ -151,6 +161,8 @@ const char* variant_label(LoopVariant k) {
       return "improved controller";
     case LoopVariant::kOracleFeedback:
       return "oracle (plate feedback: impossible on hardware)";
+    case LoopVariant::kPaperFringes:
+      return "paper's controller calibrated from fringes (no XL-80)";
   }
   return "";
 }
@@ -279,7 +291,7 @@ bool ComparisonResult::valid() const {
 std::vector<std::string> ComparisonResult::invalid_reasons() const {
   std::vector<std::string> out;
   for (std::size_t i = 0; i < medians.size(); ++i) {
-    for (LoopVariant k : kLoopVariants) {
+    for (LoopVariant k : variants()) {
       const FigureValue& m = medians[i][static_cast<std::size_t>(k)];
       if (m.measured && !m.validity.valid)
         out.push_back(fmt::format("{}: {}: {}", variant_key(k), figures[i].key, m.validity.reason));
@@ -291,7 +303,7 @@ std::vector<std::string> ComparisonResult::invalid_reasons() const {
 std::vector<std::string> ComparisonResult::not_applicable_reasons() const {
   std::vector<std::string> out;
   for (std::size_t i = 0; i < medians.size(); ++i) {
-    for (LoopVariant k : kLoopVariants) {
+    for (LoopVariant k : variants()) {
       const FigureValue& m = medians[i][static_cast<std::size_t>(k)];
       if (m.measured && m.validity.valid && !m.not_applicable.empty())
         out.push_back(fmt::format("{}: {}: {}", variant_key(k), figures[i].key, m.not_applicable));
@@ -464,10 +476,37 @@ void choose_oracle_gains(const config::ProjectConfig& config, std::uint64_t seed
   }
 }
 
-// The three variants on one seed: the paper's and the improved controller each calibrated by its
-// own procedure, the oracle feedback on the paper's calibration.
+// Issue 29: the paper's controller calibrated from the Fizeau's fringes instead of the XL-80, as
+// `calibrate --interferometer fizeau --camera twin` runs it (the twin camera on its defaults, the
+// default surface drawn from the seed, stage 1 keeping the paper's gains, scored alone: it reads
+// no interferometer, and the XL-80 column keeps the same gains), on the supervisor's limits the
+// XL-80 column calibrates with.
+void calibrate_from_fringes(const config::ProjectConfig& config, std::uint64_t seed,
+                            const Schedule& s, const rig::Progress& progress, VariantRun& run) {
+  constexpr const char* what = "calibration from fringes";
+  calibrate_or_fail(run.calibration, what, [&] {
+    camera::InstrumentConfig ic;
+    ic.installation.project = config;
+    ic.installation.safety = s.calibration.limits;
+    const instrument::FringeCalibrationOutcome f = instrument::calibrate_twin_from_fringes(
+        ic, seed, psi::SurfaceSpec{},
+        instrument::fringe_calibration_options(false, s.calibration.limits), progress);
+    run.calibration_wall_time_s = f.wall_time_s;
+    run.simulated_time_s =
+        f.pid.simulated_time_s + f.matrix.simulated_time_s + f.polynomial.simulated_time_s;
+    if (!f.validity.valid) {
+      run.calibration.fail(fmt::format("{}: {}", what, f.validity.reason));
+      return;
+    }
+    run.controller = f.controller;
+  });
+}
+
+// The variants on one seed: the paper's and the improved controller each calibrated by its own
+// procedure, the oracle feedback on the paper's calibration, and (fringes) the paper's controller
+// calibrated from fringes.
 SeedComparison compare_seed(const config::ProjectConfig& config, std::uint64_t seed,
-                            const Schedule& s, const rig::Progress& progress) {
+                            const Schedule& s, bool fringes, const rig::Progress& progress) {
   control::SemiClosedLoopParams base{};
   base.sample_time_s = config.twin.daq.sample_time_s;  // as reproduce(): the DAQ's rate
   SeedComparison sc;
@@ -500,6 +539,9 @@ SeedComparison compare_seed(const config::ProjectConfig& config, std::uint64_t s
     improved.simulated_time_s =
         m.pid.simulated_time_s + m.matrix.simulated_time_s + m.polynomial.simulated_time_s;
   });
+  if (fringes)
+    calibrate_from_fringes(config, seed, s, labelled(LoopVariant::kPaperFringes),
+                           sc.runs[static_cast<std::size_t>(LoopVariant::kPaperFringes)]);
   oracle.calibration = paper.calibration;
   oracle.controller = paper.controller;
   oracle.controller.polynomial = control::CubicPolynomial::identity();
@@ -509,7 +551,9 @@ SeedComparison compare_seed(const config::ProjectConfig& config, std::uint64_t s
   if (oracle.calibration.valid)
     calibrate_or_fail(oracle.calibration, "calibration",
                       [&] { choose_oracle_gains(config, seed, oracle_schedule, oracle); });
-  for (LoopVariant k : kLoopVariants) {
+  CompareOptions which;
+  which.fringes = fringes;
+  for (LoopVariant k : loop_variants(which)) {
     VariantRun& run = sc.runs[static_cast<std::size_t>(k)];
     if (!run.calibration.valid)
       continue;
@@ -520,7 +564,9 @@ SeedComparison compare_seed(const config::ProjectConfig& config, std::uint64_t s
     if (is_oracle)
       continue;
     const bool at_two_rates = config.twin.daq.sample_time_s != kFastSampleTime_s;
-    const std::string unstable = k == LoopVariant::kPaper && at_two_rates
+    // The paper's design whichever interferometer calibrated it: the same rule at 10 kHz.
+    const bool papers = k == LoopVariant::kPaper || k == LoopVariant::kPaperFringes;
+    const std::string unstable = papers && at_two_rates
                                      ? paper_unstable_at_10kHz(config, run.controller, seed)
                                      : std::string{};
     if (unstable.empty()) {
@@ -613,6 +659,42 @@ std::vector<Target> comparison_targets(const config::ProjectConfig& config,
   return t;
 }
 
+// Issue 29's done-when, per Table 4 figure: the fringe column's median against the XL-80 paper
+// column's smallest and largest seed. Not judged where a value of either is not a number.
+std::vector<SpreadCheck> fringes_within_spread(const ComparisonResult& r) {
+  std::vector<SpreadCheck> out;
+  for (const char* key : kTable4Figures) {
+    SpreadCheck c;
+    c.key = key;
+    std::size_t i = 0;
+    while (i < r.figures.size() && r.figures[i].key != c.key)
+      ++i;
+    if (i == r.figures.size())
+      continue;
+    c.fringes_median = r.medians[i][static_cast<std::size_t>(LoopVariant::kPaperFringes)];
+    const std::vector<FigureValue> xl80 = r.per_seed(i, LoopVariant::kPaper);
+    std::vector<double> v;
+    for (std::size_t n = 0; n < xl80.size(); ++n) {
+      if (!xl80[n].validity.valid || !xl80[n].not_applicable.empty()) {
+        c.not_judged = fmt::format("the XL-80 column is not a number on seed {}", r.seeds[n].seed);
+        break;
+      }
+      v.push_back(xl80[n].value);
+    }
+    if (c.not_judged.empty() &&
+        (!c.fringes_median.validity.valid || !c.fringes_median.not_applicable.empty()))
+      c.not_judged = "the fringe column's median is not a number";
+    if (c.not_judged.empty() && !v.empty()) {
+      const auto [lo, hi] = std::minmax_element(v.begin(), v.end());
+      c.xl80_min = *lo;
+      c.xl80_max = *hi;
+      c.within = c.fringes_median.value >= c.xl80_min && c.fringes_median.value <= c.xl80_max;
+    }
+    out.push_back(std::move(c));
+  }
+  return out;
+}
+
 }  // namespace
 
 ComparisonResult summarize_comparison(const config::ProjectConfig& config,
@@ -626,14 +708,17 @@ ComparisonResult summarize_comparison(const config::ProjectConfig& config,
   r.figures = comparison_figures(config);
   r.seeds = std::move(seeds);
   for (const SeedComparison& sc : r.seeds)
-    for (const VariantRun& run : sc.runs)
-      r.simulated_time_s += run.simulated_time_s;
+    for (LoopVariant k : r.variants())
+      r.simulated_time_s += sc[k].simulated_time_s;
   for (std::size_t i = 0; i < r.figures.size(); ++i) {
-    std::array<FigureValue, 3>& m = r.medians.emplace_back();
-    for (LoopVariant k : kLoopVariants)
+    std::array<FigureValue, kVariantCount>& m = r.medians.emplace_back();
+    m.fill(not_measured());
+    for (LoopVariant k : r.variants())
       m[static_cast<std::size_t>(k)] = median_over_seeds(r.per_seed(i, k), options.seeds);
   }
   r.targets = comparison_targets(config, r);
+  if (options.fringes)
+    r.fringes_within_spread = fringes_within_spread(r);
   return r;
 }
 
@@ -645,7 +730,7 @@ ComparisonResult compare(const config::ProjectConfig& config, const CompareOptio
   const Schedule schedule = options.quick ? Schedule::quick() : Schedule::paper();
   std::vector<SeedComparison> seeds;
   for (const std::uint64_t seed : options.seeds)
-    seeds.push_back(compare_seed(config, seed, schedule, progress));
+    seeds.push_back(compare_seed(config, seed, schedule, options.fringes, progress));
   ComparisonResult r = summarize_comparison(config, options, std::move(seeds));
   r.wall_time_s = std::chrono::duration<double>(std::chrono::steady_clock::now() - start).count();
   return r;

@@ -59,10 +59,15 @@ std::string value_text(const FigureValue& f, const std::string& unit, double res
   return format_figure(f.value, unit, resolution);
 }
 
-// paper, improved, oracle: the house cycle's first three (plot.hpp), fixed per controller so that
-// a controller has one colour and one dash in every figure.
-const char* const kColour[3] = {"#0072B2", "#D55E00", "#009E73"};
-const char* const kDash[3] = {"solid", "(8,4)", "(2,3)"};
+// paper, improved, oracle, paper_fringes: the house cycle's first four (plot.hpp), fixed per
+// controller so that a controller has one colour and one dash in every figure.
+const char* const kColour[kVariantCount] = {"#0072B2", "#D55E00", "#009E73", "#CC79A7"};
+const char* const kDash[kVariantCount] = {"solid", "(8,4)", "(2,3)", "(6,2,1,2)"};
+
+// "three" or "four": the captions' count of the columns drawn.
+const char* how_many(const std::vector<LoopVariant>& variants) {
+  return variants.size() == 3 ? "three" : "four";
+}
 
 io::Series variant_line(LoopVariant k, std::string title, std::span<const double> x,
                         std::span<const double> y) {
@@ -73,7 +78,7 @@ io::Series variant_line(LoopVariant k, std::string title, std::span<const double
 
 // The 11 um steps as the interferometer saw them, and a zoom on the last 50 nm around the
 // target with the +-10 nm band.
-io::Figure step_figure(const SeedComparison& sc) {
+io::Figure step_figure(const SeedComparison& sc, const std::vector<LoopVariant>& variants) {
   io::Figure f;
   f.title = fmt::format("11 µm step, seed {} (twin, interferometer dynamic mode)", sc.seed);
   f.rows = 2;
@@ -88,7 +93,7 @@ io::Figure step_figure(const SeedComparison& sc) {
   zoom.key = "off";
   zoom.y_range = std::pair{-50.0, 50.0};
   double t0 = 0.0, t1 = 0.0;
-  for (LoopVariant k : kLoopVariants) {
+  for (LoopVariant k : variants) {
     const VariantRun& run = sc[k];
     const auto& st = run.set.step;
     if (!run.calibration.valid || st.time_s.empty())
@@ -110,12 +115,14 @@ io::Figure step_figure(const SeedComparison& sc) {
   all.x_range = zoom.x_range = std::pair{t0, std::min(t1, t0 + 0.2)};
   zoom.series.insert(zoom.series.begin(), io::band_series("±10 nm", t0, t1, -10.0, 10.0));
   f.panels = {std::move(all), std::move(zoom)};
-  f.caption =
-      "The 11 µm step of the three controllers; below, the last 50 nm with the ±10 nm band.";
+  f.caption = fmt::format(
+      "The 11 µm step of the {} controllers; below, the last 50 nm with the ±10 nm band.",
+      how_many(variants));
   return f;
 }
 
-io::Figure phase_step_figure(const SeedComparison& sc, double tolerance_nm) {
+io::Figure phase_step_figure(const SeedComparison& sc, double tolerance_nm,
+                             const std::vector<LoopVariant>& variants) {
   io::Figure f;
   f.title = fmt::format("λ/8 step, seed {} (true plate, 1 ms exposure means)", sc.seed);
   f.rows = 2;
@@ -130,7 +137,7 @@ io::Figure phase_step_figure(const SeedComparison& sc, double tolerance_nm) {
   near.key = "off";
   near.y_range = std::pair{-4.0 * tolerance_nm, 4.0 * tolerance_nm};
   double t1 = 0.0, step_nm = 0.0;
-  for (LoopVariant k : kLoopVariants) {
+  for (LoopVariant k : variants) {
     const VariantRun& run = sc[k];
     const auto& ps = run.set.phase_step;
     if (!run.calibration.valid || ps.time_s.empty())
@@ -172,14 +179,15 @@ io::Figure phase_step_figure(const SeedComparison& sc, double tolerance_nm) {
   }
   f.panels = {std::move(p), std::move(near)};
   f.caption = fmt::format(
-      "The λ/8 phase step of the three controllers on 1 ms exposure means, ±{:g} nm band; below, "
+      "The λ/8 phase step of the {} controllers on 1 ms exposure means, ±{:g} nm band; below, "
       "around the target.",
-      tolerance_nm);
+      how_many(variants), tolerance_nm);
   return f;
 }
 
 // Zero-end deviations of the paper's protocol and of the unseen grid.
-io::Figure linearity_error_figure(const SeedComparison& sc) {
+io::Figure linearity_error_figure(const SeedComparison& sc,
+                                  const std::vector<LoopVariant>& variants) {
   io::Figure f;
   f.title = fmt::format("Linearity error (zero-end line), seed {}", sc.seed);
   f.cols = 2;
@@ -190,7 +198,7 @@ io::Figure linearity_error_figure(const SeedComparison& sc) {
   b.title = "(b) unseen 0.25 µm grid";
   a.x_label = b.x_label = "desired [µm]";
   a.y_label = b.y_label = "deviation from the zero-end line [nm]";
-  for (LoopVariant k : kLoopVariants) {
+  for (LoopVariant k : variants) {
     const VariantRun& run = sc[k];
     if (!run.calibration.valid)
       continue;
@@ -208,14 +216,16 @@ io::Figure linearity_error_figure(const SeedComparison& sc) {
     }
   }
   f.panels = {std::move(a), std::move(b)};
-  f.caption =
-      "Zero-end linearity error of the three controllers (legend: linearity in % of range).";
+  f.caption = fmt::format(
+      "Zero-end linearity error of the {} controllers (legend: linearity in % of range).",
+      how_many(variants));
   return f;
 }
 
-io::Figure repeatability_figure(const SeedComparison& sc) {
+io::Figure repeatability_figure(const SeedComparison& sc,
+                                const std::vector<LoopVariant>& variants) {
   std::vector<experiments::RepeatabilitySet> sets;
-  for (LoopVariant k : kLoopVariants) {
+  for (LoopVariant k : variants) {
     const VariantRun& run = sc[k];
     if (!run.calibration.valid)
       continue;
@@ -241,15 +251,17 @@ io::Figure repeatability_figure(const SeedComparison& sc) {
 // was on any seed (then there is nothing to draw, and the report says so). Returns that seed.
 std::vector<SeedComparison>::const_iterator draw_figures(const ComparisonResult& r,
                                                          const fs::path& dir, ReportFiles& files) {
-  const auto drawn = std::find_if(r.seeds.begin(), r.seeds.end(), [](const SeedComparison& sc) {
-    return std::any_of(sc.runs.begin(), sc.runs.end(),
-                       [](const VariantRun& run) { return run.calibration.valid; });
+  const std::vector<LoopVariant> variants = r.variants();
+  const auto drawn = std::find_if(r.seeds.begin(), r.seeds.end(), [&](const SeedComparison& sc) {
+    return std::any_of(variants.begin(), variants.end(),
+                       [&](LoopVariant k) { return sc[k].calibration.valid; });
   });
   if (drawn == r.seeds.end())
     return drawn;
-  const io::Figure figs[] = {step_figure(*drawn),
-                             phase_step_figure(*drawn, r.schedule.phase_step.tolerance_nm),
-                             linearity_error_figure(*drawn), repeatability_figure(*drawn)};
+  const io::Figure figs[] = {
+      step_figure(*drawn, variants),
+      phase_step_figure(*drawn, r.schedule.phase_step.tolerance_nm, variants),
+      linearity_error_figure(*drawn, variants), repeatability_figure(*drawn, variants)};
   const char* const stems[] = {"compare_step_response", "compare_phase_step",
                                "compare_linearity_error", "compare_repeatability"};
   for (std::size_t i = 0; i < 4; ++i) {
@@ -261,7 +273,7 @@ std::vector<SeedComparison>::const_iterator draw_figures(const ComparisonResult&
 
 // One CSV per variant: a row per seed, a column per figure it measures.
 void write_per_seed_data(const ComparisonResult& r, const fs::path& dir, ReportFiles& files) {
-  for (LoopVariant k : kLoopVariants) {
+  for (LoopVariant k : r.variants()) {
     std::vector<std::size_t> cols;
     std::vector<std::string> names{"seed"};
     for (std::size_t i = 0; i < r.figures.size(); ++i) {
@@ -297,15 +309,40 @@ void introduction(Document& doc, const ComparisonResult& r, const std::string& c
       "the median over the seeds; a figure that is not valid on one seed is not valid here.",
       seeds, r.options.quick ? "Quick (shortened)" : "The paper's full", config_label,
       r.simulated_time_s, r.wall_time_s));
+  if (r.options.fringes)
+    doc.paragraph(
+        "Fourth column (--fringes, issue 29): the paper's controller calibrated from the "
+        "Fizeau's fringes on the twin camera, no laser interferometer, then the same experiments "
+        "as the paper's column on the same seeds. Reported, not targeted.");
 }
+
+}  // namespace
+
+std::vector<std::string> spread_row(const ComparisonResult& r, const SpreadCheck& c) {
+  std::size_t i = 0;
+  while (i < r.figures.size() && r.figures[i].key != c.key)
+    ++i;
+  const FigureSpec& f = r.figures.at(i);
+  if (!c.not_judged.empty())
+    return {f.label, value_text(c.fringes_median, f.unit, f.resolution), "-",
+            "not judged: " + c.not_judged};
+  return {f.label, value_text(c.fringes_median, f.unit, f.resolution),
+          format_figure(c.xl80_min, f.unit, f.resolution) + " to " +
+              format_figure(c.xl80_max, f.unit, f.resolution),
+          c.within ? "yes" : "no"};
+}
+
+namespace {
 
 void medians_section(Document& doc, const ComparisonResult& r) {
   doc.heading(2, "Medians over the seeds");
-  std::vector<std::vector<std::string>> rows{{"figure", "paper's controller", "improved controller",
-                                              "oracle (plate feedback: impossible on hardware)"}};
+  std::vector<std::string> header{"figure"};
+  for (LoopVariant k : r.variants())
+    header.push_back(variant_label(k));
+  std::vector<std::vector<std::string>> rows{std::move(header)};
   for (std::size_t i = 0; i < r.figures.size(); ++i) {
     std::vector<std::string> row{r.figures[i].label};
-    for (LoopVariant k : kLoopVariants)
+    for (LoopVariant k : r.variants())
       row.push_back(value_text(r.medians[i][idx(k)], r.figures[i].unit, r.figures[i].resolution));
     rows.push_back(std::move(row));
   }
@@ -317,6 +354,17 @@ void medians_section(Document& doc, const ComparisonResult& r) {
       "Its linearity by the paper's protocol reads 0 % exactly, by construction, not as a "
       "placeholder: it holds the plate on its true position at each whole-micron level, and the "
       "interferometer reads that plate to 1 nm, so every reading is its level.");
+  if (!r.options.fringes)
+    return;
+  std::vector<std::vector<std::string>> spread{
+      {"Table 4 figure", "from fringes (median)", "XL-80 (seed spread)", "within"}};
+  for (const SpreadCheck& c : r.fringes_within_spread)
+    spread.push_back(spread_row(r, c));
+  doc.paragraph(
+      "Issue 29's done-when: the median of each Table 4 figure of the paper's controller "
+      "calibrated from fringes, against the same controller's spread over the same seeds "
+      "calibrated with the XL-80 (its smallest to its largest seed).");
+  doc.table(std::move(spread));
 }
 
 void targets_section(Document& doc, const ComparisonResult& r) {
@@ -341,7 +389,9 @@ void figures_section(Document& doc, const ComparisonResult& r,
                      std::vector<SeedComparison>::const_iterator drawn) {
   if (drawn != r.seeds.end()) {
     doc.heading(2, fmt::format("Figures (seed {})", drawn->seed));
-    doc.image("The 11 µm step of the three controllers; below, the last 50 nm with the ±10 nm band",
+    doc.image(fmt::format("The 11 µm step of the {} controllers; below, the last 50 nm with the "
+                          "±10 nm band",
+                          how_many(r.variants())),
               "compare_step_response.png");
     doc.image(
         "The λ/8 phase step on 1 ms exposure means with the ±1 nm band; below, around the "
@@ -359,11 +409,14 @@ void figures_section(Document& doc, const ComparisonResult& r,
 
 void per_seed_section(Document& doc, const ComparisonResult& r, const ReportFiles& files) {
   doc.heading(2, "Per seed");
-  std::vector<std::vector<std::string>> rows{{"seed", "figure", "paper", "improved", "oracle"}};
+  std::vector<std::string> header{"seed", "figure"};
+  for (LoopVariant k : r.variants())
+    header.push_back(variant_key(k));
+  std::vector<std::vector<std::string>> rows{std::move(header)};
   for (const SeedComparison& sc : r.seeds) {
     for (const FigureSpec& f : r.figures) {
       std::vector<std::string> row{std::to_string(sc.seed), f.label};
-      for (LoopVariant k : kLoopVariants)
+      for (LoopVariant k : r.variants())
         row.push_back(value_text(f.of(sc[k]), f.unit, f.resolution));
       rows.push_back(std::move(row));
     }
@@ -381,17 +434,20 @@ nlohmann::json comparison_json(const ComparisonResult& r) {
   nlohmann::json j;
   j["seeds"] = r.options.seeds;
   j["schedule"] = r.options.quick ? "quick" : "paper";
-  for (LoopVariant k : kLoopVariants)
+  for (LoopVariant k : r.variants())
     prefixed(j, r, k, [&](std::size_t i) { return r.medians[i][idx(k)]; });
   nlohmann::json per = nlohmann::json::array();
   for (std::size_t s = 0; s < r.seeds.size(); ++s) {
     nlohmann::json o;
     o["seed"] = r.seeds[s].seed;
-    for (LoopVariant k : kLoopVariants)
+    for (LoopVariant k : r.variants())
       prefixed(o, r, k, [&](std::size_t i) { return r.figures[i].of(r.seeds[s][k]); });
     o["oracle_holding_gains_scale"] = r.seeds[s][LoopVariant::kOracleFeedback].holding_gains_scale;
     const auto& notch_Hz = r.seeds[s][LoopVariant::kOracleFeedback].feedback_notch_Hz;
     o["oracle_feedback_notch_Hz"] = nlohmann::json::array({notch_Hz[0], notch_Hz[1]});
+    if (r.options.fringes)
+      o["paper_fringes_calibration_wall_s"] =
+          r.seeds[s][LoopVariant::kPaperFringes].calibration_wall_time_s;
     per.push_back(std::move(o));
   }
   j["per_seed"] = std::move(per);
@@ -409,6 +465,18 @@ nlohmann::json comparison_json(const ComparisonResult& r) {
     targets.push_back(std::move(x));
   }
   j["targets"] = std::move(targets);
+  if (r.options.fringes) {
+    // Issue 29's done-when per Table 4 figure: true, false, or null with the reason.
+    nlohmann::json within = nlohmann::json::object();
+    nlohmann::json not_judged = nlohmann::json::object();
+    for (const SpreadCheck& c : r.fringes_within_spread) {
+      within[c.key] = c.not_judged.empty() ? nlohmann::json(c.within) : nlohmann::json();
+      if (!c.not_judged.empty())
+        not_judged[c.key] = c.not_judged;
+    }
+    j["paper_fringes_within_xl80_spread"] = std::move(within);
+    j["paper_fringes_within_xl80_spread_not_judged"] = std::move(not_judged);
+  }
   j["valid"] = r.valid();
   j["invalid_reasons"] = r.invalid_reasons();
   j["not_applicable_reasons"] = r.not_applicable_reasons();

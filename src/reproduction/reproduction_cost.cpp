@@ -10,4 +10,8 @@ rig::ProcedureCost compare_seed_cost(bool quick) {
   return quick ? rig::ProcedureCost{3502.85, 1513.82} : rig::ProcedureCost{5619.59, 1601.0};
 }
 
+rig::ProcedureCost compare_fringes_seed_cost(bool quick) {
+  return quick ? rig::ProcedureCost{1174.80, 486.0} : rig::ProcedureCost{1722.80, 488.0};
+}
+
 }  // namespace piezoshift::reproduction

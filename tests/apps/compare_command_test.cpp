@@ -54,6 +54,18 @@ TEST_F(CompareCommand, ABadSeedListExitsWithStatusTwoNamingTheOption) {
   EXPECT_NE(r.err.find("bad.toml"), std::string::npos) << r.err;
 }
 
+// --fringes (issue 29) is taken, and the physics-step budget counts its column: a budget of 1
+// refuses both before anything runs, naming the quick estimates (5.02e3 and 6.68e3 s a seed,
+// reproduction_cost.hpp).
+TEST_F(CompareCommand, TheBudgetCountsTheFringeColumn) {
+  const testing::CliResult off = run("compare --quick --seeds 1 --max-physics-steps 1");
+  const testing::CliResult on = run("compare --quick --fringes --seeds 1 --max-physics-steps 1");
+  EXPECT_EQ(off.status, 2);
+  EXPECT_EQ(on.status, 2);
+  EXPECT_NE(off.err.find("(5.02e+03 s of simulated time"), std::string::npos) << off.err;
+  EXPECT_NE(on.err.find("(6.68e+03 s of simulated time"), std::string::npos) << on.err;
+}
+
 // Issue 31: configs/plants/, twins not used in development. A quick compare on each exits 0:
 // every figure of every controller valid, except that the paper's 10 kHz figures may be not
 // applicable, and then only with compare's ring test's reason (docs/compare.md). Not yet

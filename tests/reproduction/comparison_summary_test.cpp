@@ -9,6 +9,8 @@
 #include <iterator>
 #include <limits>
 #include <string>
+#include <tuple>
+#include <vector>
 
 #include "piezoshift/reproduction/comparison.hpp"
 #include "piezoshift/reproduction/comparison_report.hpp"
@@ -220,6 +222,91 @@ TEST(ComparisonSummary, TheReportSaysNotApplicableAndWhy) {
   EXPECT_NE(text.find("n/a: seed 3: made-up ring"), std::string::npos);  // the medians
   EXPECT_NE(text.find("n/a: made-up ring"), std::string::npos);          // per seed
   std::filesystem::remove_all(dir);
+}
+
+// --fringes (issue 29): off, nothing of the fourth column is in the result or the JSON; on, its
+// figures are there, and a calibration from fringes that failed makes each not valid with its
+// reason, named as the paper's column's would be.
+TEST(ComparisonSummary, TheFringeColumnIsReportedOnlyWhenAskedFor) {
+  const ComparisonResult off = nothing_calibrated();
+  EXPECT_EQ(off.variants().size(), 3U);
+  EXPECT_TRUE(off.fringes_within_spread.empty());
+  for (const auto& m : off.medians)
+    EXPECT_FALSE(m[static_cast<std::size_t>(LoopVariant::kPaperFringes)].measured);
+  const nlohmann::json j_off = comparison_json(off);
+  for (const nlohmann::json* o : {&j_off, &j_off["per_seed"][0]})
+    for (const auto& [key, value] : o->items())
+      EXPECT_EQ(key.find("fringes"), std::string::npos) << key;
+
+  CompareOptions o = off.options;
+  o.fringes = true;
+  std::vector<SeedComparison> seeds = off.seeds;
+  rig::Validity& fringe_calibration =
+      seeds[0].runs[static_cast<std::size_t>(LoopVariant::kPaperFringes)].calibration;
+  fringe_calibration = rig::Validity{};
+  fringe_calibration.fail(
+      "calibration from fringes: stage 2 (matrix A), actuator 1's scan: made up");
+  const ComparisonResult on = summarize_comparison(config::ProjectConfig{}, o, std::move(seeds));
+  ASSERT_EQ(on.variants().size(), 4U);
+  EXPECT_EQ(on.variants().back(), LoopVariant::kPaperFringes);
+  const nlohmann::json j = comparison_json(on);
+  EXPECT_TRUE(j["paper_fringes_step_settling_time_s"].is_null());
+  EXPECT_EQ(j["paper_fringes_not_valid"]["repeatability_5um_nm"],
+            "seed 7: calibration from fringes: stage 2 (matrix A), actuator 1's scan: made up");
+  EXPECT_EQ(j["per_seed"][1]["paper_fringes_not_valid"]["repeatability_5um_nm"],
+            "calibration: made up for the test");
+  EXPECT_TRUE(j["paper_fringes_pid_margins_1kHz_gain_margin_dB"].is_null());
+  EXPECT_TRUE(j["paper_fringes_within_xl80_spread"]["linearity_zero_end_pct"].is_null());
+  EXPECT_NE(j["paper_fringes_within_xl80_spread_not_judged"]["linearity_zero_end_pct"], nullptr);
+  bool named = false;
+  for (const std::string& why : on.invalid_reasons())
+    named = named || why.rfind("paper_fringes: ", 0) == 0;
+  EXPECT_TRUE(named);
+}
+
+// Issue 29's done-when per Table 4 figure: the fringe column's median against the XL-80 paper
+// column's smallest and largest seed, ends included.
+TEST(ComparisonSummary, TheFringeMedianIsJudgedAgainstTheXl80ColumnsSeedSpread) {
+  CompareOptions o;
+  o.quick = true;
+  o.fringes = true;
+  o.seeds = {1, 2, 3};
+  std::vector<SeedComparison> seeds(3);
+  const double xl80_settling[] = {0.030, 0.040, 0.036};
+  const double fringe_settling[] = {0.041, 0.035, 0.037};  // median 0.037: within
+  const double xl80_linearity[] = {0.030, 0.031, 0.032};
+  const double fringe_linearity[] = {0.047, 0.020, 0.040};  // median 0.040: above
+  for (std::size_t s = 0; s < 3; ++s) {
+    seeds[s].seed = o.seeds[s];
+    for (VariantRun& run : seeds[s].runs)
+      run.calibration.fail("calibration: made up for the test");
+    for (const auto& [k, settling, linearity] :
+         {std::tuple{LoopVariant::kPaper, xl80_settling[s], xl80_linearity[s]},
+          std::tuple{LoopVariant::kPaperFringes, fringe_settling[s], fringe_linearity[s]}}) {
+      VariantRun& run = seeds[s].runs[static_cast<std::size_t>(k)];
+      run.calibration = rig::Validity{};
+      run.set.step.metrics.settling_time_pct_s = settling;
+      run.set.linearity.metrics.linearity_zero_end_pct = linearity;
+      run.set.repeat_5um.metrics.repeatability_nm = 2.0;  // all equal: the ends count
+      run.set.repeat_10um.metrics.repeatability_nm = 2.0 + static_cast<double>(s);
+    }
+  }
+  const ComparisonResult r = summarize_comparison(config::ProjectConfig{}, o, std::move(seeds));
+  ASSERT_EQ(r.fringes_within_spread.size(), 4U);
+  const SpreadCheck& settling = r.fringes_within_spread[0];
+  EXPECT_EQ(settling.key, "step_settling_time_s");
+  EXPECT_EQ(settling.fringes_median.value, 0.037);
+  EXPECT_EQ(settling.xl80_min, 0.030);
+  EXPECT_EQ(settling.xl80_max, 0.040);
+  EXPECT_TRUE(settling.within);
+  EXPECT_FALSE(r.fringes_within_spread[1].within);  // linearity 0.040 % above 0.032 %
+  EXPECT_TRUE(r.fringes_within_spread[2].within);
+  EXPECT_TRUE(r.fringes_within_spread[3].within);  // median 3 nm within 2 to 4 nm
+  const nlohmann::json j = comparison_json(r);
+  EXPECT_EQ(j["paper_fringes_within_xl80_spread"]["step_settling_time_s"], true);
+  EXPECT_EQ(j["paper_fringes_within_xl80_spread"]["linearity_zero_end_pct"], false);
+  EXPECT_TRUE(j["paper_fringes_within_xl80_spread_not_judged"].empty());
+  EXPECT_EQ(spread_row(r, settling).back(), "yes");
 }
 
 TEST(ComparisonSummary, OneSeedPerSeedOfTheOptionsOrItIsRefused) {

@@ -14,6 +14,12 @@
 //             stage 0 chooses its own (the ring test on its plate feedback, seed + 93: the
 //             paper's where they hold, issue 31); the same set, no 10 kHz step and no
 //             inner-loop analysis of its own
+//   paper_fringes  (opt-in, CompareOptions::fringes; issue 29) the paper's controller calibrated
+//             from the Fizeau's fringes with no laser interferometer
+//             (instrument::calibrate_twin_from_fringes(s): the twin camera on its defaults, the
+//             default surface, stage 1 scoring the paper's gains alone), then everything the
+//             paper's variant runs, by the same rules; its simulated time includes the
+//             calibration's. Reported beside the others, never targeted.
 // so a figure of the paper's controller on seed s is bit for bit reproduce()'s on seed s.
 //
 // Every figure (travel, the 11 um step, the three linearity sweeps, repeatability at 5 and 10 um,
@@ -43,6 +49,9 @@ namespace piezoshift::reproduction {
 struct CompareOptions {
   std::vector<std::uint64_t> seeds{1, 2, 3, 4, 5, 6, 7, 8};
   bool quick = false;  //!< Schedule::quick() instead of Schedule::paper()
+  //! A fourth column: the paper's controller calibrated from the Fizeau's fringes (issue 29).
+  //! Off: nothing of it is run or reported, the output is the three columns' bit for bit.
+  bool fringes = false;
 };
 
 //! What closes the loop in one column of the comparison: a controller and its feedback.
@@ -50,10 +59,18 @@ enum class LoopVariant {
   kPaper = 0,           //!< the paper's controller on the strain gauges
   kImproved = 1,        //!< the improved controller on the strain gauges
   kOracleFeedback = 2,  //!< the paper's gains and A, p = identity, on the plate's true position
+  //! the paper's controller calibrated from the Fizeau's fringes, on the strain gauges (opt-in)
+  kPaperFringes = 3,
 };
+//! The variants every comparison runs.
 inline constexpr std::array<LoopVariant, 3> kLoopVariants{
     LoopVariant::kPaper, LoopVariant::kImproved, LoopVariant::kOracleFeedback};
-//! "paper", "improved", "oracle": the JSON prefixes (without the underscore) and file names.
+inline constexpr std::size_t kVariantCount = 4;
+//! The variants a comparison with these options runs and reports, in the report's order:
+//! kLoopVariants, then kPaperFringes when options.fringes.
+std::vector<LoopVariant> loop_variants(const CompareOptions& options);
+//! "paper", "improved", "oracle", "paper_fringes": the JSON prefixes (without the underscore) and
+//! file names.
 const char* variant_key(LoopVariant k);
 //! How the report names it.
 const char* variant_label(LoopVariant k);
@@ -83,11 +100,14 @@ struct VariantRun {
   //! where its plain loop held below kOracleNotchBelowScale (comparison.cpp, docs/compare.md).
   std::array<double, 2> feedback_notch_Hz{};
   double simulated_time_s = 0.0;  //!< its calibration and experiments
+  //! paper_fringes: the calibration from fringes' wall time.
+  double calibration_wall_time_s = 0.0;
 };
 
 struct SeedComparison {
   std::uint64_t seed = 0;
-  std::array<VariantRun, 3> runs;  //!< indexed by LoopVariant
+  //! Indexed by LoopVariant; kPaperFringes default-constructed (nothing ran) unless asked for.
+  std::array<VariantRun, kVariantCount> runs;
   const VariantRun& operator[](LoopVariant k) const { return runs[static_cast<std::size_t>(k)]; }
 };
 
@@ -137,17 +157,39 @@ struct Target {
   const char* verdict() const noexcept;
 };
 
+//! The figures of the paper's Table 4 among comparison_figures(): the 11 um step's settling to
+//! +-2 %, linearity (zero-end), repeatability at 5 and 10 um.
+inline constexpr std::array<const char*, 4> kTable4Figures{
+    "step_settling_time_s", "linearity_zero_end_pct", "repeatability_5um_nm",
+    "repeatability_10um_nm"};
+
+//! Issue 29's done-when on one Table 4 figure: is the median of the paper's controller calibrated
+//! from fringes within the seed spread (smallest to largest seed) of the same controller
+//! calibrated with the XL-80? Reported, not a target.
+struct SpreadCheck {
+  std::string key;  //!< the figure
+  FigureValue fringes_median;
+  double xl80_min = 0.0, xl80_max = 0.0;  //!< over the seeds (only if judged)
+  //! Why it is not judged ("": it is): a value not valid or not applicable on a seed.
+  std::string not_judged;
+  bool within = false;
+};
+
 struct ComparisonResult {
   CompareOptions options;
   Schedule schedule;
   std::vector<FigureSpec> figures;
   std::vector<SeedComparison> seeds;
-  //! [figure][variant]: the median over seeds.
-  std::vector<std::array<FigureValue, 3>> medians;
+  //! [figure][variant]: the median over seeds; not measured for a variant not run.
+  std::vector<std::array<FigureValue, kVariantCount>> medians;
   std::vector<Target> targets;
+  //! With options.fringes: one per Table 4 figure (kTable4Figures).
+  std::vector<SpreadCheck> fringes_within_spread;
   double simulated_time_s = 0.0;
   double wall_time_s = 0.0;
 
+  //! loop_variants(options).
+  std::vector<LoopVariant> variants() const { return loop_variants(options); }
   //! The per-seed values of one figure of one variant.
   std::vector<FigureValue> per_seed(std::size_t figure, LoopVariant k) const;
   //! Every measured median of every variant valid.

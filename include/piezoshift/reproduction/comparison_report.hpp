@@ -1,11 +1,12 @@
 #pragma once
 // The outputs of `piezoshift compare` (comparison.hpp):
-//   comparison_json()   the medians, keys prefixed paper_, improved_, oracle_ with the unit last
-//                       (null: a time that never came, or a figure not valid; the reason is in
-//                       <prefix>not_valid), the targets, and per_seed: one object per seed
-//                       with the same prefixed keys
+//   comparison_json()   the medians, keys prefixed paper_, improved_, oracle_ (and with
+//                       --fringes paper_fringes_) with the unit last (null: a time that never
+//                       came, or a figure not valid; the reason is in <prefix>not_valid), the
+//                       targets, and per_seed: one object per seed with the same prefixed keys;
+//                       with --fringes also paper_fringes_within_xl80_spread (SpreadCheck)
 //   write_comparison_report(dir)
-//     comparison.md, comparison.html   the three columns, the targets, the figures
+//     comparison.md, comparison.html   the three (four) columns, the targets, the figures
 //     compare_step_response.png        the 11 um steps overlaid (first seed)
 //     compare_phase_step.png           the lambda/8 steps' 1 ms exposure means (first seed)
 //     compare_linearity_error.png      zero-end deviations of the paper's protocol and the grid
@@ -15,6 +16,7 @@
 // Throws core::InputError when the folder cannot be written and io::PlotError when gnuplot fails.
 #include <filesystem>
 #include <string>
+#include <vector>
 
 #include <nlohmann/json.hpp>
 
@@ -24,6 +26,10 @@
 namespace piezoshift::reproduction {
 
 nlohmann::json comparison_json(const ComparisonResult& r);
+
+//! One row of the report's table of SpreadChecks: the figure, the fringe column's median, the
+//! XL-80 column's spread, "yes" / "no" / "not judged: why". compare's terminal prints it too.
+std::vector<std::string> spread_row(const ComparisonResult& r, const SpreadCheck& c);
 
 //! config_label says where the configuration came from (a path, or the built-in defaults).
 ReportFiles write_comparison_report(const ComparisonResult& r, const std::filesystem::path& dir,

@@ -7,6 +7,8 @@
 //   reproduce --quick      2298.5      1004
 //   compare, one seed      5619.6      1601
 //   compare --quick, seed  3502.9      1513.8
+//   --fringes adds         1722.8       488.0   (the paper's schedule; 2026-11-27)
+//   --fringes --quick adds 1174.8       486.0
 //
 // (The default reproduction is 4674 s of simulated time, 9.3e7 physics steps.)
 #include "piezoshift/rig/procedure_cost.hpp"
@@ -16,5 +18,8 @@ namespace piezoshift::reproduction {
 rig::ProcedureCost reproduce_cost(bool quick);
 //! One seed of compare(); the seeds run one after the other.
 rig::ProcedureCost compare_seed_cost(bool quick);
+//! What `compare --fringes` adds to one seed: the calibration from fringes and the fourth
+//! column's experiments (measured as compare with it minus compare without it).
+rig::ProcedureCost compare_fringes_seed_cost(bool quick);
 
 }  // namespace piezoshift::reproduction
