@@ -33,6 +33,15 @@ nlohmann::json improved_json(const ImprovedSummary& s) {
   j["shaper_rate_um_per_s"] = sh.rate_um_per_s;
   j["command_slew_um_per_s"] = s.controller.command_slew_um_per_s;
   j["slew_approach_um"] = s.controller.slew_approach_um;
+  if (s.large_move)
+    j["large_move_trial"] = {
+        {"tried", s.large_move->tried},
+        {"not_tried", s.large_move->not_tried.empty() ? nlohmann::json(nullptr)
+                                                      : nlohmann::json(s.large_move->not_tried)},
+        {"slew_um_per_s", s.large_move->slew_um_per_s},
+        {"slew_overshoot_pct", s.large_move->slew_overshoot_pct},
+        {"shaper_overshoot_pct", s.large_move->shaper_overshoot_pct},
+        {"slew_kept", s.large_move->slew_kept}};
   j["correction_ki"] = s.controller.correction_ki;
   j["sample_time_s"] = s.controller.sample_time_s;
   return j;
@@ -54,6 +63,14 @@ void print_improved(const ImprovedSummary& s) {
                s.mode.sample_rate_Hz > 0.0 ? "none the ring-down shows at this loop rate"
                                            : "no ring-down given",
                sh.rate_um_per_s);
+  if (s.large_move && s.large_move->tried)
+    fmt::print(
+        "moves    > 2 um at the slew limit {}: an 11 um step overshoots {:.2f} % with it, {:.2f} "
+        "% with the shaper alone\n",
+        s.large_move->slew_kept ? "kept" : "turned off", s.large_move->slew_overshoot_pct,
+        s.large_move->shaper_overshoot_pct);
+  else if (s.large_move)
+    fmt::print("moves    the slew path not tried: {}\n", s.large_move->not_tried);
 }
 
 namespace {

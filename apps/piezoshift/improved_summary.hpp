@@ -20,6 +20,8 @@ struct ImprovedSummary {
   const std::array<calibration::HysteresisFit, 3>& model;
   const calibration::PlateModeEstimate& mode;
   bool shaped;
+  //! Stage 7 on the twin; nullptr from records (`fit improved`: no plant to try moves on)
+  const calibration::LargeMoveTrial* large_move = nullptr;
 };
 
 nlohmann::json improved_json(const ImprovedSummary& s);

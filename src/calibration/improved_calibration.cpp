@@ -4,7 +4,9 @@
 #include <Eigen/Dense>
 #include <algorithm>
 #include <cmath>
+#include <limits>
 #include <numbers>
+#include <vector>
 
 #include "piezoshift/plant/amplifier.hpp"
 #include "piezoshift/rig/bench.hpp"
@@ -94,6 +96,62 @@ constexpr Segment kExcitation[] = {
     {0.5, 0.0},
     {2.0, 0.0},
 };
+
+// Stage 7's one trial: the plate's overshoot [%] of a step of step_um on the three points from
+// 0, as the interferometer's dynamic samples read it; NaN when the step did not reach its target
+// within 1 % (the stroke's end: nothing to judge).
+double large_move_overshoot_pct(const config::ProjectConfig& config,
+                                const control::SemiClosedLoopParams& controller, std::uint64_t seed,
+                                const ImprovedCalibrationOptions& o) {
+  rig::Bench bench(config, controller, seed, {rig::Feedback::kGauges, o.paper.limits});
+  const auto all = [](double v) { return control::Vec3{v, v, v}; };
+  const auto mean3 = [](const control::Vec3& v) { return (v[0] + v[1] + v[2]) / 3.0; };
+  bench.drive_points(all(0.0));
+  bench.run(o.large_move_pre_s);
+  bench.drive_points(all(o.large_move_trial_um));
+  std::vector<double> x;
+  bench.run(o.large_move_record_s,
+            [&](const rig::Bench& b) { x.push_back(mean3(b.twin().interferometer().dynamic_um)); });
+  if (bench.faulted())
+    throw rig::ProcedureFailed(
+        fmt::format("improved calibration, stage 7: the large move tripped the supervisor ({})",
+                    runtime::to_string(bench.fault().reason)));
+  const std::size_t tail = std::max<std::size_t>(1, x.size() / 10);
+  double final_um = 0.0;
+  for (std::size_t k = x.size() - tail; k < x.size(); ++k)
+    final_um += x[k] / static_cast<double>(tail);
+  if (std::fabs(final_um - o.large_move_trial_um) > 0.01 * o.large_move_trial_um)
+    return std::numeric_limits<double>::quiet_NaN();
+  return 100.0 * (*std::max_element(x.begin(), x.end()) - final_um) / o.large_move_trial_um;
+}
+
+// Stage 7 (the header): the slew path kept or turned off on the plant's own large move.
+LargeMoveTrial try_large_moves(const config::ProjectConfig& config,
+                               control::SemiClosedLoopParams& controller, std::uint64_t seed,
+                               const ImprovedCalibrationOptions& o) {
+  LargeMoveTrial t;
+  if (!(controller.improved.command_slew_um_per_s > 0.0)) {
+    t.not_tried = "the slew path is off";
+    return t;
+  }
+  t.slew_um_per_s = controller.improved.command_slew_um_per_s;
+  control::SemiClosedLoopParams shaper_only = controller;
+  shaper_only.improved.command_slew_um_per_s = 0.0;
+  t.slew_overshoot_pct = large_move_overshoot_pct(config, controller, seed, o);
+  t.shaper_overshoot_pct = large_move_overshoot_pct(config, shaper_only, seed, o);
+  if (!std::isfinite(t.slew_overshoot_pct) || !std::isfinite(t.shaper_overshoot_pct)) {
+    t.not_tried = fmt::format("the {} um step did not reach its target (the stroke's end)",
+                              o.large_move_trial_um);
+    t.slew_kept = true;
+    return t;
+  }
+  t.tried = true;
+  t.slew_kept = t.slew_overshoot_pct < o.large_move_keep_below_pct ||
+                t.slew_overshoot_pct <= t.shaper_overshoot_pct;
+  if (!t.slew_kept)
+    controller = shaper_only;
+  return t;
+}
 
 }  // namespace
 
@@ -198,6 +256,7 @@ ImprovedCalibrationOutcome calibrate_improved(const config::ProjectConfig& confi
       design_improved_controller(config, paper, out.model, out.mode, options);
   out.controller = design.controller;
   out.shaped = design.shaped;
+  out.large_move = try_large_moves(config, out.controller, seed + 7, options);
   return out;
 }
 
