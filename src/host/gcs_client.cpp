@@ -15,6 +15,8 @@
 
 #include <fmt/format.h>
 
+#include "piezoshift/core/wall_time.hpp"
+
 namespace piezoshift::host {
 
 namespace {
@@ -25,7 +27,7 @@ using Clock = std::chrono::steady_clock;
 int poll_ms_until(double timeout_s, Clock::time_point start) {
   if (std::isinf(timeout_s))
     return -1;
-  const double left_s = timeout_s - std::chrono::duration<double>(Clock::now() - start).count();
+  const double left_s = timeout_s - core::seconds_since(start);
   return left_s <= 0.0 ? 0 : static_cast<int>(std::ceil(left_s * 1000.0));
 }
 

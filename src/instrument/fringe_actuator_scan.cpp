@@ -10,6 +10,7 @@
 #include <stdexcept>
 
 #include "piezoshift/core/input_error.hpp"
+#include "piezoshift/core/wall_time.hpp"
 #include "piezoshift/instrument/measurement.hpp"
 
 namespace piezoshift::instrument {
@@ -17,6 +18,7 @@ namespace piezoshift::instrument {
 namespace {
 
 using Clock = std::chrono::steady_clock;
+using core::seconds_since;
 
 // The truth relative to frame 0, as the fringes are.
 void truth_from_first_frame(std::vector<FringeScanPose>& poses) {
@@ -26,10 +28,6 @@ void truth_from_first_frame(std::vector<FringeScanPose>& poses) {
   for (FringeScanPose& q : poses)
     for (std::size_t j = 0; j < 3; ++j)
       q.truth_points_um[j] -= z0[j];
-}
-
-double seconds_since(Clock::time_point t0) {
-  return std::chrono::duration<double>(Clock::now() - t0).count();
 }
 
 // The scan's state between poses: the bench, the camera, the tracker and what was taken.

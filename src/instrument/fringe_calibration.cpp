@@ -9,6 +9,7 @@
 #include "piezoshift/calibration/pid_tuning.hpp"
 #include "piezoshift/calibration/poly_fit.hpp"
 #include "piezoshift/camera/make_camera.hpp"
+#include "piezoshift/core/wall_time.hpp"
 
 namespace piezoshift::instrument {
 
@@ -147,7 +148,7 @@ FringeCalibrationOutcome calibrate_from_fringes(const config::ProjectConfig& con
   }
   if (ok)
     out.controller.polynomial = out.polynomial.fit.p;
-  out.wall_time_s = std::chrono::duration<double>(std::chrono::steady_clock::now() - w0).count();
+  out.wall_time_s = core::seconds_since(w0);
   return out;
 }
 

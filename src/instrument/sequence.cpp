@@ -11,6 +11,7 @@
 #include <fmt/core.h>
 
 #include "piezoshift/core/input_error.hpp"
+#include "piezoshift/core/wall_time.hpp"
 #include "piezoshift/instrument/exposure_accumulator.hpp"
 #include "piezoshift/instrument/fit_thread.hpp"
 #include "piezoshift/instrument/settle_window.hpp"
@@ -20,10 +21,7 @@ namespace piezoshift::instrument {
 namespace {
 
 using Clock = std::chrono::steady_clock;
-
-double seconds_since(Clock::time_point t0) {
-  return std::chrono::duration<double>(Clock::now() - t0).count();
-}
+using core::seconds_since;
 
 // Drives one sequence: the loop's ticks, the settle criterion, the camera's triggers and frames.
 class Runner {

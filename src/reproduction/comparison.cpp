@@ -12,6 +12,7 @@
 #include "piezoshift/calibration/holding_gains.hpp"
 #include "piezoshift/calibration/improved_calibration.hpp"
 #include "piezoshift/control/notch_filter.hpp"
+#include "piezoshift/core/wall_time.hpp"
 #include "piezoshift/instrument/fringe_calibration.hpp"
 #include "piezoshift/reproduction/figure_format.hpp"
 
@@ -19,8 +20,6 @@ namespace piezoshift::reproduction {
 namespace {
 
 using rig::Validity;
-
-constexpr double kFastSampleTime_s = 1e-4;  // 10 kHz, issue 12's second loop rate
 
 FigureValue figure(double value, const Validity& v) {
   FigureValue f;
@@ -732,7 +731,7 @@ ComparisonResult compare(const config::ProjectConfig& config, const CompareOptio
   for (const std::uint64_t seed : options.seeds)
     seeds.push_back(compare_seed(config, seed, schedule, options.fringes, progress));
   ComparisonResult r = summarize_comparison(config, options, std::move(seeds));
-  r.wall_time_s = std::chrono::duration<double>(std::chrono::steady_clock::now() - start).count();
+  r.wall_time_s = core::seconds_since(start);
   return r;
 }
 

@@ -7,6 +7,8 @@
 #include <fmt/core.h>
 #include <stdexcept>
 
+#include "piezoshift/core/wall_time.hpp"
+
 namespace piezoshift::reproduction {
 
 Schedule Schedule::paper() {
@@ -42,12 +44,6 @@ Schedule Schedule::quick() {
   // drift over the time the moves take, so fewer moves would measure something else.
   return s;
 }
-
-namespace {
-
-constexpr double kFastSampleTime_s = 1e-4;  // 10 kHz, the second loop rate
-
-}  // namespace
 
 Schedule with_feedback(Schedule s, rig::Feedback f) {
   s.travel.bench.feedback = f;
@@ -236,7 +232,7 @@ ReproductionResult reproduce(const config::ProjectConfig& config, const Reproduc
                        r.experiments_simulated_time_s() +
                        r.linearity_without_cubic.simulated_time_s +
                        r.oracle.experiments_simulated_time_s() + r.measurement.simulated_time_s;
-  r.wall_time_s = std::chrono::duration<double>(std::chrono::steady_clock::now() - start).count();
+  r.wall_time_s = core::seconds_since(start);
   return r;
 }
 

@@ -11,6 +11,8 @@
 
 #include <fmt/core.h>
 
+#include "piezoshift/core/wall_time.hpp"
+
 namespace piezoshift::tolerance {
 
 void run_pool(std::size_t count, unsigned jobs, const std::function<void(std::size_t)>& job,
@@ -38,8 +40,7 @@ void run_pool(std::size_t count, unsigned jobs, const std::function<void(std::si
         first_error = error;
       ++done;
       if (progress)
-        progress(done, count,
-                 std::chrono::duration<double>(std::chrono::steady_clock::now() - start).count());
+        progress(done, count, core::seconds_since(start));
     }
   };
   std::vector<std::thread> threads;

