@@ -391,13 +391,10 @@ int run_fizeau(const Options& o) {
         "--interferometer fizeau with --daq {}: the calibration from fringes runs on the twin's "
         "bench (no --daq); a guided or hardware loop with a camera is not built",
         o.daq));
-  if (o.controller != "paper")
-    throw core::InputError(
-        "--controller improved: the calibration from fringes identifies the paper's controller "
-        "only (the improved controller's identification from fringes is not built)");
   return calibrate_from_fringes_command({.out = o.out,
                                          .config = o.config,
                                          .pid = o.pid,
+                                         .controller = o.controller,
                                          .camera = o.camera,
                                          .surface = o.surface,
                                          .seed = o.seed,

@@ -9,9 +9,10 @@ namespace piezoshift::app {
 
 struct FizeauCalibrateRequest {
   std::string out;
-  std::string config;   //!< "" built-in defaults; else read with its [camera]
-  std::string pid;      //!< paper or search (stage 1, unchanged)
-  std::string camera;   //!< "" or twin; anything else refused
+  std::string config;                //!< "" built-in defaults; else read with its [camera]
+  std::string pid;                   //!< paper or search (stage 1, unchanged)
+  std::string controller = "paper";  //!< or improved: its identification around the stages
+  std::string camera;                //!< "" or twin; anything else refused
   std::string surface;  //!< the twin camera's test surface (`psi simulate`'s spec), "" default
   std::uint64_t seed = 1;
   bool json = false;

@@ -184,79 +184,107 @@ ImprovedCalibrationOutcome calibrate_improved(const config::ProjectConfig& confi
                                               std::uint64_t seed,
                                               const ImprovedCalibrationOptions& options,
                                               const rig::Progress& progress) {
+  CalibrationOutcome xl80;
+  ImprovedCalibrationOutcome out =
+      calibrate_improved(config, base, seed, options, [&](const CalibrationOptions& static_map) {
+        xl80 = calibrate(config, base, seed, static_map, progress);
+        return xl80.controller;
+      });
+  out.static_map = std::move(xl80);
+  return out;
+}
+
+namespace {
+
+// Stage 4: the channel models from an open-loop excitation (the header).
+void identify_channel_models(const config::ProjectConfig& config,
+                             const control::SemiClosedLoopParams& paper, std::uint64_t seed,
+                             const ImprovedCalibrationOptions& options,
+                             ImprovedCalibrationOutcome& out) {
+  rig::Bench bench(config, paper, seed, {rig::Feedback::kGauges, options.paper.limits});
+  const double T = bench.sample_time_s();
+  const auto ticks = static_cast<std::size_t>(std::llround(improved_excitation_duration_s() / T));
+  for (std::size_t k = 0; k < ticks; ++k) {
+    const double u = std::clamp(improved_excitation_um(static_cast<double>(k) * T),
+                                paper.output_min_um, paper.output_max_um);
+    control::Vec3 volts{};
+    for (std::size_t i = 0; i < 3; ++i)
+      volts[i] = paper.scaling[i].um_to_dac(u);
+    bench.drive_open_loop(volts);
+    bench.run(T);
+    const runtime::CycleSample& s = bench.last_cycle();
+    out.record_t_s.push_back(static_cast<double>(k) * T);
+    for (std::size_t i = 0; i < 3; ++i) {
+      out.record_command_um[i].push_back(u);
+      out.record_gauge_um[i].push_back(paper.scaling[i].sgs_to_um(s.ai_V[i]));
+    }
+  }
+  if (bench.faulted())
+    throw rig::ProcedureFailed(
+        fmt::format("improved calibration: the excitation tripped the supervisor ({})",
+                    runtime::to_string(bench.fault().reason)));
+  for (std::size_t i = 0; i < 3; ++i)
+    out.model[i] =
+        fit_hysteresis_creep(out.record_command_um[i], out.record_gauge_um[i], T, options.model);
+}
+
+// Stage 5: the plate's mode, from the interferometer's dynamic samples after a small open-loop
+// step (the gauges' conditioner filters it out; the plate rings). Prony's method on the
+// samples: x_k = a1 x_{k-1} + a2 x_{k-2} + c, a damped cosine's recursion, gives cos(theta)
+// = a1 / (2 sqrt(-a2)) at the interferometer's rate, folded like any sampled mode.
+void identify_mode(const config::ProjectConfig& config, const control::SemiClosedLoopParams& paper,
+                   std::uint64_t seed, const ImprovedCalibrationOptions& options,
+                   ImprovedCalibrationOutcome& out) {
+  rig::Bench bench(config, paper, seed, {rig::Feedback::kGauges, options.paper.limits});
+  const auto volts = [&](double u) {
+    control::Vec3 v{};
+    for (std::size_t i = 0; i < 3; ++i)
+      v[i] = paper.scaling[i].um_to_dac(u);
+    return v;
+  };
+  bench.drive_open_loop(volts(options.mode_step_from_um));
+  bench.run(1.0);
+  bench.drive_open_loop(volts(options.mode_step_from_um + options.mode_step_um));
+  double last_t = -1.0;
+  const double step_t = bench.time_s();
+  bench.run(options.mode_record_s, [&](const rig::Bench& b) {
+    const plant::InterferometerReading& r = b.twin().interferometer();
+    if (r.dynamic_time_s != last_t) {
+      last_t = r.dynamic_time_s;
+      out.mode_record_t_s.push_back(r.dynamic_time_s - step_t);
+      out.mode_record_um.push_back((r.dynamic_um[0] + r.dynamic_um[1] + r.dynamic_um[2]) / 3.0);
+    }
+  });
+  out.mode =
+      identify_plate_mode(out.mode_record_um, config.twin.interferometer.dynamic_sample_rate_Hz);
+}
+
+}  // namespace
+
+ImprovedCalibrationOutcome calibrate_improved(const config::ProjectConfig& config,
+                                              const control::SemiClosedLoopParams& base,
+                                              std::uint64_t seed,
+                                              const ImprovedCalibrationOptions& options,
+                                              const StaticMapStages& static_map) {
   ImprovedCalibrationOutcome out;
   // Stage 0: the gains the static map's stages hold with, chosen before they excite the plant.
   out.holding = holding_gains(config, base, seed + 6, options.holding,
                               "improved calibration, stage 0 (the inner loop)");
-  CalibrationOptions static_map = options.paper;
+  CalibrationOptions stages = options.paper;
   if (out.holding.scale < 1.0)
-    static_map.holding_gains = out.holding.gains;
-  out.static_map = calibrate(config, base, seed, static_map, progress);
-  const control::SemiClosedLoopParams& paper = out.static_map.controller;
-
-  // Stage 4: the channel models from an open-loop excitation.
-  {
-    rig::Bench bench(config, paper, seed + 4, {rig::Feedback::kGauges, options.paper.limits});
-    const double T = bench.sample_time_s();
-    const auto ticks = static_cast<std::size_t>(std::llround(improved_excitation_duration_s() / T));
-    for (std::size_t k = 0; k < ticks; ++k) {
-      const double u = std::clamp(improved_excitation_um(static_cast<double>(k) * T),
-                                  paper.output_min_um, paper.output_max_um);
-      control::Vec3 volts{};
-      for (std::size_t i = 0; i < 3; ++i)
-        volts[i] = paper.scaling[i].um_to_dac(u);
-      bench.drive_open_loop(volts);
-      bench.run(T);
-      const runtime::CycleSample& s = bench.last_cycle();
-      out.record_t_s.push_back(static_cast<double>(k) * T);
-      for (std::size_t i = 0; i < 3; ++i) {
-        out.record_command_um[i].push_back(u);
-        out.record_gauge_um[i].push_back(paper.scaling[i].sgs_to_um(s.ai_V[i]));
-      }
-    }
-    if (bench.faulted())
-      throw rig::ProcedureFailed(
-          fmt::format("improved calibration: the excitation tripped the supervisor ({})",
-                      runtime::to_string(bench.fault().reason)));
-    for (std::size_t i = 0; i < 3; ++i)
-      out.model[i] =
-          fit_hysteresis_creep(out.record_command_um[i], out.record_gauge_um[i], T, options.model);
-  }
-
-  // Stage 5: the plate's mode, from the interferometer's dynamic samples after a small open-loop
-  // step (the gauges' conditioner filters it out; the plate rings). Prony's method on the
-  // samples: x_k = a1 x_{k-1} + a2 x_{k-2} + c, a damped cosine's recursion, gives cos(theta)
-  // = a1 / (2 sqrt(-a2)) at the interferometer's rate, folded like any sampled mode.
-  {
-    rig::Bench bench(config, paper, seed + 5, {rig::Feedback::kGauges, options.paper.limits});
-    const auto volts = [&](double u) {
-      control::Vec3 v{};
-      for (std::size_t i = 0; i < 3; ++i)
-        v[i] = paper.scaling[i].um_to_dac(u);
-      return v;
-    };
-    bench.drive_open_loop(volts(options.mode_step_from_um));
-    bench.run(1.0);
-    bench.drive_open_loop(volts(options.mode_step_from_um + options.mode_step_um));
-    double last_t = -1.0;
-    const double step_t = bench.time_s();
-    bench.run(options.mode_record_s, [&](const rig::Bench& b) {
-      const plant::InterferometerReading& r = b.twin().interferometer();
-      if (r.dynamic_time_s != last_t) {
-        last_t = r.dynamic_time_s;
-        out.mode_record_t_s.push_back(r.dynamic_time_s - step_t);
-        out.mode_record_um.push_back((r.dynamic_um[0] + r.dynamic_um[1] + r.dynamic_um[2]) / 3.0);
-      }
-    });
-    out.mode =
-        identify_plate_mode(out.mode_record_um, config.twin.interferometer.dynamic_sample_rate_Hz);
-  }
-
+    stages.holding_gains = out.holding.gains;
+  const control::SemiClosedLoopParams paper = static_map(stages);
+  identify_channel_models(config, paper, seed + 4, options, out);
+  if (options.dynamic_interferometer)
+    identify_mode(config, paper, seed + 5, options, out);
   const ImprovedDesign design =
       design_improved_controller(config, paper, out.model, out.mode, options);
   out.controller = design.controller;
   out.shaped = design.shaped;
-  out.large_move = try_large_moves(config, out.controller, seed + 7, options);
+  if (options.dynamic_interferometer)
+    out.large_move = try_large_moves(config, out.controller, seed + 7, options);
+  else
+    out.large_move.not_tried = "no laser interferometer: a camera cannot sample the plate's mode";
   return out;
 }
 

@@ -29,9 +29,12 @@ TEST_F(FizeauCalibrateCli, WhatItCannotDoIsRefusedNamingTheOption) {
   const CliResult b = run("calibrate --interferometer fizeau --daq sim" + out);
   EXPECT_EQ(b.status, 2);
   EXPECT_NE(b.err.find("--interferometer fizeau with --daq sim"), std::string::npos) << b.err;
-  const CliResult c = run("calibrate --interferometer fizeau --controller improved" + out);
+  const CliResult c =
+      run("calibrate --interferometer fizeau --controller improved --pid search" + out);
   EXPECT_EQ(c.status, 2);
-  EXPECT_NE(c.err.find("--controller improved"), std::string::npos) << c.err;
+  EXPECT_NE(c.err.find("--pid search: the improved controller has no PID to search"),
+            std::string::npos)
+      << c.err;
   const CliResult d = run("calibrate --camera twin" + out);
   EXPECT_EQ(d.status, 2);
   EXPECT_NE(d.err.find("--camera: the Fizeau's camera, for --interferometer fizeau only"),
@@ -58,6 +61,33 @@ TEST_F(FizeauCalibrateCli, FringesItCannotTrackEndTheRunWithTheReasonAndNoFile) 
   EXPECT_NE(r.err.find("stage 2 (matrix A), actuator 1's scan: frame"), std::string::npos) << r.err;
   EXPECT_NE(r.err.find("no calibration file written"), std::string::npos) << r.err;
   EXPECT_FALSE(std::filesystem::exists(path("c.toml")));
+}
+
+// The improved controller around the stages from fringes (acceptance, 12 s): the file is the
+// improved controller's, with A from the fringes; the JSON says what no camera could identify
+// (no mode nulled, the slew path not tried). Its figures: ImprovedFromFringes (test_instrument).
+TEST_F(FizeauCalibrateCli, TheImprovedControllerIsIdentifiedAroundTheStagesFromFringes) {
+  const std::string file = path("improved.toml");
+  const CliResult r =
+      run("calibrate --interferometer fizeau --controller improved --seed 1 --json --out '" + file +
+          "'");
+  ASSERT_EQ(r.status, 0) << r.err;
+  const nlohmann::json j = nlohmann::json::parse(r.out);
+  EXPECT_EQ(j.at("interferometer"), "fizeau");
+  EXPECT_EQ(j.at("controller"), "improved");
+  EXPECT_EQ(j.at("shaped"), false);
+  EXPECT_EQ(j.at("large_move_trial").at("tried"), false);
+  EXPECT_NE(j.at("large_move_trial").at("not_tried").get<std::string>().find("no laser"),
+            std::string::npos);
+  const piezoshift::control::SemiClosedLoopParams c =
+      piezoshift::calibration::load_calibration_file(file);
+  EXPECT_EQ(c.kind, piezoshift::control::ControllerKind::kImproved);
+  const piezoshift::control::TransmissionMatrix paper{};
+  for (std::size_t i = 0; i < 3; ++i)
+    for (std::size_t k = 0; k < 3; ++k) {
+      EXPECT_NEAR(c.matrix.a[i][k], paper.a[i][k], 0.002);
+      EXPECT_EQ(c.matrix.a[i][k], j.at("A")[i][k].get<double>());
+    }
 }
 
 // The whole command on the default twin, seed 1 (acceptance: 4 scans on 256 px frames).

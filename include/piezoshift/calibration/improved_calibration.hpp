@@ -22,6 +22,7 @@
 //        set by the plate's true mode, which the 1 kHz fold of stage 5 does not give
 //        (docs/control.md, "Large moves")                           seed + 7
 #include <cstdint>
+#include <functional>
 #include <string>
 #include <vector>
 
@@ -62,6 +63,11 @@ struct ImprovedCalibrationOptions {
   double large_move_pre_s = 0.3;
   double large_move_record_s = 0.2;
   double large_move_keep_below_pct = 0.5;
+  //! Stages 5 and 7 read the laser interferometer's dynamic samples (the XL-80's, at the loop's
+  //! rate). false: there is none (the calibration from fringes, issue 29: a camera's 78 frames/s
+  //! cannot sample the plate's kHz mode): no mode nulled (shaped false, the rate limit alone)
+  //! and the slew path as stage 6 designs it, not tried.
+  bool dynamic_interferometer = true;
 };
 
 //! Stage 7's trial: the plate's overshoot of the large move each way, as the interferometer's
@@ -105,6 +111,21 @@ ImprovedCalibrationOutcome calibrate_improved(const config::ProjectConfig& confi
                                               std::uint64_t seed,
                                               const ImprovedCalibrationOptions& options = {},
                                               const rig::Progress& progress = {});
+
+//! Stages 1 to 3 run by the caller: the paper's controller (gains, A, p) calibrated with the
+//! options given (their holding_gains set when stage 0 scaled the paper's), or
+//! rig::ProcedureFailed with the stage's reason.
+using StaticMapStages =
+    std::function<control::SemiClosedLoopParams(const CalibrationOptions& static_map)>;
+
+//! The same with stages 1 to 3 as static_map runs them (the calibration from fringes: the
+//! Fizeau instead of the XL-80, instrument/fringe_calibration.hpp); the outcome's static_map is
+//! then empty, the caller has its own.
+ImprovedCalibrationOutcome calibrate_improved(const config::ProjectConfig& config,
+                                              const control::SemiClosedLoopParams& base,
+                                              std::uint64_t seed,
+                                              const ImprovedCalibrationOptions& options,
+                                              const StaticMapStages& static_map);
 
 //! Stage 6 alone, from the other stages' results however they were obtained (the twin above, or
 //! recorded bench files through `piezoshift fit improved`): paper supplies A, p, the scaling, the
