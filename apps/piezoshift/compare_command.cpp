@@ -109,6 +109,10 @@ std::string summary_tables(const reproduction::ComparisonResult& result) {
       spread.push_back(reproduction::spread_row(result, c));
     out += "\n" + reproduction::text_table(spread);
   }
+  if (result.options.lock)
+    out += fmt::format("\n{}\n{}{}\n", reproduction::hold_title(result),
+                       reproduction::text_table(reproduction::hold_median_table(result)),
+                       reproduction::hold_check_text(result));
   return out;
 }
 
@@ -119,6 +123,8 @@ struct Options {
   bool quick = false;
   bool json = false;
   bool fringes = false;
+  bool lock = false;
+  double lock_hold_s = reproduction::kDefaultHold_s;
   double max_physics_steps = plant::kDefaultPhysicsStepBudget;  // per seed
 };
 
@@ -133,11 +139,18 @@ int run(const Options& o) {
     per_seed_cost.fixed_s += f.fixed_s;
     per_seed_cost.window_s += f.window_s;
   }
+  if (o.lock) {
+    const rig::ProcedureCost h = reproduction::compare_lock_seed_cost(o.lock_hold_s);
+    per_seed_cost.fixed_s += h.fixed_s;
+    per_seed_cost.window_s += h.window_s;
+  }
   check_procedure_cost("compare, one seed", per_seed_cost, config.twin, o.max_physics_steps);
   reproduction::CompareOptions co;
   co.seeds = *parse_seeds(o.seeds);  // checked by the option's validator
   co.quick = o.quick;
   co.fringes = o.fringes;
+  co.lock = o.lock;
+  co.lock_hold_s = o.lock_hold_s;
   work_begins();  // every seed's calibrations and experiments
   reproduction::ComparisonResult result;
   {
@@ -147,8 +160,9 @@ int run(const Options& o) {
     // --seeds 1`: the bar ran [1/31] to [30/31] (the improved controller's 10 kHz calibration
     // showed 2 labels). --fringes adds the calibration from fringes (3 labels) and its
     // experiment set (7; its 10 kHz step shares the set's last label, as the paper's does):
-    // [1/41] to [40/41] on `compare --quick --fringes --seeds 1`.
-    const int per_seed = 2 * 3 + 3 * 7 + 3 + 1 + (co.fringes ? 3 + 7 : 0);
+    // [1/41] to [40/41] on `compare --quick --fringes --seeds 1`. --lock adds one label a hold.
+    const int per_seed = 2 * 3 + 3 * 7 + 3 + 1 + (co.fringes ? 3 + 7 : 0) +
+                         (co.lock ? static_cast<int>(reproduction::kHoldVariants.size()) : 0);
     ProgressBar bar(static_cast<int>(co.seeds.size()) * per_seed);
     result = reproduction::compare(config, co, bar.callback());
   }
@@ -203,6 +217,26 @@ void add_compare_command(CLI::App& app, Action& action) {
                 "a fourth column: the paper's controller calibrated from the Fizeau's fringes, no "
                 "XL-80 (issue 29); costs its calibration (10 to 16 s of wall time a seed) and its "
                 "experiments (about as long as the paper's column)");
+  CLI::Option* lock = cmd->add_flag(
+      "--lock", o->lock,
+      "the Fizeau hold (issue 29): per seed the paper's and the improved controller, "
+      "each unlocked and locked, as `measure --free-run --averages 10 --hold-s H "
+      "[--lock]` on a 96 px twin camera with the cavity's drift in the fringes; a "
+      "table of its own, not a column; costs four holds a seed (5 to 8 s of wall time "
+      "each for 60 s)");
+  cmd->add_option("--lock-hold-s", o->lock_hold_s,
+                  "with --lock: the hold's length in loop time (s, in (0, 3600])")
+      ->capture_default_str()
+      ->check(CLI::Validator(
+          [](std::string& text) -> std::string {
+            double v = 0.0;
+            const auto r = std::from_chars(text.data(), text.data() + text.size(), v);
+            const bool ok =
+                r.ec == std::errc() && r.ptr == text.data() + text.size() && v > 0.0 && v <= 3600.0;
+            return ok ? std::string() : fmt::format("{} is not a hold length in (0, 3600] s", text);
+          },
+          "SECONDS"))
+      ->needs(lock);
   cmd->add_option("--out", o->out,
                   "output folder for comparison.md, comparison.html, figures, CSVs");
   cmd->callback([o, &action] { action = [o] { return run(*o); }; });

@@ -283,6 +283,20 @@ std::vector<FigureValue> ComparisonResult::per_seed(std::size_t fig, LoopVariant
   return out;
 }
 
+std::vector<FigureValue> ComparisonResult::hold_per_seed(HoldVariant v, std::size_t fig) const {
+  std::vector<FigureValue> out;
+  for (const SeedComparison& s : seeds) {
+    const HoldRun& h = s.hold(v);
+    out.push_back(figure(h.*kHoldFigures.at(fig).member, h.validity));
+  }
+  return out;
+}
+
+bool ComparisonResult::hold_target_met() const {
+  const FigureValue& m = hold_medians[static_cast<std::size_t>(HoldVariant::kImprovedLocked)][0];
+  return options.lock && m.measured && m.validity.valid && m.value <= kHoldTarget_nm;
+}
+
 bool ComparisonResult::valid() const {
   return invalid_reasons().empty();
 }
@@ -294,6 +308,14 @@ std::vector<std::string> ComparisonResult::invalid_reasons() const {
       const FigureValue& m = medians[i][static_cast<std::size_t>(k)];
       if (m.measured && !m.validity.valid)
         out.push_back(fmt::format("{}: {}: {}", variant_key(k), figures[i].key, m.validity.reason));
+    }
+  }
+  for (const HoldVariant v : kHoldVariants) {
+    for (std::size_t i = 0; i < kHoldFigures.size(); ++i) {
+      const FigureValue& m = hold_medians[static_cast<std::size_t>(v)][i];
+      if (m.measured && !m.validity.valid)
+        out.push_back(
+            fmt::format("hold_{}: {}: {}", hold_key(v), kHoldFigures[i].key, m.validity.reason));
     }
   }
   return out;
@@ -504,8 +526,23 @@ void calibrate_from_fringes(const config::ProjectConfig& config, std::uint64_t s
 // The variants on one seed: the paper's and the improved controller each calibrated by its own
 // procedure, the oracle feedback on the paper's calibration, and (fringes) the paper's controller
 // calibrated from fringes.
+// The Fizeau's hold of the paper's and the improved controller, unlocked and locked (issue 29,
+// comparison_hold.hpp); one progress label each.
+void run_holds(const config::ProjectConfig& config, const CompareOptions& options,
+               const rig::Progress& progress, SeedComparison& sc) {
+  for (const HoldVariant v : kHoldVariants) {
+    const VariantRun& run = sc[hold_of_improved(v) ? LoopVariant::kImproved : LoopVariant::kPaper];
+    if (progress)
+      progress(0.0, 1.0, fmt::format("seed {} hold: {}", sc.seed, hold_key(v)));
+    sc.holds[static_cast<std::size_t>(v)] = run_hold(config, run.controller, run.calibration,
+                                                     sc.seed, hold_locked(v), options.lock_hold_s);
+  }
+}
+
 SeedComparison compare_seed(const config::ProjectConfig& config, std::uint64_t seed,
-                            const Schedule& s, bool fringes, const rig::Progress& progress) {
+                            const Schedule& s, const CompareOptions& options,
+                            const rig::Progress& progress) {
+  const bool fringes = options.fringes;
   control::SemiClosedLoopParams base{};
   base.sample_time_s = config.twin.daq.sample_time_s;  // as reproduce(): the DAQ's rate
   SeedComparison sc;
@@ -580,6 +617,8 @@ SeedComparison compare_seed(const config::ProjectConfig& config, std::uint64_t s
     run.phase_step_10kHz.validity.fail(unstable);
     run.not_applicable_10kHz = unstable;
   }
+  if (options.lock)
+    run_holds(config, options, progress, sc);
   return sc;
 }
 
@@ -715,6 +754,17 @@ ComparisonResult summarize_comparison(const config::ProjectConfig& config,
     for (LoopVariant k : r.variants())
       m[static_cast<std::size_t>(k)] = median_over_seeds(r.per_seed(i, k), options.seeds);
   }
+  for (auto& per_hold : r.hold_medians)
+    per_hold.fill(not_measured());
+  if (options.lock) {
+    for (const SeedComparison& sc : r.seeds)
+      for (const HoldRun& h : sc.holds)
+        r.simulated_time_s += h.simulated_time_s;
+    for (const HoldVariant v : kHoldVariants)
+      for (std::size_t i = 0; i < kHoldFigures.size(); ++i)
+        r.hold_medians[static_cast<std::size_t>(v)][i] =
+            median_over_seeds(r.hold_per_seed(v, i), options.seeds);
+  }
   r.targets = comparison_targets(config, r);
   if (options.fringes)
     r.fringes_within_spread = fringes_within_spread(r);
@@ -725,11 +775,13 @@ ComparisonResult compare(const config::ProjectConfig& config, const CompareOptio
                          const rig::Progress& progress) {
   if (options.seeds.empty())
     throw std::invalid_argument("compare: no seed");
+  if (options.lock && !(options.lock_hold_s > 0.0 && options.lock_hold_s <= 3600.0))
+    throw std::invalid_argument("compare: the hold's length is not in (0, 3600] s");
   const auto start = std::chrono::steady_clock::now();
   const Schedule schedule = options.quick ? Schedule::quick() : Schedule::paper();
   std::vector<SeedComparison> seeds;
   for (const std::uint64_t seed : options.seeds)
-    seeds.push_back(compare_seed(config, seed, schedule, options.fringes, progress));
+    seeds.push_back(compare_seed(config, seed, schedule, options, progress));
   ComparisonResult r = summarize_comparison(config, options, std::move(seeds));
   r.wall_time_s = core::seconds_since(start);
   return r;

@@ -2,6 +2,7 @@
 
 #include <algorithm>
 #include <cmath>
+#include <functional>
 #include <system_error>
 
 #include <fmt/core.h>
@@ -20,6 +21,10 @@ namespace fs = std::filesystem;
 
 std::size_t idx(LoopVariant k) {
   return static_cast<std::size_t>(k);
+}
+
+std::size_t idx(HoldVariant v) {
+  return static_cast<std::size_t>(v);
 }
 
 // JSON has no infinity, no "not valid" and no "not applicable": all are null, the reason beside
@@ -46,6 +51,44 @@ void prefixed(nlohmann::json& j, const ComparisonResult& r, LoopVariant k, Value
   }
   j[prefix + "not_valid"] = not_valid;
   j[prefix + "not_applicable"] = not_applicable;
+}
+
+// compare --lock's medians: hold_<variant>_<figure>, null and the reason in hold_not_valid when
+// not valid; issue 29's check.
+void hold_json(nlohmann::json& j, const ComparisonResult& r) {
+  nlohmann::json not_valid = nlohmann::json::object();
+  for (const HoldVariant v : kHoldVariants)
+    for (std::size_t i = 0; i < kHoldFigures.size(); ++i) {
+      const std::string key = fmt::format("{}_{}", hold_key(v), kHoldFigures[i].key);
+      const FigureValue& m = r.hold_medians[idx(v)][i];
+      j["hold_" + key] = number_or_null(m);
+      if (!m.validity.valid)
+        not_valid[key] = m.validity.reason;
+    }
+  j["hold_not_valid"] = std::move(not_valid);
+  j["hold_s"] = r.options.lock_hold_s;
+  j["hold_target_nm"] = kHoldTarget_nm;
+  j["hold_improved_locked_within_target"] = r.hold_target_met();
+}
+
+void hold_seed_json(nlohmann::json& o, const SeedComparison& sc) {
+  nlohmann::json not_valid = nlohmann::json::object();
+  double wall_s = 0.0;
+  for (const HoldVariant v : kHoldVariants) {
+    const HoldRun& h = sc.hold(v);
+    for (const HoldFigure& f : kHoldFigures) {
+      FigureValue x;
+      x.validity = h.validity;
+      x.value = h.*f.member;
+      o[fmt::format("hold_{}_{}", hold_key(v), f.key)] = number_or_null(x);
+    }
+    o[fmt::format("hold_{}_frames", hold_key(v))] = h.frames;
+    if (!h.validity.valid)
+      not_valid[hold_key(v)] = h.validity.reason;
+    wall_s += h.wall_time_s;
+  }
+  o["hold_not_valid"] = std::move(not_valid);
+  o["hold_wall_s"] = wall_s;
 }
 
 // As reproduce's report prints it (figure_format.hpp).
@@ -332,7 +375,79 @@ std::vector<std::string> spread_row(const ComparisonResult& r, const SpreadCheck
           c.within ? "yes" : "no"};
 }
 
+std::string hold_title(const ComparisonResult& r) {
+  return fmt::format("The Fizeau hold, {:g} s, cavity drift in the fringes", r.options.lock_hold_s);
+}
+
 namespace {
+
+// A row per controller, a column per hold figure unlocked and locked; value(v, i) is the cell.
+std::vector<std::vector<std::string>> hold_table(
+    const std::function<FigureValue(HoldVariant, std::size_t)>& value, const std::string& first) {
+  std::vector<std::string> header{first};
+  for (const HoldFigure& f : kHoldFigures)
+    for (const char* how : {"unlocked", "locked"})
+      header.push_back(fmt::format("{}, {}", f.label, how));
+  std::vector<std::vector<std::string>> rows{std::move(header)};
+  for (const bool improved : {false, true}) {
+    std::vector<std::string> row{improved ? "improved controller" : "paper's controller"};
+    for (std::size_t i = 0; i < kHoldFigures.size(); ++i)
+      for (const bool locked : {false, true}) {
+        const HoldVariant v = static_cast<HoldVariant>((improved ? 2 : 0) + (locked ? 1 : 0));
+        const FigureValue f = value(v, i);
+        row.push_back(f.validity.valid ? format_figure(f.value, "nm", 0.001) : "NOT VALID");
+      }
+    rows.push_back(std::move(row));
+  }
+  return rows;
+}
+
+}  // namespace
+
+std::vector<std::vector<std::string>> hold_median_table(const ComparisonResult& r) {
+  return hold_table(
+      [&r](HoldVariant v, std::size_t i) { return r.hold_medians[static_cast<std::size_t>(v)][i]; },
+      "median over seeds");
+}
+
+std::string hold_check_text(const ComparisonResult& r) {
+  const FigureValue& m = r.hold_medians[static_cast<std::size_t>(HoldVariant::kImprovedLocked)][0];
+  return fmt::format(
+      "Issue 29: the improved controller's locked hold, median {} RMS from the set point, "
+      "≤ {:g} nm: {}",
+      m.validity.valid ? format_figure(m.value, "nm", 0.001) : "NOT VALID", kHoldTarget_nm,
+      r.hold_target_met() ? "yes" : "no");
+}
+
+namespace {
+
+// compare --lock: the holds' medians, issue 29's check, and the holds seed by seed.
+void hold_section(Document& doc, const ComparisonResult& r) {
+  doc.heading(2, hold_title(r));
+  doc.paragraph(fmt::format(
+      "Per seed, `measure --free-run --averages {} --hold-s {:g} [--lock] --seed s` on the twin "
+      "camera (96 px) with the cavity's drift in the fringes, each controller as its column "
+      "calibrated it: the cavity's optical path from its set point over the hold's exposures "
+      "(twin truth), RMS, and the RMS of its means over whole seconds.",
+      kHoldAverages, r.options.lock_hold_s));
+  doc.table(hold_median_table(r));
+  doc.paragraph(hold_check_text(r) + ". Reported, not one of issue 12's targets.");
+  for (const SeedComparison& sc : r.seeds) {
+    doc.table(hold_table(
+        [&sc](HoldVariant v, std::size_t i) {
+          const HoldRun& h = sc.hold(v);
+          FigureValue f;
+          f.validity = h.validity;
+          f.value = h.*kHoldFigures[i].member;
+          return f;
+        },
+        fmt::format("seed {}", sc.seed)));
+    for (const HoldVariant v : kHoldVariants)
+      if (!sc.hold(v).validity.valid)
+        doc.paragraph(fmt::format("Seed {}, {}: not valid: {}", sc.seed, hold_key(v),
+                                  sc.hold(v).validity.reason));
+  }
+}
 
 void medians_section(Document& doc, const ComparisonResult& r) {
   doc.heading(2, "Medians over the seeds");
@@ -448,9 +563,13 @@ nlohmann::json comparison_json(const ComparisonResult& r) {
     if (r.options.fringes)
       o["paper_fringes_calibration_wall_s"] =
           r.seeds[s][LoopVariant::kPaperFringes].calibration_wall_time_s;
+    if (r.options.lock)
+      hold_seed_json(o, r.seeds[s]);
     per.push_back(std::move(o));
   }
   j["per_seed"] = std::move(per);
+  if (r.options.lock)
+    hold_json(j, r);
   nlohmann::json targets = nlohmann::json::array();
   for (const Target& t : r.targets) {
     nlohmann::json x{{"target", t.text}, {"bound", t.bound_text}};
@@ -497,6 +616,8 @@ ReportFiles write_comparison_report(const ComparisonResult& r, const fs::path& d
   Document doc;
   introduction(doc, r, config_label);
   medians_section(doc, r);
+  if (r.options.lock)
+    hold_section(doc, r);
   targets_section(doc, r);
   figures_section(doc, r, drawn);
   per_seed_section(doc, r, files);

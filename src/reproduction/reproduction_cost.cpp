@@ -14,4 +14,11 @@ rig::ProcedureCost compare_fringes_seed_cost(bool quick) {
   return quick ? rig::ProcedureCost{1174.80, 486.0} : rig::ProcedureCost{1722.80, 488.0};
 }
 
+rig::ProcedureCost compare_lock_seed_cost(double hold_s) {
+  // The ten measurements' loop time before each hold, and the ramp: 1.75 s (seed 1, quick and
+  // 5 or 60 s holds: compare's simulated time 27.0 and 247.0 s more with --lock).
+  constexpr double kBeforeTheHold_s = 1.75;
+  return rig::ProcedureCost{4.0 * (kBeforeTheHold_s + hold_s), 0.0};
+}
+
 }  // namespace piezoshift::reproduction

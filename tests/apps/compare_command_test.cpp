@@ -66,6 +66,28 @@ TEST_F(CompareCommand, TheBudgetCountsTheFringeColumn) {
   EXPECT_NE(on.err.find("(6.68e+03 s of simulated time"), std::string::npos) << on.err;
 }
 
+// compare --lock (issue 29): the hold's length is checked before anything runs, named, and only
+// with --lock; the budget counts four holds a seed of 1.75 s (the measurements before the hold)
+// plus the hold: 5016 + 4 x 61.75 s with the default minute, 5016 + 4 x 6.75 s with 5 s.
+TEST_F(CompareCommand, TheLockHoldIsCheckedAndCountedInTheBudget) {
+  for (const char* bad : {"0", "-1", "3601", "nan", "x"}) {
+    const testing::CliResult r =
+        run(std::string("compare --quick --seeds 1 --lock --lock-hold-s ") + bad);
+    EXPECT_EQ(r.status, 2) << bad;
+    EXPECT_NE(r.err.find("--lock-hold-s"), std::string::npos) << bad << ": " << r.err;
+  }
+  const testing::CliResult alone = run("compare --quick --seeds 1 --lock-hold-s 5");
+  EXPECT_EQ(alone.status, 2);
+  EXPECT_NE(alone.err.find("--lock"), std::string::npos) << alone.err;
+  const testing::CliResult minute = run("compare --quick --lock --seeds 1 --max-physics-steps 1");
+  const testing::CliResult five =
+      run("compare --quick --lock --lock-hold-s 5 --seeds 1 --max-physics-steps 1");
+  EXPECT_EQ(minute.status, 2);
+  EXPECT_EQ(five.status, 2);
+  EXPECT_NE(minute.err.find("(5.26e+03 s of simulated time"), std::string::npos) << minute.err;
+  EXPECT_NE(five.err.find("(5.04e+03 s of simulated time"), std::string::npos) << five.err;
+}
+
 // Issue 31: configs/plants/, twins not used in development. A quick compare on each exits 0:
 // every figure of every controller valid, except that the paper's 10 kHz figures may be not
 // applicable, and then only with compare's ring test's reason (docs/compare.md). Not yet

@@ -309,6 +309,63 @@ TEST(ComparisonSummary, TheFringeMedianIsJudgedAgainstTheXl80ColumnsSeedSpread) 
   EXPECT_EQ(spread_row(r, settling).back(), "yes");
 }
 
+// --lock (issue 29): off, no hold key in the JSON and every hold median not measured; on, the
+// medians over seeds of each hold, a hold that failed named (exit 4), issue 29's check on the
+// improved controller's locked median, and the report's section.
+TEST(ComparisonSummary, TheHoldsAreReportedOnlyWhenAskedForAndAFailureIsNamed) {
+  const ComparisonResult off = nothing_calibrated();
+  for (const auto& per_hold : off.hold_medians)
+    for (const FigureValue& m : per_hold)
+      EXPECT_FALSE(m.measured);
+  const nlohmann::json j_off = comparison_json(off);
+  for (const nlohmann::json* o : {&j_off, &j_off["per_seed"][0]})
+    for (const auto& [key, value] : o->items())
+      EXPECT_NE(key.rfind("hold_", 0), 0U) << key;  // phase_step_hold_jitter is not a hold
+
+  CompareOptions o = off.options;
+  o.lock = true;
+  o.lock_hold_s = 30.0;
+  std::vector<SeedComparison> seeds = off.seeds;
+  const double rms[2][4] = {{2.5, 0.55, 1.3, 0.17}, {2.1, 0.53, 1.1, 0.19}};
+  for (std::size_t s = 0; s < 2; ++s)
+    for (std::size_t v = 0; v < 4; ++v) {
+      seeds[s].holds[v].path_error_rms_nm = rms[s][v];
+      seeds[s].holds[v].path_error_1s_means_rms_nm = 0.1 * rms[s][v];
+    }
+  const ComparisonResult on = summarize_comparison(config::ProjectConfig{}, o, seeds);
+  const auto median = [&](const ComparisonResult& r, HoldVariant v, std::size_t i) {
+    return r.hold_medians[static_cast<std::size_t>(v)][i];
+  };
+  EXPECT_DOUBLE_EQ(median(on, HoldVariant::kPaperUnlocked, 0).value, 2.3);
+  EXPECT_DOUBLE_EQ(median(on, HoldVariant::kImprovedLocked, 0).value, 0.18);
+  EXPECT_DOUBLE_EQ(median(on, HoldVariant::kImprovedLocked, 1).value, 0.018);
+  EXPECT_TRUE(on.hold_target_met());  // 0.18 <= 0.2 nm
+  const nlohmann::json j = comparison_json(on);
+  EXPECT_DOUBLE_EQ(j["hold_improved_locked_path_error_rms_nm"].get<double>(), 0.18);
+  EXPECT_DOUBLE_EQ(j["per_seed"][1]["hold_paper_locked_path_error_rms_nm"].get<double>(), 0.53);
+  EXPECT_EQ(j["hold_s"], 30.0);
+  EXPECT_EQ(j["hold_improved_locked_within_target"], true);
+  EXPECT_TRUE(j["hold_not_valid"].empty());
+  EXPECT_EQ(hold_check_text(on),
+            "Issue 29: the improved controller's locked hold, median 0.180 nm RMS from the set "
+            "point, ≤ 0.2 nm: yes");
+
+  seeds[1].holds[static_cast<std::size_t>(HoldVariant::kImprovedLocked)].validity.fail(
+      "a frame lost: made up");
+  const ComparisonResult failed = summarize_comparison(config::ProjectConfig{}, o, seeds);
+  EXPECT_FALSE(median(failed, HoldVariant::kImprovedLocked, 0).validity.valid);
+  EXPECT_FALSE(failed.hold_target_met());
+  bool named = false;
+  for (const std::string& why : failed.invalid_reasons())
+    named =
+        named || why == "hold_improved_locked: path_error_rms_nm: seed 9: a frame lost: made up";
+  EXPECT_TRUE(named);
+  const nlohmann::json jf = comparison_json(failed);
+  EXPECT_TRUE(jf["hold_improved_locked_path_error_rms_nm"].is_null());
+  EXPECT_EQ(jf["per_seed"][1]["hold_not_valid"]["improved_locked"], "a frame lost: made up");
+  EXPECT_EQ(hold_median_table(failed).back().at(2), "NOT VALID");
+}
+
 TEST(ComparisonSummary, OneSeedPerSeedOfTheOptionsOrItIsRefused) {
   CompareOptions o;
   o.seeds = {1, 2};

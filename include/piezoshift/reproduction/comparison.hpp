@@ -20,6 +20,9 @@
 //             default surface, stage 1 scoring the paper's gains alone), then everything the
 //             paper's variant runs, by the same rules; its simulated time includes the
 //             calibration's. Reported beside the others, never targeted.
+//   the hold  (opt-in, CompareOptions::lock; issue 29) the Fizeau's hold on the twin camera with
+//             the cavity's drift in the fringes, the paper's and the improved controller each
+//             unlocked and locked (comparison_hold.hpp): beside the columns, not one of them.
 // so a figure of the paper's controller on seed s is bit for bit reproduce()'s on seed s.
 //
 // Every figure (travel, the 11 um step, the three linearity sweeps, repeatability at 5 and 10 um,
@@ -42,6 +45,7 @@
 #include <string>
 #include <vector>
 
+#include "piezoshift/reproduction/comparison_hold.hpp"
 #include "piezoshift/reproduction/reproduction.hpp"
 
 namespace piezoshift::reproduction {
@@ -52,6 +56,10 @@ struct CompareOptions {
   //! A fourth column: the paper's controller calibrated from the Fizeau's fringes (issue 29).
   //! Off: nothing of it is run or reported, the output is the three columns' bit for bit.
   bool fringes = false;
+  //! The Fizeau's hold, unlocked and locked, of the paper's and the improved controller (issue
+  //! 29, comparison_hold.hpp). Off: nothing of it is run or reported.
+  bool lock = false;
+  double lock_hold_s = kDefaultHold_s;  //!< the hold's length [s], in (0, 3600]
 };
 
 //! What closes the loop in one column of the comparison: a controller and its feedback.
@@ -108,7 +116,10 @@ struct SeedComparison {
   std::uint64_t seed = 0;
   //! Indexed by LoopVariant; kPaperFringes default-constructed (nothing ran) unless asked for.
   std::array<VariantRun, kVariantCount> runs;
+  //! Indexed by HoldVariant; with CompareOptions::lock only (else nothing ran).
+  std::array<HoldRun, kHoldVariants.size()> holds;
   const VariantRun& operator[](LoopVariant k) const { return runs[static_cast<std::size_t>(k)]; }
+  const HoldRun& hold(HoldVariant v) const { return holds[static_cast<std::size_t>(v)]; }
 };
 
 //! One figure of one run: a number (infinite for a time that never came: not settled), or not
@@ -185,6 +196,8 @@ struct ComparisonResult {
   std::vector<Target> targets;
   //! With options.fringes: one per Table 4 figure (kTable4Figures).
   std::vector<SpreadCheck> fringes_within_spread;
+  //! With options.lock: [HoldVariant][kHoldFigures] the median over seeds (not measured without).
+  std::array<std::array<FigureValue, kHoldFigures.size()>, kHoldVariants.size()> hold_medians;
   double simulated_time_s = 0.0;
   double wall_time_s = 0.0;
 
@@ -192,9 +205,15 @@ struct ComparisonResult {
   std::vector<LoopVariant> variants() const { return loop_variants(options); }
   //! The per-seed values of one figure of one variant.
   std::vector<FigureValue> per_seed(std::size_t figure, LoopVariant k) const;
-  //! Every measured median of every variant valid.
+  //! The per-seed values of one hold figure (kHoldFigures) of one hold.
+  std::vector<FigureValue> hold_per_seed(HoldVariant v, std::size_t figure) const;
+  //! Issue 29's check: the improved controller's locked hold, median RMS, within kHoldTarget_nm
+  //! (false without options.lock or when that median is not a number). Reported, not a target.
+  bool hold_target_met() const;
+  //! Every measured median of every variant valid (and of every hold, with options.lock).
   bool valid() const;
-  //! "variant: figure: reason" (variant_key) for every median that is not valid.
+  //! "variant: figure: reason" (variant_key; "hold_<hold_key>" for a hold) for every median that
+  //! is not valid.
   std::vector<std::string> invalid_reasons() const;
   //! The same for every median that is not applicable (these leave valid() true).
   std::vector<std::string> not_applicable_reasons() const;

@@ -4,7 +4,10 @@
 //                       --fringes paper_fringes_) with the unit last (null: a time that never
 //                       came, or a figure not valid; the reason is in <prefix>not_valid), the
 //                       targets, and per_seed: one object per seed with the same prefixed keys;
-//                       with --fringes also paper_fringes_within_xl80_spread (SpreadCheck)
+//                       with --fringes also paper_fringes_within_xl80_spread (SpreadCheck);
+//                       with --lock hold_<paper|improved>_<unlocked|locked>_<figure> medians,
+//                       hold_not_valid, hold_s, hold_improved_locked_within_target, and per
+//                       seed the same keys with hold_<...>_frames and hold_wall_s
 //   write_comparison_report(dir)
 //     comparison.md, comparison.html   the three (four) columns, the targets, the figures
 //     compare_step_response.png        the 11 um steps overlaid (first seed)
@@ -30,6 +33,14 @@ nlohmann::json comparison_json(const ComparisonResult& r);
 //! One row of the report's table of SpreadChecks: the figure, the fringe column's median, the
 //! XL-80 column's spread, "yes" / "no" / "not judged: why". compare's terminal prints it too.
 std::vector<std::string> spread_row(const ComparisonResult& r, const SpreadCheck& c);
+
+//! compare --lock: "The Fizeau hold, 60 s, cavity drift in the fringes".
+std::string hold_title(const ComparisonResult& r);
+//! compare --lock: the holds' medians, a row per controller, a column per figure unlocked and
+//! locked ("NOT VALID" for a median that is not; the reasons are invalid_reasons()'s).
+std::vector<std::vector<std::string>> hold_median_table(const ComparisonResult& r);
+//! compare --lock: issue 29's check on the improved controller's locked median, one line.
+std::string hold_check_text(const ComparisonResult& r);
 
 //! config_label says where the configuration came from (a path, or the built-in defaults).
 ReportFiles write_comparison_report(const ComparisonResult& r, const std::filesystem::path& dir,

@@ -1,0 +1,77 @@
+#include "piezoshift/instrument/twin_hold.hpp"
+
+#include <memory>
+#include <optional>
+#include <string>
+#include <utility>
+
+#include "piezoshift/camera/make_camera.hpp"
+#include "piezoshift/camera/twin_camera.hpp"
+#include "piezoshift/core/input_error.hpp"
+#include "piezoshift/instrument/acquisition.hpp"
+#include "piezoshift/instrument/measurement_lock.hpp"
+#include "piezoshift/runtime/loop_clock.hpp"
+#include "piezoshift/runtime/safety_supervisor.hpp"
+#include "piezoshift/runtime/sim_backend.hpp"
+
+namespace piezoshift::instrument {
+namespace {
+
+// measure's defaults (apps/piezoshift/measure_command.cpp): the HeNe line, hariharan5.
+constexpr double kWavelength_nm = 632.8;
+
+SequenceParams hold_sequence(const TwinHoldOptions& o) {
+  SequenceParams p;
+  p.steps_rad = commanded_steps(psi::Algorithm::kHariharan5, {}, "--steps-rad");
+  p.wavelength_nm = kWavelength_nm;
+  p.averages = o.averages;
+  p.hold_s = o.hold_s;
+  if (const std::string why = sequence_problem(p); !why.empty())
+    throw core::InputError("twin hold: " + why);
+  return p;
+}
+
+}  // namespace
+
+TwinHold twin_hold(const camera::InstrumentConfig& config,
+                   const calibration::LoopCalibration& calibration, const TwinHoldOptions& o) {
+  SequenceParams params = hold_sequence(o);
+  const camera::TwinScene scene = camera::make_twin_scene(
+      psi::SurfaceSpec{},
+      camera::measurement_optics(config.camera.settings, config.camera.pupil_radius_m,
+                                 kWavelength_nm),
+      o.seed);
+  const config::ProjectConfig& project = config.installation.project;
+  runtime::SimOptions so;
+  so.design = project.design;
+  so.twin = project.twin;
+  so.seed = o.seed;
+  so.rate_Hz = o.rate_Hz;
+  runtime::SimBackend sim(so);
+  sim.configure();
+  runtime::SimulatedClock clock;
+  if (const std::optional<std::string> who = lock_requested_by(o.lock, "--lock", calibration))
+    params.lock =
+        measurement_lock_setup(scene.mask, config.camera.pupil_radius_m, project.twin.geometry,
+                               calibration, LockSetup{}.retake_s, params, *who);
+  if (const std::string why =
+          travel_problem(params, calibration.travel_z_max_um, calibration.source);
+      !why.empty())
+    throw core::InputError("twin hold: " + why);
+  LoopSetup loop;
+  loop.controller = calibration.params;
+  loop.limits = config.installation.safety;
+  // A late host does not hurt a simulated stage (measure's resolve_overrun_trip on the twin).
+  if (loop.limits.trip_on_overruns == runtime::kOverrunTripOnHardware)
+    loop.limits.trip_on_overruns = runtime::kOverrunTripNever;
+  loop.rate_Hz = o.rate_Hz;
+  std::unique_ptr<camera::Camera> cam = camera::make_camera("twin", config.camera, &scene);
+  cam->start();
+  TwinHold out;
+  out.sequence = acquire_sequence(sim, clock, &sim.twin(), *cam, loop, params);
+  cam->stop();
+  out.summary = hold_summary(out.sequence);
+  return out;
+}
+
+}  // namespace piezoshift::instrument
