@@ -276,6 +276,13 @@ FigureValue median_over_seeds(const std::vector<FigureValue>& per_seed,
   return m;
 }
 
+std::size_t ComparisonResult::figure_index(const std::string& key) const {
+  for (std::size_t i = 0; i < figures.size(); ++i)
+    if (figures[i].key == key)
+      return i;
+  return figures.size();
+}
+
 std::vector<FigureValue> ComparisonResult::per_seed(std::size_t fig, LoopVariant k) const {
   std::vector<FigureValue> out;
   for (const SeedComparison& s : seeds)
@@ -626,12 +633,6 @@ SeedComparison compare_seed(const config::ProjectConfig& config, std::uint64_t s
 // oracle's median, then travel and the margins at the config's loop rates.
 std::vector<Target> comparison_targets(const config::ProjectConfig& config,
                                        const ComparisonResult& r) {
-  const auto index_of = [&](const std::string& key) -> std::size_t {
-    for (std::size_t i = 0; i < r.figures.size(); ++i)
-      if (r.figures[i].key == key)
-        return i;
-    return r.figures.size();
-  };
   std::vector<Target> t{
       target("11 µm step settles to ±10 nm", "step_settling_time_10nm_s", 10e-3, false, "≤ 10 ms"),
       target("λ/8 step settles to ±1 nm (1 ms means), 1 kHz", "phase_step_settling_time_s", 5e-3,
@@ -657,7 +658,7 @@ std::vector<Target> comparison_targets(const config::ProjectConfig& config,
         Relative{"repeatability at 5 µm, vs the oracle", "repeatability_5um_nm"},
         Relative{"repeatability at 10 µm, vs the oracle", "repeatability_10um_nm"}}) {
     Target x = target(rel.text, rel.key, 0.0, false, "");
-    const std::size_t i = index_of(rel.key);
+    const std::size_t i = r.figure_index(rel.key);
     const FigureValue& o = r.medians.at(i)[static_cast<std::size_t>(LoopVariant::kOracleFeedback)];
     x.not_applicable = rel.not_applicable;
     if (!x.not_applicable.empty()) {
@@ -682,7 +683,7 @@ std::vector<Target> comparison_targets(const config::ProjectConfig& config,
                        45.0, true, "≥ 45°"));
   }
   for (Target& x : t) {
-    const std::size_t i = index_of(x.key);
+    const std::size_t i = r.figure_index(x.key);
     if (x.key.empty() || i == r.figures.size()) {
       x.improved.measured = false;  // compare does not measure it (yet)
       continue;

@@ -19,6 +19,7 @@
 #include "piezoshift/reproduction/paper_bands.hpp"
 #include "piezoshift/reproduction/reproduction.hpp"
 #include "scripted_camera.hpp"
+#include "twin_bench_camera.hpp"
 
 namespace piezoshift::instrument {
 namespace {
@@ -108,18 +109,12 @@ double truth_rms_nm(const FringeCalibrationOutcome& f) {
 }
 
 std::optional<SeedFigures> one_seed(const Plant& pl, std::uint64_t seed) {
-  camera::CameraSettings settings;
-  settings.width_px = settings.height_px = 256;
-  const camera::TwinScene scene = camera::make_twin_scene(
-      psi::SurfaceSpec{},
-      camera::measurement_optics(settings, camera::CameraConfig{}.pupil_radius_m, 632.8), seed);
-  camera::TwinCamera cam(scene, psi::CameraParams{});
-  cam.configure(settings);
-  const FringeOptics optics = twin_optics(scene);
+  TwinBenchCamera bench(seed);
+  const FringeOptics optics = twin_optics(bench.scene);
   control::SemiClosedLoopParams base;
   base.sample_time_s = pl.config.twin.daq.sample_time_s;
   const FringeCalibrationOutcome f =
-      calibrate_from_fringes(pl.config, base, seed, cam, optics, paper_gains());
+      calibrate_from_fringes(pl.config, base, seed, bench.cam, optics, paper_gains());
   if (!f.validity.valid) {
     ADD_FAILURE() << pl.name << ", seed " << seed << ": " << f.validity.reason;
     return std::nullopt;

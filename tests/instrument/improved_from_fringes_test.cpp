@@ -9,12 +9,11 @@
 #include <cstdio>
 
 #include "piezoshift/calibration/improved_calibration.hpp"
-#include "piezoshift/camera/camera_config.hpp"
-#include "piezoshift/camera/twin_camera.hpp"
 #include "piezoshift/config/project_config.hpp"
 #include "piezoshift/experiments/paper_experiments.hpp"
 #include "piezoshift/experiments/phase_step.hpp"
 #include "piezoshift/instrument/fringe_calibration.hpp"
+#include "twin_bench_camera.hpp"
 
 namespace piezoshift::instrument {
 namespace {
@@ -22,13 +21,7 @@ namespace {
 TEST(ImprovedFromFringes, ItHoldsAndStepsAsTheXl80sIdentificationDoesBarTheModeItCannotSee) {
   const config::ProjectConfig config;
   const std::uint64_t seed = 1;
-  camera::CameraSettings settings;
-  settings.width_px = settings.height_px = 256;
-  const camera::TwinScene scene = camera::make_twin_scene(
-      psi::SurfaceSpec{},
-      camera::measurement_optics(settings, camera::CameraConfig{}.pupil_radius_m, 632.8), seed);
-  camera::TwinCamera cam(scene, psi::CameraParams{});
-  cam.configure(settings);
+  TwinBenchCamera bench(seed);
   control::SemiClosedLoopParams base;
   base.sample_time_s = config.twin.daq.sample_time_s;
   calibration::ImprovedCalibrationOptions io;
@@ -41,7 +34,7 @@ TEST(ImprovedFromFringes, ItHoldsAndStepsAsTheXl80sIdentificationDoesBarTheModeI
       config, base, seed, io, [&](const calibration::CalibrationOptions& stages) {
         FringeCalibrationOptions o;
         o.stages = stages;
-        f = calibrate_from_fringes(config, base, seed, cam, twin_optics(scene), o);
+        f = calibrate_from_fringes(config, base, seed, bench.cam, twin_optics(bench.scene), o);
         if (!f.validity.valid)
           throw rig::ProcedureFailed(f.validity.reason);
         return f.controller;

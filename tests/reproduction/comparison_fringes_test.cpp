@@ -55,11 +55,9 @@ TEST(ComparisonFringes, CostEstimateIsWhatOneSeedCost) {
 }
 
 std::size_t figure_index(const ComparisonResult& r, const std::string& key) {
-  for (std::size_t i = 0; i < r.figures.size(); ++i)
-    if (r.figures[i].key == key)
-      return i;
-  ADD_FAILURE() << "no figure " << key;
-  return 0;
+  const std::size_t i = r.figure_index(key);
+  EXPECT_LT(i, r.figures.size()) << "no figure " << key;
+  return i < r.figures.size() ? i : 0;
 }
 
 // Table 4's figures of the fringe column, to the last digit, are those of the fringe-calibrated

@@ -14,13 +14,17 @@
 namespace piezoshift::runtime {
 namespace {
 
+int first_cpu(const cpu_set_t& set) {
+  for (int c = 0; c < CPU_SETSIZE; ++c)
+    if (CPU_ISSET(c, &set))
+      return c;
+  return -1;
+}
+
 TEST(KeepOffCpu, TheThreadLeavesThatCpuAndKeepsTheOthers) {
   cpu_set_t mine;
   ASSERT_EQ(::pthread_getaffinity_np(::pthread_self(), sizeof(mine), &mine), 0);
-  int first = -1;
-  for (int c = 0; c < CPU_SETSIZE && first < 0; ++c)
-    if (CPU_ISSET(c, &mine))
-      first = c;
+  const int first = first_cpu(mine);
   std::atomic<bool> stop{false};
   std::thread worker([&] {
     while (!stop.load())
@@ -52,10 +56,7 @@ TEST(LeaveLoopScheduling, AWorkerTheLoopStartsLeavesItsCpuForTheOthers) {
   const long online = ::sysconf(_SC_NPROCESSORS_ONLN);
   cpu_set_t mine;
   ASSERT_EQ(::pthread_getaffinity_np(::pthread_self(), sizeof(mine), &mine), 0);
-  int first = -1;
-  for (int c = 0; c < CPU_SETSIZE && first < 0; ++c)
-    if (CPU_ISSET(c, &mine))
-      first = c;
+  const int first = first_cpu(mine);
   bool left = false;
   int policy = -1;
   cpu_set_t worker_cpus;

@@ -203,6 +203,8 @@ struct ComparisonResult {
 
   //! loop_variants(options).
   std::vector<LoopVariant> variants() const { return loop_variants(options); }
+  //! The index in figures of the figure with this key (figures.size() when none has it).
+  std::size_t figure_index(const std::string& key) const;
   //! The per-seed values of one figure of one variant.
   std::vector<FigureValue> per_seed(std::size_t figure, LoopVariant k) const;
   //! The per-seed values of one hold figure (kHoldFigures) of one hold.
