@@ -172,8 +172,8 @@ class GuidedRigs {
     lo.stop_signal = &g_stop_signal;
     loop_rig_ = std::make_unique<rig::LoopRig>(
         stack_->daq(), stack_->clock(), stack_->paced(), base,
-        resolve_overrun_trip(loop_safety_limits(installation.safety, std::nullopt),
-                             stack_->sim() != nullptr),
+        runtime::resolve_overrun_trip(loop_safety_limits(installation.safety, std::nullopt),
+                                      stack_->sim() != nullptr),
         lo);
     for (const std::string& refusal : loop_rig_->realtime().refusals)
       fmt::print(stderr, "piezoshift: warning: the loop runs without real-time treatment: {}\n",

@@ -132,25 +132,15 @@ int run(const Options& o) {
   const config::ProjectConfig config = o.config.empty()
                                            ? config::ProjectConfig{}
                                            : runtime::load_installation_config(o.config).project;
-  // Per seed: the seeds run one after another, each a whole comparison of its own.
-  rig::ProcedureCost per_seed_cost = reproduction::compare_seed_cost(o.quick);
-  if (o.fringes) {
-    const rig::ProcedureCost f = reproduction::compare_fringes_seed_cost(o.quick);
-    per_seed_cost.fixed_s += f.fixed_s;
-    per_seed_cost.window_s += f.window_s;
-  }
-  if (o.lock) {
-    const rig::ProcedureCost h = reproduction::compare_lock_seed_cost(o.lock_hold_s);
-    per_seed_cost.fixed_s += h.fixed_s;
-    per_seed_cost.window_s += h.window_s;
-  }
-  check_procedure_cost("compare, one seed", per_seed_cost, config.twin, o.max_physics_steps);
   reproduction::CompareOptions co;
   co.seeds = *parse_seeds(o.seeds);  // checked by the option's validator
   co.quick = o.quick;
   co.fringes = o.fringes;
   co.lock = o.lock;
   co.lock_hold_s = o.lock_hold_s;
+  // Per seed: the seeds run one after another, each a whole comparison of its own.
+  check_procedure_cost("compare, one seed", reproduction::compare_seed_cost(co), config.twin,
+                       o.max_physics_steps);
   work_begins();  // every seed's calibrations and experiments
   reproduction::ComparisonResult result;
   {

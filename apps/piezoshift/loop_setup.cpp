@@ -44,12 +44,6 @@ runtime::SafetyLimits loop_safety_limits(const runtime::SafetyLimits& installati
   return limits;
 }
 
-runtime::SafetyLimits resolve_overrun_trip(runtime::SafetyLimits limits, bool twin) {
-  if (limits.trip_on_overruns == runtime::kOverrunTripOnHardware)
-    limits.trip_on_overruns = twin ? runtime::kOverrunTripNever : runtime::kOverrunTripAlways;
-  return limits;
-}
-
 nlohmann::json safety_json(const runtime::SafetyLimits& limits) {
   nlohmann::json j = nlohmann::json::object();
   runtime::visit_safety_limits(limits, [&](const char*, const char* key, const auto& value,

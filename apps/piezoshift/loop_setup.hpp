@@ -32,11 +32,6 @@ void check_loop_rate(double rate_Hz);
 runtime::SafetyLimits loop_safety_limits(const runtime::SafetyLimits& installation,
                                          std::optional<std::int64_t> max_overruns);
 
-//! trip_on_overruns resolved for the backend: "on hardware" becomes never on the twin (a late
-//! host does not hurt a simulated stage: its overruns are counted and reported) and always on a
-//! board; never and always stay.
-runtime::SafetyLimits resolve_overrun_trip(runtime::SafetyLimits limits, bool twin);
-
 //! The limits as a JSON object, one member per [safety] key.
 nlohmann::json safety_json(const runtime::SafetyLimits& limits);
 

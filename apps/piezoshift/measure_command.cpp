@@ -228,8 +228,8 @@ struct Outcome {
 Outcome acquire(const MeasureOptions& o, MeasureSetup& s, LoopStack& stack) {
   instrument::LoopSetup loop;
   loop.controller = s.calibration.params;
-  loop.limits = resolve_overrun_trip(loop_safety_limits(s.config.installation.safety, std::nullopt),
-                                     stack.sim() != nullptr);
+  loop.limits = runtime::resolve_overrun_trip(
+      loop_safety_limits(s.config.installation.safety, std::nullopt), stack.sim() != nullptr);
   loop.rate_Hz = o.rate_Hz;
   loop.stop_signal = &g_stop_signal;
   std::unique_ptr<camera::Camera> cam = open_camera(o, s);

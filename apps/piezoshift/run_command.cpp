@@ -347,7 +347,7 @@ int run(const RunOptions& o) {
   LoopStatus live;
   const bool show_live = ::isatty(STDERR_FILENO) == 1 && !o.free_run;
   config.status = &live;  // the live line's and the fault reports' source
-  const SafetyLimits limits = resolve_overrun_trip(
+  const SafetyLimits limits = runtime::resolve_overrun_trip(
       loop_safety_limits(installation.safety, o.max_overruns), stack.sim() != nullptr);
   if (!o.json)
     fmt::print("safety: {}\n", describe(limits));

@@ -416,7 +416,8 @@ int serve(const ServeOptions& o) {
   const runtime::SafetyLimits limits = loop_safety_limits(installation.safety, o.max_overruns);
   // The stack first: a bad --fault, --daq or device is named before the twin's calibration runs.
   LoopStack stack(stack_options(o), config);
-  const runtime::SafetyLimits safety = resolve_overrun_trip(limits, stack.sim() != nullptr);
+  const runtime::SafetyLimits safety =
+      runtime::resolve_overrun_trip(limits, stack.sim() != nullptr);
   const LoopCalibration cal = resolve_calibration(o.calibration, o.daq, config, o.seed,
                                                   1.0 / o.rate_Hz, o.max_physics_steps);
   calibration::refuse_fringe_lock(cal, "serve");

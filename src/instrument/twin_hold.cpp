@@ -11,7 +11,7 @@
 #include "piezoshift/instrument/acquisition.hpp"
 #include "piezoshift/instrument/measurement_lock.hpp"
 #include "piezoshift/runtime/loop_clock.hpp"
-#include "piezoshift/runtime/safety_supervisor.hpp"
+#include "piezoshift/runtime/safety_ranges.hpp"
 #include "piezoshift/runtime/sim_backend.hpp"
 
 namespace piezoshift::instrument {
@@ -60,10 +60,7 @@ TwinHold twin_hold(const camera::InstrumentConfig& config,
     throw core::InputError("twin hold: " + why);
   LoopSetup loop;
   loop.controller = calibration.params;
-  loop.limits = config.installation.safety;
-  // A late host does not hurt a simulated stage (measure's resolve_overrun_trip on the twin).
-  if (loop.limits.trip_on_overruns == runtime::kOverrunTripOnHardware)
-    loop.limits.trip_on_overruns = runtime::kOverrunTripNever;
+  loop.limits = runtime::resolve_overrun_trip(config.installation.safety, true);
   loop.rate_Hz = o.rate_Hz;
   std::unique_ptr<camera::Camera> cam = camera::make_camera("twin", config.camera, &scene);
   cam->start();

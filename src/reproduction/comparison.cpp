@@ -530,9 +530,6 @@ void calibrate_from_fringes(const config::ProjectConfig& config, std::uint64_t s
   });
 }
 
-// The variants on one seed: the paper's and the improved controller each calibrated by its own
-// procedure, the oracle feedback on the paper's calibration, and (fringes) the paper's controller
-// calibrated from fringes.
 // The Fizeau's hold of the paper's and the improved controller, unlocked and locked (issue 29,
 // comparison_hold.hpp); one progress label each.
 void run_holds(const config::ProjectConfig& config, const CompareOptions& options,
@@ -546,10 +543,12 @@ void run_holds(const config::ProjectConfig& config, const CompareOptions& option
   }
 }
 
+// The variants on one seed: the paper's and the improved controller each calibrated by its own
+// procedure, the oracle feedback on the paper's calibration, and (fringes) the paper's controller
+// calibrated from fringes; then (lock) the holds.
 SeedComparison compare_seed(const config::ProjectConfig& config, std::uint64_t seed,
                             const Schedule& s, const CompareOptions& options,
                             const rig::Progress& progress) {
-  const bool fringes = options.fringes;
   control::SemiClosedLoopParams base{};
   base.sample_time_s = config.twin.daq.sample_time_s;  // as reproduce(): the DAQ's rate
   SeedComparison sc;
@@ -582,7 +581,7 @@ SeedComparison compare_seed(const config::ProjectConfig& config, std::uint64_t s
     improved.simulated_time_s =
         m.pid.simulated_time_s + m.matrix.simulated_time_s + m.polynomial.simulated_time_s;
   });
-  if (fringes)
+  if (options.fringes)
     calibrate_from_fringes(config, seed, s, labelled(LoopVariant::kPaperFringes),
                            sc.runs[static_cast<std::size_t>(LoopVariant::kPaperFringes)]);
   oracle.calibration = paper.calibration;
@@ -594,9 +593,7 @@ SeedComparison compare_seed(const config::ProjectConfig& config, std::uint64_t s
   if (oracle.calibration.valid)
     calibrate_or_fail(oracle.calibration, "calibration",
                       [&] { choose_oracle_gains(config, seed, oracle_schedule, oracle); });
-  CompareOptions which;
-  which.fringes = fringes;
-  for (LoopVariant k : loop_variants(which)) {
+  for (LoopVariant k : loop_variants(options)) {
     VariantRun& run = sc.runs[static_cast<std::size_t>(k)];
     if (!run.calibration.valid)
       continue;
@@ -705,9 +702,7 @@ std::vector<SpreadCheck> fringes_within_spread(const ComparisonResult& r) {
   for (const char* key : kTable4Figures) {
     SpreadCheck c;
     c.key = key;
-    std::size_t i = 0;
-    while (i < r.figures.size() && r.figures[i].key != c.key)
-      ++i;
+    const std::size_t i = r.figure_index(c.key);
     if (i == r.figures.size())
       continue;
     c.fringes_median = r.medians[i][static_cast<std::size_t>(LoopVariant::kPaperFringes)];

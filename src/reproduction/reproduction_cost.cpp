@@ -21,4 +21,17 @@ rig::ProcedureCost compare_lock_seed_cost(double hold_s) {
   return rig::ProcedureCost{4.0 * (kBeforeTheHold_s + hold_s), 0.0};
 }
 
+rig::ProcedureCost compare_seed_cost(const CompareOptions& options) {
+  rig::ProcedureCost c = compare_seed_cost(options.quick);
+  const auto add = [&c](const rig::ProcedureCost& more) {
+    c.fixed_s += more.fixed_s;
+    c.window_s += more.window_s;
+  };
+  if (options.fringes)
+    add(compare_fringes_seed_cost(options.quick));
+  if (options.lock)
+    add(compare_lock_seed_cost(options.lock_hold_s));
+  return c;
+}
+
 }  // namespace piezoshift::reproduction

@@ -86,4 +86,10 @@ std::string describe(const SafetyLimits& l) {
       l.oscillation_reversals, l.oscillation_band_um, l.oscillation_time_s);
 }
 
+SafetyLimits resolve_overrun_trip(SafetyLimits limits, bool twin) {
+  if (limits.trip_on_overruns == kOverrunTripOnHardware)
+    limits.trip_on_overruns = twin ? kOverrunTripNever : kOverrunTripAlways;
+  return limits;
+}
+
 }  // namespace piezoshift::runtime

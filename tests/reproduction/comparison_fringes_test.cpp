@@ -47,10 +47,11 @@ const FringesRun& quick_fringes() {
 // The per-seed estimate `compare --quick --fringes` refuses by (reproduction_cost.hpp): the three
 // columns' and the fourth's, within 2 %.
 TEST(ComparisonFringes, CostEstimateIsWhatOneSeedCost) {
-  const double simulated = quick_fringes().simulated_s;
-  const plant::TwinParams twin = config::ProjectConfig{}.twin;
-  const double estimate = rig::estimate_cost(compare_seed_cost(true), twin).simulated_s +
-                          rig::estimate_cost(compare_fringes_seed_cost(true), twin).simulated_s;
+  const FringesRun& run = quick_fringes();
+  const double simulated = run.simulated_s;
+  const double estimate =
+      rig::estimate_cost(compare_seed_cost(run.result.options), config::ProjectConfig{}.twin)
+          .simulated_s;
   EXPECT_NEAR(estimate, simulated, 0.02 * simulated);
 }
 

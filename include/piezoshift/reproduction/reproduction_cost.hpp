@@ -12,6 +12,7 @@
 //   --lock adds            4 (1.75 + H)   0      (H: --lock-hold-s; either schedule; 2026-11-27)
 //
 // (The default reproduction is 4674 s of simulated time, 9.3e7 physics steps.)
+#include "piezoshift/reproduction/comparison.hpp"
 #include "piezoshift/rig/procedure_cost.hpp"
 
 namespace piezoshift::reproduction {
@@ -25,5 +26,7 @@ rig::ProcedureCost compare_fringes_seed_cost(bool quick);
 //! What `compare --lock --lock-hold-s hold_s` adds to one seed: four holds (comparison_hold.hpp),
 //! each the hold and the ten measurements before it (their loop time, measured on seed 1).
 rig::ProcedureCost compare_lock_seed_cost(double hold_s);
+//! One seed of compare(options): compare_seed_cost(quick) plus what --fringes and --lock add.
+rig::ProcedureCost compare_seed_cost(const CompareOptions& options);
 
 }  // namespace piezoshift::reproduction

@@ -67,6 +67,11 @@ std::string safety_limits_problem(const SafetyLimits& limits);
 //! reject_unknown().
 void read_safety_section(const io::ConfigFile& file, SafetyLimits& limits);
 
+//! trip_on_overruns resolved for the backend: "on hardware" becomes never on the twin (a late
+//! host does not hurt a simulated stage: its overruns are counted and reported) and always on a
+//! board; never and always stay.
+SafetyLimits resolve_overrun_trip(SafetyLimits limits, bool twin);
+
 //! One installation's configuration: the design and twin sections and [safety].
 struct InstallationConfig {
   config::ProjectConfig project;
