@@ -1,6 +1,7 @@
 // `piezoshift calibrate`: the paper's three calibration stages on the twin, or guided on a bench
-// (--daq, --interferometer: calibration/guided_calibration.hpp), or on the twin with the Fizeau's
-// fringes as the interferometer (--interferometer fizeau: calibrate_fizeau.hpp), written as a
+// (--daq, --interferometer: calibration/guided_calibration.hpp), or with the Fizeau's fringes as
+// the interferometer, on the twin or the loop (--interferometer fizeau: calibrate_fizeau.hpp),
+// written as a
 // calibration file that `piezoshift run --calibration` loads.
 #include <algorithm>
 #include <cstdio>
@@ -17,8 +18,8 @@
 #include "calibrate_fizeau.hpp"
 #include "command.hpp"
 #include "improved_summary.hpp"
+#include "loop_rig_stack.hpp"
 #include "loop_setup.hpp"
-#include "loop_stack.hpp"
 #include "paper_summary.hpp"
 #include "physics_budget.hpp"
 #include "piezoshift/calibration/calibration_cost.hpp"
@@ -54,6 +55,7 @@ struct Options {
   std::string interferometer;  //!< guided: prompt, file:PATH or sim; or fizeau (the fringes)
   std::string camera;          //!< --interferometer fizeau: twin
   std::string surface;         //!< --interferometer fizeau: the twin camera's test surface
+  std::string mask;            //!< --interferometer fizeau --daq: the pupil as a PNG
   bool free_run = false;       //!< guided, sim-rt: the loop paced by the procedure
   bool restart = false;
   double max_zero_drift_um = calibration::GuidedOptions{}.max_zero_drift_um;
@@ -156,43 +158,27 @@ class GuidedRigs {
       rig3_ = bench_rig3_.get();
       return;
     }
-    LoopStackOptions so;
-    so.daq = o.daq == "sim-rt" ? "sim" : o.daq;
-    so.rate_Hz = 1.0 / base.sample_time_s;
-    so.seed = o.seed + 1;
-    so.config_path = o.config;
-    so.clock = o.free_run ? StackClock::kPaced : StackClock::kRealTime;
-    stack_ = std::make_unique<LoopStack>(so, config);  // names a device it cannot open
-    rig::LoopRigOptions lo;
-    lo.rate_Hz = so.rate_Hz;
-    lo.window_s = window_s;
-    // An interferometer log is stamped by the wall clock: real-time windows are in Unix time.
-    lo.unix_time = stack_->clock().real_time();
-    signals_.emplace();  // Ctrl-C ramps the stage to 0 V instead of leaving it driven
-    lo.stop_signal = &g_stop_signal;
-    loop_rig_ = std::make_unique<rig::LoopRig>(
-        stack_->daq(), stack_->clock(), stack_->paced(), base,
-        runtime::resolve_overrun_trip(loop_safety_limits(installation.safety, std::nullopt),
-                                      stack_->sim() != nullptr),
-        lo);
-    for (const std::string& refusal : loop_rig_->realtime().refusals)
-      fmt::print(stderr, "piezoshift: warning: the loop runs without real-time treatment: {}\n",
-                 refusal);
-    rig2_ = loop_rig_.get();
-    rig3_ = loop_rig_.get();
+    loop_ = std::make_unique<LoopRigStack>(LoopRigStackOptions{.daq = o.daq,
+                                                               .free_run = o.free_run,
+                                                               .seed = o.seed,
+                                                               .config_path = o.config,
+                                                               .window_s = window_s},
+                                           installation, base);
+    loop_rig_ = &loop_->rig();
+    rig2_ = loop_rig_;
+    rig3_ = loop_rig_;
   }
 
   rig::GuidedRig& stage2() { return *rig2_; }
   rig::GuidedRig& stage3() { return *rig3_; }
   //! The real-time loop's rig, or null on the simulated bench.
-  rig::LoopRig* loop_rig() { return loop_rig_.get(); }
+  rig::LoopRig* loop_rig() { return loop_rig_; }
 
  private:
-  std::optional<StopSignals> signals_;  // outlives the loop: Ctrl-C during its ramp is harmless
   std::unique_ptr<rig::Bench> bench2_, bench3_;
   std::unique_ptr<rig::BenchRig> bench_rig2_, bench_rig3_;
-  std::unique_ptr<LoopStack> stack_;
-  std::unique_ptr<rig::LoopRig> loop_rig_;
+  std::unique_ptr<LoopRigStack> loop_;
+  rig::LoopRig* loop_rig_ = nullptr;
   rig::GuidedRig* rig2_ = nullptr;
   rig::GuidedRig* rig3_ = nullptr;
 };
@@ -384,19 +370,17 @@ int run_improved(const Options& o, const runtime::InstallationConfig& installati
   return 0;
 }
 
-// --interferometer fizeau: what it cannot do is refused before anything runs.
+// --interferometer fizeau: what it cannot do is refused before anything runs (check_request).
 int run_fizeau(const Options& o) {
-  if (!o.daq.empty())
-    throw core::InputError(fmt::format(
-        "--interferometer fizeau with --daq {}: the calibration from fringes runs on the twin's "
-        "bench (no --daq); a guided or hardware loop with a camera is not built",
-        o.daq));
   return calibrate_from_fringes_command({.out = o.out,
                                          .config = o.config,
                                          .pid = o.pid,
                                          .controller = o.controller,
                                          .camera = o.camera,
                                          .surface = o.surface,
+                                         .daq = o.daq,
+                                         .free_run = o.free_run,
+                                         .mask = o.mask,
                                          .seed = o.seed,
                                          .json = o.json,
                                          .max_physics_steps = o.max_physics_steps});
@@ -405,9 +389,10 @@ int run_fizeau(const Options& o) {
 int run(const Options& o) {
   if (o.interferometer == "fizeau")
     return run_fizeau(o);
-  if (!o.camera.empty() || !o.surface.empty())
-    throw core::InputError(fmt::format("{}: the Fizeau's camera, for --interferometer fizeau only",
-                                       o.camera.empty() ? "--surface" : "--camera"));
+  if (!o.camera.empty() || !o.surface.empty() || !o.mask.empty())
+    throw core::InputError(fmt::format(
+        "{}: the Fizeau's camera, for --interferometer fizeau only",
+        !o.camera.empty() ? "--camera" : (!o.surface.empty() ? "--surface" : "--mask")));
   if (!o.daq.empty()) {
     if (o.controller != "paper")
       throw core::InputError(
@@ -500,16 +485,20 @@ void add_calibrate_command(CLI::App& app, Action& action) {
   cmd->add_option("--interferometer", o->interferometer,
                   "guided: prompt (readings typed on stdin), file:PATH (the interferometer "
                   "software's CSV log, t_s,displacement_um) or sim (the twin's; not on comedi); "
-                  "or fizeau: stages 2 and 3 from the Fizeau's fringes on the twin (no --daq)");
+                  "or fizeau: stages 2 and 3 from the Fizeau's fringes (on the twin's bench, or "
+                  "with --daq sim-rt|comedi:/dev/comediN on the real-time loop)");
   cmd->add_option("--camera", o->camera,
-                  "--interferometer fizeau: the camera whose fringes are read (twin; "
-                  "docs/fizeau.md)");
+                  "--interferometer fizeau: the camera whose fringes are read: twin, or "
+                  "aravis:ID with --daq (docs/fizeau.md)");
+  cmd->add_option("--mask", o->mask,
+                  "--interferometer fizeau --daq: the pupil on the camera as a PNG (default: the "
+                  "twin camera's, else found in the first scan's fringe modulation)");
   cmd->add_option("--surface", o->surface,
                   "--interferometer fizeau: the twin camera's test surface, as `psi simulate` "
                   "takes it (Z4=40,rough=0.5)");
   cmd->add_flag("--free-run", o->free_run,
-                "guided, --daq sim-rt: the loop runs as fast as the CPU allows, paced by the "
-                "procedure (deterministic), instead of in real time");
+                "--daq sim-rt (guided or fizeau): the loop runs as fast as the CPU allows, paced "
+                "by the procedure (deterministic), instead of in real time");
   cmd->add_flag("--restart", o->restart,
                 "guided: discard the session recorded beside --out instead of resuming it");
   cmd->add_option("--max-zero-drift-um", o->max_zero_drift_um,

@@ -2,19 +2,27 @@
 
 #include <fmt/core.h>
 
+#include <memory>
+#include <optional>
+
 #include <nlohmann/json.hpp>
 
 #include "command.hpp"
 #include "improved_summary.hpp"
+#include "loop_rig_stack.hpp"
 #include "paper_summary.hpp"
 #include "physics_budget.hpp"
 #include "piezoshift/calibration/calibration_cost.hpp"
 #include "piezoshift/calibration/calibration_file.hpp"
 #include "piezoshift/calibration/improved_calibration.hpp"
 #include "piezoshift/camera/instrument_config.hpp"
+#include "piezoshift/camera/make_camera.hpp"
 #include "piezoshift/core/input_error.hpp"
 #include "piezoshift/instrument/fringe_calibration.hpp"
+#include "piezoshift/instrument/loop_scan_stage.hpp"
+#include "piezoshift/plant/geometry.hpp"
 #include "piezoshift/psi/fizeau_simulation.hpp"
+#include "piezoshift/psi/png_image.hpp"
 #include "piezoshift/rig/validity.hpp"
 #include "progress_bar.hpp"
 
@@ -27,7 +35,9 @@ nlohmann::json outcome_json(const FizeauCalibrateRequest& q,
   nlohmann::json j = paper_calibration_json(r.controller, r.matrix, r.polynomial);
   j["calibration_file"] = q.out;
   j["interferometer"] = "fizeau";
-  j["camera"] = "twin";
+  j["camera"] = q.camera.empty() ? "twin" : q.camera;
+  j["daq"] = q.daq.empty() ? "bench" : q.daq;
+  j["pupil_source"] = r.pupil_from_modulation ? "modulation" : "given";
   j["p_points"] = r.polynomial.command_um.size();
   j["p_skipped_commands"] = r.polynomial.saturated_points;
   j["frames"] = instrument::frames_read(r);
@@ -105,15 +115,145 @@ int improved_from_fringes(const FizeauCalibrateRequest& q, const camera::Instrum
   return 0;
 }
 
+// The file `calibrate` writes, its header naming the Fizeau as the source, or nothing when the
+// calibration failed (rig::ProcedureFailed). No [travel]: Section 4.1's travel search reads the
+// XL-80; `run` and `serve` then take the paper's travel (calibration_file.hpp).
+void write_fringe_calibration(const FizeauCalibrateRequest& q,
+                              const instrument::FringeCalibrationOutcome& r,
+                              const std::string& identified_by, const std::string& pupil) {
+  if (!r.validity.valid)
+    throw rig::ProcedureFailed("calibrate --interferometer fizeau: " + r.validity.reason +
+                               "; no calibration file written");
+  calibration::write_calibration_file(
+      q.out, r.controller,
+      fmt::format("piezoshift calibration, {}\ninterferometer: the Fizeau's fringes "
+                  "(psi::FringeTracker, {} frames, pupil: {}), not the XL-80; no optics moved\n"
+                  "seed {}, configuration: {}, PID gains: {}",
+                  identified_by, instrument::frames_read(r), pupil, q.seed,
+                  q.config.empty() ? "built-in defaults" : q.config,
+                  q.pid == "paper" ? "the paper's" : "searched"));
+}
+
+// What the request cannot do, refused before anything runs.
+void check_request(const FizeauCalibrateRequest& q) {
+  const std::string& c = q.camera;
+  if (c.starts_with("files:"))
+    throw core::InputError(fmt::format(
+        "--camera {}: recorded frames carry no record of the stage's motion while they were "
+        "taken, and the calibration pairs every frame with the gauges at its exposure; run it "
+        "with the camera on the stage (twin, aravis:ID)",
+        c));
+  if (!c.empty() && c != "twin" && !c.starts_with("aravis:"))
+    throw core::InputError(
+        fmt::format("--camera {}: expected twin or aravis:ID (docs/fizeau.md)", c));
+  const bool loop = !q.daq.empty();
+  if (loop && q.daq != "sim-rt" && q.daq != "comedi" && !q.daq.starts_with("comedi:"))
+    throw core::InputError(fmt::format(
+        "--interferometer fizeau with --daq {}: expected sim-rt or comedi:/dev/comediN (no "
+        "--daq: the twin's bench on a simulated clock)",
+        q.daq));
+  if (!loop && c.starts_with("aravis:"))
+    throw core::InputError(
+        fmt::format("--camera {}: a real camera needs the stage on the real-time loop (--daq "
+                    "comedi:/dev/comediN, or sim-rt for the twin)",
+                    c));
+  if (loop && (c.empty() || c == "twin") && q.daq != "sim-rt")
+    throw core::InputError(fmt::format(
+        "--camera twin renders the twin's plate: it needs --daq sim-rt, not {}", q.daq));
+  const bool twin_fringes =
+      c.empty() || c == "twin" || (c.starts_with("aravis:Fake") && q.daq == "sim-rt");
+  if (!q.surface.empty() && !twin_fringes)
+    throw core::InputError(
+        "--surface: the test surface of the twin camera (or of aravis:Fake_1 on --daq sim-rt)");
+  if (loop && q.controller != "paper")
+    throw core::InputError(
+        "--controller improved with --daq: the improved identification runs on the twin's "
+        "bench only (no --daq)");
+  if (loop && q.pid != "paper")
+    throw core::InputError(
+        "--pid search with --daq: the gain search scores the plate between the ticks, which a "
+        "bench cannot see; the paper's gains are kept");
+  if (!loop && q.free_run)
+    throw core::InputError("--free-run needs --daq sim-rt");
+  if (q.free_run && q.daq != "sim-rt")
+    throw core::InputError(
+        fmt::format("--free-run needs --daq sim-rt (--daq {} is hardware)", q.daq));
+  if (!loop && !q.mask.empty())
+    throw core::InputError("--mask: the twin's bench takes its scene's pupil (use --daq)");
+}
+
+// The stages on the real-time loop (rig::LoopRig) with the camera on it: the twin (sim-rt), with
+// the twin camera or Aravis's fake camera shown its fringes, or a board and a real camera.
+int fringes_on_loop(const FizeauCalibrateRequest& q, const camera::InstrumentConfig& ic,
+                    const psi::SurfaceSpec& surface,
+                    const instrument::FringeCalibrationOptions& fo) {
+  const config::ProjectConfig& config = ic.installation.project;
+  const std::string spec = q.camera.empty() ? "twin" : q.camera;
+  std::optional<camera::TwinScene> scene;
+  if (q.daq == "sim-rt")
+    scene = camera::make_twin_scene(
+        surface,
+        camera::measurement_optics(ic.camera.settings, ic.camera.pupil_radius_m, fo.wavelength_nm),
+        q.seed);
+  const std::unique_ptr<camera::Camera> cam =
+      camera::make_camera(spec, ic.camera, scene ? &*scene : nullptr);
+  instrument::FringeOptics optics;
+  optics.pupil_radius_m = ic.camera.pupil_radius_m;
+  if (spec == "twin") {
+    optics = instrument::twin_optics(*scene);
+  } else if (!q.mask.empty()) {
+    optics.mask = psi::read_mask_png(q.mask);
+    const camera::CameraSettings& cs = cam->settings();
+    if (optics.mask.width != cs.width_px || optics.mask.height != cs.height_px)
+      throw core::InputError(fmt::format("{}: mask is {} x {} pixels, the camera's frames {} x {}",
+                                         q.mask, optics.mask.width, optics.mask.height, cs.width_px,
+                                         cs.height_px));
+    if (optics.mask.count() < 16)
+      throw core::InputError(fmt::format("{}: the mask holds {} pixels (16 or more needed)", q.mask,
+                                         optics.mask.count()));
+    optics.plate_m_per_px = optics.pupil_radius_m / psi::pupil_of(optics.mask).radius_px;
+  }
+  control::SemiClosedLoopParams base;
+  base.sample_time_s = config.twin.daq.sample_time_s;
+  LoopRigStack stack(
+      {.daq = q.daq, .free_run = q.free_run, .seed = q.seed, .config_path = q.config},
+      ic.installation, base);
+  instrument::LoopScanStage stage(stack.rig(), plant::make_twin_geometry(config.twin.geometry),
+                                  1.0 / base.sample_time_s);
+  instrument::FringeCalibrationOutcome r;
+  {
+    ProgressBar bar(3);
+    r = instrument::calibrate_from_fringes(stage, *cam, optics, fo, bar.callback());
+  }
+  const runtime::LoopResult loop = stack.rig().stop();
+  write_fringe_calibration(
+      q, r,
+      fmt::format("identified by `piezoshift calibrate --interferometer fizeau --daq {} --camera "
+                  "{}`",
+                  q.daq, spec),
+      r.pupil_from_modulation ? "found in the fringes' modulation"
+                              : (q.mask.empty() ? "the twin's scene" : q.mask));
+  const runtime::LoopStats& st = stack.rig().loop_stats();
+  if (q.json) {
+    nlohmann::json j = outcome_json(q, r);
+    j["loop"] = {{"ticks", loop.ticks},
+                 {"overruns", st.overruns},
+                 {"max_consecutive_overruns", st.max_consecutive_overruns},
+                 {"host_samples_dropped", loop.host_samples_dropped}};
+    fmt::print("{}\n", j.dump(2));
+    return 0;
+  }
+  print_fringe_stages(r);
+  fmt::print("loop     {} ticks, {} overruns (at most {} in a row)\n", loop.ticks, st.overruns,
+             st.max_consecutive_overruns);
+  fmt::print("written: {} (no [travel]: its search reads the XL-80)\n", q.out);
+  return 0;
+}
+
 }  // namespace
 
 int calibrate_from_fringes_command(const FizeauCalibrateRequest& q) {
-  if (!q.camera.empty() && q.camera != "twin")
-    throw core::InputError(fmt::format(
-        "--camera {}: the calibration from fringes runs on the twin's bench with the twin camera "
-        "only (--camera twin); aravis:ID and files:DIR need the scans on a hardware loop, which "
-        "is not built",
-        q.camera));
+  check_request(q);
   const camera::InstrumentConfig ic =
       q.config.empty() ? camera::InstrumentConfig{} : camera::load_instrument_config(q.config);
   const psi::SurfaceSpec surface =
@@ -131,6 +271,8 @@ int calibrate_from_fringes_command(const FizeauCalibrateRequest& q) {
                                                         fo.stages, config.twin.daq.sample_time_s),
                        config.twin, q.max_physics_steps);
   work_begins();  // the twin's scene, the stage, the camera
+  if (!q.daq.empty())
+    return fringes_on_loop(q, ic, surface, fo);
   if (q.controller == "improved")
     return improved_from_fringes(q, ic, surface, fo);
   instrument::FringeCalibrationOutcome r;
@@ -138,20 +280,11 @@ int calibrate_from_fringes_command(const FizeauCalibrateRequest& q) {
     ProgressBar bar(3);
     r = instrument::calibrate_twin_from_fringes(ic, q.seed, surface, fo, bar.callback());
   }
-  if (!r.validity.valid)
-    throw rig::ProcedureFailed("calibrate --interferometer fizeau: " + r.validity.reason +
-                               "; no calibration file written");
-  // No [travel]: Section 4.1's travel search reads the XL-80; `run` and `serve` then take the
-  // paper's travel (calibration_file.hpp).
-  calibration::write_calibration_file(
-      q.out, r.controller,
-      fmt::format("piezoshift calibration, identified on the digital twin by `piezoshift "
-                  "calibrate --interferometer fizeau --camera twin`\ninterferometer: the Fizeau's "
-                  "fringes (psi::FringeTracker, {} frames), not the XL-80; no optics moved\n"
-                  "seed {}, configuration: {}, PID gains: {}",
-                  instrument::frames_read(r), q.seed,
-                  q.config.empty() ? "built-in defaults" : q.config,
-                  q.pid == "paper" ? "the paper's" : "searched"));
+  write_fringe_calibration(
+      q, r,
+      "identified on the digital twin by `piezoshift calibrate --interferometer fizeau --camera "
+      "twin`",
+      "the twin's scene");
   if (q.json) {
     fmt::print("{}\n", outcome_json(q, r).dump(2));
     return 0;

@@ -275,7 +275,7 @@ def test_bad_lock_and_hold_values_are_refused_by_name(tmp_path):
 def test_the_calibration_from_fringes_gives_a_controller_measure_runs(tmp_path):
     # Issue 29's calibration from fringes (docs/fizeau.md), as `calibrate --interferometer fizeau
     # --camera twin --seed 1 --json`: the same A and p to the last digit (checked against the CLI
-    # when this was written: A[0] = -0.42152971984990373, p1 = 1.0165363665606377, 438 frames).
+    # when this was written: A[0] = -0.42152971984990373, p1 = 1.016541824764393, 438 frames).
     # The default twin is built from the paper's A (Eq. 8), which the fringes find within 0.002
     # (issue 29's bound; measured 0.0008 on seed 1), in less simulated time than the XL-80's 72 s.
     d = ps.calibrate_from_fringes(seed=1)

@@ -7,11 +7,14 @@
 #include <chrono>
 #include <cmath>
 #include <limits>
+#include <optional>
 #include <stdexcept>
 
 #include "piezoshift/core/input_error.hpp"
 #include "piezoshift/core/wall_time.hpp"
+#include "piezoshift/instrument/bench_scan_stage.hpp"
 #include "piezoshift/instrument/measurement.hpp"
+#include "piezoshift/psi/pupil_detection.hpp"
 
 namespace piezoshift::instrument {
 
@@ -30,23 +33,23 @@ void truth_from_first_frame(std::vector<FringeScanPose>& poses) {
       q.truth_points_um[j] -= z0[j];
 }
 
-// The scan's state between poses: the bench, the camera, the tracker and what was taken.
+// The scan's state between poses: the stage, the camera, the tracker and what was taken. With no
+// mask the tracker waits for the reference frames and takes its pupil from their modulation.
 class Scan {
  public:
-  Scan(rig::Bench& bench, camera::Camera& camera, const psi::Mask& mask,
-       const FringeActuatorScanParams& p,
-       const std::function<void(rig::Bench&, const FringeScanPose&)>& at_pose)
-      : bench_(bench),
-        camera_(camera),
-        p_(p),
-        at_pose_(at_pose),
-        tracker_(mask, tracker_params(bench, p)) {}
+  Scan(ScanStage& stage, camera::Camera& camera, const psi::Mask& mask,
+       const FringeActuatorScanParams& p, const std::function<void(const FringeScanPose&)>& at_pose)
+      : stage_(stage), camera_(camera), mask_(mask), p_(p), at_pose_(at_pose) {
+    if (mask.size() != 0)
+      tracker_.emplace(mask, tracker_params(mask));
+  }
 
   bool ok() const { return r_.validity.valid; }
   FringeActuatorScanResult& result() { return r_; }
+  const psi::Mask& mask() const { return mask_; }
 
   void start() {
-    origin_ = raw_pose();
+    stage_.mark_pose_origin();
     camera_.start();
   }
 
@@ -55,78 +58,52 @@ class Scan {
   void take(const control::Vec3& target_um, bool reference, double settle_s,
             bool drive_points = false) {
     if (drive_points)
-      bench_.drive_points(target_um);
+      stage_.drive_points(target_um);
     else
-      bench_.drive_actuators(target_um);
-    bench_.run(settle_s);
-    if (bench_.faulted()) {
-      r_.validity.fail(fmt::format("the safety supervisor tripped ({}, channel {})",
-                                   runtime::to_string(bench_.fault().reason),
-                                   bench_.fault().channel + 1));
+      stage_.drive_actuators(target_um);
+    stage_.settle(settle_s);
+    if (const std::string why = stage_.fault(); !why.empty()) {
+      r_.validity.fail(why);
       return;
     }
     FringeScanPose pose;
     pose.frame = r_.poses.size();
     pose.reference = reference;
     pose.target_um = target_um;
-    pose.saturated_mask = bench_.last_output().saturated_mask;
     expose(pose);
     if (!ok())
       return;
     r_.poses.push_back(pose);
     track();
     if (ok() && at_pose_)
-      at_pose_(bench_, r_.poses.back());
+      at_pose_(r_.poses.back());
   }
 
  private:
-  static psi::FringeTrackerParams tracker_params(const rig::Bench& bench,
-                                                 const FringeActuatorScanParams& p) {
-    psi::FringeTrackerParams t = p.tracker;
-    t.window_frames = p.reference_frames;
-    t.wavelength_nm = p.wavelength_nm;
-    t.points = bench.twin().model().geometry.points;
+  psi::FringeTrackerParams tracker_params(const psi::Mask& mask) const {
+    psi::FringeTrackerParams t = p_.tracker;
+    t.window_frames = p_.reference_frames;
+    t.wavelength_nm = p_.wavelength_nm;
+    t.points = stage_.points();
     t.first_direction = +1;  // the reference ascends
+    if (mask_.size() == 0)   // a pupil found in the frames: its size on the plate is the given one
+      t.plate_m_per_px = p_.pupil_radius_m / psi::pupil_of(mask).radius_px;
     return t;
   }
 
-  camera::PlatePose raw_pose() const {
-    const plant::TwinTruth& t = bench_.twin().truth();
-    return {bench_.time_s(), bench_.twin().fringe_piston_nm(), t.theta_x_urad, t.theta_y_urad};
-  }
-  camera::PlatePose plate_pose() const {
-    const camera::PlatePose r = raw_pose();
-    return {r.time_s, r.piston_nm - origin_.piston_nm, r.theta_x_urad - origin_.theta_x_urad,
-            r.theta_y_urad - origin_.theta_y_urad};
-  }
-
-  // Triggers, ticks through the exposure feeding the camera each tick's pose, waits for the frame.
+  // Triggers, runs through the exposure (the stage feeds the camera), waits for the frame.
   void expose(FringeScanPose& pose) {
-    const double t0 = bench_.time_s();
-    if (!camera_.trigger(t0)) {
-      r_.validity.fail(fmt::format("frame {}: the camera refused the trigger: {}", pose.frame,
-                                   camera_.message()));
+    ScanExposure e;
+    if (const std::string why = stage_.expose(camera_, camera_.settings().exposure_s, e);
+        !why.empty()) {
+      r_.validity.fail(fmt::format("frame {}: {}", pose.frame, why));
       return;
     }
-    pose.time_s = t0;
-    camera_.observe_plate(plate_pose());
-    const double end_s = t0 + camera_.settings().exposure_s;
-    // the truth as the camera integrates it: the mean over the exposure's ticks
-    control::Vec3 sgs{}, truth = bench_.twin().truth().points_um;
-    int n = 0;
-    while (bench_.time_s() < end_s - 1e-9) {
-      bench_.run(bench_.sample_time_s());
-      camera_.observe_plate(plate_pose());
-      for (std::size_t i = 0; i < 3; ++i) {
-        sgs[i] += bench_.last_output().feedback_um[i];
-        truth[i] += bench_.twin().truth().points_um[i];
-      }
-      ++n;
-    }
-    for (std::size_t j = 0; j < 3; ++j)
-      pose.truth_points_um[j] = truth[j] / (n + 1);
-    for (std::size_t i = 0; i < 3; ++i)
-      pose.sgs_um[i] = sgs[i] / n;
+    pose.time_s = e.trigger_time_s;
+    pose.saturated_mask = e.saturated_mask;
+    pose.sgs_um = e.sgs_um;
+    pose.has_truth = e.has_truth;
+    pose.truth_points_um = e.truth_points_um;
     const camera::FrameStatus s = camera_.wait(frame_, p_.frame_timeout_s);
     if (s != camera::FrameStatus::kOk) {
       const std::string why = camera_.message();
@@ -135,12 +112,45 @@ class Scan {
     }
   }
 
+  // The pupil from the reference frames' modulation, and the tracker on it, once they are in.
+  bool find_pupil() {
+    try {
+      mask_ = psi::pupil_from_modulation(waiting_).mask;
+    } catch (const std::invalid_argument& e) {
+      r_.validity.fail(fmt::format("no pupil found in the reference frames: {}", e.what()));
+      return false;
+    }
+    if (mask_.count() < 16) {
+      r_.validity.fail(fmt::format(
+          "{} pixels of pupil found in the reference frames' modulation (16 or more needed)",
+          mask_.count()));
+      return false;
+    }
+    r_.pupil_from_modulation = true;
+    tracker_.emplace(mask_, tracker_params(mask_));
+    return true;
+  }
+
   void track() {
     const auto w0 = Clock::now();
     std::vector<camera::Frame> one(1);
     one[0] = std::move(frame_);
-    const std::vector<psi::FringePose> got = tracker_.push(frame_maps(one)[0]);
+    psi::Map map = frame_maps(one)[0];
     frame_ = std::move(one[0]);
+    std::vector<psi::FringePose> got;
+    if (tracker_) {
+      got = tracker_->push(map);
+    } else {
+      waiting_.push_back(std::move(map));
+      if (waiting_.size() == static_cast<std::size_t>(p_.reference_frames)) {
+        if (!find_pupil())
+          return;
+        for (const psi::Map& m : waiting_)
+          for (const psi::FringePose& g : tracker_->push(m))
+            got.push_back(g);
+        waiting_.clear();
+      }
+    }
     r_.tracker_wall_s += seconds_since(w0);
     for (const psi::FringePose& g : got) {
       FringeScanPose& q = r_.poses.at(g.frame);
@@ -154,19 +164,20 @@ class Scan {
     }
   }
 
-  rig::Bench& bench_;
+  ScanStage& stage_;
   camera::Camera& camera_;
+  psi::Mask mask_;
   const FringeActuatorScanParams& p_;
-  const std::function<void(rig::Bench&, const FringeScanPose&)>& at_pose_;
-  psi::FringeTracker tracker_;
-  camera::PlatePose origin_{};
+  const std::function<void(const FringeScanPose&)>& at_pose_;
+  std::optional<psi::FringeTracker> tracker_;
+  std::vector<psi::Map> waiting_;  // the reference frames, while the pupil is not yet known
   camera::Frame frame_;
   FringeActuatorScanResult r_;
 };
 
 void check_frame_size(const camera::Camera& camera, const psi::Mask& mask, const char* what) {
   const camera::CameraSettings& cs = camera.settings();
-  if (cs.width_px != mask.width || cs.height_px != mask.height)
+  if (mask.size() != 0 && (cs.width_px != mask.width || cs.height_px != mask.height))
     throw core::InputError(
         fmt::format("{}: camera {} gives {}x{} px frames, the pupil's mask is {}x{}", what,
                     camera.name(), cs.width_px, cs.height_px, mask.width, mask.height));
@@ -222,26 +233,24 @@ ScanMatrixPose matrix_pose(const FringeActuatorScanResult& scan) {
 }
 
 FringeActuatorScanResult run_fringe_actuator_scan(
-    rig::Bench& bench, camera::Camera& camera, const psi::Mask& mask,
-    const FringeActuatorScanParams& p,
-    const std::function<void(rig::Bench&, const FringeScanPose&)>& at_pose) {
+    ScanStage& stage, camera::Camera& camera, const psi::Mask& mask,
+    const FringeActuatorScanParams& p, const std::function<void(const FringeScanPose&)>& at_pose) {
   if (const std::string why = fringe_actuator_scan_problem(p); !why.empty())
     throw core::InputError("fringe actuator scan: " + why);
   check_frame_size(camera, mask, "fringe actuator scan");
   const auto w0 = Clock::now();
-  const double t0 = bench.time_s();
-  Scan scan(bench, camera, mask, p, at_pose);
+  const double t0 = stage.time_s();
+  Scan scan(stage, camera, mask, p, at_pose);
   FringeActuatorScanResult& r = scan.result();
-  const auto& actuators = bench.twin().model().geometry.actuators;
-  const double per_um = pupil_step_nm(actuators, p.actuator, 1.0, p.pupil_radius_m);
+  const double per_um = pupil_step_nm(stage.actuators(), p.actuator, 1.0, p.pupil_radius_m);
   r.moves = static_cast<int>(std::ceil(p.move_um * per_um / p.max_pupil_step_nm));
   r.leg_step_um = p.move_um / r.moves;
   r.predicted_pupil_step_nm = per_um * r.leg_step_um;
 
   const int w = p.reference_frames;
   const auto common = [](double s_um) { return control::Vec3{s_um, s_um, s_um}; };
-  bench.drive_actuators(common(p.base_um - (w - 1) * p.reference_step_um));
-  bench.run(p.initial_settle_s);
+  stage.drive_actuators(common(p.base_um - (w - 1) * p.reference_step_um));
+  stage.settle(p.initial_settle_s);
   scan.start();
   for (int k = 0; k < w && scan.ok(); ++k)
     scan.take(common(p.base_um + (k - w + 1) * p.reference_step_um), true,
@@ -254,17 +263,30 @@ FringeActuatorScanResult run_fringe_actuator_scan(
   }
   camera.stop();
   truth_from_first_frame(r.poses);
-  r.simulated_time_s = bench.time_s() - t0;
+  r.pupil = scan.mask();
+  r.simulated_time_s = stage.time_s() - t0;
   r.wall_time_s = seconds_since(w0);
   return std::move(r);
+}
+
+FringeActuatorScanResult run_fringe_actuator_scan(
+    rig::Bench& bench, camera::Camera& camera, const psi::Mask& mask,
+    const FringeActuatorScanParams& params,
+    const std::function<void(rig::Bench&, const FringeScanPose&)>& at_pose) {
+  BenchScanStage stage(bench);
+  std::function<void(const FringeScanPose&)> each;
+  if (at_pose)
+    each = [&](const FringeScanPose& q) { at_pose(bench, q); };
+  return run_fringe_actuator_scan(stage, camera, mask, params, each);
 }
 
 std::string fringe_piston_scan_problem(const FringePistonScanParams& p) {
   const auto pos = [](double v) { return std::isfinite(v) && v > 0.0; };
   if (p.reference_frames < 3)
     return "reference_frames must be at least 3";
-  if (!pos(p.wavelength_nm) || !pos(p.reference_step_um) || !pos(p.frame_timeout_s))
-    return "wavelength_nm, reference_step_um and frame_timeout_s must be > 0";
+  if (!pos(p.wavelength_nm) || !pos(p.reference_step_um) || !pos(p.frame_timeout_s) ||
+      !pos(p.pupil_radius_m))
+    return "wavelength_nm, reference_step_um, frame_timeout_s and pupil_radius_m must be > 0";
   if (!pos(p.max_pupil_step_nm) || p.max_pupil_step_nm > p.wavelength_nm / 4.0)
     return "max_pupil_step_nm must be > 0 and below a quarter wave";
   if (!std::isfinite(p.settle_s) || p.settle_s < 0.0 || !std::isfinite(p.initial_settle_s) ||
@@ -275,30 +297,31 @@ std::string fringe_piston_scan_problem(const FringePistonScanParams& p) {
   return "";
 }
 
-FringePistonScanResult run_fringe_piston_scan(rig::Bench& bench, camera::Camera& camera,
+FringePistonScanResult run_fringe_piston_scan(ScanStage& stage, camera::Camera& camera,
                                               const psi::Mask& mask,
                                               const FringePistonScanParams& p) {
   if (const std::string why = fringe_piston_scan_problem(p); !why.empty())
     throw core::InputError("fringe piston scan: " + why);
   check_frame_size(camera, mask, "fringe piston scan");
   const auto w0 = Clock::now();
-  const double t0 = bench.time_s();
+  const double t0 = stage.time_s();
   // the actuator scan's machinery, with the fields a piston scan shares
   FringeActuatorScanParams sp;
   sp.reference_frames = p.reference_frames;
   sp.wavelength_nm = p.wavelength_nm;
   sp.frame_timeout_s = p.frame_timeout_s;
+  sp.pupil_radius_m = p.pupil_radius_m;
   sp.tracker = p.tracker;
-  const std::function<void(rig::Bench&, const FringeScanPose&)> no_callback;  // Scan keeps a ref
-  Scan scan(bench, camera, mask, sp, no_callback);
+  const std::function<void(const FringeScanPose&)> no_callback;  // Scan keeps a reference
+  Scan scan(stage, camera, mask, sp, no_callback);
   const int w = p.reference_frames;
   const double top_ref_um = (w - 1) * p.reference_step_um;
   FringePistonScanResult r;
   r.moves = static_cast<int>(std::ceil(1000.0 * (p.max_um - top_ref_um) / p.max_pupil_step_nm));
   r.step_um = (p.max_um - top_ref_um) / r.moves;
   const auto common = [](double z_um) { return control::Vec3{z_um, z_um, z_um}; };
-  bench.drive_points(common(0.0));
-  bench.run(p.initial_settle_s);
+  stage.drive_points(common(0.0));
+  stage.settle(p.initial_settle_s);
   scan.start();
   for (int k = 0; k < w && scan.ok(); ++k)
     scan.take(common(k * p.reference_step_um), true, k == 0 ? 0.0 : p.settle_s, true);
@@ -309,10 +332,18 @@ FringePistonScanResult run_fringe_piston_scan(rig::Bench& bench, camera::Camera&
   r.poses = std::move(got.poses);
   r.tracker_wall_s = got.tracker_wall_s;
   r.validity = got.validity;
+  r.pupil = scan.mask();
   truth_from_first_frame(r.poses);
-  r.simulated_time_s = bench.time_s() - t0;
+  r.simulated_time_s = stage.time_s() - t0;
   r.wall_time_s = seconds_since(w0);
   return r;
+}
+
+FringePistonScanResult run_fringe_piston_scan(rig::Bench& bench, camera::Camera& camera,
+                                              const psi::Mask& mask,
+                                              const FringePistonScanParams& p) {
+  BenchScanStage stage(bench);
+  return run_fringe_piston_scan(stage, camera, mask, p);
 }
 
 }  // namespace piezoshift::instrument

@@ -90,6 +90,8 @@ void LoopRig::take(const runtime::HostSample& h) {
                  : fmt::format("the safety supervisor tripped ({}, at {:.3f} s)",
                                runtime::to_string(reason), clock_s());
   }
+  if (follow_ != nullptr && h.tick >= follow_from_ && h.tick < follow_to_)
+    (*follow_)(h);
   if (window_ticks_ == 0)
     return;
   if (h.tick < window_from_ || h.tick >= window_from_ + window_ticks_)
@@ -196,6 +198,27 @@ void LoopRig::settle(double duration_s) {
   catch_up();
   const std::uint64_t until = last_.tick + ticks_of(duration_s);
   wait([&] { return last_.tick >= until; }, until);
+}
+
+void LoopRig::follow(std::uint64_t ticks,
+                     const std::function<void(const runtime::HostSample&)>& each) {
+  // Samples waiting in the ring may be old ones (as measure()): after them, the present tick.
+  runtime::HostSample h;
+  bool waiting = false;
+  while (link_.samples.try_pop(h)) {
+    take(h);
+    waiting = true;
+  }
+  if (waiting || !seen_any_)
+    catch_up();
+  follow_from_ = next_tick();
+  follow_to_ = follow_from_ + ticks;
+  follow_ = &each;
+  if (ticks > 0) {
+    const std::uint64_t last = follow_to_ - 1;
+    wait([&] { return last_.tick >= last; }, last);
+  }
+  follow_ = nullptr;
 }
 
 void LoopRig::rest(double settle_s) {

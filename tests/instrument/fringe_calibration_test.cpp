@@ -189,7 +189,7 @@ TEST_P(FringeCalibrationPlants, AWithinTheBandAndTable4WithinTheXl80sSpreadInLes
     }
     if (seed == 1) {
       EXPECT_LT(r.f_err, 0.002);  // issue 29's band, on seed 1 alone
-      // p: the XL-80's curve within 15 nm over the 11 um span (0.14 %; measured 3.4 to 4.8 nm
+      // p: the XL-80's curve within 15 nm over the 11 um span (0.14 %; measured 1.6 to 2.9 nm
       // on seed 1, docs/fizeau.md)
       EXPECT_LT(r.p_nm, 15.0);
     }

@@ -25,6 +25,7 @@
 #include <vector>
 
 #include "piezoshift/camera/camera.hpp"
+#include "piezoshift/instrument/scan_stage.hpp"
 #include "piezoshift/psi/fringe_tracker.hpp"
 #include "piezoshift/psi/grid.hpp"
 #include "piezoshift/rig/bench.hpp"
@@ -62,6 +63,7 @@ struct FringeScanPose {
   bool valid = false;               //!< the tracker resolved it (else points NaN, reason why)
   std::string reason;
   control::Vec3 points_um{};        //!< P1..P3 from the fringes, relative to frame 0
+  bool has_truth = false;           //!< the stage is the twin's (else truth_points_um is 0)
   control::Vec3 truth_points_um{};  //!< the twin's P1..P3, mean over the exposure, from frame 0's
   double time_s = 0.0;              //!< loop time of the trigger
 };
@@ -74,7 +76,9 @@ struct FringeActuatorScanResult {
   double predicted_pupil_step_nm = 0.0;  //!< the largest, per move
   double simulated_time_s = 0.0;         //!< bench time of the whole scan
   double wall_time_s = 0.0;
-  double tracker_wall_s = 0.0;  //!< of which in the tracker
+  double tracker_wall_s = 0.0;         //!< of which in the tracker
+  psi::Mask pupil;                     //!< the pupil the tracker used (given, or found)
+  bool pupil_from_modulation = false;  //!< found in the reference frames' modulation
   rig::Validity validity;
 };
 
@@ -93,9 +97,17 @@ struct ScanMatrixPose {
 };
 ScanMatrixPose matrix_pose(const FringeActuatorScanResult& scan);
 
-//! Runs the scan (see the header) on the bench with the camera (configured, not started; its
-//! size the mask's). Throws core::InputError for params fringe_actuator_scan_problem() refuses
-//! and for a camera whose frame size is not the mask's.
+//! Runs the scan (see the header) on the stage with the camera (configured, not started; its
+//! size the mask's). An empty mask: the pupil is found in the reference frames' fringe
+//! modulation (psi::pupil_from_modulation; none found, or fewer than 16 pixels, fails the scan),
+//! its radius on the plate params.pupil_radius_m. Throws core::InputError for params
+//! fringe_actuator_scan_problem() refuses and for a camera whose frame size is not the mask's.
+FringeActuatorScanResult run_fringe_actuator_scan(
+    ScanStage& stage, camera::Camera& camera, const psi::Mask& mask,
+    const FringeActuatorScanParams& params,
+    const std::function<void(const FringeScanPose&)>& at_pose = {});
+
+//! The same on the twin's bench (BenchScanStage); at_pose gets the bench, still at the pose.
 FringeActuatorScanResult run_fringe_actuator_scan(
     rig::Bench& bench, camera::Camera& camera, const psi::Mask& mask,
     const FringeActuatorScanParams& params,

@@ -8,11 +8,13 @@
 //                 from the gauges over the exposure, dZ from the fringes), A by least squares
 //                 (calibration::fit_transmission_matrix) over the three
 //   3. cubic p    one fringe piston scan (fringe_piston_scan.hpp) with the gains and A in place:
-//                 every frame is a point (Z_d, the mean of P1..P3 from the fringes), p by
+//                 every frame is a point (Z_d, the mean of P1..P3 from the fringes, on the
+//                 gauges' reading of frame 0 as the datum), p by
 //                 calibration::fit_cubic_polynomial, the poses with a PID at its limit left out
-// Each stage on its own fresh bench (seed, seed + 1, seed + 2), as calibrate() does; the scenes'
-// camera is the caller's, reused by every scan. No optics are moved: the camera sees P1..P3 at
-// once in every frame.
+// Each stage on its own fresh bench (seed, seed + 1, seed + 2), as calibrate() does, or all on
+// one ScanStage the caller holds (the real-time loop, scan_stage.hpp); the camera is the
+// caller's, reused by every scan. No optics are moved: the camera sees P1..P3 at once in every
+// frame.
 // It says when it cannot: a scan that fails (a frame lost, the fringes lost, a fault latched)
 // or a fit the data cannot give ends it with valid = false and the first reason, naming the
 // stage; the controller is then not to be used.
@@ -26,6 +28,7 @@
 #include "piezoshift/config/project_config.hpp"
 #include "piezoshift/instrument/fringe_actuator_scan.hpp"
 #include "piezoshift/instrument/fringe_piston_scan.hpp"
+#include "piezoshift/instrument/scan_stage.hpp"
 #include "piezoshift/psi/fizeau_simulation.hpp"
 #include "piezoshift/psi/grid.hpp"
 #include "piezoshift/rig/progress.hpp"
@@ -61,9 +64,14 @@ struct FringeCalibrationOutcome {
   calibration::PolynomialIdentificationResult polynomial;  //!< command/measured: every frame
   std::array<FringeActuatorScanResult, 3> actuator_scans;
   FringePistonScanResult piston_scan;
+  //! The pupil was found in the first scan's reference frames (FringeOptics::mask empty)
+  bool pupil_from_modulation = false;
   //! Bench time of stages 2 and 3 (the scans): what the XL-80's stages 2 and 3 take otherwise
   double stage2_simulated_s = 0.0;
   double stage3_simulated_s = 0.0;
+  //! Stage 3's datum: frame 0's mean displacement of P1..P3 as the gauges read it (through A),
+  //! added to every frame's from the fringes [um]
+  double stage3_datum_um = 0.0;
   double wall_time_s = 0.0;
   rig::Validity validity;
 };
@@ -73,6 +81,17 @@ struct FringeCalibrationOutcome {
 FringeCalibrationOutcome calibrate_from_fringes(const config::ProjectConfig& config,
                                                 const control::SemiClosedLoopParams& base,
                                                 std::uint64_t seed, camera::Camera& camera,
+                                                const FringeOptics& optics,
+                                                const FringeCalibrationOptions& options = {},
+                                                const rig::Progress& progress = {});
+
+//! The same on a stage the caller holds (the real-time loop: LoopScanStage, loop_scan_stage.hpp),
+//! for any camera: stage 1 keeps the stage's controller's gains (the paper's: the gain search
+//! scores the plate between the ticks, which only the twin shows, as the guided calibration's),
+//! stages 2 and 3 run on it one after the other. optics.mask empty: the pupil is found in the
+//! first scan's reference frames' modulation and kept for the scans after it, its radius on the
+//! plate optics.pupil_radius_m. The stage ends holding the last pose (A found, p the identity).
+FringeCalibrationOutcome calibrate_from_fringes(ScanStage& stage, camera::Camera& camera,
                                                 const FringeOptics& optics,
                                                 const FringeCalibrationOptions& options = {},
                                                 const rig::Progress& progress = {});

@@ -40,7 +40,8 @@ struct FringePistonScanParams {
   double settle_s = 0.1;               //!< after each move, before the exposure
   double initial_settle_s = 0.5;       //!< after the servo closes at Z_d = 0
   double frame_timeout_s = 5.0;        //!< wall time for a frame to arrive after its exposure
-  psi::FringeTrackerParams tracker{};  //!< points and window are set from the twin and above
+  double pupil_radius_m = 0.025;       //!< the pupil on the plate, for a pupil found in frames
+  psi::FringeTrackerParams tracker{};  //!< points and window are set from the stage and above
 };
 
 //! Why p cannot run ("" when it can), naming the field.
@@ -53,13 +54,20 @@ struct FringePistonScanResult {
   double simulated_time_s = 0.0;
   double wall_time_s = 0.0;
   double tracker_wall_s = 0.0;
+  psi::Mask pupil;  //!< the pupil the tracker used (given, or found)
   rig::Validity validity;
 };
 
-//! Runs the scan on the bench (its controller carrying the gains and A; the caller sets p to
-//! the identity) with the camera (configured, not started; its size the mask's). Throws
-//! core::InputError for params fringe_piston_scan_problem() refuses and for a camera whose frame
-//! size is not the mask's.
+//! Runs the scan on the stage (its controller carrying the gains and A; the caller sets p to
+//! the identity) with the camera (configured, not started; its size the mask's, or an empty mask
+//! for a pupil found in the reference frames, as the actuator scan's). Throws core::InputError
+//! for params fringe_piston_scan_problem() refuses and for a camera whose frame size is not the
+//! mask's.
+FringePistonScanResult run_fringe_piston_scan(ScanStage& stage, camera::Camera& camera,
+                                              const psi::Mask& mask,
+                                              const FringePistonScanParams& params);
+
+//! The same on the twin's bench (BenchScanStage).
 FringePistonScanResult run_fringe_piston_scan(rig::Bench& bench, camera::Camera& camera,
                                               const psi::Mask& mask,
                                               const FringePistonScanParams& params);

@@ -24,6 +24,7 @@
 // the rig only watches it. The destructor stops the loop through its ramp to 0 V and joins it.
 #include <atomic>
 #include <cstdint>
+#include <functional>
 #include <memory>
 #include <string>
 #include <thread>
@@ -81,6 +82,12 @@ class LoopRig final : public GuidedRig {
   const runtime::LoopStats& loop_stats() const { return loop_->stats(); }
   //! Seconds on the rig's clock of the last tick seen.
   double clock_s() const;
+  //! The last tick's sample the rig has taken.
+  const runtime::HostSample& last_sample() const { return last_; }
+  //! Runs the next `ticks` ticks from the loop's present one, handing each tick's sample to
+  //! `each` in tick order on the caller's thread as the rig takes it (a fringe scan's exposure:
+  //! instrument/loop_scan_stage.hpp). Returns early, as settle() does, when the loop ends.
+  void follow(std::uint64_t ticks, const std::function<void(const runtime::HostSample&)>& each);
 
  private:
   enum class Drive : std::uint8_t { kOpenLoop, kActuators, kPoints };
@@ -125,6 +132,10 @@ class LoopRig final : public GuidedRig {
   Vec3 window_sgs_V_{};
   Vec3 window_ifm_um_{};
   bool window_truth_ = true;
+  // The ticks follow() hands on (follow_ null: none).
+  const std::function<void(const runtime::HostSample&)>* follow_ = nullptr;
+  std::uint64_t follow_from_ = 0;
+  std::uint64_t follow_to_ = 0;  // one past the last
 };
 
 }  // namespace piezoshift::rig
