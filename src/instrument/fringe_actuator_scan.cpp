@@ -41,7 +41,7 @@ class Scan {
        const FringeActuatorScanParams& p, const std::function<void(const FringeScanPose&)>& at_pose)
       : stage_(stage), camera_(camera), mask_(mask), p_(p), at_pose_(at_pose) {
     if (mask.size() != 0)
-      tracker_.emplace(mask, tracker_params(mask));
+      tracker_.emplace(mask, tracker_params(mask, false));
   }
 
   bool ok() const { return r_.validity.valid; }
@@ -80,13 +80,13 @@ class Scan {
   }
 
  private:
-  psi::FringeTrackerParams tracker_params(const psi::Mask& mask) const {
+  psi::FringeTrackerParams tracker_params(const psi::Mask& mask, bool found) const {
     psi::FringeTrackerParams t = p_.tracker;
     t.window_frames = p_.reference_frames;
     t.wavelength_nm = p_.wavelength_nm;
     t.points = stage_.points();
     t.first_direction = +1;  // the reference ascends
-    if (mask_.size() == 0)   // a pupil found in the frames: its size on the plate is the given one
+    if (found)               // a pupil found in the frames: its size on the plate is the given one
       t.plate_m_per_px = p_.pupil_radius_m / psi::pupil_of(mask).radius_px;
     return t;
   }
@@ -127,7 +127,7 @@ class Scan {
       return false;
     }
     r_.pupil_from_modulation = true;
-    tracker_.emplace(mask_, tracker_params(mask_));
+    tracker_.emplace(mask_, tracker_params(mask_, true));
     return true;
   }
 
