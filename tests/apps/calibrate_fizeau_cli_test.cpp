@@ -5,6 +5,7 @@
 // twin's bench and on the real-time loop with the twin camera and Aravis's fake camera.
 #include <algorithm>
 #include <cmath>
+#include <cstdio>
 #include <filesystem>
 #include <string>
 #include <utility>
@@ -135,35 +136,63 @@ TEST_F(FizeauCalibrateCli, WritesTheCalibrationFileWithTheFizeauAsItsSource) {
             60.0);
 }
 
-// The stages on the real-time loop (rig::LoopRig, paced by the procedure: --free-run), the
-// twin's fringes seen by the twin camera and by Aravis's in-process fake camera, whose pupil is
-// found in the first scan's fringe modulation. 96 px frames (3.5 s a run): a size whose pupil
-// radius is not the tracker's default scale, so a pupil found but not scaled would show.
-TEST_F(FizeauCalibrateCli, TheStagesRunOnTheRealTimeLoopWithAravissFakeCamera) {
-  const std::string cfg = path("small16.toml");
-  {
-    std::FILE* f = std::fopen(cfg.c_str(), "w");
-    ASSERT_NE(f, nullptr);
-    // the fake camera has no Mono12
-    std::fputs("[camera]\nwidth_px = 96\nheight_px = 96\npixel_format = \"Mono16\"\n", f);
-    std::fclose(f);
-  }
-  const auto calibrate = [&](const std::string& camera, const std::string& file) {
+// The stages on the real-time loop, paced by the procedure (--free-run), with Aravis's
+// in-process fake camera shown the twin's fringes, on Mono16 frames (the fake has no Mono12) of
+// `size_px`: a run's JSON, or empty (the failure recorded) when it did not exit 0.
+class FizeauLoopCli : public FizeauCalibrateCli {
+ protected:
+  nlohmann::json calibrate(const std::string& camera, int size_px, const std::string& file) {
+    const std::string cfg = path("frames" + std::to_string(size_px) + ".toml");
+    if (!std::filesystem::exists(cfg)) {
+      std::FILE* f = std::fopen(cfg.c_str(), "w");
+      if (f == nullptr)
+        return {};
+      std::fprintf(f, "[camera]\nwidth_px = %d\nheight_px = %d\npixel_format = \"Mono16\"\n",
+                   size_px, size_px);
+      std::fclose(f);
+    }
     const CliResult r =
         run("calibrate --interferometer fizeau --daq sim-rt --free-run --camera " + camera +
             " --seed 1 --json --config '" + cfg + "' --out '" + file + "'");
     EXPECT_EQ(r.status, 0) << r.err;
     return r.status == 0 ? nlohmann::json::parse(r.out) : nlohmann::json{};
-  };
+  }
+};
+
+// Aravis's fake camera, its pupil found in the first scan's fringe modulation, on 64 px frames
+// (2.3 s; under the sanitizers about a minute): a size whose pupil radius is not the tracker's
+// default scale, so a pupil found but not scaled would show (it did: a tilt 2.7 times too large
+// at 96 px, whose A tripped the supervisor in stage 3).
+TEST_F(FizeauLoopCli, TheStagesRunOnTheRealTimeLoopWithAravissFakeCamera) {
+  const std::string file = path("fake.toml");
+  const nlohmann::json j = calibrate("aravis:Fake_1", 64, file);
+  ASSERT_FALSE(j.empty());
+  EXPECT_EQ(j.at("daq"), "sim-rt");
+  EXPECT_EQ(j.at("pupil_source"), "modulation");
+  EXPECT_EQ(j.at("frames"), 438);
+  EXPECT_GT(j.at("loop").at("ticks").get<double>(), 40000.0);  // 47.6 s of loop time
+  const piezoshift::control::SemiClosedLoopParams c =
+      piezoshift::calibration::load_calibration_file(file);
+  const piezoshift::control::TransmissionMatrix paper{};
+  for (std::size_t i = 0; i < 3; ++i)
+    for (std::size_t k = 0; k < 3; ++k)  // issue 29's band, the plant's A; measured 0.0014 worst
+      EXPECT_NEAR(c.matrix.a[i][k], paper.a[i][k], 0.002);
+  // Stage 3's datum is the gauges' reading of its first frame: stage 2 left the stacks 0.11 um
+  // above their zero (their remanence), which frame 0 as the datum would put into p0.
+  EXPECT_LT(std::fabs(c.polynomial.p0), 0.01);
+  const std::string text = read_text(file);
+  EXPECT_NE(text.find("--daq sim-rt --camera aravis:Fake_1"), std::string::npos) << text;
+  EXPECT_NE(text.find("pupil: found in the fringes' modulation"), std::string::npos) << text;
+}
+
+// The twin camera and Aravis's fake camera on the loop, 96 px frames (acceptance, 7 s): the same
+// pixels, the pupil the scene's or found, so the same A and p within the bands.
+TEST_F(FizeauLoopCli, TheTwinCameraAndAravissFakeCameraGiveTheSameCalibration) {
   const std::string twin_file = path("twin.toml"), fake_file = path("fake.toml");
-  const nlohmann::json twin = calibrate("twin", twin_file);
-  const nlohmann::json fake = calibrate("aravis:Fake_1", fake_file);
+  const nlohmann::json twin = calibrate("twin", 96, twin_file);
+  const nlohmann::json fake = calibrate("aravis:Fake_1", 96, fake_file);
   ASSERT_FALSE(twin.empty() || fake.empty());
-  EXPECT_EQ(twin.at("daq"), "sim-rt");
   EXPECT_EQ(twin.at("pupil_source"), "given");
-  EXPECT_EQ(fake.at("pupil_source"), "modulation");
-  EXPECT_EQ(fake.at("frames"), 438);
-  EXPECT_GT(fake.at("loop").at("ticks").get<double>(), 40000.0);  // 47.6 s of loop time
   const piezoshift::control::SemiClosedLoopParams t =
       piezoshift::calibration::load_calibration_file(twin_file);
   const piezoshift::control::SemiClosedLoopParams f =
@@ -171,25 +200,18 @@ TEST_F(FizeauCalibrateCli, TheStagesRunOnTheRealTimeLoopWithAravissFakeCamera) {
   const piezoshift::control::TransmissionMatrix paper{};
   for (std::size_t i = 0; i < 3; ++i)
     for (std::size_t k = 0; k < 3; ++k) {
-      // issue 29's band against the plant's A (the paper's); measured 0.00095 and 0.00106 worst
+      // issue 29's band against the plant's A; measured 0.00095 and 0.00106 worst, 0.0002 apart
       EXPECT_NEAR(t.matrix.a[i][k], paper.a[i][k], 0.002);
       EXPECT_NEAR(f.matrix.a[i][k], paper.a[i][k], 0.002);
     }
-  // The same p from either camera: the pixels are the same, the pupil found or the scene's
-  // (measured 0.00003 nm apart); 15 nm over the 11 um span, the band the bench's p is held to
-  // against the XL-80's.
+  // 15 nm over the 11 um span, the band the bench's p is held to against the XL-80's (measured
+  // 0.00003 nm apart)
   double worst_nm = 0.0;
   for (int k = 0; k <= 110; ++k)
     worst_nm =
         std::max(worst_nm, 1000.0 * std::fabs(t.polynomial(0.1 * k) - f.polynomial(0.1 * k)));
   EXPECT_LT(worst_nm, 15.0);
-  // Stage 3's datum is the gauges' reading of its first frame: stage 2 left the stacks 0.11 um
-  // above their zero (their remanence), which frame 0 as the datum would put into p0.
   EXPECT_LT(std::fabs(t.polynomial.p0), 0.01);
-  EXPECT_LT(std::fabs(f.polynomial.p0), 0.01);
-  const std::string text = read_text(fake_file);
-  EXPECT_NE(text.find("--daq sim-rt --camera aravis:Fake_1"), std::string::npos) << text;
-  EXPECT_NE(text.find("pupil: found in the fringes' modulation"), std::string::npos) << text;
 }
 
 }  // namespace
