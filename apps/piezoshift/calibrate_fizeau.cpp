@@ -22,9 +22,9 @@
 #include "piezoshift/instrument/loop_scan_stage.hpp"
 #include "piezoshift/plant/geometry.hpp"
 #include "piezoshift/psi/fizeau_simulation.hpp"
-#include "piezoshift/psi/png_image.hpp"
 #include "piezoshift/rig/validity.hpp"
 #include "progress_bar.hpp"
+#include "psi_options.hpp"
 
 namespace piezoshift::app {
 
@@ -173,11 +173,9 @@ void check_request(const FizeauCalibrateRequest& q) {
     throw core::InputError(
         "--pid search with --daq: the gain search scores the plate between the ticks, which a "
         "bench cannot see; the paper's gains are kept");
-  if (!loop && q.free_run)
-    throw core::InputError("--free-run needs --daq sim-rt");
   if (q.free_run && q.daq != "sim-rt")
-    throw core::InputError(
-        fmt::format("--free-run needs --daq sim-rt (--daq {} is hardware)", q.daq));
+    throw core::InputError(fmt::format("--free-run needs --daq sim-rt{}",
+                                       loop ? " (--daq " + q.daq + " is hardware)" : ""));
   if (!loop && !q.mask.empty())
     throw core::InputError("--mask: the twin's bench takes its scene's pupil (use --daq)");
 }
@@ -202,24 +200,19 @@ int fringes_on_loop(const FizeauCalibrateRequest& q, const camera::InstrumentCon
   if (spec == "twin") {
     optics = instrument::twin_optics(*scene);
   } else if (!q.mask.empty()) {
-    optics.mask = psi::read_mask_png(q.mask);
     const camera::CameraSettings& cs = cam->settings();
-    if (optics.mask.width != cs.width_px || optics.mask.height != cs.height_px)
-      throw core::InputError(fmt::format("{}: mask is {} x {} pixels, the camera's frames {} x {}",
-                                         q.mask, optics.mask.width, optics.mask.height, cs.width_px,
-                                         cs.height_px));
+    optics.mask = read_mask_of_size(q.mask, cs.width_px, cs.height_px, "the camera's frames");
     if (optics.mask.count() < 16)
       throw core::InputError(fmt::format("{}: the mask holds {} pixels (16 or more needed)", q.mask,
                                          optics.mask.count()));
-    optics.plate_m_per_px = optics.pupil_radius_m / psi::pupil_of(optics.mask).radius_px;
+    optics.plate_m_per_px = instrument::plate_m_per_px(optics.mask, optics.pupil_radius_m);
   }
   control::SemiClosedLoopParams base;
   base.sample_time_s = config.twin.daq.sample_time_s;
   LoopRigStack stack(
       {.daq = q.daq, .free_run = q.free_run, .seed = q.seed, .config_path = q.config},
       ic.installation, base);
-  instrument::LoopScanStage stage(stack.rig(), plant::make_twin_geometry(config.twin.geometry),
-                                  1.0 / base.sample_time_s);
+  instrument::LoopScanStage stage(stack.rig(), plant::make_twin_geometry(config.twin.geometry));
   instrument::FringeCalibrationOutcome r;
   {
     ProgressBar bar(3);

@@ -36,7 +36,6 @@
 #include "piezoshift/instrument/twin_floor.hpp"
 #include "piezoshift/psi/analysis.hpp"
 #include "piezoshift/psi/fizeau_simulation.hpp"
-#include "piezoshift/psi/png_image.hpp"
 #include "piezoshift/rig/validity.hpp"
 #include "piezoshift/runtime/control_loop.hpp"
 #include "piezoshift/runtime/safety_ranges.hpp"
@@ -175,12 +174,8 @@ instrument::LockSetup lock_setup(const MeasureOptions& o, const MeasureSetup& s,
   if (s.scene && o.camera == "twin") {
     mask = s.scene->mask;
   } else if (!o.mask.empty()) {
-    mask = psi::read_mask_png(o.mask);
     const camera::CameraSettings& cs = s.config.camera.settings;
-    if (mask.width != cs.width_px || mask.height != cs.height_px)
-      throw core::InputError(fmt::format("{}: mask is {} x {} pixels, the camera's frames {} x {}",
-                                         o.mask, mask.width, mask.height, cs.width_px,
-                                         cs.height_px));
+    mask = read_mask_of_size(o.mask, cs.width_px, cs.height_px, "the camera's frames");
   }
   return instrument::measurement_lock_setup(std::move(mask), s.config.camera.pupil_radius_m,
                                             s.config.installation.project.twin.geometry,

@@ -4,6 +4,7 @@
 #include <cstddef>
 #include <span>
 #include <string>
+#include <string_view>
 #include <vector>
 
 #include <nlohmann/json.hpp>
@@ -13,6 +14,10 @@
 
 namespace piezoshift::app {
 
+//! The mask PNG at path; InputError naming it when it is not width_px x height_px (`of`: what
+//! must have that size, "the frames", "the camera's frames").
+psi::Mask read_mask_of_size(const std::string& path, int width_px, int height_px,
+                            std::string_view of);
 //! "0,1.5,3.1" as numbers; InputError naming option and the item that is not one.
 std::vector<double> parse_list(const std::string& text, const std::string& option);
 //! The pupil: the mask PNG at path (of the frames' size), else found from the frames' fringe

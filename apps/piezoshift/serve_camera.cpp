@@ -270,9 +270,8 @@ void ServeCamera::preview(const std::vector<instrument::LoopSample>& batch) {
       origin_ = s.pose;
       have_origin_ = true;
     }
-    camera_->observe_plate({s.t_s, s.pose.piston_nm - origin_.piston_nm,
-                            s.pose.theta_x_urad - origin_.theta_x_urad,
-                            s.pose.theta_y_urad - origin_.theta_y_urad});
+    camera_->observe_plate(camera::relative_to(
+        {s.t_s, s.pose.piston_nm, s.pose.theta_x_urad, s.pose.theta_y_urad}, origin_));
     last_t_s_ = s.t_s;
   }
   take_preview_frames();

@@ -17,9 +17,7 @@ camera::PlatePose BenchScanStage::raw_pose() const {
 }
 
 camera::PlatePose BenchScanStage::plate_pose() const {
-  const camera::PlatePose r = raw_pose();
-  return {r.time_s, r.piston_nm - origin_.piston_nm, r.theta_x_urad - origin_.theta_x_urad,
-          r.theta_y_urad - origin_.theta_y_urad};
+  return camera::relative_to(raw_pose(), origin_);
 }
 
 std::string BenchScanStage::expose(camera::Camera& camera, double exposure_s, ScanExposure& e) {

@@ -87,7 +87,7 @@ class Scan {
     t.points = stage_.points();
     t.first_direction = +1;  // the reference ascends
     if (found)               // a pupil found in the frames: its size on the plate is the given one
-      t.plate_m_per_px = p_.pupil_radius_m / psi::pupil_of(mask).radius_px;
+      t.plate_m_per_px = plate_m_per_px(mask, p_.pupil_radius_m);
     return t;
   }
 
@@ -206,6 +206,10 @@ std::string fringe_actuator_scan_problem(const FringeActuatorScanParams& p) {
   if (p.base_um - (p.reference_frames - 1) * p.reference_step_um < 0.0)
     return "base_um must leave room below it for the reference's steps";
   return "";
+}
+
+double plate_m_per_px(const psi::Mask& mask, double pupil_radius_m) {
+  return pupil_radius_m / psi::pupil_of(mask).radius_px;
 }
 
 double pupil_step_nm(const std::array<kinematics::PlatePoint, 3>& actuators, std::size_t i,

@@ -46,7 +46,7 @@ bool stage2(ScanStage& stage, camera::Camera& camera, FringeOptics& optics,
     r = run_fringe_actuator_scan(stage, camera, optics.mask, p);
     if (r.pupil_from_modulation) {
       optics.mask = r.pupil;
-      optics.plate_m_per_px = optics.pupil_radius_m / psi::pupil_of(r.pupil).radius_px;
+      optics.plate_m_per_px = plate_m_per_px(r.pupil, optics.pupil_radius_m);
       out.pupil_from_modulation = true;
     }
     if (!r.validity.valid) {

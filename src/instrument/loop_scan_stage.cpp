@@ -6,8 +6,7 @@
 namespace piezoshift::instrument {
 
 camera::PlatePose LoopScanStage::pose_of(const runtime::HostSample& h) const {
-  const kinematics::PlatePose q = kinematics::TripodGeometry(geometry_.points)
-                                      .forward({h.truth_um[0], h.truth_um[1], h.truth_um[2]});
+  const kinematics::PlatePose q = points_.forward({h.truth_um[0], h.truth_um[1], h.truth_um[2]});
   return {h.t_s, 1000.0 * q.z_um + h.fringe_drift_nm, q.theta_x_urad, q.theta_y_urad};
 }
 
@@ -20,8 +19,8 @@ std::string LoopScanStage::expose(camera::Camera& camera, double exposure_s, Sca
   const control::SemiClosedLoopParams params = rig_.controller();
   e.saturated_mask = rig_.last_sample().saturated_mask;
   // As the bench: the exposure's start and then each of its ticks (the last one at or past its end)
-  const auto ticks =
-      static_cast<std::uint64_t>(std::max(1.0, std::ceil(exposure_s * rate_Hz_ - 1e-6)));
+  const auto ticks = static_cast<std::uint64_t>(
+      std::max(1.0, std::ceil(exposure_s / params.sample_time_s - 1e-6)));
   std::string refused;
   std::uint64_t n = 0;
   control::Vec3 sgs{}, truth{};
@@ -37,10 +36,7 @@ std::string LoopScanStage::expose(camera::Camera& camera, double exposure_s, Sca
     }
     e.has_truth = e.has_truth && h.has_truth != 0;
     if (h.has_truth != 0) {
-      const camera::PlatePose p = pose_of(h);
-      camera.observe_plate({p.time_s, p.piston_nm - origin_.piston_nm,
-                            p.theta_x_urad - origin_.theta_x_urad,
-                            p.theta_y_urad - origin_.theta_y_urad});
+      camera.observe_plate(camera::relative_to(pose_of(h), origin_));
       for (std::size_t j = 0; j < 3; ++j)
         truth[j] += h.truth_um[j];
     }

@@ -60,8 +60,7 @@ void SampleSequence::command(double z_um) {
 camera::PlatePose SampleSequence::relative(const LoopSample& s) const {
   if (!s.has_truth)
     return {s.t_s, 0.0, 0.0, 0.0};
-  return {s.t_s, s.pose.piston_nm - origin_.piston_nm, s.pose.theta_x_urad - origin_.theta_x_urad,
-          s.pose.theta_y_urad - origin_.theta_y_urad};
+  return camera::relative_to(s.pose, origin_);
 }
 
 std::string SampleSequence::moved_away(const LoopSample& s) const {

@@ -84,11 +84,7 @@ class Runner {
     return {now_s(), twin_->fringe_piston_nm(), t.theta_x_urad, t.theta_y_urad};
   }
 
-  camera::PlatePose pose() const {
-    const camera::PlatePose r = raw_pose();
-    return {r.time_s, r.piston_nm - origin_.piston_nm, r.theta_x_urad - origin_.theta_x_urad,
-            r.theta_y_urad - origin_.theta_y_urad};
-  }
+  camera::PlatePose pose() const { return camera::relative_to(raw_pose(), origin_); }
 
   // One loop tick, then the plate's pose to the camera and any frame that has arrived.
   bool tick() {

@@ -145,10 +145,18 @@ void LoopRig::wait(Done done, std::uint64_t horizon_tick) {
   }
 }
 
-void LoopRig::catch_up() {
+bool LoopRig::take_waiting() {
   runtime::HostSample h;
-  while (link_.samples.try_pop(h))
+  bool waiting = false;
+  while (link_.samples.try_pop(h)) {
     take(h);
+    waiting = true;
+  }
+  return waiting;
+}
+
+void LoopRig::catch_up() {
+  take_waiting();
   const std::uint64_t after = next_tick();
   wait([&] { return seen_any_ && last_.tick >= after; }, after);
 }
@@ -203,13 +211,7 @@ void LoopRig::settle(double duration_s) {
 void LoopRig::follow(std::uint64_t ticks,
                      const std::function<void(const runtime::HostSample&)>& each) {
   // Samples waiting in the ring may be old ones (as measure()): after them, the present tick.
-  runtime::HostSample h;
-  bool waiting = false;
-  while (link_.samples.try_pop(h)) {
-    take(h);
-    waiting = true;
-  }
-  if (waiting || !seen_any_)
+  if (take_waiting() || !seen_any_)
     catch_up();
   follow_from_ = next_tick();
   follow_to_ = follow_from_ + ticks;
@@ -241,13 +243,7 @@ void LoopRig::rest(double settle_s) {
 RigWindow LoopRig::measure() {
   // Samples waiting in the ring may be old ones (a ring that overflowed keeps its oldest): after
   // them, the loop's present tick. A paced loop leaves none.
-  runtime::HostSample h;
-  bool waiting = false;
-  while (link_.samples.try_pop(h)) {
-    take(h);
-    waiting = true;
-  }
-  if (waiting)
+  if (take_waiting())
     catch_up();
   window_ticks_ = std::max<std::uint64_t>(1, ticks_of(options_.window_s));
   window_n_ = 0;

@@ -31,7 +31,7 @@ TEST(LoopScanStage, AnExposureFollowsTheLoopsNextTicksAndSaysWhenTheCameraRefuse
   rig::LoopRigOptions lo;
   lo.request_realtime = false;
   rig::LoopRig rig(sim, clock, &clock, params, runtime::SafetyLimits{}, lo);
-  LoopScanStage stage(rig, plant::make_twin_geometry(config.twin.geometry), 1000.0);
+  LoopScanStage stage(rig, plant::make_twin_geometry(config.twin.geometry));
   stage.drive_actuators({2.0, 2.0, 2.0});
   stage.settle(0.3);
   ASSERT_EQ(stage.fault(), "");

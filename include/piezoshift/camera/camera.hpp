@@ -42,6 +42,13 @@ struct PlatePose {
   double theta_y_urad = 0.0;  //!< tilt about y
 };
 
+//! pose from origin (piston, tip and tilt each less origin's), at pose's time: what the twin
+//! camera renders, relative to the pose its measurement or scan started at.
+constexpr PlatePose relative_to(const PlatePose& pose, const PlatePose& origin) noexcept {
+  return {pose.time_s, pose.piston_nm - origin.piston_nm, pose.theta_x_urad - origin.theta_x_urad,
+          pose.theta_y_urad - origin.theta_y_urad};
+}
+
 class Camera {
  public:
   virtual ~Camera() = default;

@@ -29,8 +29,6 @@ class BenchScanStage final : public ScanStage {
     return bench_.twin().model().geometry.points;
   }
 
-  rig::Bench& bench() { return bench_; }
-
  private:
   camera::PlatePose raw_pose() const;
   camera::PlatePose plate_pose() const;

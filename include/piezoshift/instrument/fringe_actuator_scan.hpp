@@ -87,6 +87,10 @@ struct FringeActuatorScanResult {
 double pupil_step_nm(const std::array<kinematics::PlatePoint, 3>& actuators, std::size_t i,
                      double leg_um, double pupil_radius_m);
 
+//! The tracker's plate_m_per_px for a pupil of radius pupil_radius_m on the plate imaged as mask
+//! (its radius in pixels: psi::pupil_of). std::invalid_argument for an empty mask.
+double plate_m_per_px(const psi::Mask& mask, double pupil_radius_m);
+
 //! Stage 2's pose (matrix_identification.hpp) from a scan: its last pose against its base, dS
 //! from the gauges over the two exposures, dZ from the fringes [um]. The three actuators' poses
 //! give A through calibration::fit_transmission_matrix. std::invalid_argument for a scan that

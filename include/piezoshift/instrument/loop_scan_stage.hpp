@@ -18,9 +18,9 @@ namespace piezoshift::instrument {
 
 class LoopScanStage final : public ScanStage {
  public:
-  //! geometry: the installation's ([twin.geometry]); rate_Hz: the loop's.
-  LoopScanStage(rig::LoopRig& rig, const plant::TwinGeometry& geometry, double rate_Hz)
-      : rig_(rig), geometry_(geometry), rate_Hz_(rate_Hz) {}
+  //! geometry: the installation's ([twin.geometry]).
+  LoopScanStage(rig::LoopRig& rig, const plant::TwinGeometry& geometry)
+      : rig_(rig), geometry_(geometry), points_(geometry.points) {}
 
   void set_controller(const control::SemiClosedLoopParams& params) override {
     rig_.set_controller(params);
@@ -45,7 +45,7 @@ class LoopScanStage final : public ScanStage {
 
   rig::LoopRig& rig_;
   plant::TwinGeometry geometry_;
-  double rate_Hz_;
+  kinematics::TripodGeometry points_;  // P1..P3 -> the plate's pose
   camera::PlatePose origin_{};
 };
 

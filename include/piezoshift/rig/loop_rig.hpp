@@ -100,6 +100,8 @@ class LoopRig final : public GuidedRig {
   //! Takes whatever the ring holds, then waits for one more sample: the loop's present tick
   //! (a ring that a long prompt let overflow holds old ones).
   void catch_up();
+  //! Takes the samples waiting in the ring (old ones, when it overflowed); true when there were.
+  bool take_waiting();
   void take(const runtime::HostSample& h);
   std::uint64_t next_tick() const { return seen_any_ ? last_.tick + 1 : 0; }
   std::uint64_t ticks_of(double duration_s) const;
