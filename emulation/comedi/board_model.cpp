@@ -31,32 +31,36 @@ std::optional<BoardModel> ni_m_series_board(std::string_view name) {
     return std::nullopt;
   BoardModel b;
   b.name = std::string(name);
-  const comedi_range digital{0.0, 5.0, UNIT_volt};
-  // ni_E_init: AI flags SDF_READABLE | SDF_DIFF | SDF_DITHER | SDF_GROUND | SDF_COMMON |
-  // SDF_OTHER, and SDF_SOFT_CALIBRATED on M Series; the command flag needs an IRQ (a PCI board
-  // has one).
+  // range_digital and range_unknown (comedi's core gives a used subdevice without a range table
+  // the latter): both [0, 1] V. An unused subdevice has no ranges.
+  const comedi_range unit{0.0, 1.0, UNIT_volt};
+  // ni_E_init. The command flags (SDF_CMD_READ on AI, SDF_CMD_WRITE on AO and DIO) and their
+  // do_cmd handlers exist only when the board got its interrupt line (dev->irq); the emulation
+  // is the board attached without one, so no subdevice takes commands (docs/runtime.md).
   const int ai_flags = SDF_READABLE | SDF_DIFF | SDF_DITHER | SDF_GROUND | SDF_COMMON | SDF_OTHER |
-                       SDF_SOFT_CALIBRATED | SDF_CMD_READ;
-  const int ao_flags =
-      SDF_WRITABLE | SDF_DEGLITCH | SDF_GROUND | SDF_SOFT_CALIBRATED | SDF_CMD_WRITE;
+                       SDF_SOFT_CALIBRATED;
+  const int ao_flags = SDF_WRITABLE | SDF_DEGLITCH | SDF_GROUND | SDF_SOFT_CALIBRATED;
+  const int rw_internal = SDF_READABLE | SDF_WRITABLE | SDF_INTERNAL;
   b.subdevices = {
       subdevice(COMEDI_SUBD_AI, ai_flags, b6229 ? 32 : 16, 0xffff,
                 {volts(-10, 10), volts(-5, 5), volts(-1, 1), volts(-0.2, 0.2)}),
       b6229 ? subdevice(COMEDI_SUBD_AO, ao_flags, 4, 0xffff, {volts(-10, 10)})
             : subdevice(COMEDI_SUBD_UNUSED, 0, 0, 0),
       subdevice(COMEDI_SUBD_DIO, SDF_READABLE | SDF_WRITABLE | SDF_LSAMPL, b6229 ? 32 : 8, 1,
-                {digital}),
+                {unit}),
       subdevice(COMEDI_SUBD_UNUSED, 0, 0, 0),  // 8255: none on M Series
       subdevice(COMEDI_SUBD_UNUSED, 0, 0, 0),
-      subdevice(COMEDI_SUBD_CALIB, SDF_INTERNAL, 1, 0),
-      subdevice(COMEDI_SUBD_MEMORY, SDF_READABLE | SDF_INTERNAL, 1024, 0xff),
-      subdevice(COMEDI_SUBD_DIO, SDF_READABLE | SDF_WRITABLE | SDF_INTERNAL, 16, 1, {digital}),
-      subdevice(COMEDI_SUBD_UNUSED, 0, 0, 0),  // CS5529: 67xx only
-      subdevice(COMEDI_SUBD_SERIAL, SDF_READABLE | SDF_WRITABLE | SDF_INTERNAL, 1, 0xff),
-      subdevice(COMEDI_SUBD_DIO, SDF_READABLE | SDF_WRITABLE | SDF_INTERNAL, 8, 1, {digital}),
-      subdevice(COMEDI_SUBD_COUNTER, SDF_READABLE | SDF_WRITABLE | SDF_LSAMPL, 3, 0xffffffff),
-      subdevice(COMEDI_SUBD_COUNTER, SDF_READABLE | SDF_WRITABLE | SDF_LSAMPL, 3, 0xffffffff),
-      subdevice(COMEDI_SUBD_COUNTER, SDF_READABLE | SDF_WRITABLE, 1, 0xf),
+      subdevice(COMEDI_SUBD_CALIB, SDF_INTERNAL, 1, 0, {unit}),
+      subdevice(COMEDI_SUBD_MEMORY, SDF_READABLE | SDF_INTERNAL, 1024, 0xff, {unit}),
+      subdevice(COMEDI_SUBD_DIO, rw_internal, 16, 1, {unit}),  // PFI
+      subdevice(COMEDI_SUBD_UNUSED, 0, 0, 0),                  // CS5529: 67xx only
+      subdevice(COMEDI_SUBD_SERIAL, rw_internal, 1, 0xff, {unit}),
+      subdevice(COMEDI_SUBD_DIO, rw_internal, 8, 1, {unit}),  // RTSI
+      subdevice(COMEDI_SUBD_COUNTER, SDF_READABLE | SDF_WRITABLE | SDF_LSAMPL, 3, 0xffffffff,
+                {unit}),
+      subdevice(COMEDI_SUBD_COUNTER, SDF_READABLE | SDF_WRITABLE | SDF_LSAMPL, 3, 0xffffffff,
+                {unit}),
+      subdevice(COMEDI_SUBD_COUNTER, SDF_READABLE | SDF_WRITABLE, 1, 0xf, {unit}),  // freq out
   };
   return b;
 }

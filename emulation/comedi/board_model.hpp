@@ -10,7 +10,10 @@
 //     11 and 12 counters (3 channels, 32 bit), 13 frequency output.
 //   - PCI-6229: 32 AI, 16 bit (maxdata 0xffff), ranges +-10, +-5, +-1, +-0.2 V; 4 AO, 16 bit,
 //     +-10 V only; 32 DIO lines on port 0. AI and AO are SDF_SOFT_CALIBRATED (M Series: the raw
-//     codes are converted by polynomials that comedi_soft_calibrate writes to a file).
+//     codes are converted by polynomials that comedi_soft_calibrate writes to a file). Digital
+//     lines and the subdevices without a range table read [0, 1] V (range_digital,
+//     range_unknown).
+//   - No interrupt line: the driver then gives no subdevice a command handler (no SDF_CMD_*).
 //   - PCI-6220: the same AI (16 channels), no AO (subdevice 1 is COMEDI_SUBD_UNUSED), 8 DIO lines:
 //     the board a lab may have in the slot instead, so a client must find the AO missing.
 //

@@ -1,38 +1,33 @@
-// libcomedi's C API (comedilib.h, Comedilib's reference manual) over the emulated board: the
-// functions piezoshift's Comedi backend calls and the common ones around them, each returning
-// what the manual documents (-1 or NULL with comedi_errno() set on failure). Built as
-// libcomedi.so.0 with libcomedi's symbol versions (libcomedi.map), so the unchanged piezoshift
-// program loads it in place of Debian's libcomedi0 when LD_LIBRARY_PATH names its folder.
-// Functions not listed here are absent: a client calling one fails to load, never silently.
+// libcomedi's C API (comedilib.h, Comedilib's reference manual) over the emulated board: opening
+// and closing, errors, the device's and subdevices' description, instructions, and the one-sample
+// reads and writes. Built as libcomedi.so.0 with every symbol of libcomedi 0.11 at its symbol
+// version (libcomedi.map), so any Comedi program loads it in place of Debian's libcomedi0 when
+// LD_LIBRARY_PATH names its folder. Each function returns what the manual documents, failing
+// where libcomedi or the kernel's ni_pcimio driver would, with the same error codes
+// (api_handle.hpp). The other functions: comedilib_calibration.cpp, comedilib_async.cpp
+// (commands, buffers, locks), comedilib_config.cpp (configuration instructions, conversions).
 #include <comedilib.h>
+#include <fcntl.h>
+#include <unistd.h>
 
+#include <algorithm>
 #include <cerrno>
-#include <cmath>
 #include <cstdio>
 #include <cstdlib>
 #include <cstring>
-#include <map>
-#include <memory>
-#include <mutex>
+#include <iterator>
 #include <string>
-#include <vector>
 
 #include <fmt/core.h>
 
-#include "emulated_board.hpp"
+#include "api_handle.hpp"
 
-struct comedi_t_struct {
-  std::unique_ptr<piezoshift::emulation::EmulatedBoard> board;
-  std::string calibration_path;
-};
+namespace piezoshift::emulation::api {
 
 namespace {
-
-using piezoshift::emulation::BoardModel;
-using piezoshift::emulation::EmulatedBoard;
-using piezoshift::emulation::SubdeviceModel;
-
-thread_local int last_error = 0;
+thread_local int last_error = 0;  // comedi_errno(): per thread, as libcomedi's
+int log_level = 1;                // comedi_loglevel(); COMEDILIB_LOGLEVEL sets it at open
+}  // namespace
 
 int fail(int error) {
   last_error = error;
@@ -40,25 +35,92 @@ int fail(int error) {
   return -1;
 }
 
-// The calibrations comedi_parse_calibration_file() hands out, by the default path of the board
-// that was opened (the emulation reads no calibration file: the board's polynomials are known).
-struct CalibrationStore {
-  std::mutex mutex;
-  std::map<std::string, BoardModel> boards;  // default calibration path -> its board
-  std::map<const comedi_calibration_t*, std::shared_ptr<void>> owned;
-};
-CalibrationStore& store() {
-  static CalibrationStore s;
-  return s;
+int fail_internal(int error) {
+  last_error = error;
+  if (log_level >= 2)
+    comedi_perror("internal error");
+  return -1;
 }
 
-const SubdeviceModel* subdevice(comedi_t* it, unsigned subd) {
-  if (it == nullptr || subd >= it->board->model().subdevices.size()) {
-    fail(EINVAL);
-    return nullptr;
-  }
-  return &it->board->model().subdevices[subd];
+int fail_from_errno() {
+  last_error = errno;
+  return -1;
 }
+
+int current_error() {
+  return last_error;
+}
+
+int set_log_level(int level) {
+  const int old = log_level;
+  log_level = level;
+  return old;
+}
+
+int current_log_level() {
+  return log_level;
+}
+
+bool valid_dev(const comedi_t* it) {
+  if (it == nullptr || it->magic != comedi_t_struct::kMagic) {
+    fail_internal(EBAD_CT);
+    return false;
+  }
+  return true;
+}
+
+bool valid_subd(const comedi_t* it, unsigned subd) {
+  if (!valid_dev(it))
+    return false;
+  if (subd >= it->board->model().subdevices.size()) {
+    fail_internal(EINVAL_SUBD);
+    return false;
+  }
+  return true;
+}
+
+bool valid_chan(const comedi_t* it, unsigned subd, unsigned chan) {
+  if (!valid_subd(it, subd))
+    return false;
+  if (chan >= model_of(it, subd).n_chan) {
+    fail_internal(EINVAL_CHAN);
+    return false;
+  }
+  return true;
+}
+
+const SubdeviceModel& model_of(const comedi_t* it, unsigned subd) {
+  return it->board->model().subdevices[subd];
+}
+
+int do_insn(comedi_t* it, comedi_insn& insn) {
+  // COMEDI_INSN: more than the kernel's MAX_SAMPLES are cut to it rather than refused.
+  if (insn.n > EmulatedBoard::kMaxSamples)
+    insn.n = EmulatedBoard::kMaxSamples;
+  comedi_insnlist one{1, &insn};
+  if (it->board->do_insnlist(one) < 0)
+    return fail_from_errno();
+  return static_cast<int>(insn.n);
+}
+
+int config(comedi_t* it, unsigned subd, unsigned chanspec, lsampl_t* data, unsigned n) {
+  if (!valid_dev(it))
+    return -1;
+  comedi_insn insn{};
+  insn.insn = INSN_CONFIG;
+  insn.subdev = subd;
+  insn.chanspec = chanspec;
+  insn.n = n;
+  insn.data = data;
+  return do_insn(it, insn) < 0 ? -1 : 0;
+}
+
+}  // namespace piezoshift::emulation::api
+
+namespace {
+
+using piezoshift::emulation::SubdeviceModel;
+using namespace piezoshift::emulation::api;
 
 // The minor number of /dev/comediN, for the calibration file's name.
 std::string minor_of(const std::string& device) {
@@ -68,81 +130,43 @@ std::string minor_of(const std::string& device) {
   return i < device.size() ? device.substr(i) : "0";
 }
 
-struct OwnedCalibration {
-  comedi_calibration_t calibration{};
-  std::vector<comedi_calibration_setting_t> settings;
-  std::vector<unsigned> numbers;  // channels and ranges, one each per setting
-  std::vector<comedi_polynomial_t> polynomials;
-  std::string driver, board;
-};
-
-std::shared_ptr<OwnedCalibration> make_calibration(const BoardModel& b) {
-  auto c = std::make_shared<OwnedCalibration>();
-  c->driver = b.driver;
-  c->board = b.name;
-  std::size_t n = 0;
-  for (unsigned sub : {piezoshift::emulation::kAiSubdevice, piezoshift::emulation::kAoSubdevice})
-    if (b.subdevices[sub].type != COMEDI_SUBD_UNUSED)
-      n += b.subdevices[sub].n_chan * b.subdevices[sub].ranges.size();
-  c->settings.resize(n);
-  c->numbers.resize(2 * n);
-  c->polynomials.resize(n);
-  std::size_t k = 0;
-  for (unsigned sub : {piezoshift::emulation::kAiSubdevice, piezoshift::emulation::kAoSubdevice}) {
-    const SubdeviceModel& s = b.subdevices[sub];
-    if (s.type == COMEDI_SUBD_UNUSED)
-      continue;
-    for (unsigned ch = 0; ch < s.n_chan; ++ch) {
-      for (unsigned r = 0; r < s.ranges.size(); ++r, ++k) {
-        const auto raw = sub == piezoshift::emulation::kAiSubdevice ? b.ai_raw(ch) : b.ao_raw(ch);
-        comedi_calibration_setting_t& set = c->settings[k];
-        set.subdevice = sub;
-        c->numbers[2 * k] = ch;
-        c->numbers[2 * k + 1] = r;
-        set.channels = &c->numbers[2 * k];
-        set.num_channels = 1;
-        set.ranges = &c->numbers[2 * k + 1];
-        set.num_ranges = 1;
-        // An AI setting converts codes to volts, an AO setting volts to codes (M Series).
-        comedi_polynomial_t& p = c->polynomials[k];
-        if (sub == piezoshift::emulation::kAiSubdevice) {
-          p = piezoshift::emulation::to_physical_polynomial(s.ranges[r], s.maxdata, raw);
-          set.soft_calibration.to_phys = &p;
-        } else {
-          p = piezoshift::emulation::from_physical_polynomial(s.ranges[r], s.maxdata, raw);
-          set.soft_calibration.from_phys = &p;
-        }
-      }
-    }
-  }
-  c->calibration.driver_name = c->driver.data();
-  c->calibration.board_name = c->board.data();
-  c->calibration.settings = c->settings.data();
-  c->calibration.num_settings = static_cast<unsigned>(n);
-  return c;
+// The descriptor comedi_fileno() returns (api_handle.hpp): the read end of a pipe whose write
+// end is closed.
+int end_of_data_fd() {
+  int ends[2] = {-1, -1};
+  if (pipe2(ends, O_CLOEXEC) != 0)
+    return -1;
+  close(ends[1]);
+  return ends[0];
 }
 
-double polynomial(double x, const comedi_polynomial_t& p) {
-  double sum = 0.0;
-  double term = 1.0;
-  for (unsigned i = 0; i <= p.order && i < COMEDI_MAX_NUM_POLYNOMIAL_COEFFICIENTS; ++i) {
-    sum += p.coefficients[i] * term;
-    term *= x - p.expansion_origin;
-  }
-  return sum;
-}
+// libcomedi's messages for its own codes (COMEDI_NOERROR + 0..8), in comedi_errno.h's order.
+constexpr const char* kLibraryErrors[] = {
+    "No error",          "Unknown error",         "Bad comedi_t structure",
+    "Invalid subdevice", "Invalid channel",       "Buffer overflow",
+    "Buffer underflow",  "Command not supported", "Not supported"};
 
 }  // namespace
+
+// libcomedi 0.7.18's comedi_get_subdevice_flags: the flags read when the device was opened.
+extern "C" int piezoshift_comedi_get_subdevice_flags_v0_7_18(comedi_t* it, unsigned int subd);
+__asm__(".symver piezoshift_comedi_get_subdevice_flags_v0_7_18,comedi_get_subdevice_flags@v0.7.18");
 
 extern "C" {
 
 comedi_t* comedi_open(const char* fn) {
   using namespace piezoshift::emulation;
+  static const bool from_environment = [] {
+    if (const char* level = std::getenv("COMEDILIB_LOGLEVEL"))
+      set_log_level(static_cast<int>(std::strtol(level, nullptr, 0)));
+    return true;
+  }();
+  (void)from_environment;
   const char* file = std::getenv("PIEZOSHIFT_COMEDI_EMULATION");
   try {
     EmulationSettings settings = load_emulation_settings(file);
     if (fn == nullptr || settings.device != fn) {
-      fail(ENOENT);  // the one device this emulation has is settings.device
+      fail(ENOENT);  // open(2) of a path with no device: the one device is settings.device
       return nullptr;
     }
     auto model = ni_m_series_board(settings.model);
@@ -151,11 +175,15 @@ comedi_t* comedi_open(const char* fn) {
     auto it = std::make_unique<comedi_t_struct>();
     it->calibration_path = fmt::format("/var/lib/comedi/calibrations/{}_{}_comedi{}", model->driver,
                                        model->name, minor_of(settings.device));
+    it->locked.assign(model->subdevices.size(), false);
     const bool calibrated = settings.calibrated;
     it->board = std::make_unique<EmulatedBoard>(std::move(settings), *model);
-    if (calibrated) {
-      const std::lock_guard lock(store().mutex);
-      store().boards.insert_or_assign(it->calibration_path, *model);
+    if (calibrated)
+      register_calibration(it->calibration_path, *model);
+    it->fd = end_of_data_fd();
+    if (it->fd < 0) {
+      fail(errno);
+      return nullptr;
     }
     return it.release();
   } catch (const std::exception& e) {
@@ -167,257 +195,226 @@ comedi_t* comedi_open(const char* fn) {
 }
 
 int comedi_close(comedi_t* it) {
-  if (it == nullptr)
-    return fail(EINVAL);
+  if (!valid_dev(it))
+    return -1;
+  it->magic = 0;
   it->board->write_records();
+  close(it->fd);
   delete it;
   return 0;
 }
 
+int comedi_loglevel(int loglevel) {
+  return set_log_level(loglevel);
+}
+
 int comedi_errno(void) {
-  return last_error;
+  return current_error();
 }
 
 const char* comedi_strerror(int errnum) {
-  return std::strerror(errnum);
+  const int i = errnum - COMEDI_NOERROR;
+  if (i < 0 || i >= static_cast<int>(std::size(kLibraryErrors)))
+    return std::strerror(errnum);
+  return kLibraryErrors[i];
 }
 
 void comedi_perror(const char* s) {
-  std::fprintf(stderr, "%s: %s\n", s != nullptr ? s : "", std::strerror(last_error));
+  if (current_log_level() >= 3)
+    std::fprintf(stderr, "comedi_perror(): __comedi_errno=%d\n", current_error());
+  std::fprintf(stderr, "%s: %s\n", s != nullptr ? s : "comedilib",
+               comedi_strerror(current_error()));
 }
 
 int comedi_get_version_code(comedi_t* it) {
-  if (it == nullptr)
-    return fail(EINVAL);
-  return (0 << 16) | (7 << 8) | 76;  // comedi 0.7.76, as current kernels report
+  if (!valid_dev(it))
+    return -1;
+  return COMEDI_VERSION_CODE(0, 7, 76);  // the kernel's comedi core reports 0.7.76
 }
 
 const char* comedi_get_driver_name(comedi_t* it) {
-  return it != nullptr ? it->board->model().driver.c_str() : nullptr;
+  return valid_dev(it) ? it->board->model().driver.c_str() : nullptr;
 }
 
 const char* comedi_get_board_name(comedi_t* it) {
-  return it != nullptr ? it->board->model().name.c_str() : nullptr;
+  return valid_dev(it) ? it->board->model().name.c_str() : nullptr;
 }
 
 int comedi_get_n_subdevices(comedi_t* it) {
-  if (it == nullptr)
-    return fail(EINVAL);
-  return static_cast<int>(it->board->model().subdevices.size());
+  return valid_dev(it) ? static_cast<int>(it->board->model().subdevices.size()) : -1;
 }
 
 int comedi_get_subdevice_type(comedi_t* it, unsigned int subd) {
-  const SubdeviceModel* s = subdevice(it, subd);
-  return s != nullptr ? s->type : -1;
+  return valid_subd(it, subd) ? model_of(it, subd).type : -1;
 }
 
 int comedi_find_subdevice_by_type(comedi_t* it, int type, unsigned int subd) {
-  if (it == nullptr)
-    return fail(EINVAL);
+  if (!valid_subd(it, subd))
+    return -1;
   const auto& subs = it->board->model().subdevices;
   for (unsigned i = subd; i < subs.size(); ++i)
     if (subs[i].type == type)
       return static_cast<int>(i);
-  return fail(ENODEV);
+  return -1;  // none: no error code, as libcomedi
 }
 
-int comedi_get_subdevice_flags(comedi_t* it, unsigned int subdevice_index) {
-  const SubdeviceModel* s = subdevice(it, subdevice_index);
-  return s != nullptr ? s->flags : -1;
+int comedi_get_subdevice_flags(comedi_t* it, unsigned int subd) {
+  // COMEDI_SUBDINFO's subd_flags now: the driver's flags and the lock's state (no subdevice
+  // has a command, so none is ever SDF_CMD, SDF_BUSY or SDF_RUNNING).
+  if (!valid_subd(it, subd))
+    return -1;
+  return model_of(it, subd).flags | (it->locked[subd] ? SDF_LOCKED | SDF_LOCK_OWNER : 0);
+}
+
+int piezoshift_comedi_get_subdevice_flags_v0_7_18(comedi_t* it, unsigned int subd) {
+  return valid_subd(it, subd) ? model_of(it, subd).flags : 0;
 }
 
 int comedi_get_n_channels(comedi_t* it, unsigned int subd) {
-  const SubdeviceModel* s = subdevice(it, subd);
-  return s != nullptr ? static_cast<int>(s->n_chan) : -1;
+  return valid_subd(it, subd) ? static_cast<int>(model_of(it, subd).n_chan) : -1;
+}
+
+int comedi_range_is_chan_specific(comedi_t* it, unsigned int subd) {
+  return valid_subd(it, subd) ? 0 : -1;  // one range table per subdevice on this board
+}
+
+int comedi_maxdata_is_chan_specific(comedi_t* it, unsigned int subd) {
+  return valid_subd(it, subd) ? 0 : -1;  // one maxdata per subdevice on this board
 }
 
 lsampl_t comedi_get_maxdata(comedi_t* it, unsigned int subd, unsigned int chan) {
-  const SubdeviceModel* s = subdevice(it, subd);
-  if (s == nullptr || chan >= s->n_chan) {
-    fail(EINVAL);
-    return 0;
-  }
-  return s->maxdata;
+  return valid_chan(it, subd, chan) ? model_of(it, subd).maxdata : 0;
+}
+
+int comedi_get_rangetype(comedi_t* it, unsigned int subd, unsigned int chan) {
+  // COMEDI_SUBDINFO's range_type: subdevice << 24 | table length (0 for an unused subdevice)
+  if (!valid_chan(it, subd, chan))
+    return -1;
+  const auto n = static_cast<int>(model_of(it, subd).ranges.size());
+  return n > 0 ? static_cast<int>(subd << 24) | n : 0;
 }
 
 int comedi_get_n_ranges(comedi_t* it, unsigned int subd, unsigned int chan) {
-  const SubdeviceModel* s = subdevice(it, subd);
-  if (s == nullptr || chan >= s->n_chan)
-    return fail(EINVAL);
-  return static_cast<int>(s->ranges.size());
+  return valid_chan(it, subd, chan) ? static_cast<int>(model_of(it, subd).ranges.size()) : -1;
 }
 
 comedi_range* comedi_get_range(comedi_t* it, unsigned int subd, unsigned int chan,
                                unsigned int range) {
-  const SubdeviceModel* s = subdevice(it, subd);
-  if (s == nullptr || chan >= s->n_chan || range >= s->ranges.size()) {
-    fail(EINVAL);
-    return nullptr;
-  }
-  return const_cast<comedi_range*>(&s->ranges[range]);  // the manual's signature; never written
+  if (!valid_chan(it, subd, chan) || range >= model_of(it, subd).ranges.size())
+    return nullptr;  // a range beyond the table: NULL without an error code, as libcomedi
+  // The manual's signature is not const; the table is never written through it.
+  return const_cast<comedi_range*>(&model_of(it, subd).ranges[range]);
 }
 
 int comedi_find_range(comedi_t* it, unsigned int subd, unsigned int chan, unsigned int unit,
                       double min, double max) {
-  const SubdeviceModel* s = subdevice(it, subd);
-  if (s == nullptr || chan >= s->n_chan)
-    return fail(EINVAL);
+  if (!valid_chan(it, subd, chan))
+    return -1;
+  const SubdeviceModel& s = model_of(it, subd);
   int best = -1;  // the smallest range of that unit holding [min, max]
-  for (std::size_t i = 0; i < s->ranges.size(); ++i) {
-    const comedi_range& r = s->ranges[i];
+  for (std::size_t i = 0; i < s.ranges.size(); ++i) {
+    const comedi_range& r = s.ranges[i];
     if (r.unit != unit || r.min > min || r.max < max)
       continue;
-    if (best < 0 || r.max - r.min < s->ranges[best].max - s->ranges[best].min)
+    if (best < 0 || r.max - r.min < s.ranges[best].max - s.ranges[best].min)
       best = static_cast<int>(i);
   }
-  return best >= 0 ? best : fail(EINVAL);
+  return best;
 }
 
 int comedi_do_insnlist(comedi_t* it, comedi_insnlist* il) {
-  if (it == nullptr || il == nullptr || (il->n_insns > 0 && il->insns == nullptr))
+  if (!valid_dev(it))
+    return -1;
+  if (il == nullptr || (il->n_insns > 0 && il->insns == nullptr))
     return fail(EFAULT);
   const int r = it->board->do_insnlist(*il);
-  if (r < 0)
-    last_error = errno;
-  return r;
+  return r < 0 ? fail_from_errno() : r;
 }
 
 int comedi_do_insn(comedi_t* it, comedi_insn* insn) {
+  if (!valid_dev(it))
+    return -1;
   if (insn == nullptr)
     return fail(EFAULT);
-  comedi_insnlist one{1, insn};
-  // The manual: the number of samples done (insn->n) for a read or write.
-  return comedi_do_insnlist(it, &one) < 0 ? -1 : static_cast<int>(insn->n);
+  return do_insn(it, *insn);  // the number of samples done (insn->n)
 }
 
 int comedi_data_read(comedi_t* it, unsigned int subd, unsigned int chan, unsigned int range,
                      unsigned int aref, lsampl_t* data) {
+  if (!valid_subd(it, subd))
+    return -1;
   comedi_insn insn{};
   insn.insn = INSN_READ;
   insn.n = 1;
   insn.data = data;
   insn.subdev = subd;
   insn.chanspec = CR_PACK(chan, range, aref);
-  return comedi_do_insn(it, &insn) < 0 ? -1 : 1;
+  return do_insn(it, insn);
+}
+
+int comedi_data_read_n(comedi_t* it, unsigned int subd, unsigned int chan, unsigned int range,
+                       unsigned int aref, lsampl_t* data, unsigned int n) {
+  if (!valid_subd(it, subd))
+    return -1;
+  // In instructions of at most 100 samples, as libcomedi; 0 when all were read.
+  for (unsigned done = 0; done < n;) {
+    comedi_insn insn{};
+    insn.insn = INSN_READ;
+    insn.n = std::min(n - done, 100u);
+    insn.data = data + done;
+    insn.subdev = subd;
+    insn.chanspec = CR_PACK(chan, range, aref);
+    if (do_insn(it, insn) < 0)
+      return -1;
+    done += insn.n;
+  }
+  return 0;
+}
+
+int comedi_data_read_hint(comedi_t* it, unsigned int subd, unsigned int chan, unsigned int range,
+                          unsigned int aref) {
+  if (!valid_subd(it, subd))
+    return -1;
+  lsampl_t unused = 0;
+  comedi_insn insn{};  // a read of no sample: the driver selects the channel
+  insn.insn = INSN_READ;
+  insn.data = &unused;
+  insn.subdev = subd;
+  insn.chanspec = CR_PACK(chan, range, aref);
+  return do_insn(it, insn);
+}
+
+int comedi_data_read_delayed(comedi_t* it, unsigned int subd, unsigned int chan, unsigned int range,
+                             unsigned int aref, lsampl_t* data, unsigned int nano_sec) {
+  if (!valid_chan(it, subd, chan))
+    return -1;
+  // Select the channel, wait nano_sec, convert: one list of three instructions.
+  lsampl_t delay = nano_sec;
+  comedi_insn insns[3]{};
+  insns[0].insn = INSN_READ;
+  insns[0].data = data;
+  insns[0].subdev = subd;
+  insns[0].chanspec = CR_PACK(chan, range, aref);
+  insns[1].insn = INSN_WAIT;
+  insns[1].n = 1;
+  insns[1].data = &delay;
+  insns[2] = insns[0];
+  insns[2].n = 1;
+  comedi_insnlist list{3, insns};
+  return comedi_do_insnlist(it, &list);
 }
 
 int comedi_data_write(comedi_t* it, unsigned int subd, unsigned int chan, unsigned int range,
                       unsigned int aref, lsampl_t data) {
+  if (!valid_chan(it, subd, chan))
+    return -1;
   comedi_insn insn{};
   insn.insn = INSN_WRITE;
   insn.n = 1;
   insn.data = &data;
   insn.subdev = subd;
   insn.chanspec = CR_PACK(chan, range, aref);
-  return comedi_do_insn(it, &insn) < 0 ? -1 : 1;
-}
-
-int comedi_dio_config(comedi_t* it, unsigned int subd, unsigned int chan, unsigned int dir) {
-  if (it == nullptr)
-    return fail(EINVAL);
-  const int r = it->board->dio_config(subd, chan, dir);
-  if (r < 0)
-    last_error = errno;
-  return r;
-}
-
-int comedi_dio_write(comedi_t* it, unsigned int subd, unsigned int chan, unsigned int bit) {
-  return comedi_data_write(it, subd, chan, 0, 0, bit != 0 ? 1 : 0);
-}
-
-int comedi_dio_read(comedi_t* it, unsigned int subd, unsigned int chan, unsigned int* bit) {
-  lsampl_t v = 0;
-  const int r = comedi_data_read(it, subd, chan, 0, 0, &v);
-  if (r >= 0 && bit != nullptr)
-    *bit = v;
-  return r;
-}
-
-char* comedi_get_default_calibration_path(comedi_t* dev) {
-  if (dev == nullptr) {
-    fail(EINVAL);
-    return nullptr;
-  }
-  return strdup(dev->calibration_path.c_str());
-}
-
-comedi_calibration_t* comedi_parse_calibration_file(const char* cal_file_path) {
-  if (cal_file_path == nullptr) {
-    fail(EINVAL);
-    return nullptr;
-  }
-  const std::lock_guard lock(store().mutex);
-  const auto b = store().boards.find(cal_file_path);
-  if (b == store().boards.end()) {
-    fail(ENOENT);  // no comedi_soft_calibrate was run for it ([board] calibrated = false)
-    return nullptr;
-  }
-  std::shared_ptr<OwnedCalibration> c = make_calibration(b->second);
-  comedi_calibration_t* handle = &c->calibration;
-  store().owned[handle] = c;
-  return handle;
-}
-
-void comedi_cleanup_calibration(comedi_calibration_t* calibration) {
-  const std::lock_guard lock(store().mutex);
-  store().owned.erase(calibration);
-}
-
-int comedi_get_softcal_converter(unsigned subdevice_index, unsigned channel, unsigned range,
-                                 enum comedi_conversion_direction direction,
-                                 const comedi_calibration_t* calibration,
-                                 comedi_polynomial_t* polynomial) {
-  if (calibration == nullptr || polynomial == nullptr)
-    return fail(EINVAL);
-  for (unsigned i = 0; i < calibration->num_settings; ++i) {
-    const comedi_calibration_setting_t& s = calibration->settings[i];
-    if (s.subdevice != subdevice_index || s.channels[0] != channel || s.ranges[0] != range)
-      continue;
-    const comedi_polynomial_t* p =
-        direction == COMEDI_TO_PHYSICAL ? s.soft_calibration.to_phys : s.soft_calibration.from_phys;
-    if (p == nullptr)
-      return fail(EINVAL);  // e.g. an AO setting asked to convert codes to volts
-    *polynomial = *p;
-    return 0;
-  }
-  return fail(EINVAL);
-}
-
-int comedi_get_hardcal_converter(comedi_t* dev, unsigned subdevice_index, unsigned channel,
-                                 unsigned range, enum comedi_conversion_direction direction,
-                                 comedi_polynomial_t* polynomial) {
-  const SubdeviceModel* s = subdevice(dev, subdevice_index);
-  if (s == nullptr || polynomial == nullptr || channel >= s->n_chan || range >= s->ranges.size())
-    return fail(EINVAL);
-  if ((s->flags & SDF_SOFT_CALIBRATED) != 0)
-    return fail(EINVAL);  // its codes need the software calibration's polynomials
-  const comedi_range& r = s->ranges[range];
-  comedi_polynomial_t p{};
-  p.order = 1;
-  if (direction == COMEDI_TO_PHYSICAL) {
-    p.coefficients[0] = r.min;
-    p.coefficients[1] = (r.max - r.min) / s->maxdata;
-  } else {
-    p.expansion_origin = r.min;
-    p.coefficients[1] = s->maxdata / (r.max - r.min);
-  }
-  *polynomial = p;
-  return 0;
-}
-
-double comedi_to_physical(lsampl_t data, const comedi_polynomial_t* conversion_polynomial) {
-  return conversion_polynomial != nullptr
-             ? polynomial(static_cast<double>(data), *conversion_polynomial)
-             : std::nan("");
-}
-
-lsampl_t comedi_from_physical(double data, const comedi_polynomial_t* conversion_polynomial) {
-  if (conversion_polynomial == nullptr)
-    return 0;
-  const double code = std::nearbyint(polynomial(data, *conversion_polynomial));
-  if (!(code > 0.0))
-    return 0;
-  return code >= 4294967295.0 ? 0xffffffffu : static_cast<lsampl_t>(code);
+  return do_insn(it, insn);
 }
 
 }  // extern "C"

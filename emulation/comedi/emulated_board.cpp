@@ -1,9 +1,11 @@
 #include "emulated_board.hpp"
 
 #include <sys/time.h>
+#include <bit>
 #include <cerrno>
 #include <cmath>
 #include <fstream>
+#include <thread>
 
 #include <fmt/core.h>
 #include <nlohmann/json.hpp>
@@ -133,90 +135,172 @@ void EmulatedBoard::sample_series() {
 }
 
 int EmulatedBoard::check(const comedi_insn& insn) const {
+  // comedi's parse_insn, before the subdevice's handler: an unused subdevice is EIO, a channel
+  // or range beyond the subdevice's (comedi_check_chanlist) EINVAL, data above maxdata EINVAL.
   if (insn.subdev >= model_.subdevices.size())
     return -EINVAL;
   const SubdeviceModel& s = model_.subdevices[insn.subdev];
   if (s.type == COMEDI_SUBD_UNUSED)
-    return -EIO;  // the kernel refuses instructions to an unused subdevice
+    return -EIO;
   if (insn.n > 0 && insn.data == nullptr)
     return -EFAULT;
-  if (insn.insn == INSN_READ || insn.insn == INSN_WRITE) {
-    if (CR_CHAN(insn.chanspec) >= s.n_chan)
-      return -EINVAL;
-    if (!s.ranges.empty() && CR_RANGE(insn.chanspec) >= s.ranges.size())
-      return -EINVAL;
-  }
+  if (CR_CHAN(insn.chanspec) >= s.n_chan || CR_RANGE(insn.chanspec) >= s.ranges.size())
+    return -EINVAL;
   if (insn.insn == INSN_WRITE) {
     for (unsigned i = 0; i < insn.n; ++i)
       if (insn.data[i] > s.maxdata)
-        return -EINVAL;  // comedi's core checks written data against maxdata
+        return -EINVAL;
   }
   return 0;
 }
 
-int EmulatedBoard::execute(comedi_insn& insn) {
-  if (insn.insn == INSN_GTOD) {
-    timeval tv{};
-    gettimeofday(&tv, nullptr);
-    if (insn.n < 2 || insn.data == nullptr)
+int EmulatedBoard::special(comedi_insn& insn) {
+  switch (insn.insn) {
+    case INSN_GTOD: {
+      if (insn.n != 2 || insn.data == nullptr)
+        return -EINVAL;
+      timeval tv{};
+      gettimeofday(&tv, nullptr);
+      insn.data[0] = static_cast<lsampl_t>(tv.tv_sec);
+      insn.data[1] = static_cast<lsampl_t>(tv.tv_usec);
+      return 2;
+    }
+    case INSN_WAIT:  // a delay of data[0] ns, under 100 us, at microsecond resolution
+      if (insn.n != 1 || insn.data == nullptr || insn.data[0] >= 100000)
+        return -EINVAL;
+      std::this_thread::sleep_for(std::chrono::microseconds(insn.data[0] / 1000));
+      return 1;
+    case INSN_INTTRIG:  // needs a command waiting for its trigger; no subdevice has commands
+    default:
       return -EINVAL;
-    insn.data[0] = static_cast<lsampl_t>(tv.tv_sec);
-    insn.data[1] = static_cast<lsampl_t>(tv.tv_usec);
-    return 2;
   }
+}
+
+int EmulatedBoard::execute(comedi_insn& insn) {
+  if ((insn.insn & INSN_MASK_SPECIAL) != 0)
+    return special(insn);
   if (const int bad = check(insn); bad < 0)
     return bad;
   const SubdeviceModel& s = model_.subdevices[insn.subdev];
+  if (insn.subdev == kAiSubdevice)
+    return analog_in(insn, s);
+  if (insn.subdev == kAoSubdevice)
+    return analog_out(insn, s);
+  if (insn.subdev == kDioSubdevice)
+    return digital_io(insn, s);
+  // Calibration PWM, EEPROM, PFI, serial, RTSI, counters and frequency output are not emulated:
+  // their instructions fail as an instruction with no handler does (the core's insn_inval).
+  return -EINVAL;
+}
+
+int EmulatedBoard::analog_in(comedi_insn& insn, const SubdeviceModel& s) {
+  if (insn.insn != INSN_READ)
+    return -EINVAL;  // AI has no insn_write or insn_bits; its configurations are not emulated
   const unsigned ch = CR_CHAN(insn.chanspec);
   const double t = elapsed_s();
-  if (s.type == COMEDI_SUBD_AI && insn.insn == INSN_READ) {
-    if (settings_.ai_timeout_at_s >= 0.0 && t >= settings_.ai_timeout_at_s) {
-      ++failed_ai_timeout_;
-      return -ETIME;  // ni_ai_insn_read: the conversion did not complete
-    }
-    const comedi_range& r = s.ranges[CR_RANGE(insn.chanspec)];
-    const bool open = settings_.ai_open_at_s >= 0.0 && t >= settings_.ai_open_at_s &&
-                      ch == static_cast<unsigned>(settings_.ai_open_channel);
-    const double v = ch < 3 ? twin_->read_ai()[ch] : 0.0;
+  if (settings_.ai_timeout_at_s >= 0.0 && t >= settings_.ai_timeout_at_s) {
+    ++failed_ai_timeout_;
+    return -ETIME;  // ni_ai_insn_read: the conversion did not complete
+  }
+  const comedi_range& r = s.ranges[CR_RANGE(insn.chanspec)];
+  const bool open = settings_.ai_open_at_s >= 0.0 && t >= settings_.ai_open_at_s &&
+                    ch == static_cast<unsigned>(settings_.ai_open_channel);
+  const double v = ch < 3 ? twin_->read_ai()[ch] : 0.0;
+  for (unsigned i = 0; i < insn.n; ++i)
+    insn.data[i] = open ? s.maxdata : raw_code(v, r, s.maxdata, model_.ai_raw(ch));
+  ai_open_reads_ += open && insn.n > 0 ? 1 : 0;
+  return static_cast<int>(insn.n);
+}
+
+int EmulatedBoard::analog_out(comedi_insn& insn, const SubdeviceModel& s) {
+  const unsigned ch = CR_CHAN(insn.chanspec);
+  if (insn.insn == INSN_READ) {  // comedi_readback_insn_read: the last code written
     for (unsigned i = 0; i < insn.n; ++i)
-      insn.data[i] = open ? s.maxdata : raw_code(v, r, s.maxdata, model_.ai_raw(ch));
-    ai_open_reads_ += open ? 1 : 0;
+      insn.data[i] = ao_readback_[ch];
     return static_cast<int>(insn.n);
   }
-  if (s.type == COMEDI_SUBD_AO && insn.insn == INSN_WRITE) {
-    if (settings_.ao_busy_at_s >= 0.0 && t >= settings_.ao_busy_at_s) {
-      ++failed_ao_busy_;
-      return -EBUSY;
-    }
-    if (insn.n == 0)
-      return 0;
-    const comedi_range& r = s.ranges[CR_RANGE(insn.chanspec)];
-    ao_codes_[ch] = insn.data[insn.n - 1];
-    ao_V_[ch] = raw_volts(ao_codes_[ch], r, s.maxdata, model_.ao_raw(ch));
-    twin_->write_ao(control::Vec3{ao_V_[0], ao_V_[1], ao_V_[2]});
-    return static_cast<int>(insn.n);
+  if (insn.insn != INSN_WRITE)
+    return -EINVAL;
+  if (settings_.ao_busy_at_s >= 0.0 && elapsed_s() >= settings_.ao_busy_at_s) {
+    ++failed_ao_busy_;
+    return -EBUSY;
   }
-  if (insn.subdev == kDioSubdevice && (insn.insn == INSN_WRITE || insn.insn == INSN_READ)) {
-    // comedi's core emulates single-line reads and writes with the subdevice's insn_bits
-    const std::uint32_t bit = 1u << ch;
-    for (unsigned i = 0; i < insn.n; ++i) {
-      if (insn.insn == INSN_READ) {
+  if (insn.n == 0)
+    return 0;
+  const comedi_range& r = s.ranges[CR_RANGE(insn.chanspec)];
+  ao_codes_[ch] = insn.data[insn.n - 1];
+  ao_readback_[ch] = ao_codes_[ch];
+  ao_V_[ch] = raw_volts(ao_codes_[ch], r, s.maxdata, model_.ao_raw(ch));
+  twin_->write_ao(control::Vec3{ao_V_[0], ao_V_[1], ao_V_[2]});
+  return static_cast<int>(insn.n);
+}
+
+void EmulatedBoard::set_dio_levels(std::uint32_t mask, std::uint32_t bits) {
+  // A rising edge counts on a line made an output (a camera trigger's).
+  dio_rising_edges_ +=
+      static_cast<std::uint64_t>(std::popcount(mask & bits & ~dio_level_ & dio_output_));
+  dio_level_ = (dio_level_ & ~mask) | (bits & mask);
+}
+
+int EmulatedBoard::digital_io(comedi_insn& insn, const SubdeviceModel& s) {
+  const unsigned ch = CR_CHAN(insn.chanspec);
+  const std::uint32_t bit = 1u << ch;
+  switch (insn.insn) {
+    case INSN_READ:  // the core emulates one line's read and write with insn_bits
+      for (unsigned i = 0; i < insn.n; ++i)
         insn.data[i] = (dio_level_ & bit) != 0 ? 1 : 0;
-        continue;
-      }
-      const bool high = insn.data[i] != 0;
-      if (high && (dio_level_ & bit) == 0 && (dio_output_ & bit) != 0)
-        ++dio_rising_edges_;
-      dio_level_ = high ? (dio_level_ | bit) : (dio_level_ & ~bit);
+      return static_cast<int>(insn.n);
+    case INSN_WRITE:
+      for (unsigned i = 0; i < insn.n; ++i)
+        set_dio_levels(bit, insn.data[i] != 0 ? bit : 0);
+      return static_cast<int>(insn.n);
+    case INSN_BITS: {  // data[0] the lines to write, data[1] their levels, from line `ch` up
+      if (insn.n != 2)
+        return -EINVAL;
+      const unsigned shift = s.n_chan <= 32 ? ch : 0;
+      set_dio_levels(insn.data[0] << shift, insn.data[1] << shift);
+      insn.data[1] = dio_level_ >> shift;
+      return 2;
     }
-    return static_cast<int>(insn.n);
+    case INSN_CONFIG:
+      return dio_config(insn, bit);
+    default:
+      return -EINVAL;
   }
-  return -EINVAL;  // not emulated: a clear refusal, never a silent success
+}
+
+int EmulatedBoard::dio_config(comedi_insn& insn, std::uint32_t bit) {
+  // comedi_dio_insn_config, after check_insn_config_length
+  if (insn.n < 1)
+    return -EINVAL;
+  switch (insn.data[0]) {
+    case INSN_CONFIG_DIO_OUTPUT:
+    case INSN_CONFIG_DIO_INPUT:
+      if (insn.n != 1)
+        return -EINVAL;
+      dio_output_ =
+          insn.data[0] == INSN_CONFIG_DIO_OUTPUT ? (dio_output_ | bit) : (dio_output_ & ~bit);
+      return 1;
+    case INSN_CONFIG_DIO_QUERY:
+      if (insn.n != 2)
+        return -EINVAL;
+      insn.data[1] = (dio_output_ & bit) != 0 ? COMEDI_OUTPUT : COMEDI_INPUT;
+      return 2;
+    default:
+      return -EINVAL;
+  }
 }
 
 int EmulatedBoard::do_insnlist(comedi_insnlist& list) {
   const std::lock_guard lock(mutex_);
   ++transactions_;
+  for (unsigned i = 0; i < list.n_insns; ++i) {
+    if (list.insns[i].n > kMaxSamples) {  // do_insnlist_ioctl refuses the list before any runs
+      ++failed_transactions_;
+      errno = EINVAL;
+      return -1;
+    }
+  }
   advance_to_now();
   if (settings_.io_error_at_s >= 0.0 && elapsed_s() >= settings_.io_error_at_s && failed_io_ == 0) {
     ++failed_io_;
@@ -233,18 +317,6 @@ int EmulatedBoard::do_insnlist(comedi_insnlist& list) {
     }
   }
   return static_cast<int>(list.n_insns);
-}
-
-int EmulatedBoard::dio_config(unsigned subdevice, unsigned channel, unsigned direction) {
-  const std::lock_guard lock(mutex_);
-  if (subdevice != kDioSubdevice || channel >= model_.subdevices[subdevice].n_chan ||
-      (direction != COMEDI_INPUT && direction != COMEDI_OUTPUT)) {
-    errno = EINVAL;
-    return -1;
-  }
-  const std::uint32_t bit = 1u << channel;
-  dio_output_ = direction == COMEDI_OUTPUT ? (dio_output_ | bit) : (dio_output_ & ~bit);
-  return 0;
 }
 
 void EmulatedBoard::write_records() const {

@@ -12,7 +12,10 @@
 // goes out at once; an AI read converts the twin's latest gauge voltage through the channel's
 // ADC in the range asked for (a gauge above a range reads maxdata). The first instruction that
 // fails stops the list, which then fails as a whole with its errno (the kernel's
-// do_insnlist_ioctl); the instructions before it have happened.
+// do_insnlist_ioctl); the instructions before it have happened. Emulated: AI reads, AO writes
+// and read-back, DIO 0 (reads, writes, INSN_BITS, direction configuration and query), and the
+// special INSN_GTOD and INSN_WAIT; every other instruction fails with EINVAL, the errno of an
+// instruction its subdevice has no handler for.
 #include <comedilib.h>
 
 #include <array>
@@ -42,8 +45,8 @@ class EmulatedBoard {
 
   //! The number of instructions done, or -1 with errno set.
   int do_insnlist(comedi_insnlist& list);
-  //! INSN_CONFIG_DIO_OUTPUT / _INPUT on a DIO line; -1 with errno set.
-  int dio_config(unsigned subdevice, unsigned channel, unsigned direction);
+  //! The most samples one instruction may carry (the kernel's MAX_SAMPLES).
+  static constexpr unsigned kMaxSamples = 65536;
 
   //! Writes the record files (settings.record, settings.series), if asked for.
   void write_records() const;
@@ -52,8 +55,15 @@ class EmulatedBoard {
   //! A transaction after a longer stall advances the twin this much and drops the rest.
   static constexpr double kMaxCatchUp_s = 1.0;
   void advance_to_now();
-  int execute(comedi_insn& insn);  // instructions done (insn.n) or -errno
+  // Each returns the instruction's result (its sample count) or -errno.
+  int execute(comedi_insn& insn);
   int check(const comedi_insn& insn) const;
+  int special(comedi_insn& insn);  // INSN_GTOD, INSN_WAIT, INSN_INTTRIG
+  int analog_in(comedi_insn& insn, const SubdeviceModel& s);
+  int analog_out(comedi_insn& insn, const SubdeviceModel& s);
+  int digital_io(comedi_insn& insn, const SubdeviceModel& s);
+  int dio_config(comedi_insn& insn, std::uint32_t bit);
+  void set_dio_levels(std::uint32_t mask, std::uint32_t bits);
   void sample_series();
   double elapsed_s() const;
 
@@ -69,7 +79,8 @@ class EmulatedBoard {
   std::uint64_t failed_transactions_ = 0;
   std::array<lsampl_t, 4> ao_codes_{};
   std::array<double, 4> ao_V_{};
-  std::uint32_t dio_output_ = 0;  // subdevice 2's lines made outputs (bit mask)
+  std::array<lsampl_t, 4> ao_readback_{};  // what an AO read returns: 0 until written
+  std::uint32_t dio_output_ = 0;           // subdevice 2's lines made outputs (bit mask)
   std::uint32_t dio_level_ = 0;
   std::uint64_t dio_rising_edges_ = 0;
   std::uint64_t failed_ai_timeout_ = 0, failed_ao_busy_ = 0, failed_io_ = 0, ai_open_reads_ = 0;

@@ -2,6 +2,7 @@
 // shipping program, unchanged, loads the emulation as libcomedi.so.0 through LD_LIBRARY_PATH.
 // The board's facts are checked through libcomedi's API itself (dlopen), then the loop is closed
 // on the twin behind it and compared with `--daq sim`, and device errors are injected.
+#include <comedi_errno.h>
 #include <comedilib.h>
 #include <dlfcn.h>
 
@@ -103,9 +104,9 @@ TEST_F(ComediEmulation, PresentsThePci6229AsNiPcimioDoes) {
   EXPECT_EQ(data_write(dev, 1, 0, 0, AREF_GROUND, 0x10000), -1) << "data above maxdata";
   EXPECT_EQ(error(), EINVAL);
   EXPECT_EQ(data_write(dev, 3, 0, 0, AREF_GROUND, 0), -1) << "an unused subdevice";
-  EXPECT_EQ(error(), EIO);
+  EXPECT_EQ(error(), EINVAL_CHAN) << "libcomedi checks the channel first: it has none";
   EXPECT_EQ(data_write(dev, 1, 4, 0, AREF_GROUND, 0), -1) << "AO has channels 0..3";
-  EXPECT_EQ(error(), EINVAL);
+  EXPECT_EQ(error(), EINVAL_CHAN) << "libcomedi's own check, before the kernel's";
   EXPECT_EQ(close(dev), 0);
   dlclose(api.lib);
   unsetenv("PIEZOSHIFT_COMEDI_EMULATION");
