@@ -275,7 +275,10 @@ class Network {
   // server that fails stops the loop through its ramp (g_stop_signal); stop() rethrows it.
   void start() {
     if (camera_)
-      camera_->start();
+      camera_->start([this](std::exception_ptr e) {
+        camera_error_ = std::move(e);
+        g_stop_signal.store(kNetworkFailed);
+      });
     line_thread_ = std::thread([this] { serve_until_stopped(*server_, line_error_); });
     if (http_)
       http_thread_ = std::thread([this] {
@@ -304,6 +307,8 @@ class Network {
       std::rethrow_exception(line_error_);
     if (http_error_)
       std::rethrow_exception(http_error_);
+    if (camera_error_)
+      std::rethrow_exception(camera_error_);
   }
 
   // Moves the servers' threads off the loop's CPU; false when there is no other CPU.
@@ -340,7 +345,7 @@ class Network {
   std::unique_ptr<host::HttpServer> http_;
   std::unique_ptr<host::LineServer> server_;
   std::thread line_thread_, http_thread_;
-  std::exception_ptr line_error_, http_error_;
+  std::exception_ptr line_error_, http_error_, camera_error_;
 };
 
 void print_serve_summary(const ServeOptions& o, Network& net, const std::string& daq_name,
