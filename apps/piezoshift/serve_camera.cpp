@@ -250,7 +250,7 @@ void ServeCamera::run() {
         return;
       batch.clear();
       std::swap(batch, incoming_);
-      begin = requested_.has_value() && !running_ && !preview_pending_;
+      begin = requested_.has_value() && !running_ && !preview_pending_ && now_s() >= drain_until_s_;
     }
     // A measurement fails alone: whatever it throws (std::bad_alloc, a surface the twin cannot
     // render) ends it with the reason; the thread, the loop and the clients go on.
@@ -290,12 +290,19 @@ void ServeCamera::step_measurement(bool begin, const std::vector<instrument::Loo
 void ServeCamera::abandon_measurement(const std::string& what) {
   json j = {{"valid", false}, {"camera", camera_->name()}};
   std::size_t frames = 0;
+  {
+    const std::lock_guard lock(mutex_);
+    frames = progress_frames_;  // what it had taken (its result may be taken already)
+  }
   if (running_) {
-    frames = running_->sequence.frames_taken();
+    frames = std::max(frames, running_->sequence.frames_taken());
     j["algorithm"] = psi::algorithm_name(running_->request.algorithm);
     j["averages"] = running_->request.params.averages;
   }
   running_.reset();  // its frames go first: the memory the report needs
+  // Its exposures still in flight arrive within a frame timeout; the live view takes them, and
+  // the next measurement starts after (else they would be frames no trigger of its asked for).
+  drain_until_s_ = now_s() + options_.sequence.frame_timeout_s;
   j["frames"] = frames;
   j["reason"] =
       what == std::bad_alloc().what()
@@ -303,7 +310,7 @@ void ServeCamera::abandon_measurement(const std::string& what) {
           : fmt::format("the measurement failed after {} frames: {}", frames, what);
   const std::lock_guard lock(mutex_);
   j["id"] = measurement_id_;
-  measurement_json_ = j.dump();
+  measurement_json_ = j.dump(-1, ' ', false, json::error_handler_t::replace);  // any bytes
   surface_png_.clear();
   modulation_png_.clear();
   measuring_ = false;
@@ -467,6 +474,8 @@ void ServeCamera::begin_measurement() {
 void ServeCamera::finish_measurement() {
   instrument::SequenceResult r = running_->sequence.take();
   const Request& req = running_->request;
+  if (!r.validity.valid)  // as a measurement that threw: its frames in flight come first
+    drain_until_s_ = now_s() + options_.sequence.frame_timeout_s;
   if (!options_.preview && !r.frames.empty())
     publish_frame(r.frames.front());  // no live view: the measurement's first frame instead
   MeasurementOutcome out;

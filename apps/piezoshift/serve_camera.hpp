@@ -124,6 +124,7 @@ class ServeCamera final : public host::DashboardPanel {
   double pending_since_s_ = 0.0;
   double refused_since_s_ = -1.0;  //!< live triggers refused since (-1: the last was taken)
   std::uint64_t next_preview_ns_ = 0;
+  double drain_until_s_ = 0.0;  //!< a failed measurement's frames may arrive until then
 };
 
 }  // namespace piezoshift::app

@@ -48,8 +48,8 @@ MeasureRequestCheck check_measure_request(std::string_view body, const MeasureRe
     req.params.averages = static_cast<int>(avg.get<long long>());
     if (std::string why = instrument::sequence_problem(req.params); !why.empty())
       throw core::InputError(why);
-    if (std::string why = instrument::travel_problem(req.params, c.travel_z_max_um,
-                                                     c.calibration_source);
+    if (std::string why =
+            instrument::travel_problem(req.params, c.travel_z_max_um, c.calibration_source);
         !why.empty())
       throw core::InputError(why);
   } catch (const std::bad_alloc&) {

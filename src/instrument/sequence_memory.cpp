@@ -30,8 +30,8 @@ std::uint64_t sequence_memory_bytes(const SequenceParams& p, const camera::Camer
   const std::uint64_t px = pixels_of(camera);
   const auto averages = static_cast<std::uint64_t>(std::max(p.averages, 0));
   const std::uint64_t frames = averages * p.steps_rad.size();
-  return px * (frames * kFrameBytesPerPixel + averages * kAverageBytesPerPixel +
-               kWorkingBytesPerPixel);
+  return px *
+         (frames * kFrameBytesPerPixel + averages * kAverageBytesPerPixel + kWorkingBytesPerPixel);
 }
 
 std::string sequence_memory_problem(const SequenceParams& p, const camera::CameraSettings& camera) {

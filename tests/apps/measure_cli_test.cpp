@@ -141,7 +141,7 @@ TEST_F(MeasureCli, BadInputIsRefusedBeforeAnythingRuns) {
   EXPECT_TRUE(fs::exists(path("full/keep.txt")));
 }
 
-// Issue 47: a 2048 px camera took 350 MB an average, 35 GB at the 100 allowed. The memory bound
+// A 2048 px camera took 350 MB an average, 35 GB at the 100 allowed. The memory bound
 // refuses it before the loop starts, naming the options and what fits.
 TEST_F(MeasureCli, AMeasurementBeyondTheMemoryBoundIsRefusedBeforeItStarts) {
   const std::string big = write("big.toml", "[camera]\nwidth_px = 2048\nheight_px = 2048\n");

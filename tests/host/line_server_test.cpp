@@ -142,7 +142,7 @@ bool eventually(const std::function<bool()>& condition, double timeout_s = 5.0) 
   return true;
 }
 
-// Issue 47: `curl -X POST --data-binary $'SVO Z 1 U 1 V 1\nMOV Z 10\n' http://127.0.0.1:GCSPORT/`
+// `curl -X POST --data-binary $'SVO Z 1 U 1 V 1\nMOV Z 10\n' http://127.0.0.1:GCSPORT/`
 // (or a browser's no-cors fetch) had its body run a line at a time. A connection whose first
 // line is HTTP's is closed before anything of it is handled.
 TEST(LineServerInput, AnHttpRequestIsClosedBeforeAnyOfItRuns) {
@@ -668,7 +668,7 @@ TEST(GcsClient, SplitsAnswersAndReportsConnectionFailures) {
   EXPECT_THROW(client->read_answer(), std::runtime_error);
 }
 
-// Issue 47: `piezoshift gcs` against a server that never ends its answer buffered 8.6 GB in
+// `piezoshift gcs` against a server that never ends its answer buffered 8.6 GB in
 // 40 s. An answer is read up to max_answer_bytes (by default the largest DRR?) and no further.
 TEST(GcsClient, AnAnswerBeyondItsBoundIsRefusedNamingIt) {
   EXPECT_EQ(DataRecorder::kMaxAnswerBytes, 1180672u);

@@ -9,7 +9,7 @@
 //              counted), while another client keeps being answered.
 //   refusal    a connection beyond max_clients is refused and counted on both.
 //   room       with the table full, a newcomer takes the place of the client whose line or
-//              request head has been incomplete longest (2 s at least; issue 47: clients sending
+//              request head has been incomplete longest (2 s at least: clients sending
 //              a byte every 0.9 s refused 196 of 198 newcomers), else of the client silent
 //              longest (issue 27: eight silent GCS clients locked everyone out for the 600 s idle
 //              timeout); event streams leave slots for requests (sixteen streams made every
@@ -336,7 +336,7 @@ class Trickler {
   std::thread thread_;
 };
 
-// Issue 47: eight GCS clients sending a byte every 0.9 s are never silent for the 1 s that makes
+// Eight GCS clients sending a byte every 0.9 s are never silent for the 1 s that makes
 // a client give way, and refused 196 of 198 newcomers. A client whose line is incomplete 2 s
 // after its first byte (evict_incomplete_when_full_s) now gives way first, the oldest line first.
 // The bound is a lower one: waiting longer on a loaded machine changes nothing.
@@ -352,9 +352,10 @@ TEST(PollServerRoom, LineClientsThatNeverEndALineGiveWayToNewcomers) {
         eventually([&] { return server.client_count() == i + 1 && slow[i]->sent_first(); }));
   }
   std::this_thread::sleep_for(std::chrono::milliseconds(2200));
+  std::vector<std::unique_ptr<GcsClient>> newcomers;  // each kept: each takes a place
   for (int n = 0; n < 3; ++n) {
-    GcsClient newcomer("127.0.0.1", server.port());
-    EXPECT_EQ(newcomer.query("ECHO " + std::to_string(n)), std::to_string(n) + "\n");
+    newcomers.push_back(std::make_unique<GcsClient>("127.0.0.1", server.port()));
+    EXPECT_EQ(newcomers.back()->query("ECHO " + std::to_string(n)), std::to_string(n) + "\n");
   }
   EXPECT_TRUE(slow[0]->closed(10.0));  // the oldest line went first
   EXPECT_GE(server.stats().evicted_for_room, 3u);
@@ -564,7 +565,7 @@ TEST(PollServerRoom, HttpOldestStreamGivesWayWhenTheTableIsFull) {
   EXPECT_FALSE(open) << "the first stream was not the one closed";
 }
 
-// Issue 47: sixteen HTTP clients sending one header line a second denied 81 % of another
+// Sixteen HTTP clients sending one header line a second denied 81 % of another
 // client's requests. A request whose head is incomplete 2 s after its first byte now gives way
 // to a newcomer, whose GET is answered.
 TEST(PollServerRoom, HttpClientsThatNeverEndTheirHeadGiveWayToNewcomers) {
@@ -579,9 +580,10 @@ TEST(PollServerRoom, HttpClientsThatNeverEndTheirHeadGiveWayToNewcomers) {
     ASSERT_TRUE(eventually([&] { return slow[i]->sent_first(); }));
   }
   std::this_thread::sleep_for(std::chrono::milliseconds(2200));
+  // Each answered request is closed, so the first newcomer's place serves the next ones too.
   for (int n = 0; n < 3; ++n)
     EXPECT_EQ(http_status(testing::http_exchange(server.port(), get_root(server.port()))), 200);
-  EXPECT_GE(server.stats().evicted_for_room, 3u);
+  EXPECT_GE(server.stats().evicted_for_room, 1u);
   EXPECT_EQ(server.stats().refused_max_clients, 0u);
 }
 

@@ -497,7 +497,7 @@ TEST_F(Serve, TheGcsCommandSendsCommandsAndPrintsTheAnswersOfQueries) {
       << slurp(path("gcs2_err.txt"));
 }
 
-// Issue 47: `curl -X POST --data-binary $'SVO Z 1 U 1 V 1\nMOV Z 10\n' http://127.0.0.1:PORT/`
+// `curl -X POST --data-binary $'SVO Z 1 U 1 V 1\nMOV Z 10\n' http://127.0.0.1:PORT/`
 // at the GCS port switched the servo on and moved the stage. Its first line is HTTP's: the
 // connection is closed before anything of it runs.
 TEST_F(Serve, AnHttpRequestToTheGcsPortRunsNothing) {
@@ -520,7 +520,7 @@ TEST_F(Serve, AnHttpRequestToTheGcsPortRunsNothing) {
   stop();
 }
 
-// Issue 47: `piezoshift gcs` against a server that never ends its answer buffered 8.6 GB in 40 s.
+// `piezoshift gcs` against a server that never ends its answer buffered 8.6 GB in 40 s.
 // Now exit 2 once the answer passes the largest a GCS answer can be, naming it.
 TEST_F(Serve, TheGcsCommandRefusesAnAnswerBeyondTheLargest) {
   const int listener = ::socket(AF_INET, SOCK_STREAM, 0);

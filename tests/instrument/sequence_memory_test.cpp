@@ -1,4 +1,4 @@
-// Issue 47: a measurement's memory estimated from its request, and the bound serve and measure
+// A measurement's memory estimated from its request, and the bound serve and measure
 // refuse it beyond (sequence_memory.hpp), with the figures of the reproducers.
 #include "piezoshift/instrument/sequence_memory.hpp"
 
