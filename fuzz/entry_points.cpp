@@ -58,12 +58,13 @@ void command_line_input(std::string_view data) {
 }
 
 std::span<const Target> targets() {
-  static constexpr std::array<Target, 6> kTargets{{{"config", config_input},
+  static constexpr std::array<Target, 7> kTargets{{{"config", config_input},
                                                    {"csv", csv_input},
                                                    {"calibration", calibration_input},
                                                    {"gcs", gcs_input},
                                                    {"plot", plot_input},
-                                                   {"command_line", command_line_input}}};
+                                                   {"command_line", command_line_input},
+                                                   {"measure_request", measure_request_input}}};
   return kTargets;
 }
 

@@ -26,7 +26,12 @@ void csv_input(std::string_view data);
 void calibration_input(std::string_view data);
 //! A GCS session: the input split at LF into lines fed to host::GcsInterpreter on the twin's
 //! stage model, with a stand-in loop thread that applies every command and answers with samples.
+//! A first line that host::looks_like_http ends it, as LineServer closes such a connection.
 void gcs_input(std::string_view data);
+//! The body of serve's POST /api/measure through app::check_measure_request: what it accepts must
+//! be within sequence_problem's, the travel's and the memory bound; a refusal is 400 or 413 with
+//! its reason.
+void measure_request_input(std::string_view data);
 //! The texts of a figure (file name, titles, labels; fields at NUL) through io::check_output_path
 //! and io::write_plot_files: none may reach gnuplot's command stream (plot_entry.cpp).
 void plot_input(std::string_view data);

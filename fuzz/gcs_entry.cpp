@@ -6,9 +6,11 @@
 #include <stdexcept>
 #include <string>
 #include <thread>
+#include <utility>
 
 #include "entry_points.hpp"
 #include "piezoshift/host/gcs_interpreter.hpp"
+#include "piezoshift/host/http_line.hpp"
 #include "piezoshift/plant/geometry.hpp"
 #include "piezoshift/runtime/safety_supervisor.hpp"
 
@@ -119,7 +121,9 @@ void gcs_input(std::string_view data) {
   gcs.on_connect(kClient);
   gcs.on_connect(kClient + 1);  // a second session, for the answers that go to every client
   // LineServer's framing: a single-character command where a line starts, otherwise lines at LF
-  // without one trailing CR; the last line without LF is dropped, as at EOF.
+  // without one trailing CR; the last line without LF is dropped, as at EOF. A first line that is
+  // HTTP's closes the connection before anything runs.
+  bool first_line = true;
   while (!data.empty()) {
     if (gcs.is_immediate(data.front())) {
       gcs.on_immediate(kClient, data.front());
@@ -132,6 +136,8 @@ void gcs_input(std::string_view data) {
     std::string_view line = data.substr(0, lf);
     if (!line.empty() && line.back() == '\r')
       line.remove_suffix(1);
+    if (std::exchange(first_line, false) && host::looks_like_http(line))
+      break;
     if (line.size() > kMaxLineBytes)
       gcs.on_overlong_line(kClient);
     else

@@ -33,6 +33,7 @@
 #include "piezoshift/instrument/measurement.hpp"
 #include "piezoshift/instrument/measurement_lock.hpp"
 #include "piezoshift/instrument/sequence.hpp"
+#include "piezoshift/instrument/sequence_memory.hpp"
 #include "piezoshift/instrument/twin_floor.hpp"
 #include "piezoshift/psi/analysis.hpp"
 #include "piezoshift/psi/fizeau_simulation.hpp"
@@ -253,6 +254,13 @@ int measure(const MeasureOptions& o) {
   s.params = sequence_params(o, s.algorithm, wavelength_nm);
   if (o.trigger == "line")
     s.config.camera.settings.trigger = camera::TriggerSource::kLine;
+  // Before anything runs: the frames of every average are held to the end.
+  if (const std::string why =
+          instrument::sequence_memory_problem(s.params, s.config.camera.settings);
+      !why.empty())
+    throw core::InputError(
+        "measure: --averages and --algorithm (--steps-rad) with [camera] width_px, height_px: " +
+        why);
   work_begins();  // the twin's scene, the stage, the camera
   if (o.camera == "twin" || fed_by_twin(o))
     s.scene = twin_scene(o, s.config.camera, wavelength_nm);

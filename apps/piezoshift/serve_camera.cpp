@@ -9,6 +9,7 @@
 #include <cmath>
 #include <cstdlib>
 #include <limits>
+#include <new>
 #include <utility>
 
 #include <fmt/core.h>
@@ -25,6 +26,7 @@
 #include "piezoshift/psi/pupil_detection.hpp"
 #include "piezoshift/runtime/safety_supervisor.hpp"
 #include "psi_options.hpp"
+#include "serve_measure_request.hpp"
 
 namespace piezoshift::app {
 
@@ -180,15 +182,20 @@ ServeCamera::~ServeCamera() {
   gcs_.on_disconnect(kSession);
 }
 
-void ServeCamera::start() {
+void ServeCamera::start(std::function<void(std::exception_ptr)> on_failure) {
   camera_->start();
   started_ = true;
-  thread_ = std::thread([this] {
+  thread_ = std::thread([this, on_failure = std::move(on_failure)] {
     // The analysis of a measurement takes a core for a while: it yields to the GCS clients and
     // the dashboard (as the dashboard's thread yields to the GCS clients). Best effort.
     if (::setpriority(PRIO_PROCESS, static_cast<id_t>(::gettid()), 10) != 0) {
     }
-    run();
+    try {
+      run();
+    } catch (...) {  // only what a failed measurement's own report throws: serve stops, ramped
+      if (on_failure)
+        on_failure(std::current_exception());
+    }
   });
 }
 
@@ -243,25 +250,70 @@ void ServeCamera::run() {
         return;
       batch.clear();
       std::swap(batch, incoming_);
-      begin = requested_.has_value() && !running_ && !preview_pending_;
+      begin = requested_.has_value() && !running_ && !preview_pending_ && now_s() >= drain_until_s_;
     }
-    if (begin)
-      begin_measurement();
-    if (running_) {
-      for (const instrument::LoopSample& s : batch)
-        running_->sequence.feed(s);
-      running_->sequence.poll();
-      {
-        const std::lock_guard lock(mutex_);
-        progress_frames_ = running_->sequence.frames_taken();
-        progress_total_ = running_->sequence.frames_total();
+    // A measurement fails alone: whatever it throws (std::bad_alloc, a surface the twin cannot
+    // render) ends it with the reason; the thread, the loop and the clients go on.
+    if (begin || running_) {
+      try {
+        step_measurement(begin, batch);
+      } catch (const std::exception& e) {
+        abandon_measurement(e.what());
       }
-      if (running_->sequence.done())
-        finish_measurement();
       continue;
     }
-    preview(batch);
+    try {
+      preview(batch);
+    } catch (const std::exception& e) {
+      preview_pending_ = false;
+      const std::lock_guard lock(mutex_);
+      message_ = fmt::format("camera {}: the live view failed: {}", camera_->name(), e.what());
+    }
   }
+}
+
+void ServeCamera::step_measurement(bool begin, const std::vector<instrument::LoopSample>& batch) {
+  if (begin)
+    begin_measurement();
+  for (const instrument::LoopSample& s : batch)
+    running_->sequence.feed(s);
+  running_->sequence.poll();
+  {
+    const std::lock_guard lock(mutex_);
+    progress_frames_ = running_->sequence.frames_taken();
+    progress_total_ = running_->sequence.frames_total();
+  }
+  if (running_->sequence.done())
+    finish_measurement();
+}
+
+void ServeCamera::abandon_measurement(const std::string& what) {
+  json j = {{"valid", false}, {"camera", camera_->name()}};
+  std::size_t frames = 0;
+  {
+    const std::lock_guard lock(mutex_);
+    frames = progress_frames_;  // what it had taken (its result may be taken already)
+  }
+  if (running_) {
+    frames = std::max(frames, running_->sequence.frames_taken());
+    j["algorithm"] = psi::algorithm_name(running_->request.algorithm);
+    j["averages"] = running_->request.params.averages;
+  }
+  running_.reset();  // its frames go first: the memory the report needs
+  // Its exposures still in flight arrive within a frame timeout; the live view takes them, and
+  // the next measurement starts after (else they would be frames no trigger of its asked for).
+  drain_until_s_ = now_s() + options_.sequence.frame_timeout_s;
+  j["frames"] = frames;
+  j["reason"] =
+      what == std::bad_alloc().what()
+          ? fmt::format("the measurement ran out of memory after {} frames ({})", frames, what)
+          : fmt::format("the measurement failed after {} frames: {}", frames, what);
+  const std::lock_guard lock(mutex_);
+  j["id"] = measurement_id_;
+  measurement_json_ = j.dump(-1, ' ', false, json::error_handler_t::replace);  // any bytes
+  surface_png_.clear();
+  modulation_png_.clear();
+  measuring_ = false;
 }
 
 void ServeCamera::preview(const std::vector<instrument::LoopSample>& batch) {
@@ -422,6 +474,8 @@ void ServeCamera::begin_measurement() {
 void ServeCamera::finish_measurement() {
   instrument::SequenceResult r = running_->sequence.take();
   const Request& req = running_->request;
+  if (!r.validity.valid)  // as a measurement that threw: its frames in flight come first
+    drain_until_s_ = now_s() + options_.sequence.frame_timeout_s;
   if (!options_.preview && !r.frames.empty())
     publish_frame(r.frames.front());  // no live view: the measurement's first frame instead
   MeasurementOutcome out;
@@ -465,35 +519,15 @@ host::HttpResponse ServeCamera::png(const std::string& bytes, const char* missin
 }
 
 host::HttpResponse ServeCamera::measure_post(const host::HttpRequest& request) {
-  json body;
-  try {
-    body = request.body.empty() ? json::object() : json::parse(request.body);
-  } catch (const json::exception& e) {
-    return host::HttpResponse::text(400, fmt::format("body is not JSON: {}", e.what()));
-  }
-  if (!body.is_object())
-    return host::HttpResponse::text(400, R"(expected {"algorithm": "hariharan5", "averages": 1})");
-  Request req;
-  req.params = options_.sequence;
-  try {
-    const json alg = body.value("algorithm", json("hariharan5"));
-    const json avg = body.value("averages", json(1));
-    if (!alg.is_string())
-      throw core::InputError("algorithm: a name (4step, carre, hariharan5, ...)");
-    if (!avg.is_number_integer() || avg.get<long long>() < 1 || avg.get<long long>() > 100)
-      throw core::InputError("averages: a whole number, 1 to 100");
-    req.algorithm = psi::parse_algorithm(alg.get<std::string>());
-    req.params.steps_rad = instrument::commanded_steps(req.algorithm, {}, "algorithm");
-    req.params.averages = static_cast<int>(avg.get<long long>());
-    if (std::string why = instrument::sequence_problem(req.params); !why.empty())
-      throw core::InputError(why);
-    if (std::string why = instrument::travel_problem(req.params, options_.travel_z_max_um,
-                                                     options_.calibration_source);
-        !why.empty())
-      throw core::InputError(why);
-  } catch (const std::exception& e) {
-    return host::HttpResponse::text(400, fmt::format("measurement: {}", e.what()));
-  }
+  MeasureRequestContext context;
+  context.sequence = options_.sequence;
+  context.travel_z_max_um = options_.travel_z_max_um;
+  context.calibration_source = options_.calibration_source;
+  context.camera = camera_->settings();
+  MeasureRequestCheck check = check_measure_request(request.body, context);
+  if (check.status != 200)
+    return host::HttpResponse::text(check.status, check.reason);
+  Request req = std::move(check.request);
   const std::lock_guard lock(mutex_);
   if (measuring_)
     return host::HttpResponse::text(

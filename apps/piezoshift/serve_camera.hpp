@@ -22,6 +22,8 @@
 //               valid one as PNGs; a failed one has its reason and no surface
 // Nothing here runs on the loop's thread; the HTTP thread never waits for the camera.
 #include <cstdint>
+#include <exception>
+#include <functional>
 #include <memory>
 #include <mutex>
 #include <optional>
@@ -35,6 +37,7 @@
 #include "piezoshift/host/gcs_interpreter.hpp"
 #include "piezoshift/host/stage_model.hpp"
 #include "piezoshift/instrument/sample_sequence.hpp"
+#include "serve_measure_request.hpp"
 
 namespace piezoshift::app {
 
@@ -60,8 +63,10 @@ class ServeCamera final : public host::DashboardPanel {
   ServeCamera(const ServeCamera&) = delete;
   ServeCamera& operator=(const ServeCamera&) = delete;
 
-  //! Starts the camera and the camera thread; stop() joins it (also in the destructor).
-  void start();
+  //! Starts the camera and the camera thread; stop() joins it (also in the destructor). A
+  //! measurement or a live frame that throws fails alone (its reason in GET /api/measure or
+  //! /api/camera); on_failure gets only what escapes that (the thread has ended then).
+  void start(std::function<void(std::exception_ptr)> on_failure = {});
   void stop();
   std::thread& thread() { return thread_; }
 
@@ -72,18 +77,18 @@ class ServeCamera final : public host::DashboardPanel {
   static constexpr host::ClientId kSession = ~host::ClientId{0} - 1;
 
  private:
-  struct Request {
-    psi::Algorithm algorithm = psi::Algorithm::kHariharan5;
-    instrument::SequenceParams params;
-  };
+  using Request = MeasureRequest;
   struct Running;
 
   void run();
   void preview(const std::vector<instrument::LoopSample>& batch);
   void take_preview_frames();
   void publish_frame(const camera::Frame& frame);
+  void step_measurement(bool begin, const std::vector<instrument::LoopSample>& batch);
   void begin_measurement();
   void finish_measurement();
+  //! Ends the running measurement (if any) as failed, with what.
+  void abandon_measurement(const std::string& what);
   std::string move(double z_um);
   host::HttpResponse measure_post(const host::HttpRequest& request);
   host::HttpResponse png(const std::string& bytes, const char* missing) const;
@@ -119,6 +124,7 @@ class ServeCamera final : public host::DashboardPanel {
   double pending_since_s_ = 0.0;
   double refused_since_s_ = -1.0;  //!< live triggers refused since (-1: the last was taken)
   std::uint64_t next_preview_ns_ = 0;
+  double drain_until_s_ = 0.0;  //!< a failed measurement's frames may arrive until then
 };
 
 }  // namespace piezoshift::app

@@ -12,9 +12,12 @@
 #include <sys/resource.h>
 #include <unistd.h>
 
+#include <atomic>
+#include <chrono>
 #include <cmath>
 #include <cstdint>
 #include <cstdio>
+#include <cstdlib>
 #include <exception>
 #include <limits>
 #include <memory>
@@ -60,6 +63,21 @@ namespace {
 
 // Set in g_stop_signal when the network thread fails, so that the loop ramps down.
 constexpr int kNetworkFailed = -1;
+
+// Set once the loop has run its ramp to 0 V and returned.
+std::atomic<bool> g_loop_ramped{false};
+
+// A thread that dies in std::terminate (an exception out of a noexcept function, one no catch
+// took) would abort the process with the outputs where they are: the loop, still ticking on
+// its own thread, is stopped through its ramp first, for at most 2 s, then the process aborts.
+[[noreturn]] void ramp_then_abort() noexcept {
+  std::fputs("piezoshift serve: a thread failed (std::terminate); ramping the outputs to 0 V\n",
+             stderr);
+  g_stop_signal.store(kNetworkFailed);
+  for (int i = 0; i < 200 && !g_loop_ramped.load(); ++i)
+    std::this_thread::sleep_for(std::chrono::milliseconds(10));
+  std::abort();
+}
 
 struct ServeOptions {
   double max_physics_steps = plant::kDefaultPhysicsStepBudget;  // the start-up calibration
@@ -275,7 +293,10 @@ class Network {
   // server that fails stops the loop through its ramp (g_stop_signal); stop() rethrows it.
   void start() {
     if (camera_)
-      camera_->start();
+      camera_->start([this](std::exception_ptr e) {
+        camera_error_ = std::move(e);
+        g_stop_signal.store(kNetworkFailed);
+      });
     line_thread_ = std::thread([this] { serve_until_stopped(*server_, line_error_); });
     if (http_)
       http_thread_ = std::thread([this] {
@@ -304,6 +325,8 @@ class Network {
       std::rethrow_exception(line_error_);
     if (http_error_)
       std::rethrow_exception(http_error_);
+    if (camera_error_)
+      std::rethrow_exception(camera_error_);
   }
 
   // Moves the servers' threads off the loop's CPU; false when there is no other CPU.
@@ -340,7 +363,7 @@ class Network {
   std::unique_ptr<host::HttpServer> http_;
   std::unique_ptr<host::LineServer> server_;
   std::thread line_thread_, http_thread_;
-  std::exception_ptr line_error_, http_error_;
+  std::exception_ptr line_error_, http_error_, camera_error_;
 };
 
 void print_serve_summary(const ServeOptions& o, Network& net, const std::string& daq_name,
@@ -382,6 +405,8 @@ void print_serve_summary(const ServeOptions& o, Network& net, const std::string&
   j["clients_dropped_slow"] = ns.disconnected_slow;
   j["clients_dropped_idle"] = ns.disconnected_idle;
   j["clients_evicted_for_room"] = ns.evicted_for_room;
+  j["clients_refused_http"] = ns.refused_http;  // an HTTP request at the GCS port
+  j["clients_failed"] = ns.failed;              // a line whose handling threw
   j["command_lines"] = gs.lines;
   j["gcs_errors"] = gs.errors;
   j["loop_commands_applied"] = r.host_commands_applied;
@@ -474,11 +499,15 @@ int serve(const ServeOptions& o) {
     dashboard->set_realtime({true, rt.fifo, rt.memory_locked, rt.cpu});
 
   stack.daq().activate();
+  g_loop_ramped.store(false);
+  const std::terminate_handler previous = std::set_terminate(ramp_then_abort);
   const runtime::LoopResult r = loop.run();
+  g_loop_ramped.store(true);
   stack.daq().deactivate();
   fault_reporter.stop();
   net.stop();
   stack.stop_logging();
+  std::set_terminate(previous);  // every thread joined
   net.rethrow_failure();
   print_serve_summary(o, net, daq_name, loop, r, safety, rt, fault_reporter.loads());
   fmt::print("{}", device_error_line(stack.daq()));

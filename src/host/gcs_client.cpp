@@ -37,8 +37,11 @@ std::string describe(double timeout_s) {
 
 }  // namespace
 
-GcsClient::GcsClient(const std::string& host, std::uint16_t port, double timeout_s)
-    : where_(fmt::format("{}:{}", host, port)), timeout_s_(timeout_s) {
+GcsClient::GcsClient(const std::string& host, std::uint16_t port, double timeout_s,
+                     std::size_t max_answer_bytes)
+    : where_(fmt::format("{}:{}", host, port)),
+      timeout_s_(timeout_s),
+      max_answer_bytes_(max_answer_bytes) {
   if (!(timeout_s > 0.0))
     throw std::runtime_error(
         fmt::format("GCS client for {}: the timeout must be > 0 s (+inf: none)", where_));
@@ -175,6 +178,8 @@ std::string GcsClient::read_answer() {
   for (;;) {
     // scanned_ saves re-scanning a large answer on every chunk.
     for (std::size_t lf; (lf = buffer_.find('\n', scanned_)) != std::string::npos;) {
+      if (lf >= max_answer_bytes_)
+        break;  // refused below, whether or not it ends here
       if (lf == 0 || buffer_[lf - 1] != ' ') {
         std::string answer = buffer_.substr(0, lf + 1);
         buffer_.erase(0, lf + 1);
@@ -184,6 +189,11 @@ std::string GcsClient::read_answer() {
       scanned_ = lf + 1;
     }
     scanned_ = buffer_.size();
+    if (scanned_ > max_answer_bytes_)
+      throw std::runtime_error(fmt::format(
+          "GCS client: an answer from {} exceeds {} bytes, the largest a GCS answer can be (a "
+          "DRR? of 8 tables x 8192 points): not a GCS server, or a broken one",
+          where_, max_answer_bytes_));
     if (!receive_some())
       throw std::runtime_error(fmt::format(
           "GCS client: {} closed the connection{}", where_,

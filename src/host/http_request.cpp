@@ -110,8 +110,12 @@ HttpParse parse_http_request(std::string_view input, std::size_t max_head_bytes,
     const std::size_t colon = lines[i].find(':');
     if (colon == std::string_view::npos || colon == 0)
       return HttpParse::kBad;
-    r.headers[lower(trim(lines[i].substr(0, colon)))] =
-        std::string(trim(lines[i].substr(colon + 1)));
+    const auto [it, added] = r.headers.insert_or_assign(
+        lower(trim(lines[i].substr(0, colon))), std::string(trim(lines[i].substr(colon + 1))));
+    // Two lengths (or hosts) are read differently by different parsers (request smuggling): one
+    // or the request is refused, never the last taken.
+    if (!added && (it->first == "content-length" || it->first == "host"))
+      return HttpParse::kBad;
   }
   if (r.headers.count("transfer-encoding") != 0)
     return HttpParse::kBad;  // no chunked uploads: nothing here needs them

@@ -90,6 +90,7 @@ const char* http_reason(int status) noexcept {
 struct HttpServer::Client : PollClient {
   std::string input;
   std::chrono::steady_clock::time_point accepted = std::chrono::steady_clock::now();
+  std::chrono::steady_clock::time_point first_byte;  // of the request (input not empty)
   bool answered = false;  // a response is queued: closed once it is sent (unless a stream)
   bool stream = false;
   bool deferred = false;  // the handler answers in parts (resume())
@@ -111,7 +112,7 @@ HttpServer::HttpServer(const HttpServerOptions& options, HttpHandler& handler)
   };
   if (options.max_clients < 1 || options.max_request_bytes < 256 || options.max_body_bytes < 1 ||
       !(options.request_timeout_s > 0.0) || options.max_pending_output_bytes < 1 ||
-      !(options.evict_idle_when_full_s >= 0.0))
+      !(options.evict_idle_when_full_s >= 0.0) || !(options.evict_incomplete_when_full_s >= 0.0))
     fail("invalid limits");
   const Ipv4Host ip = parse_ipv4_host(options.host, "HTTP server", where);
   if (!ip.loopback && options.token.empty())
@@ -128,6 +129,7 @@ HttpServer::HttpServer(const HttpServerOptions& options, HttpHandler& handler)
   core.send_timeout_s = std::numeric_limits<double>::infinity();
   core.idle_timeout_s = std::numeric_limits<double>::infinity();
   core.evict_idle_when_full_s = options.evict_idle_when_full_s;
+  core.evict_incomplete_when_full_s = options.evict_incomplete_when_full_s;
   core_ = std::make_unique<PollServer>(ip, options.port, "HTTP server", where, core,
                                        static_cast<PollProtocol&>(*this));
   for (const std::string& h : {std::string("127.0.0.1"), std::string("localhost"), ip.numeric})
@@ -212,6 +214,14 @@ void HttpServer::on_end_of_input(PollClient& polled) {
     PollProtocol::on_end_of_input(polled);
 }
 
+std::optional<std::chrono::steady_clock::time_point> HttpServer::incomplete_since(
+    const PollClient& polled) const {
+  const Client& c = client(polled);
+  if (c.answered || c.input.empty())
+    return std::nullopt;
+  return c.first_byte;
+}
+
 bool HttpServer::has_work(const PollClient& polled) const {
   return HttpServer::client(polled).deferred;
 }
@@ -244,6 +254,8 @@ void HttpServer::on_input(PollClient& polled, std::string_view bytes) {
   Client& c = client(polled);
   if (c.answered)
     return;  // nothing more is read on an answered connection (a stream's peer is silent)
+  if (c.input.empty())
+    c.first_byte = std::chrono::steady_clock::now();
   c.input.append(bytes);
   try_answer(c);
 }

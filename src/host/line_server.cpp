@@ -8,6 +8,7 @@
 #include <fmt/format.h>
 
 #include "piezoshift/core/input_error.hpp"
+#include "piezoshift/host/http_line.hpp"
 
 namespace piezoshift::host {
 
@@ -15,6 +16,8 @@ struct LineServer::Client : PollClient {
   std::string unread;       // received, not handled yet (at most one read chunk)
   std::string input;        // the partial line received so far (at most max_line_bytes + 1)
   bool discarding = false;  // inside an overlong line: drop bytes up to the next LF
+  bool first_line = true;   // no line (nor overlong one) handled yet
+  std::chrono::steady_clock::time_point partial_since;  // the first byte of input (or discarding)
 };
 
 namespace {
@@ -68,6 +71,7 @@ LineServer::LineServer(const ListenAddress& address, const LineServerLimits& lim
   core.send_timeout_s = limits.send_timeout_s;
   core.idle_timeout_s = limits.idle_timeout_s;
   core.evict_idle_when_full_s = limits.evict_idle_when_full_s;
+  core.evict_incomplete_when_full_s = limits.evict_incomplete_when_full_s;
   core_ = std::make_unique<PollServer>(ip, address.port, "TCP server", where, core,
                                        static_cast<PollProtocol&>(*this));
 }
@@ -94,6 +98,8 @@ LineServerStats LineServer::stats() const {
   s.evicted_for_room = c.evicted_for_room;
   s.rounds = c.rounds;
   s.overlong_lines = overlong_lines_.load(std::memory_order_relaxed);
+  s.refused_http = refused_http_.load(std::memory_order_relaxed);
+  s.failed = c.failed;
   s.bytes_in = c.bytes_in;
   s.bytes_out = c.bytes_out;
   s.accept_failures = c.accept_failures;
@@ -118,6 +124,14 @@ bool LineServer::throttled(const PollClient& c) const {
 
 bool LineServer::wants_input(const PollClient& c) const {
   return client(c).unread.empty() && !throttled(c);
+}
+
+std::optional<std::chrono::steady_clock::time_point> LineServer::incomplete_since(
+    const PollClient& polled) const {
+  const Client& c = client(polled);
+  if (c.input.empty() && !c.discarding)
+    return std::nullopt;
+  return c.partial_since;
 }
 
 bool LineServer::has_work(const PollClient& c) const {
@@ -181,10 +195,13 @@ void LineServer::serve(PollClient& polled) {
       continue;
     }
     if (lf == std::string_view::npos) {
+      if (c.input.empty())
+        c.partial_since = std::chrono::steady_clock::now();
       c.input.append(data);
       data = {};
       // One byte of slack: the last byte may be the CR of a CRLF that does not count.
       if (c.input.size() > limits_.max_line_bytes + 1) {
+        c.first_line = false;
         c.input.clear();
         c.discarding = true;
         overlong_lines_.fetch_add(1, std::memory_order_relaxed);
@@ -200,6 +217,13 @@ void LineServer::serve(PollClient& polled) {
     }
     if (!line.empty() && line.back() == '\r')
       line.remove_suffix(1);
+    if (std::exchange(c.first_line, false) && limits_.refuse_http && looks_like_http(line)) {
+      // Another protocol's request (a browser's or curl's POST): none of it runs.
+      refused_http_.fetch_add(1, std::memory_order_relaxed);
+      core_->close(c);
+      data = {};
+      break;
+    }
     if (line.size() > limits_.max_line_bytes) {
       overlong_lines_.fetch_add(1, std::memory_order_relaxed);
       answer(handler_.on_overlong_line(c.id()));

@@ -8,6 +8,7 @@
 #include <cmath>
 #include <cstring>
 #include <limits>
+#include <optional>
 #include <stdexcept>
 #include <utility>
 
@@ -40,6 +41,8 @@ const PollServerLimits& checked(const PollServerLimits& limits, const std::strin
     fail("send_timeout_s must be > 0 (+inf: no timeout)");
   if (!(limits.evict_idle_when_full_s >= 0.0))
     fail("evict_idle_when_full_s must be >= 0 (+inf: never)");
+  if (!(limits.evict_incomplete_when_full_s >= 0.0))
+    fail("evict_incomplete_when_full_s must be >= 0 (+inf: never)");
   return limits;
 }
 
@@ -78,6 +81,8 @@ PollServerStats PollServer::stats() const {
   s.evicted_slow = stats_.evicted_slow.load(r);
   s.evicted_idle = stats_.evicted_idle.load(r);
   s.evicted_for_room = stats_.evicted_for_room.load(r);
+  s.failed = stats_.failed.load(r);
+  s.failed_rounds = stats_.failed_rounds.load(r);
   s.rounds = stats_.rounds.load(r);
   s.bytes_in = stats_.bytes_in.load(r);
   s.bytes_out = stats_.bytes_out.load(r);
@@ -98,7 +103,12 @@ void PollServer::run(const std::atomic<int>* stop_flag, int poll_interval_ms) {
   };
   try {
     while (!stopping()) {
-      protocol_.on_round();
+      try {
+        protocol_.on_round();
+      } catch (const std::exception&) {
+        // Its work (e.g. the samples drained for the dashboard) is lost; the clients go on.
+        stats_.failed_rounds.fetch_add(1, std::memory_order_relaxed);
+      }
       close_marked_clients();  // what on_round() gave up (e.g. a request timeout)
       serve_round(poll_interval_ms);
       evict_stale_clients();
@@ -144,13 +154,19 @@ void PollServer::serve_round(int poll_interval_ms) {
       c.close_ = PollClient::Close::kNow;
     if (c.closing())
       continue;
-    // POLLHUP/POLLERR: recv() or send() reports what happened.
-    if ((fds_[i + 2].events & POLLIN) && (revents & (POLLIN | POLLHUP | POLLERR)))
-      read_from(c);
-    if (!c.closing())
-      protocol_.serve(c);
-    if (!c.closing() && c.pending() > 0)
-      flush(c);
+    // A client whose request throws (std::bad_alloc, a handler's bug) is closed: it fails alone,
+    // the others are served.
+    try {
+      // POLLHUP/POLLERR: recv() or send() reports what happened.
+      if ((fds_[i + 2].events & POLLIN) && (revents & (POLLIN | POLLHUP | POLLERR)))
+        read_from(c);
+      if (!c.closing())
+        protocol_.serve(c);
+      if (!c.closing() && c.pending() > 0)
+        flush(c);
+    } catch (const std::exception&) {
+      c.close_ = PollClient::Close::kFailed;
+    }
   }
 }
 
@@ -179,29 +195,47 @@ void PollServer::accept_clients() {
     clients_.push_back(std::move(c));
     client_count_.store(clients_.size());
     stats_.accepted.fetch_add(1, std::memory_order_relaxed);
-    protocol_.on_connect(*clients_.back());
+    try {
+      protocol_.on_connect(*clients_.back());
+    } catch (const std::exception&) {
+      clients_.back()->close_ = PollClient::Close::kFailed;
+    }
   }
 }
 
 bool PollServer::make_room() {
-  if (!(limits_.evict_idle_when_full_s < std::numeric_limits<double>::infinity()))
-    return false;
-  const auto min_idle = std::chrono::duration_cast<Clock::duration>(
-      std::chrono::duration<double>(limits_.evict_idle_when_full_s));
+  const auto at_least = [](double s) {
+    return s < std::numeric_limits<double>::infinity()
+               ? std::optional(
+                     std::chrono::duration_cast<Clock::duration>(std::chrono::duration<double>(s)))
+               : std::nullopt;
+  };
+  const std::optional<Clock::duration> min_idle = at_least(limits_.evict_idle_when_full_s);
+  const std::optional<Clock::duration> min_incomplete =
+      at_least(limits_.evict_incomplete_when_full_s);
   const auto now = Clock::now();
   PollClient* idlest = nullptr;
+  PollClient* stalled = nullptr;  // its request incomplete the longest
+  Clock::time_point stalled_since{};
   for (auto& c : clients_) {
     // Only a client waiting for its peer: one whose input ended, or whose input the protocol does
     // not want (an answer on its way, a throttled reader), is busy by our side's doing.
-    if (c->closing() || c->input_ended_ || !protocol_.wants_input(*c) ||
-        now - c->last_input_ < min_idle)
+    if (c->closing() || c->input_ended_ || !protocol_.wants_input(*c))
       continue;
-    if (idlest == nullptr || c->last_input_ < idlest->last_input_)
+    if (const auto since = protocol_.incomplete_since(*c);
+        min_incomplete && since && now - *since >= *min_incomplete &&
+        (stalled == nullptr || *since < stalled_since)) {
+      stalled = c.get();
+      stalled_since = *since;
+    }
+    if (min_idle && now - c->last_input_ >= *min_idle &&
+        (idlest == nullptr || c->last_input_ < idlest->last_input_))
       idlest = c.get();  // ties: the older connection, met first
   }
-  if (idlest == nullptr)
+  PollClient* chosen = stalled != nullptr ? stalled : idlest;
+  if (chosen == nullptr)
     return false;
-  idlest->close_ = PollClient::Close::kRoom;
+  chosen->close_ = PollClient::Close::kRoom;
   return true;
 }
 
@@ -314,6 +348,8 @@ void PollServer::close_marked_clients() {
       stats_.evicted_idle.fetch_add(1, std::memory_order_relaxed);
     if (c->close_ == PollClient::Close::kRoom)
       stats_.evicted_for_room.fetch_add(1, std::memory_order_relaxed);
+    if (c->close_ == PollClient::Close::kFailed)
+      stats_.failed.fetch_add(1, std::memory_order_relaxed);
     close_fd(c->fd_);
     closed.push_back(std::move(c));
   }

@@ -141,6 +141,21 @@ TEST_F(MeasureCli, BadInputIsRefusedBeforeAnythingRuns) {
   EXPECT_TRUE(fs::exists(path("full/keep.txt")));
 }
 
+// A 2048 px camera took 350 MB an average, 35 GB at the 100 allowed. The memory bound
+// refuses it before the loop starts, naming the options and what fits.
+TEST_F(MeasureCli, AMeasurementBeyondTheMemoryBoundIsRefusedBeforeItStarts) {
+  const std::string big = write("big.toml", "[camera]\nwidth_px = 2048\nheight_px = 2048\n");
+  const testing::CliResult r =
+      run("measure --free-run --out '" + path("m") + "' --config '" + big + "' --averages 100");
+  EXPECT_EQ(r.status, 2) << r.err;
+  EXPECT_NE(r.err.find("--averages and --algorithm (--steps-rad) with [camera] width_px, "
+                       "height_px: 100 averages x 5 frames of 2048 x 2048 px"),
+            std::string::npos)
+      << r.err;
+  EXPECT_NE(r.err.find("at most 2 averages on this camera"), std::string::npos) << r.err;
+  EXPECT_FALSE(fs::exists(path("m")));
+}
+
 // Issue 29's lock on the twin with the cavity's drift in the fringes: the first average is the
 // reference, every later frame is locked, and the cavity's path stays nearer its set point than
 // on the gauges alone (same seed). Measured on this camera: 2.6 nm RMS unlocked (the drift over

@@ -96,6 +96,24 @@ TEST_F(Http, MalformedRequestsGet400) {
     EXPECT_EQ(http_status(http_exchange(server_->port(), bad)), 400) << bad;
 }
 
+// A second Content-Length was accepted, the last one winning; two parsers that take
+// different ones see different requests (smuggling). One Content-Length (and one Host) or 400.
+TEST_F(Http, ASecondContentLengthOrHostIsRefused) {
+  start();
+  const std::string json = "Content-Type: application/json\r\n";
+  for (const std::string& twice :
+       std::vector<std::string>{"Content-Length: 2\r\nContent-Length: 0\r\n",
+                                "Content-Length: 2\r\ncontent-length: 2\r\n",
+                                "Content-Length: 2\r\nTransfer-Encoding: identity\r\n", host()})
+    EXPECT_EQ(http_status(http_exchange(server_->port(),
+                                        "POST / HTTP/1.1\r\n" + host() + json + twice + "\r\n{}")),
+              400)
+        << twice;
+  EXPECT_EQ(http_status(http_exchange(server_->port(), "POST / HTTP/1.1\r\n" + host() + json +
+                                                           "Content-Length: 2\r\n\r\n{}")),
+            200);
+}
+
 TEST_F(Http, OversizedHeadersGet431AndBodies413) {
   HttpServerOptions o;
   o.max_request_bytes = 1024;
@@ -151,6 +169,13 @@ TEST_F(Http, PostsMustBeJsonFromThisOrigin) {
   EXPECT_EQ(post("Content-Type: application/json\r\nOrigin: http://evil.example\r\n"), 403);
   EXPECT_EQ(post("Content-Type: application/json\r\nOrigin: http://127.0.0.1:" + p + "\r\n"), 200);
   EXPECT_EQ(post("Content-Type: application/json\r\n"), 200);  // curl sends no Origin
+  // A page on another localhost port is another origin, and so is the same port
+  // named otherwise than the Host header names it, and a sandboxed page's "null".
+  const std::string other = std::to_string(server_->port() == 65535 ? 1 : server_->port() + 1);
+  for (const std::string& origin :
+       std::vector<std::string>{"http://127.0.0.1:" + other, "http://localhost:" + other,
+                                "http://localhost:" + p, "https://127.0.0.1:" + p, "null"})
+    EXPECT_EQ(post("Content-Type: application/json\r\nOrigin: " + origin + "\r\n"), 403) << origin;
 }
 
 TEST_F(Http, ATokenIsRequiredOnEveryRequest) {

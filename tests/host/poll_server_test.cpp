@@ -8,8 +8,10 @@
 //   slow       a reader that never reads is evicted once its send queue exceeds its bound (and
 //              counted), while another client keeps being answered.
 //   refusal    a connection beyond max_clients is refused and counted on both.
-//   room       with the table full, a newcomer takes the place of the client silent longest
-//              (issue 27: eight silent GCS clients locked everyone out for the 600 s idle
+//   room       with the table full, a newcomer takes the place of the client whose line or
+//              request head has been incomplete longest (2 s at least: clients sending
+//              a byte every 0.9 s refused 196 of 198 newcomers), else of the client silent
+//              longest (issue 27: eight silent GCS clients locked everyone out for the 600 s idle
 //              timeout); event streams leave slots for requests (sixteen streams made every
 //              other dashboard request a 503).
 // Descriptor exhaustion (the accept back-off) is pinned for both in line_server_test.cpp and
@@ -293,6 +295,94 @@ TEST(PollServerRoom, LineRecentlyActiveClientKeepsItsPlace) {
   EXPECT_EQ(server.stats().refused_max_clients, 1u);
 }
 
+// Sends `first` at once, then one byte of `pattern` (cyclically) every period_s until destroyed:
+// a client that is never silent for a second and never completes its line or request head.
+class Trickler {
+ public:
+  Trickler(std::uint16_t port, std::string first, std::string pattern, double period_s)
+      : connection_(port), thread_([this, first = std::move(first), pattern, period_s] {
+          connection_.send(first);
+          sent_first_ = true;
+          for (std::size_t i = 0; !stop_.load(); ++i) {
+            const auto until =
+                std::chrono::steady_clock::now() + std::chrono::duration<double>(period_s);
+            while (!stop_.load() && std::chrono::steady_clock::now() < until)
+              std::this_thread::sleep_for(std::chrono::milliseconds(5));
+            if (!stop_.load())
+              connection_.send(std::string(1, pattern[i % pattern.size()]));
+          }
+        }) {}
+  ~Trickler() {
+    stop_ = true;
+    thread_.join();
+  }
+  Trickler(const Trickler&) = delete;
+  Trickler& operator=(const Trickler&) = delete;
+  bool sent_first() const { return sent_first_.load(); }
+  //! True once the server has closed the connection (EOF or reset), within timeout_s.
+  bool closed(double timeout_s) {
+    std::string ignored;
+    const auto end = std::chrono::steady_clock::now() + std::chrono::duration<double>(timeout_s);
+    while (std::chrono::steady_clock::now() < end)
+      if (!connection_.read_some(ignored, 0.05))
+        return true;
+    return false;
+  }
+
+ private:
+  HttpConnection connection_;  // a plain TCP connection
+  std::atomic<bool> stop_{false};
+  std::atomic<bool> sent_first_{false};
+  std::thread thread_;
+};
+
+// Eight GCS clients sending a byte every 0.9 s are never silent for the 1 s that makes
+// a client give way, and refused 196 of 198 newcomers. A client whose line is incomplete 2 s
+// after its first byte (evict_incomplete_when_full_s) now gives way first, the oldest line first.
+// The bound is a lower one: waiting longer on a loaded machine changes nothing.
+TEST(PollServerRoom, LineClientsThatNeverEndALineGiveWayToNewcomers) {
+  LineCounting handler;
+  LineServerLimits limits;  // max_clients 8, evict_idle_when_full_s 1, incomplete 2
+  LineServer server(ListenAddress{"127.0.0.1", 0, false}, limits, handler);
+  Running running(server);
+  std::vector<std::unique_ptr<Trickler>> slow;
+  for (std::size_t i = 0; i < limits.max_clients; ++i) {
+    slow.push_back(std::make_unique<Trickler>(server.port(), "E", "CHO", 0.3));
+    ASSERT_TRUE(
+        eventually([&] { return server.client_count() == i + 1 && slow[i]->sent_first(); }));
+  }
+  std::this_thread::sleep_for(std::chrono::milliseconds(2200));
+  std::vector<std::unique_ptr<GcsClient>> newcomers;  // each kept: each takes a place
+  for (int n = 0; n < 3; ++n) {
+    newcomers.push_back(std::make_unique<GcsClient>("127.0.0.1", server.port()));
+    EXPECT_EQ(newcomers.back()->query("ECHO " + std::to_string(n)), std::to_string(n) + "\n");
+  }
+  EXPECT_TRUE(slow[0]->closed(10.0));  // the oldest line went first
+  EXPECT_GE(server.stats().evicted_for_room, 3u);
+  EXPECT_EQ(server.stats().refused_max_clients, 0u);
+}
+
+// Clients that complete their lines keep their places, however long they stay: the newcomer is
+// refused (the idle rule set aside, so that only the incomplete-line rule could choose).
+TEST(PollServerRoom, LineClientsThatEndTheirLinesKeepTheirPlaces) {
+  LineCounting handler;
+  LineServerLimits limits;
+  limits.max_clients = 2;
+  limits.evict_idle_when_full_s = std::numeric_limits<double>::infinity();
+  LineServer server(ListenAddress{"127.0.0.1", 0, false}, limits, handler);
+  Running running(server);
+  GcsClient a("127.0.0.1", server.port());
+  GcsClient b("127.0.0.1", server.port());
+  EXPECT_EQ(a.query("ECHO a"), "a\n");
+  EXPECT_EQ(b.query("ECHO b"), "b\n");
+  std::this_thread::sleep_for(std::chrono::milliseconds(2200));
+  GcsClient c("127.0.0.1", server.port());
+  EXPECT_TRUE(c.wait_closed(10.0));
+  EXPECT_EQ(a.query("ECHO a"), "a\n");
+  EXPECT_EQ(server.stats().evicted_for_room, 0u);
+  EXPECT_EQ(server.stats().refused_max_clients, 1u);
+}
+
 // ---- HttpServer ----
 
 // "/" -> 200 "ok", "/stream" -> an event stream. Records per round (on_poll starts one) the bytes
@@ -473,6 +563,28 @@ TEST(PollServerRoom, HttpOldestStreamGivesWayWhenTheTableIsFull) {
   for (int i = 0; i < 100 && open; ++i)
     open = streams.front()->read_some(rest, 0.1);
   EXPECT_FALSE(open) << "the first stream was not the one closed";
+}
+
+// Sixteen HTTP clients sending one header line a second denied 81 % of another
+// client's requests. A request whose head is incomplete 2 s after its first byte now gives way
+// to a newcomer, whose GET is answered.
+TEST(PollServerRoom, HttpClientsThatNeverEndTheirHeadGiveWayToNewcomers) {
+  HttpCounting handler;
+  HttpServerOptions o;  // max_clients 16, evict_idle_when_full_s 1, incomplete 2
+  HttpServer server(o, handler);
+  Running running(server);
+  std::vector<std::unique_ptr<Trickler>> slow;
+  for (std::size_t i = 0; i < o.max_clients; ++i) {
+    slow.push_back(
+        std::make_unique<Trickler>(server.port(), "GET / HTTP/1.1\r\n", "X-Slow: 1\r\n", 0.3));
+    ASSERT_TRUE(eventually([&] { return slow[i]->sent_first(); }));
+  }
+  std::this_thread::sleep_for(std::chrono::milliseconds(2200));
+  // Each answered request is closed, so the first newcomer's place serves the next ones too.
+  for (int n = 0; n < 3; ++n)
+    EXPECT_EQ(http_status(testing::http_exchange(server.port(), get_root(server.port()))), 200);
+  EXPECT_GE(server.stats().evicted_for_room, 1u);
+  EXPECT_EQ(server.stats().refused_max_clients, 0u);
 }
 
 }  // namespace

@@ -2,7 +2,10 @@
 // in-project GCS client drives it over loopback. The loop runs on the real clock; the overrun rule
 // is lifted (--max-overruns) so that a loaded test machine cannot turn a test into a fault run:
 // timing is not what these tests check. No wall-clock asserts: waits are generous upper bounds.
+#include <arpa/inet.h>
+#include <netinet/in.h>
 #include <signal.h>
+#include <sys/socket.h>
 #include <unistd.h>
 
 #include <algorithm>
@@ -492,6 +495,57 @@ TEST_F(Serve, TheGcsCommandSendsCommandsAndPrintsTheAnswersOfQueries) {
   EXPECT_NE(slurp(path("gcs2_err.txt")).find("127.0.0.1:" + std::to_string(port)),
             std::string::npos)
       << slurp(path("gcs2_err.txt"));
+}
+
+// `curl -X POST --data-binary $'SVO Z 1 U 1 V 1\nMOV Z 10\n' http://127.0.0.1:PORT/`
+// at the GCS port switched the servo on and moved the stage. Its first line is HTTP's: the
+// connection is closed before anything of it runs.
+TEST_F(Serve, AnHttpRequestToTheGcsPortRunsNothing) {
+  const std::uint16_t port = start();
+  ASSERT_NE(port, 0);
+  const std::string body = "SVO Z 1 U 1 V 1\nMOV Z 10\n";
+  GcsClient c("127.0.0.1", port);
+  const double target_before = value_of(c.query_lines("MOV? Z"), "Z");
+  {
+    GcsClient curl("127.0.0.1", port);
+    curl.send_raw(fmt::format(
+        "POST / HTTP/1.1\r\nHost: 127.0.0.1:{}\r\nUser-Agent: curl/7.88.1\r\nAccept: */*\r\n"
+        "Content-Length: {}\r\nContent-Type: application/x-www-form-urlencoded\r\n\r\n{}",
+        port, body.size(), body));
+    EXPECT_TRUE(curl.wait_closed(10.0));
+  }
+  EXPECT_EQ(c.query("SVO? Z"), "Z=0\n");
+  EXPECT_EQ(value_of(c.query_lines("MOV? Z"), "Z"), target_before);
+  EXPECT_EQ(error(c), 0);
+  stop();
+}
+
+// `piezoshift gcs` against a server that never ends its answer buffered 8.6 GB in 40 s.
+// Now exit 2 once the answer passes the largest a GCS answer can be, naming it.
+TEST_F(Serve, TheGcsCommandRefusesAnAnswerBeyondTheLargest) {
+  const int listener = ::socket(AF_INET, SOCK_STREAM, 0);
+  sockaddr_in sa{};
+  sa.sin_family = AF_INET;
+  sa.sin_addr.s_addr = htonl(INADDR_LOOPBACK);
+  ASSERT_EQ(::bind(listener, reinterpret_cast<sockaddr*>(&sa), sizeof sa), 0);
+  ASSERT_EQ(::listen(listener, 1), 0);
+  socklen_t len = sizeof sa;
+  ::getsockname(listener, reinterpret_cast<sockaddr*>(&sa), &len);
+  std::thread endless([listener] {
+    const int fd = ::accept(listener, nullptr, nullptr);
+    const std::string chunk(65536, '7');
+    while (fd >= 0 && ::send(fd, chunk.data(), chunk.size(), MSG_NOSIGNAL) > 0) {
+    }
+    if (fd >= 0)
+      ::close(fd);
+  });
+  const Spawned client = spawn({"gcs", "--port", std::to_string(ntohs(sa.sin_port)), "POS?"},
+                               path("gcs.txt"), path("gcs_err.txt"));
+  EXPECT_EQ(wait_exit(client), 2);
+  EXPECT_NE(slurp(path("gcs_err.txt")).find("exceeds 1180672 bytes"), std::string::npos)
+      << slurp(path("gcs_err.txt"));
+  endless.join();
+  ::close(listener);
 }
 
 // Waits for s to exit, at most limit_s (a hang guard, not a timing assertion: the cases below end

@@ -6,6 +6,9 @@
 // every line but the last ends with a SPACE before its LF, so an answer ends at the first LF that
 // does not follow a space:
 //   "0 1 X=1.0 \n0 1 Y=2.0 \n0 1 Z=3.0\n"  is one answer of three lines.
+// An answer is bounded: beyond max_answer_bytes (by default the largest piezoshift's server
+// makes, DataRecorder::kMaxAnswerBytes, a DRR? of 8 tables x 8192 points) read_answer() throws
+// instead of buffering a server that never ends its answer (8.6 GB in 40 s before the bound).
 // Not real-time code; errors are std::runtime_error naming host:port.
 #include <cstddef>
 #include <cstdint>
@@ -13,13 +16,17 @@
 #include <string_view>
 #include <vector>
 
+#include "piezoshift/host/data_recorder.hpp"
+
 namespace piezoshift::host {
 
 class GcsClient {
  public:
   //! Connects within timeout_s [s] (+inf: no limit); throws std::runtime_error naming host:port
-  //! (unknown host, refused, timed out). host: a name or a numeric address.
-  GcsClient(const std::string& host, std::uint16_t port, double timeout_s = 5.0);
+  //! (unknown host, refused, timed out). host: a name or a numeric address. max_answer_bytes:
+  //! the longest answer read_answer() takes.
+  GcsClient(const std::string& host, std::uint16_t port, double timeout_s = 5.0,
+            std::size_t max_answer_bytes = DataRecorder::kMaxAnswerBytes);
   ~GcsClient();
   GcsClient(const GcsClient&) = delete;
   GcsClient& operator=(const GcsClient&) = delete;
@@ -30,7 +37,8 @@ class GcsClient {
   //! takes nothing for timeout_s or the peer is gone.
   void send_raw(std::string_view bytes);
   //! Reads one whole answer, exactly as received (terminators included). Throws
-  //! std::runtime_error when no byte arrives for timeout_s, or on EOF or reset before its end.
+  //! std::runtime_error when no byte arrives for timeout_s, on EOF or reset before its end, or
+  //! once more than max_answer_bytes of it have arrived without its end.
   std::string read_answer();
   //! read_answer() split into its lines, without their " \n" or "\n".
   std::vector<std::string> read_answer_lines();
@@ -55,6 +63,7 @@ class GcsClient {
 
   std::string where_;  // "host:port", for messages
   double timeout_s_;
+  std::size_t max_answer_bytes_;
   int fd_ = -1;
   std::string buffer_;       // received, not yet returned
   std::size_t scanned_ = 0;  // buffer_[0, scanned_) holds no answer terminator

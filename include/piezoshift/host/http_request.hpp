@@ -1,7 +1,8 @@
 #pragma once
 // One HTTP/1.1 request as the dashboard's server (http_server.hpp) takes it, and its parser:
 // "METHOD target HTTP/1.x" (LF or CRLF line ends), headers, a body only with Content-Length
-// (no chunked uploads: nothing here needs them).
+// (no chunked uploads: nothing here needs them; any Transfer-Encoding is refused). A second
+// Content-Length or Host header is refused (kBad), never the last one taken.
 #include <cstddef>
 #include <cstdint>
 #include <map>

@@ -23,8 +23,10 @@
 //              server calls resume() once a round (serving every other client in between) until
 //              it returns one, or abandon() when the connection ends first (reset, or the request
 //              timeout, which answers 503)
-//   room       with max_clients connected, a new connection takes the place of the one silent
-//              longest (a stream: the one opened first) if silent for evict_idle_when_full_s
+//   room       with max_clients connected, a new connection takes the place of the one whose
+//              request has been incomplete longest, if for evict_incomplete_when_full_s since its
+//              first byte (a client trickling its headers), else of the one silent longest (a
+//              stream: the one opened first) if silent for evict_idle_when_full_s
 //              (poll_server.hpp); otherwise it gets 503
 //   memory     per client: max_request_bytes + max_body_bytes of request, max_pending_output_bytes
 //              of queued answer and events (the handler's own state aside)
@@ -39,6 +41,7 @@
 #include <cstddef>
 #include <cstdint>
 #include <memory>
+#include <optional>
 #include <string>
 #include <string_view>
 #include <vector>
@@ -63,6 +66,9 @@ struct HttpServerOptions {
   //! A full table's newcomer takes the place of the client silent longest if silent this long
   //! [s] (PollServerLimits::evict_idle_when_full_s); 0: always, +inf: never.
   double evict_idle_when_full_s = 1.0;
+  //! Before that: the client whose request (head and body) has been incomplete longest, if its
+  //! first byte came at least this long ago [s] (evict_incomplete_when_full_s); +inf: never.
+  double evict_incomplete_when_full_s = 2.0;
 };
 
 struct HttpResponse {
@@ -152,6 +158,8 @@ class HttpServer : private PollProtocol {
   void on_round() override;
   bool wants_input(const PollClient& client) const override;
   bool has_work(const PollClient& client) const override;
+  std::optional<std::chrono::steady_clock::time_point> incomplete_since(
+      const PollClient& client) const override;
   void on_input(PollClient& client, std::string_view bytes) override;
   void on_end_of_input(PollClient& client) override;
   //! Resumes a deferred request.

@@ -18,7 +18,9 @@
 // line is a DRR? of DataRecorder::kMaxAnswerBytes), and a client that does not read its answers
 // is throttled (its further lines wait, in its own socket, until it reads) and, if it reads
 // nothing for send_timeout_s, disconnected. With max_clients connected, a new client takes the
-// place of the one silent longest (at least evict_idle_when_full_s; poll_server.hpp).
+// place of the one whose line has been incomplete longest (at least evict_incomplete_when_full_s
+// since its first byte), else of the one silent longest (at least evict_idle_when_full_s;
+// poll_server.hpp).
 // Memory per client: kReadChunkBytes unread + max_line_bytes + 1 of a partial line +
 // max_pending_output_bytes queued + one answer (at most DataRecorder::kMaxAnswerBytes).
 // Not real-time code (heap, exceptions); it talks to the loop through its handler.
@@ -27,6 +29,7 @@
 #include <cstddef>
 #include <cstdint>
 #include <memory>
+#include <optional>
 #include <string>
 #include <string_view>
 #include <vector>
@@ -67,13 +70,21 @@ struct LineServerLimits {
   //! when it has been silent at least this long [s]; 0: always, +inf: never (the newcomer is
   //! refused).
   double evict_idle_when_full_s = 1.0;
+  //! With max_clients connected, a new connection first takes the place of the client whose
+  //! line has been incomplete longest (no LF yet), if its first byte came at least this long ago
+  //! [s]; +inf: never. A client sending a byte every 0.9 s is never silent for 1 s.
+  double evict_incomplete_when_full_s = 2.0;
   //! One client's lines handled in one round stop once they have taken this long [s] (the line
   //! that crosses it is finished): other clients are served in between.
   double turn_budget_s = 1e-3;
+  //! A connection whose first line is HTTP's (http_line.hpp) is closed before anything of it is
+  //! handled: a browser or curl pointed at the port does not have its request's body run.
+  bool refuse_http = true;
 };
 
 //! What the protocol implements (the GCS interpreter). Called from the run() thread only.
-//! An exception from a handler ends run() (all connections are closed first) and propagates.
+//! A std::exception from a handler closes the client it was called for (the others are served,
+//! LineServerStats::failed); from on_poll() it loses that poll (poll_server.hpp).
 class LineHandler {
  public:
   virtual ~LineHandler() = default;
@@ -111,6 +122,8 @@ struct LineServerStats {
   std::uint64_t evicted_for_room = 0;   //!< silent longest when a new client found the table full
   std::uint64_t rounds = 0;             //!< poll rounds served (a clock for the tests)
   std::uint64_t overlong_lines = 0;     //!< lines longer than max_line_bytes
+  std::uint64_t refused_http = 0;       //!< closed: the first line was HTTP's (refuse_http)
+  std::uint64_t failed = 0;             //!< closed: the handler threw for it
   std::uint64_t bytes_in = 0;           //!< received from all clients
   std::uint64_t bytes_out = 0;          //!< sent (accepted by the kernel) to all clients
   //! accept() failed for lack of descriptors or memory; each pauses accepting for 100 ms
@@ -160,6 +173,8 @@ class LineServer : private PollProtocol {
   void on_round() override { handler_.on_poll(); }
   bool wants_input(const PollClient& client) const override;
   bool has_work(const PollClient& client) const override;
+  std::optional<std::chrono::steady_clock::time_point> incomplete_since(
+      const PollClient& client) const override;
   void on_input(PollClient& client, std::string_view bytes) override;
   void on_end_of_input(PollClient& client) override;
   //! Handles the client's complete lines in unread, within the round's budget (see the top).
@@ -172,6 +187,7 @@ class LineServer : private PollProtocol {
   LineHandler& handler_;
   std::unique_ptr<PollServer> core_;
   std::atomic<std::uint64_t> overlong_lines_{0};
+  std::atomic<std::uint64_t> refused_http_{0};
 };
 
 }  // namespace piezoshift::host

@@ -12,18 +12,21 @@
 //                    input()); protocol.serve(); send() what is queued (MSG_NOSIGNAL)
 //   evict idle clients (no byte received for idle_timeout_s while input is wanted) and slow ones
 //   (none of their queue taken for send_timeout_s); close the marked ones -> on_disconnect()
-//   accept() new connections: beyond max_clients, the client idle longest (no byte received for
-//        the longest time, at least evict_idle_when_full_s, its input wanted) is closed to make
-//        room (counted); when none is that idle, protocol.refusal() is sent best effort to the
-//        newcomer and it is closed (counted)
+//   accept() new connections: beyond max_clients, the client whose request (line, HTTP request)
+//        has been incomplete longest, at least evict_incomplete_when_full_s since its first byte,
+//        else the client idle longest (no byte received for the longest time, at least
+//        evict_idle_when_full_s), its input wanted either way, is closed to make room (counted);
+//        when there is none, protocol.refusal() is sent best effort to the newcomer and it is
+//        closed (counted)
 // Fairness: a round reads at most read_budget_bytes from each client and then serves every
 // client, so a client that floods delays another's answer by at most two budgets of its bytes
 // (the rest of the round in which the other's bytes arrive, and the round that reads them), not
 // by all it sent. Output: each client has its own queue, bounded by max_pending_output_bytes;
 // queue() beyond the bound sends at once, and a client whose socket still takes too little is
 // evicted as slow while the others are served. Room: silent connections cannot lock the others
-// out; a client that sent something within evict_idle_when_full_s keeps its place. Memory per
-// client: read_budget_bytes (the protocol's own buffers aside) + max_pending_output_bytes + one
+// out, nor can connections that trickle a byte at a time and never end a request; a client
+// that sent something within evict_idle_when_full_s, its request complete, keeps its place. Memory
+// per client: read_budget_bytes (the protocol's own buffers aside) + max_pending_output_bytes + one
 // answer. Not real-time code (heap, exceptions).
 #include <poll.h>
 
@@ -33,6 +36,7 @@
 #include <cstdint>
 #include <functional>
 #include <memory>
+#include <optional>
 #include <string>
 #include <string_view>
 #include <vector>
@@ -58,6 +62,11 @@ struct PollServerLimits {
   //! With max_clients connected, a new connection closes the client idle longest if it has been
   //! idle (no byte received, input wanted) at least this long [s]; 0: always, +inf: never.
   double evict_idle_when_full_s = 1.0;
+  //! With max_clients connected, a new connection first closes the client whose request (a line,
+  //! an HTTP request) has been incomplete longest, if its first byte came at least this long ago
+  //! [s] (PollProtocol::incomplete_since): a client that trickles a byte at a time is never silent
+  //! for evict_idle_when_full_s. +inf: never.
+  double evict_incomplete_when_full_s = 2.0;
 };
 
 //! Counters since construction.
@@ -67,9 +76,11 @@ struct PollServerStats {
   std::uint64_t evicted_slow = 0;         //!< queue beyond its bound, or not taken in time
   std::uint64_t evicted_idle = 0;         //!< nothing received for idle_timeout_s
   std::uint64_t evicted_for_room = 0;     //!< idle longest when the table was full
-  std::uint64_t rounds = 0;               //!< rounds of run() (a clock for the tests)
-  std::uint64_t bytes_in = 0;             //!< received from all clients
-  std::uint64_t bytes_out = 0;            //!< sent (taken by the kernel) to all clients
+  std::uint64_t failed = 0;  //!< closed because a protocol call threw for it (std::bad_alloc)
+  std::uint64_t failed_rounds = 0;  //!< on_round() threw (its work lost, the clients served)
+  std::uint64_t rounds = 0;         //!< rounds of run() (a clock for the tests)
+  std::uint64_t bytes_in = 0;       //!< received from all clients
+  std::uint64_t bytes_out = 0;      //!< sent (taken by the kernel) to all clients
   //! accept() failed for lack of descriptors or memory; each pauses accepting for 100 ms
   std::uint64_t accept_failures = 0;
 };
@@ -97,13 +108,16 @@ class PollClient {
   bool finishing_ = false;  // close once output_ is sent
   Clock::time_point last_input_;
   Clock::time_point last_output_;  // output queued on an empty queue, or taken by the socket
-  enum class Close { kNo, kNow, kSlow, kIdle, kRoom } close_ = Close::kNo;
+  enum class Close { kNo, kNow, kSlow, kIdle, kRoom, kFailed } close_ = Close::kNo;
 };
 
 class PollServer;
 
-//! What a protocol implements. Called from the run() thread only; an exception ends run() (every
-//! connection is closed first, with on_disconnect()) and propagates.
+//! What a protocol implements. Called from the run() thread only. A std::exception from a call
+//! for one client (on_connect, on_input, on_end_of_input, serve) closes that client alone
+//! (counted in `failed`), one from on_round() loses that round's work (`failed_rounds`); any
+//! other exception ends run() (every connection is closed first, with on_disconnect()) and
+//! propagates.
 class PollProtocol {
  public:
   virtual ~PollProtocol() = default;
@@ -118,6 +132,13 @@ class PollProtocol {
   virtual void on_round() {}
   //! Whether to read from the client this round (false: its bytes wait in its socket).
   virtual bool wants_input(const PollClient&) const { return true; }
+  //! When the first byte of the client's request under way (a line, an HTTP request) arrived;
+  //! nullopt when none is under way. Makes the client a first choice to close for room once the
+  //! request is incomplete for evict_incomplete_when_full_s.
+  virtual std::optional<std::chrono::steady_clock::time_point> incomplete_since(
+      const PollClient&) const {
+    return std::nullopt;
+  }
   //! Work left from earlier rounds (e.g. input beyond a per-round budget): poll() does not sleep.
   virtual bool has_work(const PollClient&) const { return false; }
   //! At most read_budget_bytes received.
@@ -195,7 +216,8 @@ class PollServer {
   // Atomic so that stats() may be read from any thread while run() serves.
   struct AtomicStats {
     std::atomic<std::uint64_t> accepted{0}, refused_max_clients{0}, evicted_slow{0},
-        evicted_idle{0}, evicted_for_room{0}, rounds{0}, bytes_in{0}, bytes_out{0};
+        evicted_idle{0}, evicted_for_room{0}, failed{0}, failed_rounds{0}, rounds{0}, bytes_in{0},
+        bytes_out{0};
   } stats_;
 };
 
