@@ -42,8 +42,14 @@ TEST_F(BadInput, APlotPathThatCannotBeWrittenIsRefusedBeforeTheData) {
   refused("analyze linearity --data '" + data + "' --plot /proc/x.png",
           {"--plot /proc/x.png: cannot create a file in /proc"});
   refused("analyze step --data '" + data + "' --plot /proc/self/sub/x.svg",
-          {"--plot /proc/self/sub/x.svg: cannot create a file in /proc/self"});
+          {"--plot /proc/self/sub/x.svg: the folder /proc/self/sub does not exist (it is not "
+           "created)"});
   refused("analyze repeatability --data missing.csv --plot /proc/x.png", {"--plot /proc/x.png"});
+  // Issue 47: a line break in the name was exit 1; a folder that does not exist was created.
+  refused("analyze linearity --data '" + data + "' --plot '" + dir() + "/a\nb.png'",
+          {"--plot " + dir() + "/a b.png: holds a control character"});
+  refused("analyze linearity --data '" + data + "' --plot '" + dir() + "/new/x.png'",
+          {"--plot " + dir() + "/new/x.png: the folder " + dir() + "/new does not exist"});
   refused("analyze linearity --data '" + data + "' --plot '" + data + "/x.png'",
           {"--plot " + data + "/x.png: " + data + " is not a folder"});
   refused("analyze linearity --data '" + data + "' --plot '" + dir() + "/.'",
