@@ -315,14 +315,14 @@ Json measure_json(const MeasureRecord& r) {
 }
 
 std::optional<fs::path> measurement_destination(const fs::path& out) {
-  const auto free = [](const fs::path& p) {
+  const auto is_free = [](const fs::path& p) {
     std::error_code ec;
     const fs::file_status st = fs::symlink_status(p, ec);
     if (st.type() == fs::file_type::not_found)
       return true;
     return fs::is_directory(st) && fs::is_empty(p, ec) && !ec;
   };
-  if (free(out))
+  if (is_free(out))
     return out;
   // "DIR/" names DIR: its siblings are DIR.1, ... (not DIR/.1)
   fs::path base = out;
