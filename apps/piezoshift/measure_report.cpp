@@ -405,9 +405,9 @@ void write_measurement(MeasureRecord& r, const std::string& out_name) {
   }
   // The finished measurement is kept whatever --out has become.
   if (!move_into_place(r, tmp, out_name))
-    throw core::InputError(fmt::format(
-        "--out {}: it and {}.1 .. {}.99 are all taken; the measurement is kept in {}", out_name,
-        out_name, out_name, tmp.string()));
+    throw core::InputError(
+        fmt::format("--out {}: it and {}.1 .. {}.99 are all taken; the measurement is kept in {}",
+                    out_name, out_name, out_name, tmp.string()));
 }
 
 }  // namespace piezoshift::app

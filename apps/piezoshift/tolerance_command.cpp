@@ -68,8 +68,9 @@ std::optional<std::pair<std::uint64_t, std::uint64_t>> parse_shard(const std::st
 // dask.distributed connects by (tcp, tls, ws, wss, ucx), or inproc://NAME; the same check as
 // python/piezoshift/tolerance.py's, made before an interpreter starts.
 std::string scheduler_problem(const std::string& text) {
-  const std::string form = "give SCHEME://HOST:PORT (tcp, tls, ws, wss or ucx; e.g. "
-                           "tcp://127.0.0.1:8786) or inproc://NAME";
+  const std::string form =
+      "give SCHEME://HOST:PORT (tcp, tls, ws, wss or ucx; e.g. "
+      "tcp://127.0.0.1:8786) or inproc://NAME";
   for (const char c : text)
     if (static_cast<unsigned char>(c) < 0x20 || c == 0x7f || c == ' ')
       return fmt::format("'{}' holds a space or a control character; {}", text, form);
@@ -241,8 +242,7 @@ int run_merge(const Options& given) {
         o.config.clear();
       o.seed = h.at("seed").get<std::uint64_t>();
       o.samples = h.at("samples").get<std::uint64_t>();
-      if (const std::string p = tolerance::samples_problem(o.shard_files[0], o.samples);
-          !p.empty())
+      if (const std::string p = tolerance::samples_problem(o.shard_files[0], o.samples); !p.empty())
         throw core::InputError(p);
       o.procedure = h.at("procedure").get<std::string>();
       o.experiments = h.at("experiments").get<std::string>();
@@ -305,8 +305,8 @@ void add_tolerance_command(CLI::App& app, Action& action) {
   cmd->add_option("--scheduler", o->scheduler,
                   "a Dask scheduler (tcp://host:8786): the samples run on its workers through "
                   "the Python package (docs/tolerance.md)")
-      ->check(CLI::Validator(
-          [](std::string& t) -> std::string { return scheduler_problem(t); }, "ADDRESS"));
+      ->check(CLI::Validator([](std::string& t) -> std::string { return scheduler_problem(t); },
+                             "ADDRESS"));
   cmd->add_option("--shard", o->shard, "run samples i, i+N, ... and write a shard file")
       ->check(CLI::Validator(
           [](std::string& t) -> std::string {

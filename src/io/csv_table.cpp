@@ -1,9 +1,9 @@
 #include "piezoshift/io/csv_table.hpp"
 
 #include <algorithm>
-#include <limits>
 #include <charconv>
 #include <cmath>
+#include <limits>
 
 #include <fmt/core.h>
 

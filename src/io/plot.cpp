@@ -342,9 +342,8 @@ std::string read_text(const fs::path& p) {
 }
 
 bool has_control_character(std::string_view s) {
-  return std::any_of(s.begin(), s.end(), [](char ch) {
-    return static_cast<unsigned char>(ch) < 0x20 || ch == 0x7f;
-  });
+  return std::any_of(s.begin(), s.end(),
+                     [](char ch) { return static_cast<unsigned char>(ch) < 0x20 || ch == 0x7f; });
 }
 
 bool is_executable_file(const fs::path& p) {
@@ -383,8 +382,8 @@ void check_output_path(const fs::path& path, std::string_view option) {
   // A line break in the name would split the script's lines (exit 1 from gnuplot): refused.
   if (has_control_character(path.string()))
     throw core::InputError(fmt::format(
-        "{} {}: holds a control character (a line break, a tab ...); give a name without",
-        option, one_line(path.string())));
+        "{} {}: holds a control character (a line break, a tab ...); give a name without", option,
+        one_line(path.string())));
   const fs::path stem = strip_format_extension(path);
   const fs::path name = path.filename();
   if (name == ".png" || name == ".svg")  // an extension alone: it would draw ".png.png"
@@ -418,8 +417,8 @@ PlotFiles write_plot_files(const Figure& figure, const fs::path& stem_in) {
     throw core::InputError(
         fmt::format("plot output {}: names a folder, not a file", stem_in.string()));
   if (has_control_character(stem.string()))
-    throw core::InputError(fmt::format("plot output {}: holds a control character",
-                                       one_line(stem_in.string())));
+    throw core::InputError(
+        fmt::format("plot output {}: holds a control character", one_line(stem_in.string())));
   // Into a folder that exists, never created; each file replaced whole through a fresh
   // temporary (atomic_file.hpp: O_EXCL | O_NOFOLLOW, then rename), so a link planted at a
   // side file's name is replaced, not followed.

@@ -51,7 +51,8 @@ SurfaceSpec parse_surface_spec(std::string_view spec) {
     if (ec2 != std::errc{} || q != key.data() + key.size() || j < 1 || j > 231)
       throw fail(item, "needs a Noll index 1..231");
     if (std::abs(v) > kMaxSurfaceTermNm)
-      throw fail(item, fmt::format("is beyond +-{} nm RMS per term (docs/psi.md)", kMaxSurfaceTermNm));
+      throw fail(item,
+                 fmt::format("is beyond +-{} nm RMS per term (docs/psi.md)", kMaxSurfaceTermNm));
     s.zernike_nm.emplace_back(j, v);
   }
   // Noll terms are orthonormal: the surface's RMS is the root sum of squares of the summed
@@ -63,9 +64,9 @@ SurfaceSpec parse_surface_spec(std::string_view spec) {
   for (double c : sum)
     squares += c * c;
   if (std::sqrt(squares) > kMaxSurfaceTermNm)
-    throw core::InputError(fmt::format(
-        "--surface '{}': the terms make {:.0f} nm RMS, beyond {} nm RMS (docs/psi.md)", spec,
-        std::sqrt(squares), kMaxSurfaceTermNm));
+    throw core::InputError(
+        fmt::format("--surface '{}': the terms make {:.0f} nm RMS, beyond {} nm RMS (docs/psi.md)",
+                    spec, std::sqrt(squares), kMaxSurfaceTermNm));
   return s;
 }
 

@@ -146,12 +146,11 @@ TEST_F(ToleranceCli, ShardFilesShardsAndSchedulersAreCheckedBeforeUse) {
     EXPECT_NE(r.err.find(message), std::string::npos) << args << "\n" << r.err;
     EXPECT_EQ(r.err.find("Traceback"), std::string::npos) << r.err;
   };
-  const nlohmann::json header{{"tolerance_file", tol},    {"config", "built-in defaults"},
-                              {"seed", 1},                {"samples", 1000000000000ULL},
-                              {"procedure", "paper"},     {"experiments", "quick"}};
-  const std::string huge =
-      write("huge.json", nlohmann::json{{"study", header}, {"samples", nlohmann::json::array()}}
-                             .dump());
+  const nlohmann::json header{
+      {"tolerance_file", tol},       {"config", "built-in defaults"}, {"seed", 1},
+      {"samples", 1000000000000ULL}, {"procedure", "paper"},          {"experiments", "quick"}};
+  const std::string huge = write(
+      "huge.json", nlohmann::json{{"study", header}, {"samples", nlohmann::json::array()}}.dump());
   refused("tolerance merge '" + huge + "' --out " + path("m"),
           huge + ": 1000000000000 samples; a study has 1 to 1000000 (docs/tolerance.md)");
   const std::string bomb = write("bomb.json", std::string(8u << 20, '['));

@@ -133,7 +133,8 @@ TEST_F(FilesCameraTest, APngThatIsNotARegularFileIsRefusedByName) {
   EXPECT_EQ(error_of([&] { FilesCamera c(dir_.string()); }), prefix + "a FIFO (pipe)" + suffix);
   std::filesystem::remove(path("frame_01b.png"));
   std::filesystem::create_symlink("/dev/zero", path("frame_01b.png"));
-  EXPECT_EQ(error_of([&] { FilesCamera c(dir_.string()); }), prefix + "a link to a device" + suffix);
+  EXPECT_EQ(error_of([&] { FilesCamera c(dir_.string()); }),
+            prefix + "a link to a device" + suffix);
   std::filesystem::remove(path("frame_01b.png"));
   std::filesystem::create_symlink(path("frame_01b.png"), path("frame_01b.png"));
   EXPECT_EQ(error_of([&] { FilesCamera c(dir_.string()); }),

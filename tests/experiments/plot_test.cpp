@@ -197,8 +197,8 @@ TEST(Plot, SideFilesReplacePlantedLinksAndNoFolderIsCreated) {
             "--plot " + missing.string() + ": the folder " + (dir / "nonexistent").string() +
                 " does not exist (it is not created)");
   EXPECT_EQ(refusal([&] { write_plot_files(two_panel_figure(), missing); }),
-            "plot output " + missing.string() + ": the folder " +
-                (dir / "nonexistent").string() + " does not exist");
+            "plot output " + missing.string() + ": the folder " + (dir / "nonexistent").string() +
+                " does not exist");
   EXPECT_FALSE(fs::exists(dir / "nonexistent"));
   const fs::path broken = dir / "a\nb.png";
   EXPECT_EQ(refusal([&] { check_output_path(broken, "--plot"); }),

@@ -111,7 +111,8 @@ TEST(PsiFilesTest, InterlacedPngDecodesToTheSamePixelsAndAnalysis) {
       for (int i = 0; i < w; ++i) {
         const double x = (i - w / 2.0) / (w / 2.0), y = (j - h / 2.0) / (h / 2.0);
         const double phase = 0.4 * i + 0.1 * j + 3.0 * (x * x + y * y) + k * std::numbers::pi / 2;
-        frame.v[static_cast<std::size_t>(j * w + i)] = std::round(30000.0 + 20000.0 * std::cos(phase));
+        frame.v[static_cast<std::size_t>(j * w + i)] =
+            std::round(30000.0 + 20000.0 * std::cos(phase));
       }
     plain.push_back((d / ("p" + std::to_string(k) + ".png")).string());
     interlaced.push_back((d / ("i" + std::to_string(k) + ".png")).string());
