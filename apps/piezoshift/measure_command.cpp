@@ -308,7 +308,9 @@ int measure(const MeasureOptions& o) {
                     .truth_nm = s.scene ? &s.scene->surface_nm : nullptr,
                     .error_rms_nm = std::nullopt,
                     .ideal_error_rms_nm = std::nullopt,
-                    .floor_error_rms_nm = std::nullopt};
+                    .floor_error_rms_nm = std::nullopt,
+                    .out = {},
+                    .out_given = {}};
   if (s.scene) {
     rec.error_rms_nm = psi::surface_error_rms_nm(a.surface_nm, s.scene->surface_nm, a.valid);
     rec.ideal_error_rms_nm =
