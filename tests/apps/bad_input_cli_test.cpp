@@ -129,6 +129,15 @@ TEST_F(BadInput, CommandLineErrorsNameTheProgramAndSuggestTheClosestOption) {
   EXPECT_NE(help.out.find("a whole number in [0, 2^64 - 1]"), std::string::npos) << help.out;
 }
 
+// Issue 47: `serve --camera twin --surface Z4=1e308` ended a measurement in an uncaught
+// exception; --mask was ignored with the twin camera. Both are refused before anything runs.
+TEST_F(BadInput, ServesTwinSurfaceAndMaskAreCheckedBeforeItStarts) {
+  refused("serve --camera twin --http-port 0 --surface Z4=1e308",
+          {"--surface 'Z4=1e308': 'Z4=1e308' is beyond +-2000 nm RMS per term"});
+  refused("serve --camera twin --http-port 0 --mask '" + dir() + "/m.png'",
+          {"--mask: the twin camera renders its own pupil and analyses it"});
+}
+
 TEST_F(BadInput, RunTimesBeyondTheLongestRunNameTheirLimit) {
   refused("run --duration-s 1e9", {"--duration-s 1000000000: must be in (0, 1000000] s"});
   refused("run --duration-s 1 --free-run --fault sgs-open@1e10",
