@@ -178,6 +178,11 @@ void check_request(const FizeauCalibrateRequest& q) {
                                        loop ? " (--daq " + q.daq + " is hardware)" : ""));
   if (!loop && !q.mask.empty())
     throw core::InputError("--mask: the twin's bench takes its scene's pupil (use --daq)");
+  // It used to be ignored: the twin camera analyses the pupil it renders.
+  if (loop && (c.empty() || c == "twin") && !q.mask.empty())
+    throw core::InputError(
+        "--mask: the twin camera renders its own pupil and analyses it; --mask is the pupil of "
+        "other cameras");
 }
 
 // The stages on the real-time loop (rig::LoopRig) with the camera on it: the twin (sim-rt), with

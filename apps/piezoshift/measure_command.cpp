@@ -164,6 +164,11 @@ void check_options(const MeasureOptions& o) {
   if (o.camera != "twin" && !fed_by_twin(o) && !o.surface.empty())
     throw core::InputError(
         "--surface: the test surface of the twin camera (or of aravis:Fake_1 on --daq sim)");
+  // It used to be ignored: the twin analyses the pupil it renders.
+  if (o.camera == "twin" && !o.mask.empty())
+    throw core::InputError(
+        "--mask: the twin camera renders its own pupil and analyses it; --mask is the pupil of "
+        "other cameras");
 }
 
 // The fringe lock, asked for by `who` (instrument::lock_requested_by). Its pupil: the twin
@@ -199,9 +204,11 @@ std::unique_ptr<camera::Camera> open_camera(const MeasureOptions& o, const Measu
 
 psi::Mask measurement_mask(const MeasureOptions& o, const MeasureSetup& s,
                            const instrument::SequenceResult& r) {
-  if (s.scene)
-    return s.scene->mask;
+  // --mask first (never with the twin camera, check_options): Aravis's fake camera fed the
+  // twin takes it too, as its lock does.
   const std::size_t n = s.params.steps_rad.size();
+  if (s.scene && o.mask.empty())
+    return s.scene->mask;
   const std::vector<psi::Map> frames = instrument::frame_maps(
       std::vector<camera::Frame>(r.frames.begin(), r.frames.begin() + static_cast<long>(n)));
   if (!o.mask.empty())
@@ -309,7 +316,9 @@ int measure(const MeasureOptions& o) {
                     .truth_nm = s.scene ? &s.scene->surface_nm : nullptr,
                     .error_rms_nm = std::nullopt,
                     .ideal_error_rms_nm = std::nullopt,
-                    .floor_error_rms_nm = std::nullopt};
+                    .floor_error_rms_nm = std::nullopt,
+                    .out = {},
+                    .out_given = {}};
   if (s.scene) {
     rec.error_rms_nm = psi::surface_error_rms_nm(a.surface_nm, s.scene->surface_nm, a.valid);
     rec.ideal_error_rms_nm =
@@ -336,7 +345,7 @@ int measure(const MeasureOptions& o) {
         a.figures.pv,
         rec.error_rms_nm ? fmt::format(", measured - true {:.3f} nm RMS", *rec.error_rms_nm)
                          : std::string(),
-        a.step_error_text(), r.wall_time_s, r.floor_s, r.overruns, o.out);
+        a.step_error_text(), r.wall_time_s, r.floor_s, r.overruns, rec.out);
     if (!r.hold.empty()) {
       const std::optional<double> rms = instrument::hold_summary(r).path_error_rms_nm;
       fmt::print("hold: {} frames over {:.1f} s{}\n", r.hold.size(), o.hold_s,

@@ -307,15 +307,77 @@ Json measure_json(const MeasureRecord& r) {
   for (const psi::SurfaceFigures& f : a.average_figures)
     averages.push_back({{"rms_nm", f.rms}, {"pv_nm", f.pv}, {"pvr_nm", f.pvr}});
   j["average_figures"] = averages;
+  if (!r.out.empty())
+    j["out"] = r.out;
+  if (!r.out_given.empty())
+    j["out_given"] = r.out_given;
   return j;
 }
 
-void write_measurement(const MeasureRecord& r, const std::string& out_name) {
+std::optional<fs::path> measurement_destination(const fs::path& out) {
+  const auto is_free = [](const fs::path& p) {
+    std::error_code ec;
+    const fs::file_status st = fs::symlink_status(p, ec);
+    if (st.type() == fs::file_type::not_found)
+      return true;
+    return fs::is_directory(st) && fs::is_empty(p, ec) && !ec;
+  };
+  if (is_free(out))
+    return out;
+  // "DIR/" names DIR: its siblings are DIR.1, ... (not DIR/.1)
+  fs::path base = out;
+  while (!base.has_filename() && base.has_relative_path())
+    base = base.parent_path();
+  for (int k = 1; k < 100; ++k) {
+    const fs::path p = base.string() + fmt::format(".{}", k);
+    std::error_code ec;
+    if (fs::symlink_status(p, ec).type() == fs::file_type::not_found)
+      return p;
+  }
+  return std::nullopt;
+}
+
+namespace {
+
+// The built folder renamed to where the measurement now goes (an empty folder there gives way);
+// false when out and out.1 .. out.99 are all taken. r.out / r.out_given say where it went, and
+// measurement.json is written again when that is not --out.
+bool move_into_place(MeasureRecord& r, const fs::path& built, const std::string& out_name) {
+  for (int attempt = 0; attempt < 100; ++attempt) {
+    const std::optional<fs::path> dest = measurement_destination(out_name);
+    if (!dest)
+      return false;
+    if (*dest != fs::path(out_name) && r.out_given.empty()) {
+      r.out_given = out_name;
+      fmt::print(stderr,
+                 "piezoshift: measure: --out {}: something appeared in it while the measurement "
+                 "ran; the measurement is written to {} instead\n",
+                 out_name, dest->string());
+    }
+    if (r.out != dest->string()) {
+      r.out = dest->string();
+      io::write_file_atomically((built / "measurement.json").string(),
+                                measure_json(r).dump(2) + "\n");
+    }
+    std::error_code ec;
+    if (fs::is_directory(fs::symlink_status(*dest, ec)))
+      fs::remove(*dest, ec);  // only an empty folder is removed
+    fs::rename(built, *dest, ec);
+    if (!ec)
+      return true;
+    // Taken between the look and the rename: look again.
+  }
+  return false;
+}
+
+}  // namespace
+
+void write_measurement(MeasureRecord& r, const std::string& out_name) {
   const fs::path out(out_name);
-  check_measure_out(out_name);
   const fs::path tmp = out.string() + fmt::format(".partial-{}", ::getpid());
   fs::remove_all(tmp);
   fs::create_directories(tmp);
+  r.out = out_name;
   try {
     write_frames(r, tmp / "frames");
     psi::write_mask_png((tmp / "mask.png").string(), *r.mask);
@@ -336,14 +398,16 @@ void write_measurement(const MeasureRecord& r, const std::string& out_name) {
       io::render(stage_figure(r), tmp / "stage");
     }
     io::write_file_atomically((tmp / "report.md").string(), report_markdown(r));
-    std::error_code ec;
-    fs::remove(out, ec);  // an empty folder (check_out) gives way to the whole measurement
-    fs::rename(tmp, out);
   } catch (...) {
     std::error_code ec;
     fs::remove_all(tmp, ec);
     throw;
   }
+  // The finished measurement is kept whatever --out has become.
+  if (!move_into_place(r, tmp, out_name))
+    throw core::InputError(
+        fmt::format("--out {}: it and {}.1 .. {}.99 are all taken; the measurement is kept in {}",
+                    out_name, out_name, out_name, tmp.string()));
 }
 
 }  // namespace piezoshift::app

@@ -1,6 +1,7 @@
 #pragma once
 // What `piezoshift measure` writes (docs/measure.md): into a folder of its own, renamed into
 // place only once everything is in it, so a measurement that fails leaves nothing half-written.
+#include <filesystem>
 #include <optional>
 #include <string>
 
@@ -30,6 +31,10 @@ struct MeasureRecord {
   //! The same over the whole measurement, every exposure with its own frame's noise draws
   //! (twin camera): the floor the stage's error adds to.
   std::optional<double> floor_error_rms_nm;
+  //! The folder the measurement was written to (write_measurement's), "" before.
+  std::string out;
+  //! --out when something appeared in it while the measurement ran: written beside it instead.
+  std::string out_given;
 };
 
 //! The summary measure prints with --json and writes as measurement.json.
@@ -41,7 +46,14 @@ void check_measure_out(const std::string& out);
 
 //! Writes the measurement into out (which must not exist, or be an empty folder): frames,
 //! surface, truth, mask, exposures.csv, measurement.json, figures and report.md. Built in a
-//! sibling folder first and renamed into place at the end.
-void write_measurement(const MeasureRecord& r, const std::string& out);
+//! sibling folder first and renamed into place at the end. A finished measurement is never
+//! discarded: when out has become something else while it ran (a file appeared in it), it goes
+//! to the first free of out.1 .. out.99 instead, said on stderr and in r.out / r.out_given
+//! (measurement.json's "out" and "out_given").
+void write_measurement(MeasureRecord& r, const std::string& out);
+
+//! The folder a measurement for `out` goes to now: out when it does not exist or is an empty
+//! folder, else the first of out.1 .. out.99 that does not exist; nothing when all are taken.
+std::optional<std::filesystem::path> measurement_destination(const std::filesystem::path& out);
 
 }  // namespace piezoshift::app

@@ -204,6 +204,11 @@ void check_serve_options(const ServeOptions& o) {
   check(o.surface.empty() || o.camera == "twin" || fed_by_twin,
         "--surface: the test surface of the twin camera (or of aravis:Fake_1 on --daq sim)");
   check(o.mask.empty() || !o.camera.empty(), "--mask: the pupil of --camera's frames");
+  if (!o.surface.empty())
+    psi::parse_surface_spec(o.surface);  // refused before the start-up calibration, not after
+  check(o.mask.empty() || o.camera != "twin",
+        "--mask: the twin camera renders its own pupil and analyses it; --mask is the pupil of "
+        "other cameras");
   check(o.camera.empty() || o.http_port >= 0,
         "--camera: the live view and the measurements are the dashboard's; give --http-port");
 }

@@ -47,7 +47,7 @@ struct Options {
   std::vector<std::string> shard_files;  // merge
 };
 
-// "i/N" with 0 <= i < N.
+// "i/N" with 0 <= i < N <= kMaxSamples (N is checked against --samples once it is known).
 std::optional<std::pair<std::uint64_t, std::uint64_t>> parse_shard(const std::string& text) {
   const std::size_t slash = text.find('/');
   if (slash == std::string::npos)
@@ -58,9 +58,40 @@ std::optional<std::pair<std::uint64_t, std::uint64_t>> parse_shard(const std::st
     return !s.empty() && r.ec == std::errc() && r.ptr == s.data() + s.size();
   };
   if (!num(std::string_view(text).substr(0, slash), i) ||
-      !num(std::string_view(text).substr(slash + 1), n) || n == 0 || i >= n)
+      !num(std::string_view(text).substr(slash + 1), n) || n == 0 || i >= n ||
+      n > tolerance::kMaxSamples)
     return std::nullopt;
   return std::pair{i, n};
+}
+
+// "" or why text is not the address of a Dask scheduler: SCHEME://HOST:PORT for the schemes
+// dask.distributed connects by (tcp, tls, ws, wss, ucx), or inproc://NAME; the same check as
+// python/piezoshift/tolerance.py's, made before an interpreter starts.
+std::string scheduler_problem(const std::string& text) {
+  const std::string form =
+      "give SCHEME://HOST:PORT (tcp, tls, ws, wss or ucx; e.g. "
+      "tcp://127.0.0.1:8786) or inproc://NAME";
+  for (const char c : text)
+    if (static_cast<unsigned char>(c) < 0x20 || c == 0x7f || c == ' ')
+      return fmt::format("'{}' holds a space or a control character; {}", text, form);
+  const std::size_t sep = text.find("://");
+  if (sep == std::string::npos)
+    return fmt::format("'{}' is not a scheduler address; {}", text, form);
+  const std::string scheme = text.substr(0, sep), rest = text.substr(sep + 3);
+  if (scheme == "inproc")
+    return rest.empty() ? fmt::format("'{}' names no process; {}", text, form) : "";
+  if (scheme != "tcp" && scheme != "tls" && scheme != "ws" && scheme != "wss" && scheme != "ucx")
+    return fmt::format("'{}': unknown scheme '{}'; {}", text, scheme, form);
+  const std::size_t colon = rest.rfind(':');
+  unsigned port = 0;
+  const std::string_view digits =
+      colon == std::string::npos ? std::string_view{} : std::string_view(rest).substr(colon + 1);
+  const auto r = std::from_chars(digits.data(), digits.data() + digits.size(), port);
+  if (colon == 0 || colon == std::string::npos || digits.empty() || r.ec != std::errc() ||
+      r.ptr != digits.data() + digits.size() || port < 1 || port > 65535 ||
+      rest.find_first_of("/?#@") != std::string::npos)
+    return fmt::format("'{}' needs a host and a port 1..65535; {}", text, form);
+  return "";
 }
 
 tolerance::Study load_study(const Options& o) {
@@ -139,6 +170,15 @@ void write_outputs(const tolerance::Study& s, const std::vector<SampleResult>& s
 }
 
 int run(const Options& o) {
+  if (!o.shard.empty()) {
+    // Sample i of shard i/N is the shard's first: a shard past the samples would run none.
+    const std::uint64_t n = parse_shard(o.shard)->second;  // checked by the option's validator
+    if (n > o.samples)
+      throw core::InputError(fmt::format(
+          "tolerance --shard {}: {} shards for {} samples (--samples {}); N may be at most the "
+          "sample count, so that every shard runs a sample",
+          o.shard, n, o.samples, o.samples));
+  }
   const tolerance::Study s = load_study(o);
   // A shard writes its samples only: what needs all of them is merge's (or a whole run's).
   if (!o.shard.empty() && (o.sensitivity || o.figures || !o.spec.empty()))
@@ -202,6 +242,8 @@ int run_merge(const Options& given) {
         o.config.clear();
       o.seed = h.at("seed").get<std::uint64_t>();
       o.samples = h.at("samples").get<std::uint64_t>();
+      if (const std::string p = tolerance::samples_problem(o.shard_files[0], o.samples); !p.empty())
+        throw core::InputError(p);
       o.procedure = h.at("procedure").get<std::string>();
       o.experiments = h.at("experiments").get<std::string>();
     } catch (const nlohmann::json::exception& e) {
@@ -262,11 +304,15 @@ void add_tolerance_command(CLI::App& app, Action& action) {
   cmd->add_option("--jobs", o->jobs, "local threads (0: every core)")->check(whole_number(0, 1024));
   cmd->add_option("--scheduler", o->scheduler,
                   "a Dask scheduler (tcp://host:8786): the samples run on its workers through "
-                  "the Python package (docs/tolerance.md)");
+                  "the Python package (docs/tolerance.md)")
+      ->check(CLI::Validator([](std::string& t) -> std::string { return scheduler_problem(t); },
+                             "ADDRESS"));
   cmd->add_option("--shard", o->shard, "run samples i, i+N, ... and write a shard file")
       ->check(CLI::Validator(
           [](std::string& t) -> std::string {
-            return parse_shard(t) ? "" : fmt::format("{} is not i/N with 0 <= i < N", t);
+            return parse_shard(t) ? ""
+                                  : fmt::format("{} is not i/N with 0 <= i < N <= {}", t,
+                                                tolerance::kMaxSamples);
           },
           "i/N"));
   cmd->add_option("--sample", o->sample, "rerun sample K alone and print it")

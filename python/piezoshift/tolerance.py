@@ -13,6 +13,7 @@ command line (``piezoshift tolerance --scheduler ...`` runs it).
 """
 
 import argparse
+import re
 import sys
 import time
 
@@ -87,6 +88,29 @@ def run_study(tolerances, *, samples=100, seed=1, config=None, spec=None, proced
     return study.write_outputs(out, [results[i] for i in range(samples)], figures, runs)
 
 
+MAX_SAMPLES = 1_000_000  # tolerance::kMaxSamples (docs/tolerance.md)
+_SCHEDULER_FORM = ("give SCHEME://HOST:PORT (tcp, tls, ws, wss or ucx; e.g. tcp://127.0.0.1:8786) "
+                   "or inproc://NAME")
+
+
+def scheduler_problem(text):
+    """Empty when text is a Dask scheduler's address, else why not (as `piezoshift tolerance`)."""
+    if any(ord(c) < 0x20 or c in " \x7f" for c in text):
+        return f"'{text}' holds a space or a control character; {_SCHEDULER_FORM}"
+    scheme, sep, rest = text.partition("://")
+    if not sep:
+        return f"'{text}' is not a scheduler address; {_SCHEDULER_FORM}"
+    if scheme == "inproc":
+        return "" if rest else f"'{text}' names no process; {_SCHEDULER_FORM}"
+    if scheme not in ("tcp", "tls", "ws", "wss", "ucx"):
+        return f"'{text}': unknown scheme '{scheme}'; {_SCHEDULER_FORM}"
+    host, colon, port = rest.rpartition(":")
+    if (not colon or not host or not re.fullmatch(r"[0-9]{1,5}", port)
+            or not 1 <= int(port) <= 65535 or any(c in rest for c in "/?#@")):
+        return f"'{text}' needs a host and a port 1..65535; {_SCHEDULER_FORM}"
+    return ""
+
+
 def _arguments(argv):
     p = argparse.ArgumentParser(
         prog="python3 -m piezoshift.tolerance",
@@ -113,9 +137,13 @@ def _arguments(argv):
 def main(argv=None):
     """The command line; returns the exit status (2: bad input or no scheduler)."""
     a = _arguments(sys.argv[1:] if argv is None else argv)
-    if a.samples < 1 or a.seed < 0 or a.jobs < 0:
-        print("piezoshift: error: tolerance: --samples must be at least 1, --seed and --jobs not "
-              "negative", file=sys.stderr)
+    if not 1 <= a.samples <= MAX_SAMPLES or a.seed < 0 or a.jobs < 0:
+        print(f"piezoshift: error: tolerance: --samples must be 1 to {MAX_SAMPLES}, --seed and "
+              "--jobs not negative", file=sys.stderr)
+        return 2
+    if a.scheduler and scheduler_problem(a.scheduler):
+        print(f"piezoshift: error: tolerance --scheduler: {scheduler_problem(a.scheduler)}",
+              file=sys.stderr)
         return 2
     client = None
     try:

@@ -17,6 +17,36 @@ namespace piezoshift::camera {
 
 namespace fs = std::filesystem;
 
+namespace {
+
+// Why the entry at path cannot be a frame ("" when it is a regular file, through links).
+std::string not_a_frame(const fs::path& path) {
+  std::error_code ec;
+  const bool link = fs::is_symlink(fs::symlink_status(path, ec));
+  const fs::file_status st = fs::status(path, ec);
+  if (ec)
+    return link ? fmt::format("a link that does not lead to a file ({})", ec.message())
+                : fmt::format("cannot be examined ({})", ec.message());
+  const char* prefix = link ? "a link to " : "";
+  switch (st.type()) {
+    case fs::file_type::regular:
+      return "";
+    case fs::file_type::directory:
+      return fmt::format("{}a directory", prefix);
+    case fs::file_type::fifo:
+      return fmt::format("{}a FIFO (pipe)", prefix);
+    case fs::file_type::character:
+    case fs::file_type::block:
+      return fmt::format("{}a device", prefix);
+    case fs::file_type::socket:
+      return fmt::format("{}a socket", prefix);
+    default:
+      return fmt::format("{}not a regular file", prefix);
+  }
+}
+
+}  // namespace
+
 FilesCamera::FilesCamera(const std::string& dir) : dir_(dir) {
   std::error_code ec;
   if (!fs::is_directory(dir, ec))
@@ -26,8 +56,16 @@ FilesCamera::FilesCamera(const std::string& dir) : dir_(dir) {
     std::transform(ext.begin(), ext.end(), ext.begin(), [](unsigned char c) {
       return static_cast<char>(c >= 'A' && c <= 'Z' ? c - 'A' + 'a' : c);
     });
-    if (ext == ".png" && e.is_regular_file(ec))
-      files_.push_back(e.path().string());
+    if (ext != ".png")
+      continue;
+    // A frame that is not a regular file used to be skipped, shifting every later frame one
+    // step: it is refused by name. Links are followed (a link to a recorded frame is a frame);
+    // read_input_file checks the opened file again, so a swap after this listing is caught too.
+    if (const std::string kind = not_a_frame(e.path()); !kind.empty())
+      throw core::InputError(
+          fmt::format("camera files:{}: {}: {}; every *.png must be a regular file", dir,
+                      e.path().filename().string(), kind));
+    files_.push_back(e.path().string());
   }
   if (ec)
     throw core::InputError(fmt::format("camera files:{}: {}", dir, ec.message()));

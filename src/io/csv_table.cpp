@@ -3,6 +3,7 @@
 #include <algorithm>
 #include <charconv>
 #include <cmath>
+#include <limits>
 
 #include <fmt/core.h>
 
@@ -102,6 +103,11 @@ CsvTable CsvTable::from_text(std::string text, const std::string& source_name) {
   t.source_ = source_name;
   t.text_ = std::move(text);
   const std::string_view all = t.text_;
+  if (all.size() >= std::numeric_limits<std::uint32_t>::max())
+    throw core::InputError(
+        fmt::format("{}: {} bytes; a table is read from less than 4 GiB", source_name, all.size()));
+  // One row a line at most: reserved once, so the rows never take twice their size while read.
+  t.rows_.reserve(static_cast<std::size_t>(std::count(all.begin(), all.end(), '\n')) + 1);
   std::size_t pos = all.substr(0, 3) == "\xEF\xBB\xBF" ? 3 : 0;
   std::size_t line_no = 0;
   while (pos < all.size()) {
@@ -126,7 +132,7 @@ CsvTable CsvTable::from_text(std::string text, const std::string& source_name) {
                                          source_name, line_no, fields, t.header_line_,
                                          t.header_.size()));
     }
-    t.rows_.push_back(Row{begin, line_no});
+    t.rows_.push_back(Row{static_cast<std::uint32_t>(begin), static_cast<std::uint32_t>(line_no)});
   }
   if (t.header_.empty()) {
     throw core::InputError(

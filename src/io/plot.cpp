@@ -17,6 +17,7 @@
 #include <fmt/core.h>
 
 #include "piezoshift/core/input_error.hpp"
+#include "piezoshift/io/atomic_file.hpp"
 
 namespace piezoshift::io {
 namespace fs = std::filesystem;
@@ -340,12 +341,9 @@ std::string read_text(const fs::path& p) {
   return s.str();
 }
 
-void write_text(const fs::path& p, const std::string& text) {
-  std::ofstream out(p, std::ios::binary | std::ios::trunc);
-  out << text;
-  out.close();
-  if (!out)
-    throw PlotError(fmt::format("{}: cannot write: {}", p.string(), std::strerror(errno)));
+bool has_control_character(std::string_view s) {
+  return std::any_of(s.begin(), s.end(),
+                     [](char ch) { return static_cast<unsigned char>(ch) < 0x20 || ch == 0x7f; });
 }
 
 bool is_executable_file(const fs::path& p) {
@@ -381,6 +379,11 @@ std::optional<fs::path> find_gnuplot(std::string_view program) {
 }
 
 void check_output_path(const fs::path& path, std::string_view option) {
+  // A line break in the name would split the script's lines (exit 1 from gnuplot): refused.
+  if (has_control_character(path.string()))
+    throw core::InputError(fmt::format(
+        "{} {}: holds a control character (a line break, a tab ...); give a name without", option,
+        one_line(path.string())));
   const fs::path stem = strip_format_extension(path);
   const fs::path name = path.filename();
   if (name == ".png" || name == ".svg")  // an extension alone: it would draw ".png.png"
@@ -392,21 +395,19 @@ void check_output_path(const fs::path& path, std::string_view option) {
     throw core::InputError(fmt::format("{} {}: names a folder; give a file, e.g. {}", option,
                                        path.string(), (folder / "figure.png").string()));
   }
-  // The folder is created when the figure is drawn: what must exist now is the nearest folder on
-  // its way, and it must take a file.
-  fs::path existing = stem.parent_path();
+  // The figure goes into a folder that exists and takes a file: a folder is never created (a
+  // mistyped --plot /nonexistent/x.png made /nonexistent).
+  const fs::path folder = stem.parent_path().empty() ? fs::path(".") : stem.parent_path();
   std::error_code ec;
-  while (!existing.empty() && !fs::exists(fs::symlink_status(existing, ec)) &&
-         existing != existing.parent_path())
-    existing = existing.parent_path();
-  if (existing.empty())
-    existing = ".";
-  if (!fs::is_directory(existing, ec))
+  if (!fs::exists(fs::symlink_status(folder, ec)))
+    throw core::InputError(fmt::format("{} {}: the folder {} does not exist (it is not created)",
+                                       option, path.string(), folder.string()));
+  if (!fs::is_directory(folder, ec))
     throw core::InputError(
-        fmt::format("{} {}: {} is not a folder", option, path.string(), existing.string()));
-  if (const std::error_code e = can_create_in(existing))
+        fmt::format("{} {}: {} is not a folder", option, path.string(), folder.string()));
+  if (const std::error_code e = can_create_in(folder))
     throw core::InputError(fmt::format("{} {}: cannot create a file in {}: {}", option,
-                                       path.string(), existing.string(), e.message()));
+                                       path.string(), folder.string(), e.message()));
 }
 
 PlotFiles write_plot_files(const Figure& figure, const fs::path& stem_in) {
@@ -415,13 +416,17 @@ PlotFiles write_plot_files(const Figure& figure, const fs::path& stem_in) {
   if (!names_a_file(stem))
     throw core::InputError(
         fmt::format("plot output {}: names a folder, not a file", stem_in.string()));
-  const fs::path dir = stem.parent_path();
-  if (!dir.empty()) {
-    std::error_code ec;
-    fs::create_directories(dir, ec);
-    if (ec)
-      throw PlotError(fmt::format("{}: cannot create folder: {}", dir.string(), ec.message()));
-  }
+  if (has_control_character(stem.string()))
+    throw core::InputError(
+        fmt::format("plot output {}: holds a control character", one_line(stem_in.string())));
+  // Into a folder that exists, never created; each file replaced whole through a fresh
+  // temporary (atomic_file.hpp: O_EXCL | O_NOFOLLOW, then rename), so a link planted at a
+  // side file's name is replaced, not followed.
+  const fs::path dir = stem.parent_path().empty() ? fs::path(".") : stem.parent_path();
+  std::error_code ec;
+  if (!fs::is_directory(dir, ec))
+    throw core::InputError(fmt::format("plot output {}: the folder {} does not exist",
+                                       stem_in.string(), dir.string()));
   const std::string name = stem.filename().string();
   PlotFiles files;
   files.data = fs::path(stem).concat(".dat");
@@ -444,7 +449,7 @@ PlotFiles write_plot_files(const Figure& figure, const fs::path& stem_in) {
       data += "\n\n";
     }
   }
-  write_text(files.data, data);
+  write_file_atomically(files.data.string(), data);
 
   const std::string body = script_body(figure);
   std::string script = fmt::format(
@@ -473,7 +478,7 @@ PlotFiles write_plot_files(const Figure& figure, const fs::path& stem_in) {
         figure.width_px, figure.height_px, kFont, kFontPt, gp_quote(name + ".svg"));
     script += body + "set output\n";
   }
-  write_text(files.script, script);
+  write_file_atomically(files.script.string(), script);
   if (figure.png)
     files.png = fs::path(stem).concat(".png");
   if (figure.svg)
@@ -495,10 +500,14 @@ PlotFiles render(const Figure& figure, const fs::path& stem_in, const PlotOption
   const std::string name = stem.filename().string();
   const std::string script_name = name + ".gp";
   const std::string log_name = name + ".gnuplot.log";
+  // gnuplot opens its outputs and log by name: whatever is at those names now (an old figure, a
+  // planted link) is removed first, and the log is created afresh without following a link.
   for (const auto& out : {files.png, files.svg}) {
     if (out)
       fs::remove(*out);
   }
+  std::error_code gone;
+  fs::remove(dir / log_name, gone);
 
   // gnuplot runs in the figure's folder so the script's relative names resolve as they will
   // when a user reruns it; its output goes to a log that ends up in the error on failure.
@@ -510,7 +519,8 @@ PlotFiles render(const Figure& figure, const fs::path& stem_in, const PlotOption
   if (pid == 0) {
     if (::chdir(dir_s.c_str()) != 0)
       ::_exit(126);
-    const int log = ::open(log_name.c_str(), O_WRONLY | O_CREAT | O_TRUNC, 0644);
+    const int log =
+        ::open(log_name.c_str(), O_WRONLY | O_CREAT | O_EXCL | O_NOFOLLOW | O_CLOEXEC, 0644);
     const int null_in = ::open("/dev/null", O_RDONLY);
     if (log < 0 || null_in < 0)
       ::_exit(126);

@@ -39,8 +39,8 @@ SurfaceSpec parse_surface_spec(std::string_view spec) {
     if (ec != std::errc{} || p != val.data() + val.size() || !std::isfinite(v))
       throw fail(item, "has no number after '='");
     if (key == "rough") {
-      if (v < 0.0)
-        throw fail(item, "must be >= 0");
+      if (v < 0.0 || v > kMaxRoughnessRmsNm)
+        throw fail(item, fmt::format("must be in 0..{} nm RMS (docs/psi.md)", kMaxRoughnessRmsNm));
       s.roughness_rms_nm = v;
       continue;
     }
@@ -50,8 +50,23 @@ SurfaceSpec parse_surface_spec(std::string_view spec) {
     const auto [q, ec2] = std::from_chars(key.data() + 1, key.data() + key.size(), j);
     if (ec2 != std::errc{} || q != key.data() + key.size() || j < 1 || j > 231)
       throw fail(item, "needs a Noll index 1..231");
+    if (std::abs(v) > kMaxSurfaceTermNm)
+      throw fail(item,
+                 fmt::format("is beyond +-{} nm RMS per term (docs/psi.md)", kMaxSurfaceTermNm));
     s.zernike_nm.emplace_back(j, v);
   }
+  // Noll terms are orthonormal: the surface's RMS is the root sum of squares of the summed
+  // coefficients of each index.
+  std::vector<double> sum(232, 0.0);
+  for (const auto& [j, c] : s.zernike_nm)
+    sum[static_cast<std::size_t>(j)] += c;
+  double squares = 0.0;
+  for (double c : sum)
+    squares += c * c;
+  if (std::sqrt(squares) > kMaxSurfaceTermNm)
+    throw core::InputError(
+        fmt::format("--surface '{}': the terms make {:.0f} nm RMS, beyond {} nm RMS (docs/psi.md)",
+                    spec, std::sqrt(squares), kMaxSurfaceTermNm));
   return s;
 }
 

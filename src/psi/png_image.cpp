@@ -120,6 +120,9 @@ GrayImage read_png_gray(const std::string& path) {
     png_set_strip_alpha(png);
     if (type & PNG_COLOR_MASK_COLOR)
       png_set_rgb_to_gray_fixed(png, 1, -1, -1);
+    // An Adam7 file's rows come in seven passes, each filling part of every row: libpng merges
+    // them when asked and each pass's rows are read over the same whole-image buffer.
+    const int passes = png_set_interlace_handling(png);
     png_read_update_info(png, info);
     const int depth = png_get_bit_depth(png, info);
     const int channels = png_get_channels(png, info);
@@ -127,9 +130,13 @@ GrayImage read_png_gray(const std::string& path) {
       throw PngFailure(fmt::format("unsupported layout ({} channels, {} bits)", channels, depth));
     img.bit_depth = depth;
     img.counts = Map(static_cast<int>(w), static_cast<int>(h));
-    std::vector<png_byte> row(png_get_rowbytes(png, info));
+    const std::size_t row_bytes = png_get_rowbytes(png, info);
+    std::vector<png_byte> pixels(row_bytes * h);
+    for (int pass = 0; pass < passes; ++pass)
+      for (png_uint_32 j = 0; j < h; ++j)
+        png_read_row(png, pixels.data() + j * row_bytes, nullptr);
     for (png_uint_32 j = 0; j < h; ++j) {
-      png_read_row(png, row.data(), nullptr);
+      const png_byte* row = pixels.data() + j * row_bytes;
       for (png_uint_32 i = 0; i < w; ++i)
         img.counts.v[j * w + i] =
             depth == 8 ? row[i] : static_cast<double>((row[2 * i] << 8) | row[2 * i + 1]);

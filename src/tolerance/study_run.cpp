@@ -22,6 +22,8 @@ constexpr const char* kBuiltIn = "built-in defaults";
 Study build_study(const std::string& tolerance_name, std::string tolerance_text,
                   const std::string& config_name, std::string config_text, std::uint64_t samples,
                   const StudyOptions& options) {
+  if (const std::string p = samples_problem("tolerance: --samples", samples); !p.empty())
+    throw core::InputError(p);
   Study s;
   if (!config_name.empty())
     s.config = runtime::parse_installation_config(config_text, config_name).project;
@@ -106,10 +108,28 @@ std::vector<ReportFigure> write_figures(const std::vector<SampleResult>& samples
 
 }  // namespace
 
+std::string samples_problem(const std::string& what, std::uint64_t samples) {
+  if (samples >= 1 && samples <= kMaxSamples)
+    return "";
+  return fmt::format("{}: {} samples; a study has 1 to {} (docs/tolerance.md)", what, samples,
+                     kMaxSamples);
+}
+
 nlohmann::json read_study_json(const fs::path& path) {
   const std::string text = io::read_input_file(path.string(), io::kMaxDataFileBytes);
+  // The callback sees each value's depth as the parser reaches it: a deeper one stops the parse
+  // before it holds more than kMaxJsonDepth levels.
+  struct TooDeep {};
+  const auto bounded = [](int depth, nlohmann::json::parse_event_t, nlohmann::json&) {
+    if (depth > kMaxJsonDepth)
+      throw TooDeep{};
+    return true;
+  };
   try {
-    return nlohmann::json::parse(text);
+    return nlohmann::json::parse(text, bounded);
+  } catch (const TooDeep&) {
+    throw core::InputError(fmt::format("{}: nests deeper than {} levels; not a study's file",
+                                       path.string(), kMaxJsonDepth));
   } catch (const nlohmann::json::exception& e) {
     throw core::InputError(fmt::format("{}: not JSON: {}", path.string(), e.what()));
   }

@@ -42,8 +42,14 @@ TEST_F(BadInput, APlotPathThatCannotBeWrittenIsRefusedBeforeTheData) {
   refused("analyze linearity --data '" + data + "' --plot /proc/x.png",
           {"--plot /proc/x.png: cannot create a file in /proc"});
   refused("analyze step --data '" + data + "' --plot /proc/self/sub/x.svg",
-          {"--plot /proc/self/sub/x.svg: cannot create a file in /proc/self"});
+          {"--plot /proc/self/sub/x.svg: the folder /proc/self/sub does not exist (it is not "
+           "created)"});
   refused("analyze repeatability --data missing.csv --plot /proc/x.png", {"--plot /proc/x.png"});
+  // Issue 47: a line break in the name was exit 1; a folder that does not exist was created.
+  refused("analyze linearity --data '" + data + "' --plot '" + dir() + "/a\nb.png'",
+          {"--plot " + dir() + "/a b.png: holds a control character"});
+  refused("analyze linearity --data '" + data + "' --plot '" + dir() + "/new/x.png'",
+          {"--plot " + dir() + "/new/x.png: the folder " + dir() + "/new does not exist"});
   refused("analyze linearity --data '" + data + "' --plot '" + data + "/x.png'",
           {"--plot " + data + "/x.png: " + data + " is not a folder"});
   refused("analyze linearity --data '" + data + "' --plot '" + dir() + "/.'",
@@ -121,6 +127,15 @@ TEST_F(BadInput, CommandLineErrorsNameTheProgramAndSuggestTheClosestOption) {
   refused("simulate --zzzzzz 5", {"--zzzzzz is not an option of simulate\n"});
   const CliResult help = run("simulate --help");
   EXPECT_NE(help.out.find("a whole number in [0, 2^64 - 1]"), std::string::npos) << help.out;
+}
+
+// Issue 47: `serve --camera twin --surface Z4=1e308` ended a measurement in an uncaught
+// exception; --mask was ignored with the twin camera. Both are refused before anything runs.
+TEST_F(BadInput, ServesTwinSurfaceAndMaskAreCheckedBeforeItStarts) {
+  refused("serve --camera twin --http-port 0 --surface Z4=1e308",
+          {"--surface 'Z4=1e308': 'Z4=1e308' is beyond +-2000 nm RMS per term"});
+  refused("serve --camera twin --http-port 0 --mask '" + dir() + "/m.png'",
+          {"--mask: the twin camera renders its own pupil and analyses it"});
 }
 
 TEST_F(BadInput, RunTimesBeyondTheLongestRunNameTheirLimit) {

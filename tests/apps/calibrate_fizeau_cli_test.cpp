@@ -42,6 +42,9 @@ TEST_F(FizeauCalibrateCli, WhatItCannotDoIsRefusedNamingTheOption) {
       {"--daq sim-rt --controller improved", "--controller improved with --daq"},
       {"--free-run", "--free-run needs --daq sim-rt"},
       {"--mask " + path("m.png"), "--mask: the twin's bench takes its scene's pupil"},
+      // issue 47: it was ignored on the loop with the twin camera
+      {"--daq sim-rt --mask " + path("m.png"), "--mask: the twin camera renders its own pupil"},
+      {"--daq sim-rt --surface Z4=1e308", "'Z4=1e308' is beyond +-2000 nm RMS per term"},
       {"--daq sim-rt --camera aravis:Basler-1 --surface Z4=1", "--surface: the test surface"},
       {"--camera webcam", "--camera webcam: expected twin or aravis:ID"}};
   for (const auto& [args, said] : loop_refusals) {

@@ -134,6 +134,11 @@ TEST_F(MeasureCli, BadInputIsRefusedBeforeAnythingRuns) {
   refused("--out '" + path("x") + "' --algorithm lsq --steps-rad 0,1", "3 to 64 frames");
   refused("--out '" + path("x") + "' --base-um 11.4", "beyond the calibrated travel");
   refused("--out '" + path("x") + "' --camera files:" + path("none"), path("none"));
+  // Issue 47: --mask was ignored with the twin camera; a surface of 1e308 nm was an internal error.
+  refused("--out '" + path("x") + "' --mask '" + path("m.png") + "'",
+          "--mask: the twin camera renders its own pupil and analyses it");
+  refused("--out '" + path("x") + "' --surface Z4=1e308",
+          "--surface 'Z4=1e308': 'Z4=1e308' is beyond +-2000 nm RMS per term");
   write("full/keep.txt", "");
   fs::create_directories(path("full"));
   write("full/keep.txt", "data");

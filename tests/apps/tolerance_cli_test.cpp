@@ -134,5 +134,41 @@ TEST_F(ToleranceCli, BadTolerancesExit2NamingTheKey) {
   EXPECT_FALSE(std::filesystem::exists(path("x")));
 }
 
+// Issue 47: what a shard file, --shard or --scheduler says is checked before it is used. A
+// shard's header claiming 1e12 samples ended merge in std::bad_alloc (exit 1); a file of '['
+// took 5 GB to parse; --shard 2/18446744073709551615 wrapped round; --shard 5/8 --samples 4 ran
+// nothing with a misleading message; --scheduler garbage ended in a Python traceback.
+TEST_F(ToleranceCli, ShardFilesShardsAndSchedulersAreCheckedBeforeUse) {
+  const std::string tol = write("tol.toml", kTolerances);
+  const auto refused = [&](const std::string& args, const std::string& message) {
+    const testing::CliResult r = run(args);
+    EXPECT_EQ(r.status, 2) << args << "\n" << r.err;
+    EXPECT_NE(r.err.find(message), std::string::npos) << args << "\n" << r.err;
+    EXPECT_EQ(r.err.find("Traceback"), std::string::npos) << r.err;
+  };
+  const nlohmann::json header{
+      {"tolerance_file", tol},       {"config", "built-in defaults"}, {"seed", 1},
+      {"samples", 1000000000000ULL}, {"procedure", "paper"},          {"experiments", "quick"}};
+  const std::string huge = write(
+      "huge.json", nlohmann::json{{"study", header}, {"samples", nlohmann::json::array()}}.dump());
+  refused("tolerance merge '" + huge + "' --out " + path("m"),
+          huge + ": 1000000000000 samples; a study has 1 to 1000000 (docs/tolerance.md)");
+  const std::string bomb = write("bomb.json", std::string(8u << 20, '['));
+  refused("tolerance merge '" + bomb + "' --out " + path("m"),
+          bomb + ": nests deeper than 16 levels; not a study's file");
+  refused("tolerance --tolerances '" + tol + "' --samples 1000001", "--samples");
+  refused("tolerance --tolerances '" + tol + "' --shard 2/18446744073709551615",
+          "2/18446744073709551615 is not i/N with 0 <= i < N <= 1000000");
+  refused("tolerance --tolerances '" + tol + "' --shard 5/8 --samples 4 --out " + path("s"),
+          "tolerance --shard 5/8: 8 shards for 4 samples (--samples 4); N may be at most the "
+          "sample count, so that every shard runs a sample");
+  refused("tolerance --tolerances '" + tol + "' --scheduler garbage --out " + path("d"),
+          "'garbage' is not a scheduler address; give SCHEME://HOST:PORT");
+  refused("tolerance --tolerances '" + tol + "' --scheduler tcp://127.0.0.1 --out " + path("d"),
+          "'tcp://127.0.0.1' needs a host and a port 1..65535");
+  for (const char* out : {"m", "s", "d"})
+    EXPECT_FALSE(std::filesystem::exists(path(out))) << out;
+}
+
 }  // namespace
 }  // namespace piezoshift

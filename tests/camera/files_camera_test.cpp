@@ -1,6 +1,7 @@
 #include "piezoshift/camera/files_camera.hpp"
 
 #include <gtest/gtest.h>
+#include <sys/stat.h>
 
 #include <cmath>
 #include <filesystem>
@@ -111,6 +112,38 @@ TEST_F(FilesCameraTest, MissingOrEmptyDirectoriesAreRefusedByName) {
     write(fmt::format("f{:03}.png", k), "");
   EXPECT_NE(error_of([&] { FilesCamera c(dir_.string()); }).find("65 PNG files, at most 64"),
             std::string::npos);
+}
+
+// A FIFO, a link to a device or a link loop among the *.png files was skipped and every later
+// frame shifted one step: each is refused by name before anything is decoded. A link to a
+// regular PNG is a frame.
+TEST_F(FilesCameraTest, APngThatIsNotARegularFileIsRefusedByName) {
+  const std::vector<psi::Map> frames = simulated_frames(3);
+  for (int k = 0; k < 3; ++k)
+    psi::write_png_gray16(path(fmt::format("frame_{:02}.png", k)), frames[k]);
+  std::filesystem::create_symlink(path("frame_02.png"), path("frame_03.png"));
+  {
+    FilesCamera cam(dir_.string());
+    ASSERT_EQ(cam.files().size(), 4u);
+    cam.configure(settings());
+  }
+  const std::string prefix = "camera files:" + dir_.string() + ": frame_01b.png: ";
+  const std::string suffix = "; every *.png must be a regular file";
+  ASSERT_EQ(::mkfifo(path("frame_01b.png").c_str(), 0600), 0);
+  EXPECT_EQ(error_of([&] { FilesCamera c(dir_.string()); }), prefix + "a FIFO (pipe)" + suffix);
+  std::filesystem::remove(path("frame_01b.png"));
+  std::filesystem::create_symlink("/dev/zero", path("frame_01b.png"));
+  EXPECT_EQ(error_of([&] { FilesCamera c(dir_.string()); }),
+            prefix + "a link to a device" + suffix);
+  std::filesystem::remove(path("frame_01b.png"));
+  std::filesystem::create_symlink(path("frame_01b.png"), path("frame_01b.png"));
+  EXPECT_EQ(error_of([&] { FilesCamera c(dir_.string()); }),
+            prefix + "a link that does not lead to a file (" +
+                std::make_error_code(std::errc::too_many_symbolic_link_levels).message() + ")" +
+                suffix);
+  std::filesystem::remove(path("frame_01b.png"));
+  std::filesystem::create_directory(path("frame_01b.png"));
+  EXPECT_EQ(error_of([&] { FilesCamera c(dir_.string()); }), prefix + "a directory" + suffix);
 }
 
 TEST_F(FilesCameraTest, SizeOrBitDepthOtherThanTheSettingsIsRefusedNamingTheFile) {

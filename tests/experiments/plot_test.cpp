@@ -5,8 +5,11 @@
 #include <cstdint>
 #include <filesystem>
 #include <fstream>
+#include <functional>
 #include <sstream>
 #include <vector>
+
+#include "piezoshift/core/input_error.hpp"
 
 namespace piezoshift::io {
 namespace {
@@ -154,6 +157,56 @@ TEST(Plot, NoTitleLabelOrNameReachesGnuplotsCommandStream) {
     return;  // the script's lines were checked; drawing needs gnuplot
   render(f, dir / "fig");
   EXPECT_FALSE(fs::exists(pwned));
+}
+
+// Issue 47: --plot wrote its .gp and .dat through links planted at their names, in place; a
+// line break in the name was exit 1; --plot /nonexistent/x.png created /nonexistent. The side
+// files replace a planted link (its target untouched), a name with a control character and a
+// folder that does not exist are refused, and no folder is created.
+TEST(Plot, SideFilesReplacePlantedLinksAndNoFolderIsCreated) {
+  const fs::path dir = temp_dir("links");
+  const fs::path victim = dir / "victim.txt";
+  std::ofstream(victim) << "keep me";
+  for (const char* side : {"fig.gp", "fig.dat", "fig.gnuplot.log", "fig.png"})
+    fs::create_symlink(victim, dir / side);
+  const PlotFiles files = write_plot_files(two_panel_figure(), dir / "fig.png");
+  EXPECT_FALSE(fs::is_symlink(files.script));
+  EXPECT_FALSE(fs::is_symlink(files.data));
+  EXPECT_NE(read(files.script).find("set terminal pngcairo"), std::string::npos);
+  if (find_gnuplot()) {
+    render(two_panel_figure(), dir / "fig.png");
+    EXPECT_FALSE(fs::is_symlink(dir / "fig.png"));
+    EXPECT_EQ(png_size(dir / "fig.png"), (std::pair<std::uint32_t, std::uint32_t>{640, 480}));
+  }
+  EXPECT_EQ(read(victim), "keep me");
+  std::size_t temporaries = 0;
+  for (const auto& e : fs::directory_iterator(dir))
+    temporaries += e.path().filename().string().find(".tmp.") != std::string::npos;
+  EXPECT_EQ(temporaries, 0u);
+
+  const auto refusal = [](const std::function<void()>& f) -> std::string {
+    try {
+      f();
+    } catch (const core::InputError& e) {
+      return e.what();
+    }
+    return "no refusal";
+  };
+  const fs::path missing = dir / "nonexistent" / "x.png";
+  EXPECT_EQ(refusal([&] { check_output_path(missing, "--plot"); }),
+            "--plot " + missing.string() + ": the folder " + (dir / "nonexistent").string() +
+                " does not exist (it is not created)");
+  EXPECT_EQ(refusal([&] { write_plot_files(two_panel_figure(), missing); }),
+            "plot output " + missing.string() + ": the folder " + (dir / "nonexistent").string() +
+                " does not exist");
+  EXPECT_FALSE(fs::exists(dir / "nonexistent"));
+  const fs::path broken = dir / "a\nb.png";
+  EXPECT_EQ(refusal([&] { check_output_path(broken, "--plot"); }),
+            "--plot " + (dir / "a b.png").string() +
+                ": holds a control character (a line break, a tab ...); give a name without");
+  EXPECT_NE(refusal([&] { write_plot_files(two_panel_figure(), broken); }).find("control"),
+            std::string::npos);
+  EXPECT_FALSE(fs::exists(dir / "a\nb.gp"));
 }
 
 TEST(Plot, HistogramBinsAlignOnMultiplesOfTheWidth) {

@@ -5,8 +5,12 @@
 
 #include <cmath>
 #include <numbers>
+#include <string>
+#include <string_view>
 
+#include "piezoshift/core/input_error.hpp"
 #include "piezoshift/psi/error_budget.hpp"
+#include "piezoshift/psi/fizeau_simulation.hpp"
 #include "piezoshift/psi/step_calibration.hpp"
 #include "piezoshift/rig/bench.hpp"
 
@@ -17,6 +21,34 @@ control::SemiClosedLoopParams paper_controller(const config::ProjectConfig& conf
   control::SemiClosedLoopParams cp;
   cp.sample_time_s = config.twin.daq.sample_time_s;
   return cp;
+}
+
+// Coefficients of 1e200 or 1e308 nm gave an internal error, a reported error of 0 nm, or an
+// uncaught std::invalid_argument in `serve`'s measurement: a test surface is bounded at parse,
+// the refusal naming the option and the term.
+TEST(SurfaceSpecTest, CoefficientsBeyondAFizeausRangeAreRefusedNamingTheTerm) {
+  const auto error = [](std::string_view spec) -> std::string {
+    try {
+      parse_surface_spec(spec);
+    } catch (const core::InputError& e) {
+      return e.what();
+    }
+    return "";
+  };
+  EXPECT_EQ(error("Z4=1e308"),
+            "--surface 'Z4=1e308': 'Z4=1e308' is beyond +-2000 nm RMS per term (docs/psi.md) "
+            "(expected e.g. Z4=40,Z5=-20,rough=0.5)");
+  EXPECT_EQ(error("Z5=40,Z11=-1e200"),
+            "--surface 'Z5=40,Z11=-1e200': 'Z11=-1e200' is beyond +-2000 nm RMS per term "
+            "(docs/psi.md) (expected e.g. Z4=40,Z5=-20,rough=0.5)");
+  EXPECT_EQ(error("Z4=2000,Z5=2000"),
+            "--surface 'Z4=2000,Z5=2000': the terms make 2828 nm RMS, beyond 2000 nm RMS "
+            "(docs/psi.md)");
+  EXPECT_EQ(error("Z4=40,rough=51"),
+            "--surface 'Z4=40,rough=51': 'rough=51' must be in 0..50 nm RMS (docs/psi.md) "
+            "(expected e.g. Z4=40,Z5=-20,rough=0.5)");
+  EXPECT_EQ(error("Z4=2000,rough=50"), "");
+  EXPECT_EQ(error("Z4=-2000,Z4=1000,Z5=1700"), "");  // one index's terms add: 1972 nm RMS
 }
 
 TEST(PsiAcquisitionTest, BenchStageStepsByLambdaOverEightAndComesOnTarget) {

@@ -124,16 +124,20 @@ struct PlotFiles {
   std::optional<std::filesystem::path> svg;
 };
 
-//! Writes <stem>.dat and <stem>.gp and runs gnuplot to draw the requested formats. Creates the
-//! folder of stem if needed. Throws std::invalid_argument for an inconsistent figure (series
-//! sizes, grid too small), InputError for a stem that names no file, and PlotError when gnuplot is
+//! Writes <stem>.dat and <stem>.gp and runs gnuplot to draw the requested formats. The folder of
+//! stem must exist (it is never created). The side files are replaced atomically
+//! (io::write_file_atomically: a fresh temporary, O_EXCL | O_NOFOLLOW, renamed over the name),
+//! and what is at the images' and the log's names is removed before gnuplot runs, so a link
+//! planted at any of the names is replaced, never written through. Throws std::invalid_argument
+//! for an inconsistent figure (series sizes, grid too small), InputError for a stem that names no
+//! file, holds a control character or whose folder does not exist, and PlotError when gnuplot is
 //! not found, fails (its messages are in the error), or leaves an empty output file.
 PlotFiles render(const Figure& figure, const std::filesystem::path& stem,
                  const PlotOptions& options = {});
 
 //! Refuses, with an InputError naming `option` and the path, an output path that names no file
-//! ("dir/", ".", "..") or whose folder cannot take a file: the nearest folder on
-//! its way that exists must be a folder in which a file can be created (tried, then removed).
+//! ("dir/", ".", ".."), holds a control character (a line break would split the script), or
+//! whose folder does not exist (it is not created) or cannot take a file (tried, then removed).
 //! For a command to call on its option before its work; render() checks the name again.
 void check_output_path(const std::filesystem::path& path, std::string_view option);
 

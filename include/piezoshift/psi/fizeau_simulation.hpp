@@ -34,8 +34,17 @@ struct SurfaceSpec {
   int roughness_correlation_px = 3;
 };
 
+//! The largest test surface [nm RMS], of one term and of all terms together: about 3 waves RMS
+//! at 632.8 nm, the range of a Fizeau (docs/psi.md, "Test surfaces"). Z4 at this bound slopes
+//! 115 nm per pixel at the edge of the default 120 px pupil, below the lambda/4 = 158 nm
+//! (pi of phase in reflection) that leaves fringes resolvable.
+inline constexpr double kMaxSurfaceTermNm = 2000.0;
+//! Roughness [nm RMS]: lambda/12 at 632.8 nm, adjacent pixels still within pi of phase.
+inline constexpr double kMaxRoughnessRmsNm = 50.0;
+
 //! "Z4=40,Z5=25,rough=0.5" (Noll index = nm; rough = nm RMS; "flat" for none). Throws
-//! core::InputError naming the spec and the offending item.
+//! core::InputError naming the spec and the offending item, and refuses terms, or all terms
+//! together, beyond kMaxSurfaceTermNm and roughness beyond kMaxRoughnessRmsNm.
 SurfaceSpec parse_surface_spec(std::string_view spec);
 //! The surface [nm] over the mask (NaN outside). Roughness draws from rng.
 Map make_surface_nm(const SurfaceSpec& spec, const Mask& mask, plant::Rng& rng);

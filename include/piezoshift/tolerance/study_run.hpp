@@ -19,6 +19,16 @@
 
 namespace piezoshift::tolerance {
 
+//! A study's sample count, everywhere it is given (--samples, a shard's or a description's
+//! header, the Python API): merge holds one result a sample, so a shard claiming 1e12 samples
+//! ended in std::bad_alloc. 10^6 quick samples are about 5 CPU-days.
+inline constexpr std::uint64_t kMaxSamples = 1000000;
+//! "" or why `samples` is not a study's sample count, naming `what` (the option or the file).
+std::string samples_problem(const std::string& what, std::uint64_t samples);
+//! The deepest nesting of a study's JSON file (a record or a shard nests 4 levels): a file of
+//! 64 MiB of '[' took 5 GB to parse; it is refused at the first level past this one.
+inline constexpr int kMaxJsonDepth = 16;
+
 struct StudyInputs {
   std::string tolerances;  //!< path of the tolerance file
   std::string config;      //!< path of the nominal configuration; "" for the built-in defaults
@@ -50,7 +60,7 @@ Study study_from_description(const nlohmann::json& description);
 SampleResult run_study_sample(const Study& study, std::uint64_t index);
 
 //! A study's JSON file (a record, a shard), whole; core::InputError naming the file when it
-//! cannot be read or is not JSON.
+//! cannot be read, is not JSON or nests deeper than kMaxJsonDepth.
 nlohmann::json read_study_json(const std::filesystem::path& path);
 
 //! <out>/samples/sample-NNNNNN.json
