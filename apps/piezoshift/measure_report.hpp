@@ -30,6 +30,9 @@ struct MeasureRecord {
   //! The same over the whole measurement, every exposure with its own frame's noise draws
   //! (twin camera): the floor the stage's error adds to.
   std::optional<double> floor_error_rms_nm;
+  //! The surface's lateral scale, metres on the plate per pixel (instrument::plate_m_per_px of
+  //! the mask and [camera] pupil_radius_m): surface_m.gsf's. 0: no .gsf written.
+  double m_per_px = 0.0;
 };
 
 //! The summary measure prints with --json and writes as measurement.json.
@@ -40,8 +43,9 @@ nlohmann::json measure_json(const MeasureRecord& r);
 void check_measure_out(const std::string& out);
 
 //! Writes the measurement into out (which must not exist, or be an empty folder): frames,
-//! surface, truth, mask, exposures.csv, measurement.json, figures and report.md. Built in a
-//! sibling folder first and renamed into place at the end.
+//! surface (.npy, .png, and .gsf with its lateral scale), truth, mask, exposures.csv,
+//! measurement.json, figures and report.md. Built in a sibling folder first and renamed into place
+//! at the end.
 void write_measurement(const MeasureRecord& r, const std::string& out);
 
 }  // namespace piezoshift::app
