@@ -29,6 +29,7 @@
 #include "piezoshift/camera/twin_camera.hpp"
 #include "piezoshift/core/input_error.hpp"
 #include "piezoshift/instrument/acquisition.hpp"
+#include "piezoshift/instrument/fringe_actuator_scan.hpp"
 #include "piezoshift/instrument/hold_summary.hpp"
 #include "piezoshift/instrument/measurement.hpp"
 #include "piezoshift/instrument/measurement_lock.hpp"
@@ -318,7 +319,8 @@ int measure(const MeasureOptions& o) {
                     .ideal_error_rms_nm = std::nullopt,
                     .floor_error_rms_nm = std::nullopt,
                     .out = {},
-                    .out_given = {}};
+                    .out_given = {},
+                    .m_per_px = instrument::plate_m_per_px(mask, s.config.camera.pupil_radius_m)};
   if (s.scene) {
     rec.error_rms_nm = psi::surface_error_rms_nm(a.surface_nm, s.scene->surface_nm, a.valid);
     rec.ideal_error_rms_nm =

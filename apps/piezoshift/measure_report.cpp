@@ -17,6 +17,7 @@
 #include "piezoshift/psi/npy.hpp"
 #include "piezoshift/psi/png_image.hpp"
 #include "piezoshift/psi/surface_figure.hpp"
+#include "piezoshift/psi/surface_file.hpp"
 #include "piezoshift/psi/zernike_figure.hpp"
 
 namespace piezoshift::app {
@@ -311,6 +312,7 @@ Json measure_json(const MeasureRecord& r) {
     j["out"] = r.out;
   if (!r.out_given.empty())
     j["out_given"] = r.out_given;
+  j["lateral_scale_m_per_px"] = r.m_per_px > 0.0 ? Json(r.m_per_px) : Json(nullptr);
   return j;
 }
 
@@ -382,6 +384,9 @@ void write_measurement(MeasureRecord& r, const std::string& out_name) {
     write_frames(r, tmp / "frames");
     psi::write_mask_png((tmp / "mask.png").string(), *r.mask);
     psi::write_npy((tmp / "surface_nm.npy").string(), r.analysis->surface_nm);
+    if (r.m_per_px > 0.0)
+      psi::write_gsf((tmp / "surface_m.gsf").string(),
+                     {r.analysis->surface_nm, r.m_per_px, "surface, piston and tilt removed"});
     const auto [lo, hi] = psi::finite_range(r.analysis->surface_nm);
     psi::write_surface_map(tmp / "surface_nm.png", r.analysis->surface_nm, lo, hi,
                            fmt::format("Measured surface: RMS {:.2f} nm, PV {:.2f} nm",

@@ -1,7 +1,9 @@
 // `piezoshift psi simulate|analyze|calibrate`: phase-shifting interferometry (docs/psi.md).
 //   simulate   the acquisition on the twin with the paper's controller, frames rendered from the
 //              plate's true motion, analysed; the surface error the stage causes; a budget table
-//   analyze    frames (8- or 16-bit PNG) to a surface map: surface_nm.npy, surface_nm.png, JSON
+//   analyze    frames (8- or 16-bit PNG) to a surface map: surface_nm.npy, surface_nm.png,
+//              surface_m.gsf (with its lateral scale), JSON
+//   compare    two .gsf maps of one part: the difference, its RMS, Zernike terms (psi_compare.hpp)
 //   calibrate  the steps the stage made, recovered from frames (AIA), as a TOML table
 // Bad files, sizes, counts or values exit with status 2 and a message naming the file or option.
 #include <algorithm>
@@ -18,8 +20,11 @@
 #include <nlohmann/json.hpp>
 
 #include "command.hpp"
+#include "piezoshift/camera/camera_config.hpp"
 #include "piezoshift/config/project_config.hpp"
+#include "piezoshift/core/bounds.hpp"
 #include "piezoshift/core/input_error.hpp"
+#include "piezoshift/instrument/fringe_actuator_scan.hpp"
 #include "piezoshift/io/atomic_file.hpp"
 #include "piezoshift/psi/analysis.hpp"
 #include "piezoshift/psi/error_budget.hpp"
@@ -30,9 +35,11 @@
 #include "piezoshift/psi/simulation.hpp"
 #include "piezoshift/psi/step_calibration.hpp"
 #include "piezoshift/psi/surface_figure.hpp"
+#include "piezoshift/psi/surface_file.hpp"
 #include "piezoshift/psi/zernike.hpp"
 #include "piezoshift/rig/validity.hpp"
 #include "piezoshift/runtime/safety_ranges.hpp"
+#include "psi_compare.hpp"
 #include "psi_options.hpp"
 #include "whole_number.hpp"
 
@@ -53,6 +60,8 @@ struct PsiOptions {
   std::string mask;
   std::string steps_rad;
   bool remove_power = false;
+  //! The pupil's radius on the plate, which sets the surface's lateral scale: [camera]'s.
+  double pupil_radius_m = camera::CameraConfig{}.pupil_radius_m;
   double nominal_step_rad = std::numbers::pi / 2.0;
   // simulate
   std::string config;
@@ -84,11 +93,29 @@ void add_fit_check(Json& j, const psi::PhaseResult& r) {
     j["step_conditioning"] = r.step_conditioning;
 }
 
-// Writes surface_nm.npy and surface_nm.png into out; returns the JSON of the analysis.
+// --pupil-radius-m against [camera] pupil_radius_m's range (camera_config.hpp), the one list.
+void check_pupil_radius(double radius_m) {
+  core::Bounds bounds;
+  camera::CameraConfig config;
+  camera::visit_camera_values(
+      config, [&](std::string_view, std::string_view key, const auto&, const core::Bounds& b) {
+        if (key == "pupil_radius_m")
+          bounds = b;
+      });
+  if (const std::string problem = core::range_problem("--pupil-radius-m", radius_m, bounds);
+      !problem.empty())
+    throw core::InputError(problem);
+}
+
+// Writes surface_nm.npy and surface_nm.png into out, and surface_m.gsf when m_per_px > 0 (the
+// lateral scale, metres on the plate per pixel); returns the JSON of the analysis.
 Json write_analysis(const psi::Analysis& a, psi::Algorithm alg, double wavelength_nm,
-                    const std::string& out, const Json& pupil = nullptr) {
+                    const std::string& out, const Json& pupil = nullptr, double m_per_px = 0.0) {
   fs::create_directories(out);
   psi::write_npy((fs::path(out) / "surface_nm.npy").string(), a.surface_nm);
+  if (m_per_px > 0.0)
+    psi::write_gsf((fs::path(out) / "surface_m.gsf").string(),
+                   {a.surface_nm, m_per_px, "surface, piston and tilt removed"});
   const auto [lo, hi] = psi::finite_range(a.surface_nm);
   psi::write_surface_map(
       fs::path(out) / "surface_nm.png", a.surface_nm, lo, hi,
@@ -103,6 +130,8 @@ Json write_analysis(const psi::Analysis& a, psi::Algorithm alg, double wavelengt
   add_fit_check(j, a.phase);
   if (!pupil.is_null())
     j["pupil"] = pupil;
+  if (m_per_px > 0.0)
+    j["lateral_scale_m_per_px"] = m_per_px;
   if (!a.phase.shifts.empty()) {
     const psi::FrameShiftColumns c = psi::shift_columns(a.phase.shifts);
     j["piston_rad"] = c.piston_rad;
@@ -113,7 +142,8 @@ Json write_analysis(const psi::Analysis& a, psi::Algorithm alg, double wavelengt
   return j;
 }
 
-void print_analysis(const psi::Analysis& a, psi::Algorithm alg, const std::string& out) {
+void print_analysis(const psi::Analysis& a, psi::Algorithm alg, const std::string& out,
+                    double m_per_px = 0.0) {
   fmt::print("algorithm {}  frames {}  valid pixels {}\n", psi::algorithm_name(alg),
              a.phase.steps_rad.size(), a.figures.pixels);
   std::string steps;
@@ -128,11 +158,15 @@ void print_analysis(const psi::Analysis& a, psi::Algorithm alg, const std::strin
   fmt::print("Zernike (Noll, nm RMS):");
   for (std::size_t j = 3; j < std::min<std::size_t>(a.zernike_nm.size(), 11); ++j)
     fmt::print(" Z{}={:.2f}", j + 1, a.zernike_nm[j]);
-  fmt::print("\nwritten: {0}/surface_nm.npy {0}/surface_nm.png {0}/analysis.json\n", out);
+  fmt::print("\nwritten: {0}/surface_nm.npy {0}/surface_nm.png {0}/analysis.json", out);
+  if (m_per_px > 0.0)
+    fmt::print(" {}/surface_m.gsf ({:.6g} mm per pixel)", out, 1e3 * m_per_px);
+  fmt::print("\n");
 }
 
 int run_analyze(const PsiOptions& o) {
   check_wavelength(o.wavelength_nm);
+  check_pupil_radius(o.pupil_radius_m);
   const std::vector<psi::Map> frames = psi::read_frame_set(o.frames);
   const psi::Algorithm alg = choose_algorithm(o.algorithm, frames.size());
   check_count(alg, frames.size());
@@ -161,11 +195,14 @@ int run_analyze(const PsiOptions& o) {
     }
     throw rig::ProcedureFailed(fmt::format("psi analyze: {}", a.phase.reason));
   }
-  const Json j = write_analysis(a, alg, o.wavelength_nm, o.out, pupil.json);
+  const double m_per_px = instrument::plate_m_per_px(pupil.mask, o.pupil_radius_m);
+  Json pupil_json = pupil.json;
+  pupil_json["radius_m"] = o.pupil_radius_m;
+  const Json j = write_analysis(a, alg, o.wavelength_nm, o.out, pupil_json, m_per_px);
   if (o.json)
     fmt::print("{}\n", j.dump(2));
   else
-    print_analysis(a, alg, o.out);
+    print_analysis(a, alg, o.out, m_per_px);
   return 0;
 }
 
@@ -369,7 +406,7 @@ int run_simulate(const PsiOptions& o) {
 
 void add_psi_command(CLI::App& app, Action& action) {
   CLI::App* psi = app.add_subcommand(
-      "psi", "Phase-shifting interferometry: simulate, analyze, calibrate (docs/psi.md)");
+      "psi", "Phase-shifting interferometry: simulate, analyze, calibrate, compare (docs/psi.md)");
   psi->require_subcommand(1);
   auto o = std::make_shared<PsiOptions>();
   const std::string names = "4step, carre, hariharan5, degroot7, frame13, lsq, aia, tilt-aia";
@@ -400,6 +437,9 @@ void add_psi_command(CLI::App& app, Action& action) {
   ana->add_option("--steps-rad", o->steps_rad, "Known steps for lsq, e.g. 0,1.57,3.14,4.71");
   ana->add_option("--wavelength-nm", o->wavelength_nm, "Wavelength [nm]")->capture_default_str();
   ana->add_flag("--remove-power", o->remove_power, "Remove power (Z4) as well as piston and tilt");
+  ana->add_option("--pupil-radius-m", o->pupil_radius_m,
+                  "The pupil's radius on the plate [m]: the lateral scale of surface_m.gsf")
+      ->capture_default_str();
   ana->add_option("--out", o->out, "Output folder")->required();
   ana->add_flag("--json", o->json, "Machine-readable output");
 
@@ -414,7 +454,16 @@ void add_psi_command(CLI::App& app, Action& action) {
   cal->add_option("--out", o->out, "Calibration file to write (TOML)")->required();
   cal->add_flag("--json", o->json, "Machine-readable output");
 
+  auto c = std::make_shared<PsiCompareOptions>();
+  CLI::App* cmp = psi->add_subcommand(
+      "compare", "Two surface maps (.gsf) of one part: B - A, its RMS and Zernike terms");
+  cmp->add_option("a", c->a, "Map A (Gwyddion Simple Field, .gsf)")->required();
+  cmp->add_option("b", c->b, "Map B (.gsf), the same size and lateral scale")->required();
+  cmp->add_option("--out", c->out, "Folder for difference_m.gsf and comparison.json");
+  cmp->add_flag("--json", c->json, "Machine-readable output");
+
   sim->callback([o, &action] { action = [o] { return run_simulate(*o); }; });
+  cmp->callback([c, &action] { action = [c] { return run_psi_compare(*c); }; });
   ana->callback([o, &action] { action = [o] { return run_analyze(*o); }; });
   cal->callback([o, &action] { action = [o] { return run_calibrate(*o); }; });
 }

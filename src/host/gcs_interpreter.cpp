@@ -218,7 +218,7 @@ const GcsInterpreter::Command GcsInterpreter::kCommands[] = {
     {"MOV?", "[{axis} ...]", "target position", &GcsInterpreter::target_query},
     {"POS?", "[{axis} ...]", "position from the strain gauges", &GcsInterpreter::position_query},
     {"ONT?", "[{axis} ...]", "on target", &GcsInterpreter::on_target_query},
-    {"OVF?", "[{axis} ...]", "overflow: a PID at its output limit (closed loop)",
+    {"OVF?", "[{axis} ...]", "overflow: a PID at its limit, the target not held",
      &GcsInterpreter::overflow_query},
     {"STP", "", "stop: wave generators off, hold where the stage is (sets error 10)",
      &GcsInterpreter::stop},
@@ -505,12 +505,13 @@ void GcsInterpreter::take(const runtime::HostSample& s) {
   position_ = model_.pose_from_sgs(s.sgs_V);
   const bool counting =
       servo_on_ && !faulted && s.closed_loop != 0 && s.applied_sequence >= move_sequence_;
+  std::array<bool, 3> off_target{};
   for (std::size_t a = 0; a < 3; ++a) {
     const double tol = a == 0 ? options_.on_target_tolerance_um : options_.on_target_tolerance_urad;
-    settled_[a] = counting && !waves_.running(a) && std::fabs(position_[a] - target[a]) <= tol
-                      ? settled_[a] + 1
-                      : 0;
+    off_target[a] = !(std::fabs(position_[a] - target[a]) <= tol);
+    settled_[a] = counting && !waves_.running(a) && !off_target[a] ? settled_[a] + 1 : 0;
   }
+  overflow_.update(s.closed_loop != 0, s.saturated_mask, off_target);
 
   if (!trigger_.records(s.applied_sequence))
     return;  // from before the command that started this recording took effect
@@ -1060,12 +1061,11 @@ std::string GcsInterpreter::command_level_query(Session& s, const Args&) {
   return fmt::format("{}\n", s.command_level);
 }
 
-// One loop drives all three axes through all three channels, so a channel at its limit is an
-// overflow of every axis (as SVO switches them together).
+// A PID at its limit while the axis is on target (at rest at the bottom of the travel) is no
+// overflow: overflow_monitor.hpp.
 std::string GcsInterpreter::overflow_query(Session& s, const Args& args) {
   std::string answer;
-  const bool overflow = have_sample_ && last_.closed_loop != 0 && last_.saturated_mask != 0;
-  const auto value = [overflow](std::size_t) { return overflow ? 1 : 0; };
+  const auto value = [this](std::size_t a) { return overflow_.overflow(a) ? 1 : 0; };
   return reply(s, axis_lines(args, value, answer), answer);
 }
 

@@ -16,6 +16,7 @@
 
 #include "../support/cli_test.hpp"
 #include "piezoshift/psi/npy.hpp"
+#include "piezoshift/psi/surface_file.hpp"
 
 namespace piezoshift {
 namespace {
@@ -93,10 +94,24 @@ class MeasureCli : public testing::CliTest {
 TEST_F(MeasureCli, TwinMeasurementWritesEverythingAndItsFramesReplay) {
   const std::string cam = small_camera();
   const Json j = measure("--config '" + cam + "' --out '" + path("m") + "'");
-  for (const char* f :
-       {"frames/frame_a1_00.png", "frames/frame_a1_04.png", "mask.png", "surface_nm.npy",
-        "surface_truth_nm.npy", "exposures.csv", "measurement.json", "report.md"})
+  for (const char* f : {"frames/frame_a1_00.png", "frames/frame_a1_04.png", "mask.png",
+                        "surface_nm.npy", "surface_m.gsf", "surface_m_mask.gsf",
+                        "surface_truth_nm.npy", "exposures.csv", "measurement.json", "report.md"})
     EXPECT_TRUE(fs::exists(path("m") + "/" + f)) << f;
+  // The .gsf: the .npy's surface in float32 metres, its pixels without a value masked, and the
+  // lateral scale the JSON states (the twin's 25 mm pupil over its radius in pixels).
+  const psi::ScaledSurface gsf = psi::read_gsf(path("m") + "/surface_m.gsf");
+  const psi::Map npy = psi::read_npy(path("m") + "/surface_nm.npy");
+  EXPECT_EQ(gsf.m_per_px, j["lateral_scale_m_per_px"].get<double>());
+  EXPECT_GT(gsf.m_per_px, 0.025 / 48);  // a pupil of 40 to 48 px radius in the 96 px frame
+  EXPECT_LT(gsf.m_per_px, 0.025 / 40);
+  ASSERT_EQ(gsf.height_nm.size(), npy.size());
+  for (std::size_t p = 0; p < npy.size(); ++p) {
+    ASSERT_EQ(std::isfinite(gsf.height_nm.v[p]), std::isfinite(npy.v[p])) << p;
+    if (std::isfinite(npy.v[p])) {
+      ASSERT_EQ(gsf.height_nm.v[p], static_cast<float>(npy.v[p] * 1e-9) * 1e9) << p;
+    }
+  }
   EXPECT_EQ(j["frames"], 5);
   EXPECT_EQ(j["exposures"].size(), 5u);
   EXPECT_TRUE(j["converged"].get<bool>());

@@ -21,6 +21,7 @@
 #include "entry_points.hpp"
 #include "piezoshift/config/project_config.hpp"
 #include "piezoshift/psi/png_image.hpp"
+#include "piezoshift/psi/surface_file.hpp"
 #include "piezoshift/rig/simulation_meter.hpp"
 #include "piezoshift/tolerance/study_run.hpp"
 
@@ -68,6 +69,9 @@ class CommandLineBudget : public ::testing::Test {
       psi::Map frame(32, 32, 1000.0 + 100.0 * k);
       psi::write_png_gray16((dir_ / "frames" / fmt::format("f{}.png", k)).string(), frame);
     }
+    // Two 32 x 32 maps for psi compare (reading them is a check; the fits are its work).
+    for (const char* name : {"a.gsf", "b.gsf"})
+      psi::write_gsf((dir_ / name).string(), {psi::Map(32, 32, 1.0), 1e-4, name});
   }
   void TearDown() override { fs::remove_all(dir_); }
 
@@ -138,6 +142,7 @@ std::map<std::string, Case> CommandLineBudget::cases() const {
       {"psi simulate", {{"psi", "simulate", "--out", out}}},
       {"psi analyze", psi_analyze},
       {"psi calibrate", psi_calibrate},
+      {"psi compare", {{"psi", "compare", in("a.gsf"), in("b.gsf"), "--out", out}}},
       {"measure", {{"measure", "--camera", "twin", "--out", out}}},
       {"tolerance",
        {{"tolerance", "--tolerances",

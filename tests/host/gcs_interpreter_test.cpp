@@ -984,19 +984,48 @@ TEST_F(GcsInterpreterTest, AClientConnectingWhileAFaultIsLatchedReadsIt) {
   EXPECT_EQ(err(4), 0);
 }
 
-TEST_F(GcsInterpreterTest, OverflowIsAPidAtItsLimitInClosedLoop) {
+// OVF? as PI defines it: the control variables out of range while the loop cannot hold its
+// target. The settle window is 10 samples here (10 ms at 1 kHz).
+TEST_F(GcsInterpreterTest, OverflowIsAPidAtItsLimitThatCannotHoldTheTarget) {
   EXPECT_EQ(cmd("OVF?"), "Z=0 \nU=0 \nV=0\n");  // no sample yet
-  const std::uint64_t on = servo_on_at({3.0, 0.0, 0.0});
-  HostSample s = at({3.0, 0.0, 0.0}, on, true);
-  s.saturated_mask = 0b100;  // channel 3 at its rail
-  feed(s);
-  EXPECT_EQ(cmd("OVF? Z V"), "Z=1 \nV=1\n");
-  s.saturated_mask = 0;
-  feed(s);
-  EXPECT_EQ(cmd("OVF? U"), "U=0\n");
-  s.saturated_mask = 0b001;
-  s.closed_loop = 0;  // open loop: no PID runs
-  feed(s);
+  // At rest at the bottom of the travel a PID sits at 0 V, its lower limit, on target: no
+  // overflow however long it stays there (it read 1 at every poll).
+  const std::uint64_t on = servo_on_at({0.0, 0.0, 0.0});
+  HostSample rest = at({0.0, 0.0, 0.0}, on, true);
+  rest.saturated_mask = 0b111;
+  feed(rest, 500);
+  EXPECT_EQ(cmd("ONT?"), "Z=1 \nU=1 \nV=1\n");
+  EXPECT_EQ(cmd("OVF?"), "Z=0 \nU=0 \nV=0\n");
+
+  // A move the stage cannot hold: the gauges stay at 3 um, short of 5 um, a PID pinned.
+  EXPECT_EQ(cmd("MOV Z 5"), "");
+  const HostCommand move = only_command();
+  HostSample pinned = at({3.0, 0.0, 0.0}, move.sequence, true);
+  pinned.saturated_mask = 0b001;
+  feed(pinned, 9);  // a step touching a rail for less than the window is not an overflow
+  EXPECT_EQ(cmd("OVF?"), "Z=0 \nU=0 \nV=0\n");
+  feed(pinned, 1);
+  EXPECT_EQ(cmd("OVF?"), "Z=1 \nU=0 \nV=0\n");  // U and V are on target
+  EXPECT_EQ(cmd("OVF? Z V"), "Z=1 \nV=0\n");
+  EXPECT_EQ(cmd("ONT? Z"), "Z=0\n");
+
+  // Off target without a PID at its limit: still moving, no overflow.
+  HostSample moving = pinned;
+  moving.saturated_mask = 0;
+  feed(moving);
+  EXPECT_EQ(cmd("OVF? Z"), "Z=0\n");
+  feed(pinned, 20);
+  EXPECT_EQ(cmd("OVF? Z"), "Z=1\n");
+  // A gauge that reads nothing is off target too.
+  HostSample blind = pinned;
+  blind.sgs_V[0] = std::numeric_limits<double>::quiet_NaN();
+  feed(blind, 10);
+  EXPECT_EQ(cmd("OVF? Z"), "Z=1\n");
+
+  // Open loop: no PID runs, whatever the mask.
+  HostSample open = pinned;
+  open.closed_loop = 0;
+  feed(open);
   EXPECT_EQ(cmd("OVF? Z"), "Z=0\n");
   EXPECT_EQ(cmd("OVF? W"), "\n");
   EXPECT_EQ(err(), 15);

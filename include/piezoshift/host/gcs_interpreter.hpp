@@ -21,6 +21,8 @@
 //                with the servo off they are refused (5); SVA with the servo on too (79)
 //   on target    ONT? of an axis is 1 when the servo is on, the loop has applied the last move
 //                and |POS? - MOV?| <= tolerance has held for settle_time_s
+//   overflow     OVF? of an axis is 1 when, in closed loop, a PID has sat at its output limit
+//                while the axis was off target for settle_time_s (overflow_monitor.hpp)
 //   faults       when the safety supervisor latches a fault, the servo is reported off and every
 //                client's error becomes -1024; SVO (either value) clears the fault
 //   STP, #24     stop the wave generators and hold where the stage is (servo on: MOV? :=
@@ -40,6 +42,7 @@
 #include "piezoshift/host/data_recorder.hpp"
 #include "piezoshift/host/gcs_error.hpp"
 #include "piezoshift/host/line_server.hpp"
+#include "piezoshift/host/overflow_monitor.hpp"
 #include "piezoshift/host/record_trigger.hpp"
 #include "piezoshift/host/sample_observer.hpp"
 #include "piezoshift/host/servo_parameters.hpp"
@@ -252,8 +255,9 @@ class GcsInterpreter final : public LineHandler {
   std::array<bool, 3> measured_target_{};
   AxisValues open_loop_V_{};
   std::array<std::uint64_t, 3> settled_{};
-  std::array<double, 3> velocity_{};  // VEL, stored (velocity control is off, VCO? 0)
-  WaveGenerators waves_{model_};      // one per axis
+  OverflowMonitor overflow_{settle_samples_};  // OVF?: pinned at a limit, off target
+  std::array<double, 3> velocity_{};           // VEL, stored (velocity control is off, VCO? 0)
+  WaveGenerators waves_{model_};               // one per axis
 };
 
 }  // namespace piezoshift::host
