@@ -10,10 +10,10 @@
 #include "piezoshift/calibration/calibration_cost.hpp"
 #include "piezoshift/calibration/calibration_file.hpp"
 #include "piezoshift/calibration/calibration_procedure.hpp"
-#include "piezoshift/calibration/controller_ranges.hpp"
 #include "piezoshift/control/parameter_check.hpp"
 #include "piezoshift/core/bounds.hpp"
 #include "piezoshift/core/input_error.hpp"
+#include "piezoshift/runtime/controller_ranges.hpp"
 #include "piezoshift/runtime/safety_ranges.hpp"
 
 namespace piezoshift::app {

@@ -12,10 +12,10 @@
 #include "bindings.hpp"
 #include "piezoshift/calibration/calibration_file.hpp"
 #include "piezoshift/calibration/calibration_procedure.hpp"
-#include "piezoshift/calibration/controller_ranges.hpp"
 #include "piezoshift/calibration/matrix_fit.hpp"
 #include "piezoshift/calibration/poly_fit.hpp"
 #include "piezoshift/config/project_config.hpp"
+#include "piezoshift/runtime/controller_ranges.hpp"
 #include "values.hpp"
 
 namespace piezoshift::python {
@@ -158,13 +158,13 @@ void bind_calibration_file(py::module_& m) {
   m.def(
       "controller_problem",
       [](const Scl& params, std::optional<double> loop_sample_time_s) {
-        return ps::calibration::controller_problem(
-            params, loop_sample_time_s.value_or(ps::calibration::own_sample_time_s(params)));
+        return ps::runtime::controller_problem(
+            params, loop_sample_time_s.value_or(ps::runtime::own_sample_time_s(params)));
       },
       py::arg("params"), py::arg("loop_sample_time_s") = py::none(),
       "The first problem of params as a calibration, naming the field (each number's range, p "
       "rising over the stroke, A finite, normal and well conditioned, PIDs stable on the nominal "
-      "inner loop, what the loop itself refuses; calibration/controller_ranges.hpp); '' when "
+      "inner loop, what the loop itself refuses; runtime/controller_ranges.hpp); '' when "
       "none. loop_sample_time_s: the loop's period (default: the rate the set was made for). "
       "load_calibration_file refuses a file this finds a problem in.");
   m.def(

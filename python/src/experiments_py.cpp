@@ -5,15 +5,19 @@
 #include <pybind11/stl.h>
 
 #include <cstdint>
+#include <memory>
+#include <string>
 #include <vector>
 
 #include "bindings.hpp"
 #include "piezoshift/config/project_config.hpp"
+#include "piezoshift/core/input_error.hpp"
 #include "piezoshift/experiments/metrics_linearity.hpp"
 #include "piezoshift/experiments/metrics_repeatability.hpp"
 #include "piezoshift/experiments/metrics_step_response.hpp"
 #include "piezoshift/experiments/paper_experiments.hpp"
 #include "piezoshift/rig/bench.hpp"
+#include "piezoshift/runtime/controller_ranges.hpp"
 #include "values.hpp"
 
 namespace piezoshift::python {
@@ -23,6 +27,14 @@ namespace {
 namespace ex = ps::experiments;
 namespace rig = ps::rig;
 using Scl = ps::control::SemiClosedLoopParams;
+
+// A controller from Python passes the check a calibration file and SPA pass
+// (runtime/controller_ranges.hpp) at the loop's rate before a loop runs it.
+const Scl& checked(const Scl& p, double loop_sample_time_s) {
+  if (const std::string why = ps::runtime::controller_problem(p, loop_sample_time_s); !why.empty())
+    throw ps::core::InputError("controller: " + why);
+  return p;
+}
 
 void bind_bench(py::module_& m) {
   py::enum_<rig::DriveMode>(m, "DriveMode")
@@ -36,9 +48,14 @@ void bind_bench(py::module_& m) {
       .PS_RO(Sm, window_end_s);
 
   py::class_<rig::Bench>(m, "Bench")
-      .def(py::init<const ps::config::ProjectConfig&, const Scl&, std::uint64_t>(),
+      .def(py::init([](const ps::config::ProjectConfig& c, const Scl& p, std::uint64_t seed) {
+             return std::make_unique<rig::Bench>(c, checked(p, c.twin.daq.sample_time_s), seed);
+           }),
            py::arg("config"), py::arg("controller"), py::arg("seed"))
-      .def("set_controller", &rig::Bench::set_controller, py::arg("params"))
+      .def(
+          "set_controller",
+          [](rig::Bench& b, const Scl& p) { b.set_controller(checked(p, b.sample_time_s())); },
+          py::arg("params"))
       .def("controller_params", &rig::Bench::controller_params)
       .def("drive_open_loop", &rig::Bench::drive_open_loop, py::arg("ao_V"))
       .def("drive_actuators", &rig::Bench::drive_actuators, py::arg("target_um"))
@@ -235,6 +252,7 @@ void bind_experiment_runs(py::module_& m) {
   m.def(
       "run_travel_range",
       [](const ps::config::ProjectConfig& c, const Scl& p, std::uint64_t seed, const TrO& o) {
+        checked(p, c.twin.daq.sample_time_s);
         py::gil_scoped_release nogil;
         return ex::run_travel_range(c, p, seed, o);
       },
@@ -243,6 +261,7 @@ void bind_experiment_runs(py::module_& m) {
   m.def(
       "run_step_response",
       [](const ps::config::ProjectConfig& c, const Scl& p, std::uint64_t seed, const StO& o) {
+        checked(p, c.twin.daq.sample_time_s);
         py::gil_scoped_release nogil;
         return ex::run_step_response(c, p, seed, o);
       },
@@ -251,6 +270,7 @@ void bind_experiment_runs(py::module_& m) {
   m.def(
       "run_linearity",
       [](const ps::config::ProjectConfig& c, const Scl& p, std::uint64_t seed, const LiO& o) {
+        checked(p, c.twin.daq.sample_time_s);
         py::gil_scoped_release nogil;
         return ex::run_linearity(c, p, seed, o);
       },
@@ -259,6 +279,7 @@ void bind_experiment_runs(py::module_& m) {
   m.def(
       "run_repeatability",
       [](const ps::config::ProjectConfig& c, const Scl& p, std::uint64_t seed, const RpO& o) {
+        checked(p, c.twin.daq.sample_time_s);
         py::gil_scoped_release nogil;
         return ex::run_repeatability(c, p, seed, o);
       },

@@ -51,3 +51,26 @@ def test_a_calibration_is_checked_as_its_file_is_at_load(controller, tmp_path):
     ps.write_calibration_file(path, controller)
     with pytest.raises(ps.InputError, match="unstable.toml"):
         ps.load_calibration_file(path)
+
+
+def test_a_controller_from_python_passes_the_files_check_before_a_loop_runs_it(config, tmp_path):
+    # The same check as the file's loader and SPA over GCS, whatever the door.
+    unstable = ps.SemiClosedLoopParams()
+    unstable.gains = ps.PidGains(5.0, 3.0, 2.0)
+    with pytest.raises(ps.InputError, match="unstable on the nominal inner loop"):
+        ps.Bench(config, unstable, 1)
+    bench = ps.Bench(config, ps.SemiClosedLoopParams(), 1)
+    with pytest.raises(ps.InputError, match="unstable on the nominal inner loop"):
+        bench.set_controller(unstable)
+    steep = ps.SemiClosedLoopParams()
+    steep.polynomial = ps.CubicPolynomial(0.0, 0.0, 1000.0, 0.0)  # full stroke for 1 um
+    with pytest.raises(ps.InputError, match="slope over the 0 to 16 um stroke"):
+        ps.run_step_response(config, steep, 1)
+    # A travel beyond the stroke is neither written nor read.
+    with pytest.raises(ps.InputError, match="z_max_um"):
+        ps.write_calibration_file(str(tmp_path / "far.toml"), ps.SemiClosedLoopParams(),
+                                  z_max_um=1e308)
+    far = tmp_path / "far.toml"
+    far.write_text("[controller]\nkp = 0.6\n[travel]\nz_max_um = 1e308\n")
+    with pytest.raises(ps.InputError, match="far.toml:4:.*z_max_um"):
+        ps.load_calibration_file(str(far))

@@ -114,7 +114,7 @@ def test_polynomial_and_matrix_round_trip_exactly(controller, tmp_path):
                                                -SEVENTH_PI)
     a = np.array([[1.0 + THIRD, -THIRD, SEVENTH_PI],
                   [THIRD / 7, 1.0 - SEVENTH_PI, 2.0 ** -40],
-                  [-1e-17, THIRD * 3, 0.9999999999999999]])
+                  [-1e-17, THIRD, 0.9999999999999999]])
     controller.matrix.a = a
     p = controller.polynomial
     assert [p.p3, p.p2, p.p1, p.p0] == [-THIRD * 1e-3, SEVENTH_PI * 1e-2, 1.0 + THIRD,

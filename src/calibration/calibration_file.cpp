@@ -9,15 +9,23 @@
 
 #include <fmt/core.h>
 
-#include "piezoshift/calibration/controller_ranges.hpp"
 #include "piezoshift/core/bounds.hpp"
 #include "piezoshift/core/input_error.hpp"
 #include "piezoshift/io/atomic_file.hpp"
 #include "piezoshift/io/config_file.hpp"
+#include "piezoshift/runtime/controller_ranges.hpp"
 
 namespace piezoshift::calibration {
 
 namespace {
+
+using runtime::ListField;
+using runtime::model_section;
+using runtime::visit_controller_fields;
+using runtime::visit_fringe_lock_fields;
+using runtime::visit_improved_fields;
+using runtime::visit_model_fields;
+using runtime::visit_travel_fields;
 
 [[noreturn]] void fail(const io::ConfigFile& file, std::string_view section, std::string_view key,
                        const std::string& why) {
@@ -26,8 +34,8 @@ namespace {
   throw core::InputError(fmt::format("{}: [{}] {}: {}", file.source(), section, key, why));
 }
 
-// Reads each number of the field list (controller_ranges.hpp) that the file holds, within its
-// range; a required one must be there, a list sharing its count with another must match it.
+// Reads each number of the field list (runtime/controller_ranges.hpp) that the file holds, within
+// its range; a required one must be there, a list sharing its count with another must match it.
 class FieldReader {
  public:
   explicit FieldReader(const io::ConfigFile& file) : file_(file) {}
@@ -151,7 +159,7 @@ void read_controller_section(const io::ConfigFile& file, control::SemiClosedLoop
                           params.polynomial.p0};
   if (c.read("p", p))
     params.polynomial = control::CubicPolynomial{p[0], p[1], p[2], p[3]};
-  c.read("A", params.matrix.a);
+  c.read("A", params.matrix.a, runtime::kMatrixEntry);
   std::string kind = "paper";
   if (c.read("kind", kind)) {
     if (kind == "improved")
@@ -180,15 +188,25 @@ control::SemiClosedLoopParams load_calibration_file(
   if (fringe_lock != nullptr)
     *fringe_lock = lock;
   double z_max_um = 0.0, z_min_um = 0.0;
-  const bool has_max = file.section("travel").read("z_max_um", z_max_um, core::Bounds::positive());
-  const bool has_min =
-      file.section("travel").read("z_min_um", z_min_um, core::Bounds::non_negative());
+  const io::ConfigSection travel = file.section("travel");
+  const bool has_max = travel.has("z_max_um");
+  const bool has_min = travel.has("z_min_um");
+  visit_travel_fields(z_max_um, z_min_um, FieldReader(file));
   file.reject_unknown();
-  if (const std::string why = controller_problem(params, own_sample_time_s(params)); !why.empty())
-    throw core::InputError(fmt::format("{}: {}", path, why));
-  if (has_min && has_max && !(z_min_um < z_max_um))
-    throw core::InputError(fmt::format("{}: [travel] z_min_um = {} must be below z_max_um = {}",
-                                       path, z_min_um, z_max_um));
+  // The checks over a whole set name the key's line when the file has it.
+  const auto refuse = [&file](const runtime::FieldProblem& why) {
+    throw core::InputError(
+        fmt::format("{}: {}", file.section(why.section).location(why.key), why.why));
+  };
+  if (const runtime::FieldProblem why =
+          runtime::controller_field_problem(params, runtime::own_sample_time_s(params));
+      !why.empty())
+    refuse(why);
+  if (const runtime::FieldProblem why =
+          runtime::travel_problem(has_max ? std::optional<double>(z_max_um) : std::nullopt,
+                                  has_min ? std::optional<double>(z_min_um) : std::nullopt);
+      !why.empty())
+    refuse(why);
   if (travel_z_max_um != nullptr)
     *travel_z_max_um = has_max ? std::optional<double>(z_max_um) : std::nullopt;
   if (travel_z_min_um != nullptr)
@@ -199,6 +217,11 @@ control::SemiClosedLoopParams load_calibration_file(
 std::string format_calibration(const control::SemiClosedLoopParams& params,
                                const std::string& header, std::optional<double> travel_z_max_um,
                                std::optional<double> travel_z_min_um) {
+  // A travel the loader would refuse is not written (Python and calibrate on a stage beyond this
+  // one's stroke both end here, naming the key).
+  if (const runtime::FieldProblem why = runtime::travel_problem(travel_z_max_um, travel_z_min_um);
+      !why.empty())
+    throw core::InputError(fmt::format("the calibration to write: {}", why.why));
   std::string out;
   std::istringstream lines(header);
   for (std::string line; std::getline(lines, line);)

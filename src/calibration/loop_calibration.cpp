@@ -5,9 +5,9 @@
 #include "piezoshift/calibration/calibration_cost.hpp"
 #include "piezoshift/calibration/calibration_file.hpp"
 #include "piezoshift/calibration/calibration_procedure.hpp"
-#include "piezoshift/calibration/controller_ranges.hpp"
 #include "piezoshift/control/parameter_check.hpp"
 #include "piezoshift/core/input_error.hpp"
+#include "piezoshift/runtime/controller_ranges.hpp"
 
 namespace piezoshift::calibration {
 
@@ -24,7 +24,7 @@ void check_at_loop_rate(const control::SemiClosedLoopParams& params, double loop
         source, params.improved.sample_time_s, loop_sample_time_s, 1.0 / loop_sample_time_s));
   // Checked at its own rate when it was made; the gains are rescaled to the loop's, where they
   // must be stable too.
-  if (const std::string why = controller_problem(params, loop_sample_time_s); !why.empty())
+  if (const std::string why = runtime::controller_problem(params, loop_sample_time_s); !why.empty())
     throw core::InputError(
         fmt::format("{} at the loop's {} Hz: {}", source, 1.0 / loop_sample_time_s, why));
 }

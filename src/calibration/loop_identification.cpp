@@ -140,31 +140,31 @@ LoopIdentification identify_loop(const config::ProjectConfig& config,
 
 std::complex<double> loop_frequency_response(const ArxModel& plant, const control::PidParams& pid,
                                              double frequency_Hz) {
-  return pid_frequency_response(pid, frequency_Hz, plant.sample_time_s) *
+  return runtime::pid_frequency_response(pid, frequency_Hz, plant.sample_time_s) *
          plant.frequency_response(frequency_Hz);
 }
 
-std::array<StabilityMargins, 3> pid_margins(const LoopIdentification& plant,
-                                            const control::PidParams& pid) {
-  std::array<StabilityMargins, 3> out{};
+std::array<runtime::StabilityMargins, 3> pid_margins(const LoopIdentification& plant,
+                                                     const control::PidParams& pid) {
+  std::array<runtime::StabilityMargins, 3> out{};
   for (std::size_t i = 0; i < 3; ++i) {
     const ArxModel& m = plant.channel[i];
-    out[i] = stability_margins([&](double f) { return loop_frequency_response(m, pid, f); }, 0.01,
-                               0.5 / m.sample_time_s);
+    out[i] = runtime::stability_margins(
+        [&](double f) { return loop_frequency_response(m, pid, f); }, 0.01, 0.5 / m.sample_time_s);
   }
   return out;
 }
 
-std::array<StabilityMargins, 3> correction_margins(const LoopIdentification& plant,
-                                                   const control::ImprovedParams& improved,
-                                                   double ki) {
-  std::array<StabilityMargins, 3> out{};
+std::array<runtime::StabilityMargins, 3> correction_margins(const LoopIdentification& plant,
+                                                            const control::ImprovedParams& improved,
+                                                            double ki) {
+  std::array<runtime::StabilityMargins, 3> out{};
   for (std::size_t i = 0; i < 3; ++i) {
     control::PidParams c{};
     c.gains = {0.0, ki / improved.model[i].linear_weight, 0.0};
     const ArxModel& m = plant.channel[i];
-    out[i] = stability_margins([&](double f) { return loop_frequency_response(m, c, f); }, 0.01,
-                               0.5 / m.sample_time_s);
+    out[i] = runtime::stability_margins([&](double f) { return loop_frequency_response(m, c, f); },
+                                        0.01, 0.5 / m.sample_time_s);
   }
   return out;
 }

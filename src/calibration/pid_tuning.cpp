@@ -6,9 +6,9 @@
 #include <limits>
 #include <stdexcept>
 
-#include "piezoshift/calibration/controller_ranges.hpp"
 #include "piezoshift/experiments/metrics_step_response.hpp"
 #include "piezoshift/rig/bench.hpp"
+#include "piezoshift/runtime/controller_ranges.hpp"
 
 namespace piezoshift::calibration {
 namespace {
@@ -123,7 +123,7 @@ PidTrial score_pid_gains(const config::ProjectConfig& config,
   }
   trial.faulted = bench.faulted();
   trial.simulated_time_s = bench.time_s();
-  trial.nominal_gain_margin_dB = nominal_gain_margin_dB(params);
+  trial.nominal_gain_margin_dB = runtime::nominal_gain_margin_dB(params);
   trial.acceptable = trial.nominal_gain_margin_dB > 0.0 && !trial.faulted &&
                      w.overshoot_pct <= options.max_overshoot_pct &&
                      trial.plate_overshoot_pct <= options.max_overshoot_pct &&

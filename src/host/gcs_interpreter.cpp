@@ -999,9 +999,9 @@ std::string GcsInterpreter::parameters(Session& s, const Args& args) {
   return framed(lines);
 }
 
-// SPA {item} {id} {value} ...: every write checked first (nothing changes when one fails), then
-// one parameter set to the loop through its one parameter path (kConfigure), applied between two
-// ticks and bumplessly (ControlCycle::try_configure).
+// SPA {item} {id} {value} ...: every write checked first, then the set they make (nothing changes
+// when one fails), then one parameter set to the loop through its one parameter path
+// (kConfigure), applied between two ticks and bumplessly (ControlCycle::try_configure).
 std::string GcsInterpreter::set_parameters(Session& s, const Args& args) {
   if (args.empty() || args.size() % 3 != 0) {
     fail(s, GcsError::kParamCount);
@@ -1025,6 +1025,8 @@ std::string GcsInterpreter::set_parameters(Session& s, const Args& args) {
       return {};
     next.applied(written);
   }
+  if (!accepted(s, next.check(next.controller())))
+    return {};  // 17: the whole set, as a calibration file is checked
   if (!link_.params.try_push(next.controller())) {
     fail(s, GcsError::kCommunication);
     return {};

@@ -4,9 +4,9 @@
 
 #include <fmt/core.h>
 
-#include "piezoshift/control/parameter_check.hpp"
 #include "piezoshift/host/data_recorder.hpp"
 #include "piezoshift/host/wave_tables.hpp"
+#include "piezoshift/runtime/controller_ranges.hpp"
 
 namespace piezoshift::host {
 
@@ -86,9 +86,14 @@ GcsError ServoParameters::write(long long id, double value, int level,
   out = controller_;
   out.sample_time_s = servo_cycle_s_;
   (id == kPTerm ? out.gains.kp : out.gains.ki) = value;
-  if (control::params_problem(out, servo_cycle_s_) != control::ParamsProblem::kNone)
-    return GcsError::kParamOutOfRange;
   return GcsError::kNone;
+}
+
+GcsError ServoParameters::check(const control::SemiClosedLoopParams& p) const {
+  // The calibration file's check (runtime/controller_ranges.hpp), stability on the nominal inner
+  // loop included: gains the loader refuses are refused here too.
+  return runtime::controller_problem(p, servo_cycle_s_).empty() ? GcsError::kNone
+                                                                : GcsError::kParamOutOfRange;
 }
 
 }  // namespace piezoshift::host

@@ -182,6 +182,13 @@ bool ConfigSection::has(std::string_view key) const {
   return file_->find(name_, key) != nullptr;
 }
 
+std::string ConfigSection::location(std::string_view key) const {
+  const toml::node* n = file_->find(name_, key);
+  if (n == nullptr || n->source().begin.line == 0)
+    return file_->source;
+  return fmt::format("{}:{}:{}", file_->source, n->source().begin.line, n->source().begin.column);
+}
+
 bool ConfigSection::read(std::string_view key, double& value, core::Bounds bounds) const {
   const auto& impl = *file_;
   std::string path;

@@ -85,7 +85,10 @@ void set_stack(TwinModel& m, const design::DesignInputs& d, const TwinParams& p)
   m.hysteresis = built("twin.piezo", [&] {
     return PrandtlIshlinskii(p.piezo.hysteresis, p.amplifier.output_max_V);
   });
-  m.creep = built("twin.piezo", [&] { return CreepChain(p.piezo.creep, m.control_period_s); });
+  m.creep = built(
+      "twin.piezo (creep_shortest_time_constant_s, creep_longest_time_constant_s, "
+      "creep_terms_per_decade)",
+      [&] { return CreepChain(p.piezo.creep, m.control_period_s); });
   const double f_ref = reference_creep_factor(m, p);
   for (std::size_t i = 0; i < 3; ++i) {
     const double s = p.piezo.free_stroke_scale[i];
@@ -93,6 +96,11 @@ void set_stack(TwinModel& m, const design::DesignInputs& d, const TwinParams& p)
     m.stroke_gain_um[i] = m.free_stroke_um[i] / f_ref;
   }
 }
+
+// What the contact is identified from, named when it cannot be.
+constexpr const char* kContactKeys =
+    "twin.contact (open_loop_travel_um, open_loop_time_s, ball_radius_m, preload_N; with "
+    "twin.piezo.free_stroke_scale)";
 
 // The contact's stiffness from the open-loop travel: given, Hertz (its preload given or
 // identified), or linear identified. free_at_measurement: the stacks' mean free stroke when the
@@ -111,7 +119,7 @@ void set_contact(TwinModel& m, const TwinParams& p, double free_at_measurement) 
     if (p.contact.preload_N.has_value()) {
       m.contact_preload_N = *p.contact.preload_N;
     } else {
-      m.contact_preload_N = built("twin.contact", [&] {
+      m.contact_preload_N = built(kContactKeys, [&] {
         return identify_hertz_preload_N(travel, free_at_measurement, ka, km, r, e);
       });
       m.contact_preload_identified = true;
@@ -126,7 +134,7 @@ void set_contact(TwinModel& m, const TwinParams& p, double free_at_measurement) 
     // ball_radius_m = 0, or a design whose mechanism is so soft that no preload's Hertz contact
     // gives up enough stroke (a design study with another hinge): the linear contact
     // identified from the same travel.
-    m.contact_stiffness_N_per_um = built("twin.contact", [&] {
+    m.contact_stiffness_N_per_um = built(kContactKeys, [&] {
       return identify_contact_stiffness_N_per_um(travel, free_at_measurement, ka, km);
     });
     m.contact_identified = true;
@@ -172,7 +180,9 @@ void set_masses(TwinModel& m, const design::DesignInputs& d, const TwinParams& p
 
 // Geometry: the measurement points on the plate, the legs' effect on the plate's pose
 void set_geometry(TwinModel& m, const TwinParams& p) {
-  m.geometry = built("twin.geometry", [&] { return make_twin_geometry(p.geometry); });
+  m.geometry =
+      built("twin.geometry (actuator_radius_m, first_actuator_angle_deg, transmission_matrix)",
+            [&] { return make_twin_geometry(p.geometry); });
   for (std::size_t j = 0; j < 3; ++j) {
     const double r = std::hypot(m.geometry.points[j].x_m, m.geometry.points[j].y_m);
     require(r <= p.plate.radius_m,

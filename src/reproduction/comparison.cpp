@@ -80,7 +80,7 @@ std::function<FigureValue(const VariantRun&)> margin(std::size_t i, bool gain) {
       return not_applicable(r.not_applicable_10kHz);
     if (!a.validity.valid)
       return figure(0.0, a.validity);
-    const calibration::StabilityMargins w = a.worst();
+    const runtime::StabilityMargins w = a.worst();
     return figure(gain ? w.gain_margin_dB : w.phase_margin_deg, a.validity);
   };
 }

@@ -162,7 +162,7 @@ io::Figure inner_loop_figure(const ReproductionResult& r) {
       mag.series.push_back(std::move(m));
       ph.series.push_back(std::move(p));
     }
-    const calibration::StabilityMargins w = a.worst();
+    const runtime::StabilityMargins w = a.worst();
     if (std::isfinite(w.gain_margin_dB) && std::isfinite(w.phase_crossover_Hz)) {
       const std::vector<double> x{w.phase_crossover_Hz}, y{-w.gain_margin_dB};
       io::Series gm = io::point_series(fmt::format("{}: gain margin {:.1f} dB at {:.0f} Hz", khz,
@@ -621,7 +621,7 @@ void inner_loop_section(Document& doc, const ReproductionResult& r, bool any_loo
       "by least squares (ARX, 3 poles, 4 delayed inputs) from ±80 nm pseudo-random steps around "
       "5 µm, through the loop that ships, so its delays are the real ones; the 10 kHz row runs "
       "the twin's DAQ at 0.1 ms with the same gains re-expressed per sample. The margins are "
-      "those of the calibrated PID on that model (calibration/stability_margins.hpp).");
+      "those of the calibrated PID on that model (runtime/stability_margins.hpp).");
   if (any_loop)
     figure(doc, "Inner loop Bode plot", "inner_loop_bode.png", inner_loop_figure(r).caption);
 }

@@ -154,8 +154,8 @@ std::vector<InnerLoopAnalysis> analyze_inner_loop(const config::ProjectConfig& c
   return out;
 }
 
-calibration::StabilityMargins InnerLoopAnalysis::worst() const {
-  calibration::StabilityMargins w = margins[0];
+runtime::StabilityMargins InnerLoopAnalysis::worst() const {
+  runtime::StabilityMargins w = margins[0];
   for (const auto& m : margins) {
     w.gain_margin_dB = std::min(w.gain_margin_dB, m.gain_margin_dB);
     if (m.phase_margin_deg < w.phase_margin_deg) {

@@ -135,7 +135,7 @@ nlohmann::json summary_json(const ReproductionResult& r) {
       j[at + "reason"] = a.validity.reason;
       continue;
     }
-    const calibration::StabilityMargins w = a.worst();
+    const runtime::StabilityMargins w = a.worst();
     const double gm = w.gain_margin_dB, pm = w.phase_margin_deg, fc = w.gain_crossover_Hz;
     j[at + "gain_margin_dB"] = std::isfinite(gm) ? nlohmann::json(gm) : nlohmann::json();
     j[at + "phase_margin_deg"] = std::isfinite(pm) ? nlohmann::json(pm) : nlohmann::json();

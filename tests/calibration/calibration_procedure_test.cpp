@@ -164,7 +164,7 @@ TEST(CalibrationFile, WritesAtomicallyAndReadsBackTheSameDoubles) {
   control::SemiClosedLoopParams p;
   p.gains = control::PidGains{0.55, 0.1 / 3.0, 0.002};
   p.polynomial = control::CubicPolynomial{-1.0 / 7.0 * 1e-4, 3e-4, 1.0 + 1e-9, 0.123456789012345};
-  p.matrix.a[1][2] = 0.1 + 0.2;
+  p.matrix.a[1][2] = 0.1 + 0.2 + 0.4;  // 0.7000000000000001; row 1 sums to 0.899
   write_calibration_file(path, p, "a test\nsecond line");
   const control::SemiClosedLoopParams q = load_calibration_file(path);
   EXPECT_EQ(q.gains.ki, p.gains.ki);
@@ -190,12 +190,13 @@ TEST(CalibrationFile, WritesAtomicallyAndReadsBackTheSameDoubles) {
 TEST(CalibrationFile, NumbersAreWrittenShortestAndReadBackBitIdentical) {
   control::SemiClosedLoopParams p;
   p.gains = control::PidGains{0.6, 0.2, 1.0 / 3000.0};  // no short decimal; stable (kd 1/3 is not)
-  p.polynomial = control::CubicPolynomial{-1.009e-4, 1e-300, 16.0, 0.1 + 0.2};
-  p.matrix.a[2][0] = -2.2250738585072014e-308;  // the smallest normal (a subnormal is refused)
+  p.polynomial = control::CubicPolynomial{-1.009e-4, 1e-300, 1.5, 0.1 + 0.2};
+  // The smallest normal (a subnormal is refused), in place of -0.1491: row 1 still sums to 1.04.
+  p.matrix.a[1][1] = -2.2250738585072014e-308;
   const std::string text = format_calibration(p, "");
   EXPECT_NE(text.find("kp = 0.6  #"), std::string::npos) << text;
   EXPECT_NE(text.find("ki = 0.2\n"), std::string::npos) << text;
-  EXPECT_NE(text.find("p = [-0.0001009, 1e-300, 16, 0.30000000000000004]"), std::string::npos)
+  EXPECT_NE(text.find("p = [-0.0001009, 1e-300, 1.5, 0.30000000000000004]"), std::string::npos)
       << text;
   const auto dir = std::filesystem::temp_directory_path() / "piezoshift_calfile_shortest";
   std::filesystem::create_directories(dir);
@@ -209,7 +210,7 @@ TEST(CalibrationFile, NumbersAreWrittenShortestAndReadBackBitIdentical) {
   EXPECT_EQ(q.polynomial.p2, p.polynomial.p2);
   EXPECT_EQ(q.polynomial.p1, p.polynomial.p1);
   EXPECT_EQ(q.polynomial.p0, p.polynomial.p0);
-  EXPECT_EQ(q.matrix.a[2][0], p.matrix.a[2][0]);
+  EXPECT_EQ(q.matrix.a[1][1], p.matrix.a[1][1]);
 }
 
 // The procedure on a plant other than the default: a loose set screw (a linear 15 N/um contact

@@ -1,4 +1,4 @@
-// The controller's field list (calibration/controller_ranges.hpp): the calibration file's reader
+// The controller's field list (runtime/controller_ranges.hpp): the calibration file's reader
 // and writer walk it (every number read back bit for bit), and controller_problem() refuses what
 // would make the stage report nonsense or the loop unstable (issue 27), naming the field.
 #include <cmath>
@@ -12,15 +12,25 @@
 #include <gtest/gtest.h>
 
 #include "piezoshift/calibration/calibration_file.hpp"
-#include "piezoshift/calibration/controller_ranges.hpp"
 #include "piezoshift/core/bounds.hpp"
 #include "piezoshift/core/input_error.hpp"
+#include "piezoshift/runtime/controller_ranges.hpp"
 #include "temp_dir_test.hpp"
 
 namespace piezoshift::calibration {
 namespace {
 
 using control::SemiClosedLoopParams;
+using runtime::controller_problem;
+using runtime::kMaxMatrixCondition;
+using runtime::kNominalPlantGain;
+using runtime::ListField;
+using runtime::model_section;
+using runtime::nominal_gain_margin_dB;
+using runtime::own_sample_time_s;
+using runtime::visit_controller_fields;
+using runtime::visit_improved_fields;
+using runtime::visit_model_fields;
 
 // Every number the list visits, in order, as (section.key[i], value).
 struct Collect {
@@ -161,7 +171,12 @@ TEST(ControllerProblem, ACubicThatDoesNotRiseOverTheStrokeIsRefused) {
   EXPECT_NE(controller_problem(p, 1e-3).find("[controller] p"), std::string::npos);
   // Rising at 0 but falling before 16 um: p'(z) = 1 - 0.01 z^2 is negative past 10 um.
   p.polynomial = {-0.01 / 3.0, 0.0, 1.0, 0.0};
-  EXPECT_NE(controller_problem(p, 1e-3).find("must rise"), std::string::npos);
+  EXPECT_NE(controller_problem(p, 1e-3).find("slope over the 0 to 16 um stroke"),
+            std::string::npos);
+  // Within the band over the stroke but falling where the host reads the gauges through it
+  // (up to 32 um): p'(z) = 1.5 - 0.0015 z^2 is 1.116 at 16 um and -0.036 at 32 um.
+  p.polynomial = {-0.0005, 0.0, 1.5, 0.0};
+  EXPECT_NE(controller_problem(p, 1e-3).find("must rise over [-16, 32] um"), std::string::npos);
   p.polynomial = {0.0, 0.0, 1.0, std::numeric_limits<double>::quiet_NaN()};
   EXPECT_NE(controller_problem(p, 1e-3).find("not a finite number"), std::string::npos);
 }
@@ -174,8 +189,11 @@ TEST(ControllerProblem, AnAThatIsSubnormalSingularOrIllConditionedIsRefused) {
   EXPECT_NE(controller_problem(p, 1e-3).find("not a finite, normal number"), std::string::npos);
   p.matrix.a = {{{1, 0, 0}, {0, 1, 0}, {0, 0, 0.5 / kMaxMatrixCondition}}};  // cond = 200
   EXPECT_NE(controller_problem(p, 1e-3).find("condition number 200"), std::string::npos);
-  p.matrix.a = {{{1, 0, 0}, {0, 1, 0}, {0, 0, 2.0 / kMaxMatrixCondition}}};  // cond = 50
+  // Rows at unit piston gain (the bands below), the third nearly the mean of the others.
+  p.matrix.a = {{{1, 0, 0}, {0, 1, 0}, {0.485, 0.485, 0.03}}};  // cond = 49.0
   EXPECT_EQ(controller_problem(p, 1e-3), "");
+  p.matrix.a = {{{1, 0, 0}, {0, 1, 0}, {0.49575, 0.49575, 0.0085}}};  // cond = 175
+  EXPECT_NE(controller_problem(p, 1e-3).find("condition number 175"), std::string::npos);
 }
 
 // The nominal loop's gain margin against an independent evaluation (a Python script on a
@@ -214,6 +232,72 @@ TEST_F(ControllerFile, GainsOutsideTheStableRegionAreRefusedAtLoad) {
     EXPECT_NE(std::string(e.what()).find("unstable.toml"), std::string::npos) << e.what();
     EXPECT_NE(std::string(e.what()).find("kp = 5, ki = 3, kd = 2"), std::string::npos) << e.what();
   }
+}
+
+// Reproducers: a calibration that loaded drove the plate to full stroke for a 1 um step (p = [0, 0,
+// 1000, 0], A x 1000), moved it 2 nm (p or A x 1e-3) without a fault, or advertised a travel of
+// 1e308 (TMX?). Each is refused at load naming the file, the key's line and the key.
+TEST_F(ControllerFile, AFeedforwardGainOrATravelNoStageHasIsRefusedAtLoadNamingTheLine) {
+  const std::string gains = "[controller]\nkp = 0.6\nki = 0.2\nkd = 0.001\n";
+  const std::string paper_a =
+      "A = [[-0.4218, 0.6030, 0.6547], [0.3482, -0.1491, 0.6962], [0.6321, 0.4397, -0.2980]]\n";
+  const struct {
+    std::string text;
+    const char* where;  // the key's line and column in bad.toml
+    const char* piece;
+  } bad[] = {
+      {gains + "p = [0, 0, 1000, 0]\n", "bad.toml:5:5", "slope over the 0 to 16 um stroke"},
+      {gains + "p = [-1.009e-7, 3.89e-7, 1.014e-3, 2.914e-4]\n", "bad.toml:5:5", "runs from 0.000"},
+      {gains + "A = [[-421.8, 603.0, 654.7], [348.2, -149.1, 696.2], [632.1, 439.7, -298.0]]\n",
+       "bad.toml:5:", "controller.A[0][0]"},
+      {gains + "A = [[-4.218e-4, 6.030e-4, 6.547e-4], [3.482e-4, -1.491e-4, 6.962e-4], "
+               "[6.321e-4, 4.397e-4, -2.980e-4]]\n",
+       "bad.toml:5:5", "row 0 sums to 0.0008359"},
+      {gains + "[travel]\nz_max_um = 1e308\n", "bad.toml:6:", "z_max_um"},
+      {gains + "[travel]\nz_max_um = 16.5\n", "bad.toml:6:", "z_max_um"},
+      {gains + "[travel]\nz_max_um = 11.1\nz_min_um = 17\n", "bad.toml:7:", "z_min_um"},
+      {gains + "[travel]\nz_max_um = 11.1\nz_min_um = 11.1\n",
+       "bad.toml:7:", "must be below z_max_um"},
+  };
+  for (const auto& b : bad) {
+    const std::string file = write("bad.toml", b.text);
+    try {
+      load_calibration_file(file);
+      ADD_FAILURE() << b.text << " was accepted";
+    } catch (const core::InputError& e) {
+      EXPECT_NE(std::string(e.what()).find(b.where), std::string::npos) << e.what();
+      EXPECT_NE(std::string(e.what()).find(b.piece), std::string::npos) << e.what();
+    }
+  }
+  // The paper's A and p, and the default twin's travel, load.
+  std::optional<double> z_max, z_min;
+  load_calibration_file(write("good.toml", gains + paper_a +
+                                               "p = [-0.0001009, 0.000389, 1.014, 0.2914]\n"
+                                               "[travel]\nz_max_um = 11.1\nz_min_um = 0.05\n"),
+                        &z_max, &z_min);
+  EXPECT_EQ(z_max, 11.1);
+  EXPECT_EQ(z_min, 0.05);
+}
+
+// The bands' edges are accepted, beyond them refused (the derivation is in docs/calibration.md).
+TEST(ControllerProblem, TheFeedforwardsGainBandsHoldAtTheirEdges) {
+  SemiClosedLoopParams p;
+  p.polynomial = {0.0, 0.0, 0.5, 0.0};
+  EXPECT_EQ(controller_problem(p, 1e-3), "");
+  p.polynomial = {0.0, 0.0, 2.0, 0.0};
+  EXPECT_EQ(controller_problem(p, 1e-3), "");
+  p.polynomial = {0.0, 0.0, 2.01, 0.0};
+  EXPECT_NE(controller_problem(p, 1e-3).find("must be in [0.5, 2]"), std::string::npos);
+  p.polynomial = {};
+  p.matrix.a = {{{0.5, 0, 0}, {0, 0.5, 0}, {0, 0, 0.5}}};
+  EXPECT_EQ(controller_problem(p, 1e-3), "");
+  p.matrix.a = {{{1.5, 0, 0}, {0, 1.5, 0}, {0, 0, 1.5}}};
+  EXPECT_EQ(controller_problem(p, 1e-3), "");
+  p.matrix.a = {{{1.5, 0, 0}, {0, 1.6, 0}, {0, 0, 1.5}}};
+  EXPECT_NE(controller_problem(p, 1e-3).find("row 1 sums to 1.6"), std::string::npos);
+  p.matrix.a = {{{2.5, -1.5, 0}, {0, 1, 0}, {0, 0, 1}}};  // row sum 1, an entry beyond 2
+  EXPECT_NE(controller_problem(p, 1e-3).find("A[0][0] = 2.5: must be in [-2, 2]"),
+            std::string::npos);
 }
 
 // [controller] outer = "fringes" and [fringe_lock] (issue 29): read into the lock's parameters

@@ -62,7 +62,7 @@ TEST(ImprovedController, OnTheDefaultTwinItHoldsQuieterAndSettlesFaster) {
   const LoopIdentification loop = identify_loop(config, c.static_map.controller, 91);
   for (const double ki :
        {c.controller.improved.correction_ki, c.controller.improved.correction_ki_max}) {
-    for (const StabilityMargins& m : correction_margins(loop, c.controller.improved, ki)) {
+    for (const runtime::StabilityMargins& m : correction_margins(loop, c.controller.improved, ki)) {
       EXPECT_GE(m.gain_margin_dB, 6.0) << ki;
       EXPECT_GE(m.phase_margin_deg, 45.0) << ki;
     }

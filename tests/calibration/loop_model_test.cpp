@@ -8,12 +8,16 @@
 
 #include "piezoshift/calibration/fit_error.hpp"
 #include "piezoshift/calibration/loop_identification.hpp"
-#include "piezoshift/calibration/stability_margins.hpp"
 #include "piezoshift/plant/random.hpp"
 #include "piezoshift/rig/bench.hpp"
+#include "piezoshift/runtime/stability_margins.hpp"
 
 namespace piezoshift::calibration {
 namespace {
+
+using runtime::pid_frequency_response;
+using runtime::stability_margins;
+using runtime::StabilityMargins;
 
 constexpr double kPi = std::numbers::pi;
 

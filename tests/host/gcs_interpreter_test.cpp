@@ -22,6 +22,7 @@
 #include "piezoshift/control/semi_closed_loop.hpp"
 #include "piezoshift/host/gcs_interpreter.hpp"
 #include "piezoshift/plant/geometry.hpp"
+#include "piezoshift/runtime/controller_ranges.hpp"
 #include "piezoshift/runtime/safety_supervisor.hpp"
 
 #include "../support/test_paths.hpp"
@@ -1085,6 +1086,40 @@ TEST_F(GcsInterpreterTest, E727ServoParametersAndCommandLevels) {
   EXPECT_EQ(err(), 60);
   const std::string hpa = cmd("HPA?");
   EXPECT_NE(hpa.find("0x07000300=\t0\t1\tFLOAT\tServo\t"), std::string::npos) << hpa;
+}
+
+// Reproducer: SPA installed kp 5, ki 3, which the calibration loader refuses as unstable (-15.6 dB
+// of gain margin on the nominal inner loop with kd 2, -13.4 dB with the running kd);
+// the loop oscillated until the supervisor tripped. SPA now runs the loader's check on the set a
+// line makes: refused with 17, nothing sent, the gains unchanged.
+TEST_F(GcsInterpreterTest, SpaRefusesGainsTheCalibrationLoaderRefuses) {
+  const control::SemiClosedLoopParams running = model_.params().controller;
+  control::SemiClosedLoopParams unstable = running;
+  unstable.gains = {5.0, 3.0, 2.0};
+  unstable.sample_time_s = 1e-3;
+  EXPECT_NEAR(runtime::nominal_gain_margin_dB(unstable), -15.57, 0.01);
+  unstable.gains.kd = running.gains.kd;
+  EXPECT_NEAR(runtime::nominal_gain_margin_dB(unstable), -13.45, 0.01);
+  EXPECT_NE(runtime::controller_problem(unstable, 1e-3).find("unstable"), std::string::npos);
+  const std::string kp = fmt::format("{:.12g}", running.gains.kp);
+  const std::string ki = fmt::format("{:.12g}", running.gains.ki);
+  EXPECT_EQ(cmd("CCL 1 advanced"), "");
+  EXPECT_EQ(cmd("SPA Z 0x07000300 5 Z 0x07000301 3"), "");
+  EXPECT_EQ(err(), 17);
+  EXPECT_EQ(cmd("SPA Z 0x07000300 5"), "");  // kp 5 with the running ki: unstable too
+  EXPECT_EQ(err(), 17);
+  EXPECT_TRUE(commands().empty());
+  control::SemiClosedLoopParams sent{};
+  EXPECT_FALSE(link_.params.try_pop(sent));
+  EXPECT_EQ(cmd("SPA? Z 0x07000300 Z 0x07000301"),
+            "Z 0x07000300=" + kp + " \nZ 0x07000301=" + ki + "\n");
+  // The set is checked once a line's writes are made: ki 1.2 with the running kp 0.6 has
+  // -0.12 dB, with kp 0.3 in the same line +1.02 dB, accepted.
+  EXPECT_EQ(cmd("SPA Z 0x07000301 1.2"), "");
+  EXPECT_EQ(err(), 17);
+  EXPECT_EQ(cmd("SPA Z 0x07000301 1.2 Z 0x07000300 0.3"), "");
+  EXPECT_EQ(err(), 0);
+  EXPECT_EQ(only_command().kind, Kind::kConfigure);
 }
 
 }  // namespace

@@ -13,6 +13,7 @@
 #include "piezoshift/control/semi_closed_loop.hpp"
 #include "piezoshift/host/stage_model.hpp"
 #include "piezoshift/plant/geometry.hpp"
+#include "piezoshift/runtime/controller_ranges.hpp"
 
 namespace piezoshift::host {
 namespace {
@@ -288,6 +289,42 @@ TEST(StageModelTest, ConstructorRefusesBadParameters) {
   StageModelParams no_gain = twin_params();
   no_gain.amplifier_gain = 0.0;
   EXPECT_THROW(StageModel{no_gain}, std::invalid_argument);
+}
+
+// Reproducer: with z_max_um = 1e308 POS? answered -nan. For every calibration the loader accepts
+// (runtime/controller_ranges.hpp's bands, here at their corners) the gauges' whole +-10 V give a
+// finite pose.
+TEST(StageModelTest, PoseIsFiniteAtTheBandsCorners) {
+  const control::SemiClosedLoopParams paper;
+  const control::Mat3 matrices[] = {
+      paper.matrix.a,
+      {{{0.5, 0, 0}, {0, 0.5, 0}, {0, 0, 0.5}}},
+      {{{1.5, 0, 0}, {0, 1.5, 0}, {0, 0, 1.5}}},
+  };
+  const control::CubicPolynomial cubics[] = {
+      paper.polynomial,
+      {0.0, 0.0, 0.5, 0.0},
+      {0.0, 0.0, 2.0, 0.0},
+      {-0.00048, 0.0, 1.5, 0.0},  // slope 1.13 at 16 um, 0.025 at 32 um
+  };
+  for (const control::Mat3& a : matrices)
+    for (const control::CubicPolynomial& p : cubics)
+      for (double z_max : {0.5, 11.1, runtime::kStrokeUm}) {
+        StageModelParams params = twin_params();
+        params.controller.matrix.a = a;
+        params.controller.polynomial = p;
+        params.z_max_um = z_max;
+        ASSERT_EQ(runtime::controller_problem(params.controller, 1e-3), "");
+        ASSERT_TRUE(runtime::travel_problem(z_max, std::nullopt).empty());
+        const StageModel model(params);
+        for (int corner = 0; corner < 27; ++corner) {
+          const Vec3 v{-10.0 + 10.0 * (corner % 3), -10.0 + 10.0 * (corner / 3 % 3),
+                       -10.0 + 10.0 * (corner / 9)};
+          for (double x : model.pose_from_sgs(v))
+            EXPECT_TRUE(std::isfinite(x)) << "p1 " << p.p1 << ", A[0][0] " << a[0][0] << ", z_max "
+                                          << z_max << ", corner " << corner;
+        }
+      }
 }
 
 }  // namespace

@@ -110,6 +110,23 @@ TEST(TwinConfig, ValuesBeyondTheTwinsBoundsAreRefusedWithFileLineAndKey) {
       << m;
 }
 
+// Reproducers: settings that loaded and failed later without naming the key are refused at load
+// with the file, line and key (tests/plant/twin_ranges_edges_test.cpp tries every key's ends).
+TEST(TwinConfig, ValuesThatFailedLaterAreRefusedAtLoadWithTheirKey) {
+  std::string m = error_for("j.toml", "[twin.amplifier]\ngain = 5e-324\n");
+  EXPECT_NE(m.find("j.toml:2:8: twin.amplifier.gain: value 5e-324 is not allowed: must be in "
+                   "[1, 1000]"),
+            std::string::npos)
+      << m;
+  m = error_for("k.toml", "[twin.daq]\nresolution_bits = 2\n");
+  EXPECT_NE(m.find("k.toml:2:19: twin.daq.resolution_bits: value 2 is not allowed: must be in "
+                   "[12, 32]"),
+            std::string::npos)
+      << m;
+  m = error_for("l.toml", "[twin.interferometer]\nresolution_nm = 1e-320\n");
+  EXPECT_NE(m.find("l.toml:2:17: twin.interferometer.resolution_nm"), std::string::npos) << m;
+}
+
 // The ranges are one list: the paper's values are inside it, and a struct built in code (as the
 // Python bindings do) is checked against the same list, naming the TOML key.
 TEST(TwinConfig, TheRangesListCoversTheDefaultsAndChecksStructsBuiltInCode) {

@@ -71,14 +71,14 @@ ki = 0.25
 kd = 0.0
 gains_sample_time_s = 2e-3
 p = [0.0, 0.0, 1.0, 0.1]
-A = [[1, 0, 0], [0, 2, 0], [0, 0, 3]]
+A = [[1, 0, 0], [0, 1.25, 0], [0, 0, 1.5]]
 )"));
   EXPECT_EQ(p.gains.kp, 0.5);
   EXPECT_EQ(p.gains.ki, 0.25);
   EXPECT_EQ(p.gains_sample_time_s, 2e-3);
   EXPECT_EQ(p.polynomial.p1, 1.0);
   EXPECT_EQ(p.polynomial.p0, 0.1);
-  EXPECT_EQ(p.matrix.a[1][1], 2.0);
+  EXPECT_EQ(p.matrix.a[1][1], 1.25);
 }
 
 TEST_F(ControllerConfigTest, AbsentKeysKeepThePapersValues) {

@@ -22,8 +22,8 @@
 //   [controller] outer = "fringes"   # optional ("none" by default): `measure` runs the fringe
 //                                    # lock around the loop (docs/fizeau.md), as with --lock
 //   [fringe_lock]              # optional with outer = "fringes": control/fringe_lock.hpp's
-//   gain_per_frame = 0.5       # parameters (controller_ranges.hpp lists them); absent keys keep
-//                              # its defaults
+//   gain_per_frame = 0.5       # parameters (runtime/controller_ranges.hpp lists them);
+//                              # absent keys keep its defaults
 //
 // Every key is optional (absent: the paper's value, Section 4); an unknown key or section, a
 // wrong type or a bad value throws core::InputError naming file, key and reason. The run's own

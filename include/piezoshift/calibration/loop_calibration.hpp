@@ -26,7 +26,7 @@ void refuse_fringe_lock(const LoopCalibration& c, const std::string& command);
 
 //! core::InputError naming source when params cannot run at the loop's rate: an improved
 //! controller designed at another rate (its shaper and correction hold at one rate only), or
-//! gains that are not stable once rescaled to it (controller_ranges.hpp).
+//! gains that are not stable once rescaled to it (runtime/controller_ranges.hpp).
 void check_at_loop_rate(const control::SemiClosedLoopParams& params, double loop_sample_time_s,
                         const std::string& source);
 

@@ -18,9 +18,9 @@
 #include <span>
 #include <vector>
 
-#include "piezoshift/calibration/stability_margins.hpp"
 #include "piezoshift/config/project_config.hpp"
 #include "piezoshift/control/semi_closed_loop.hpp"
+#include "piezoshift/runtime/stability_margins.hpp"
 
 namespace piezoshift::calibration {
 
@@ -71,8 +71,8 @@ std::complex<double> loop_frequency_response(const ArxModel& plant, const contro
 
 //! The margins of each channel's loop: the PID (per-sample gains at the models' sample time)
 //! times its identified plant, from 0.01 Hz to Nyquist.
-std::array<StabilityMargins, 3> pid_margins(const LoopIdentification& plant,
-                                            const control::PidParams& pid);
+std::array<runtime::StabilityMargins, 3> pid_margins(const LoopIdentification& plant,
+                                                     const control::PidParams& pid);
 
 //! The improved controller's correction loop (control/semi_closed_loop.hpp) on the identified
 //! plant: c integrates the error with ki per sample and reaches the command through the model's
@@ -80,8 +80,8 @@ std::array<StabilityMargins, 3> pid_margins(const LoopIdentification& plant,
 //! largest loop gain), so L = ki / (1 - z^-1) P / w0 per channel. Evaluated at ki the hold's gain
 //! and at ki_max the boost's ceiling; the plant's models must be at the improved controller's
 //! sample time.
-std::array<StabilityMargins, 3> correction_margins(const LoopIdentification& plant,
-                                                   const control::ImprovedParams& improved,
-                                                   double ki);
+std::array<runtime::StabilityMargins, 3> correction_margins(const LoopIdentification& plant,
+                                                            const control::ImprovedParams& improved,
+                                                            double ki);
 
 }  // namespace piezoshift::calibration

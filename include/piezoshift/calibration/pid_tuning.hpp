@@ -12,14 +12,14 @@
 //     on the plate, between ticks (the twin's physics-rate truth, mean of P1..P3):
 //       plate_overshoot_pct   100 max(0, max z - z_inf) / |z_inf - z_0|
 // A candidate is acceptable when its gains are stable on the nominal inner loop (the check every
-// calibration file passes at load, controller_ranges.hpp), the supervisor did not trip, every
-// actuator's and the plate's
-// overshoot is <= max_overshoot_pct ("little or even no overshoot"), it settled within the
-// record and the steady-state error is <= max_steady_state_error_nm. (An actuator stepped alone
-// scores a different loop: the plate couples the legs, and the overshoot the single-leg score
-// passed showed on the full step, 3 to 9 %, and between the ticks.) Among acceptable candidates the
-// one with the shortest worst settling time wins, ties going to the smaller error; if none is
-// acceptable, the smallest worst-case overshoot wins and `acceptable` says so.
+// calibration file passes at load, runtime/controller_ranges.hpp), the supervisor did not trip,
+// every actuator's and the plate's overshoot is <= max_overshoot_pct ("little or even no
+// overshoot"), it settled within the record and the steady-state error is <=
+// max_steady_state_error_nm. (An actuator stepped alone scores a different loop: the plate couples
+// the legs, and the overshoot the single-leg score passed showed on the full step, 3 to 9 %, and
+// between the ticks.) Among acceptable candidates the one with the shortest worst settling time
+// wins, ties going to the smaller error; if none is acceptable, the smallest worst-case overshoot
+// wins and `acceptable` says so.
 //
 // S_max,i is what actuator i's SGS reads at the full 10 V open loop (measured first, on the
 // same twin), times step_fraction (< 1, so that the step scores the loop and not the amplifier's
@@ -46,8 +46,8 @@ struct PidTrial {
   PidScore worst{};                  //!< element-wise worst over the three actuators
   double plate_overshoot_pct = 0.0;  //!< the plate between ticks (physics-rate truth)
   bool faulted = false;              //!< the supervisor tripped during the step
-  //! On the nominal inner loop (controller_ranges.hpp): <= 0 dB is a set a calibration file may
-  //! not hold, so it is never acceptable.
+  //! On the nominal inner loop (runtime/controller_ranges.hpp): <= 0 dB is a set a calibration file
+  //! may not hold, so it is never acceptable.
   double nominal_gain_margin_dB = 0.0;
   bool acceptable = false;
   double simulated_time_s = 0.0;

@@ -42,9 +42,12 @@ class ServoParameters {
   //! The value as SPA? answers it; empty when the id is not a parameter here.
   std::string value(long long id) const;
   //! Checks `SPA {item} id value` at command level `level`; kNone and `out` = the running set
-  //! with the value written, or 54 (unknown), 64 (read-only), 60 (level too low), 17 (a value
-  //! the loop would refuse: not finite, negative, or failing control::params_problem).
+  //! with the value written, or 54 (unknown), 64 (read-only), 60 (level too low), 17 (not
+  //! finite or negative). The set a line's writes make is then checked whole, by check().
   GcsError write(long long id, double value, int level, control::SemiClosedLoopParams& out) const;
+  //! kNone, or 17 for a set a calibration file could not hold (runtime::controller_problem at
+  //! the servo cycle: e.g. gains unstable on the nominal inner loop, kp 5 and ki 3).
+  GcsError check(const control::SemiClosedLoopParams& p) const;
   //! The set the loop now runs (after its kConfigure was applied).
   void applied(const control::SemiClosedLoopParams& p) noexcept { controller_ = p; }
   const control::SemiClosedLoopParams& controller() const noexcept { return controller_; }

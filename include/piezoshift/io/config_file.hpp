@@ -45,6 +45,9 @@ class ConfigSection {
             core::Bounds bounds = core::Bounds::any()) const;
 
   bool has(std::string_view key) const;
+  //! "FILE:LINE:COLUMN" of the key's value, for a message about a value checked after reading
+  //! (with others); the file's name alone when the key is absent.
+  std::string location(std::string_view key) const;
   const std::string& name() const { return name_; }
 
  private:

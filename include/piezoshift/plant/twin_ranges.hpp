@@ -12,6 +12,7 @@
 #include <string>
 
 #include "piezoshift/core/bounds.hpp"
+#include "piezoshift/plant/sgs.hpp"
 #include "piezoshift/plant/twin_params.hpp"
 
 namespace piezoshift::plant {
@@ -31,18 +32,27 @@ void visit_twin_values(Twin& t, Visit&& visit) {
   visit("twin", "physics_rate_Hz", t.physics_rate_Hz, B::closed(1.0, 1e7));
   // 10 us (100 kHz) to 1 s: the PCI-6229's fastest loop to the slowest useful one.
   visit("twin.daq", "sample_time_s", t.daq.sample_time_s, B::closed(1e-5, 1.0));
-  visit("twin.daq", "range_V", t.daq.range_V, B::above(0.0, 1000.0));
-  visit("twin.daq", "resolution_bits", t.daq.resolution_bits, B::closed(2, 32));
+  // +-0.1 to +-10 V: the ranges of NI's M Series (the PCI-6229's +-10 V the largest); a denormal
+  // range made every code 0 V and the stage never moved.
+  visit("twin.daq", "range_V", t.daq.range_V, B::closed(0.1, 10.0));
+  // 12 bits (the coarsest multifunction DAQs, NI's USB-6008) to 32: 2 bits gave 5 V steps (an
+  // AO step of 8 um at the plate) and the procedures failed without naming the key.
+  visit("twin.daq", "resolution_bits", t.daq.resolution_bits, B::closed(12, 32));
   visit("twin.daq", "ai_noise_V_rms", t.daq.ai_noise_V_rms, B::closed(0.0, 10.0));
 
-  visit("twin.amplifier", "gain", t.amplifier.gain, B::above(0.0, 1000.0));
+  // 1 (a follower) to 1000 V/V (high-voltage amplifiers' largest): 5e-324 left the stacks at 0 V.
+  visit("twin.amplifier", "gain", t.amplifier.gain, B::closed(1.0, 1000.0));
   visit("twin.amplifier", "output_min_V", t.amplifier.output_min_V, B::closed(-1000.0, 1000.0));
   // At least 1 V: the hysteresis model works on the input over this span (a denormal span made
   // it infinite).
   visit("twin.amplifier", "output_max_V", t.amplifier.output_max_V, B::closed(1.0, 1000.0));
-  visit("twin.amplifier", "average_power_W", t.amplifier.average_power_W, B::above(0.0, 1e4));
+  // At least 0.1 W: a 0-150 V step into Table 1's 1.8 uF in 0.4 s (S = P / V_max / C); a
+  // denormal power never charged the stacks.
+  visit("twin.amplifier", "average_power_W", t.amplifier.average_power_W, B::closed(0.1, 1e4));
+  // At least 1 Hz, the slowest loop's rate (daq.sample_time_s <= 1 s): below, no command is
+  // followed within a run.
   visit("twin.amplifier", "small_signal_bandwidth_Hz", t.amplifier.small_signal_bandwidth_Hz,
-        B::above(0.0, 1e7));
+        B::closed(1.0, 1e7));
 
   visit("twin.piezo", "hysteresis_fraction", t.piezo.hysteresis.hysteresis_fraction,
         B{0.0, 0.5, false, true});
@@ -55,7 +65,9 @@ void visit_twin_values(Twin& t, Visit&& visit) {
         B::closed(1e-6, 1e9));
   visit("twin.piezo", "creep_terms_per_decade", t.piezo.creep.terms_per_decade, B::closed(1, 10));
   visit("twin.piezo", "creep_reference_time_s", t.piezo.creep_reference_time_s, B::above(0.0, 1e9));
-  visit("twin.piezo", "free_stroke_scale", t.piezo.free_stroke_scale, B::above(0.0, 10.0));
+  // 0.5 to 1.5 of nominal: stacks' stroke tolerance is +-10 to 15 % (PI) and the tolerance
+  // studies draw +-9 %; a denormal scale failed as a contact that could not be identified.
+  visit("twin.piezo", "free_stroke_scale", t.piezo.free_stroke_scale, B::closed(0.5, 1.5));
 
   visit("twin.contact", "open_loop_travel_um", t.contact.open_loop_travel_um, B::above(0.0, 1e4));
   visit("twin.contact", "open_loop_time_s", t.contact.open_loop_time_s, B::above(0.0, 1e9));
@@ -87,15 +99,22 @@ void visit_twin_values(Twin& t, Visit&& visit) {
   visit("twin.sgs", "offset_V", t.sgs.offset_V, B::closed(-100.0, 100.0));
   visit("twin.sgs", "zero_drift_nm_per_K", t.sgs.zero_drift_nm_per_K, B::closed(-1e6, 1e6));
   visit("twin.sgs", "gauge_creep_fraction", t.sgs.gauge_creep_fraction, B::closed(0.0, 0.1));
-  visit("twin.sgs", "gauge_creep_time_s", t.sgs.gauge_creep_time_s, B::above(0.0, 1e9));
+  // At least 1 ms (one control period at 1 kHz): the creep a step shows sooner is ~0, and
+  // dividing by it failed as a negative per-decade fraction.
+  visit("twin.sgs", "gauge_creep_time_s", t.sgs.gauge_creep_time_s, B::closed(1e-3, 1e9));
   visit("twin.sgs", "flicker_corner_Hz", t.sgs.flicker_corner_Hz, B::closed(0.0, 1e6));
   visit("twin.sgs", "excitation_drift_ppm_rms", t.sgs.excitation_drift_ppm_rms,
         B::closed(0.0, 1e6));
+  // At least the excitation flicker's shortest time (sgs.hpp): over a shorter window it has no
+  // variance to state, and the level came out infinite.
   visit("twin.sgs", "excitation_drift_window_s", t.sgs.excitation_drift_window_s,
-        B::above(0.0, 1e9));
+        B::closed(kSgsExcitationShortestS, 1e9));
 
   visit("twin.interferometer", "wavelength_nm", t.interferometer.wavelength_nm, B::above(0.0, 1e5));
-  visit("twin.interferometer", "resolution_nm", t.interferometer.resolution_nm, B::above(0.0, 1e6));
+  // At least 1 pm, the finest of displacement interferometers (the XL-80's: 1 nm); a denormal
+  // resolution made every reading infinite.
+  visit("twin.interferometer", "resolution_nm", t.interferometer.resolution_nm,
+        B::closed(1e-3, 1e6));
   visit("twin.interferometer", "accuracy_ppm", t.interferometer.accuracy_ppm, B::closed(0.0, 1e6));
   visit("twin.interferometer", "noise_nm_rms", t.interferometer.noise_nm_rms, B::closed(0.0, 1e6));
   visit("twin.interferometer", "cyclic_error_nm", t.interferometer.cyclic_error_nm,

@@ -38,6 +38,7 @@
 #include "piezoshift/experiments/paper_experiments.hpp"
 #include "piezoshift/experiments/phase_step.hpp"
 #include "piezoshift/reproduction/phase_measurement.hpp"
+#include "piezoshift/runtime/stability_margins.hpp"
 
 namespace piezoshift::reproduction {
 
@@ -94,14 +95,14 @@ struct InnerLoopAnalysis {
   //! boost's ceiling, calibration::correction_margins).
   control::PidParams pid;
   calibration::LoopIdentification plant;
-  std::array<calibration::StabilityMargins, 3> margins{};
+  std::array<runtime::StabilityMargins, 3> margins{};
   //! Not valid when the twin cannot run at this rate (its physics rate is not a whole multiple)
   //! or the identification tripped the supervisor; plant and margins are then empty.
   rig::Validity validity;
 
   //! The worst of the three channels: the smallest gain margin, the smallest phase margin and
   //! its gain crossover.
-  calibration::StabilityMargins worst() const;
+  runtime::StabilityMargins worst() const;
 };
 
 //! The schedule with every experiment's feedback set to f (the oracle: Feedback::kOracle).

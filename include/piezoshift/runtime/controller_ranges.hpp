@@ -1,8 +1,13 @@
 #pragma once
 // Every number of the controller's parameters a calibration file holds, with its range, in one
-// list (as runtime/safety_ranges.hpp is for [safety]): the file's reader and writer
-// (calibration_file.hpp) walk it, and controller_problem() below, which every command that loads
-// a calibration and the Python bindings use, checks it. The list is the file's order:
+// list (as safety_ranges.hpp is for [safety]), and controller_problem(): the one check a
+// controller passes before any loop runs it, whatever the door. The calibration file's reader and
+// writer (calibration/calibration_file.hpp) walk the list; the file's loader, `SPA` over GCS
+// (host/servo_parameters.hpp), the Python bindings (a controller handed to a bench, an
+// experiment or a measurement) and every command that loads a calibration call
+// controller_problem(). It lives in runtime, below both calibration and host, so that the GCS
+// server runs the same check as the loader without including a module above it. The list is the
+// file's order:
 //
 //   [controller]           kp, ki, kd (per sample, Eq. 7), gains_sample_time_s;
 //                          then p, A and kind, which are checked as a whole below
@@ -14,40 +19,63 @@
 //   [fringe_lock]          with [controller] outer = "fringes": gain_per_frame, max_step_* and
 //                          max_correction_* (piston_nm, theta_x_urad, theta_y_urad),
 //                          max_lost_frames; checked as a whole by control::fringe_lock_problem
+//   [travel]               z_max_um, z_min_um: within the stroke (visit_travel_fields)
 //
 // Beyond each number's range, controller_problem() refuses what would make the stage report
-// nonsense or the loop unstable (issue 27's findings):
-//   p          a coefficient that is not finite, or a cubic that does not rise over the stroke
-//              (p'(z) > 0 on [0, 16] um: an all-zero p maps every Z_d to p0)
-//   A          an entry that is not finite or is subnormal (POS? answered -nan), or an A whose
-//              2-norm condition number exceeds kMaxMatrixCondition (an all-zero or singular A
-//              cannot be inverted for the positions the gauges show)
+// nonsense, move where it was not asked or the loop unstable:
+//   p          a coefficient that is not finite; a slope p'(z) outside kPolynomialSlope over the
+//              stroke [0, kStrokeUm] (the twin identifies 1.016, the paper 1.014: p = [0, 0,
+//              1000, 0] sent the plate to full stroke for 1 um, p / 1000 moved it 2 nm); or a
+//              cubic that does not rise over [-kStrokeUm, 2 kStrokeUm], where the host inverts
+//              it for the gauges' positions (host/stage_model.hpp)
+//   A          an entry that is not finite, is subnormal (POS? answered -nan) or is outside
+//              kMatrixEntry; a row whose sum (the actuator's gauge um per um of plate piston)
+//              is outside kMatrixRowSum (the paper's rows: 0.77 to 0.90); or an A whose 2-norm
+//              condition number exceeds kMaxMatrixCondition (an all-zero or singular A cannot be
+//              inverted for the positions the gauges show)
 //   gains      PIDs that are unstable on the nominal inner loop: the plant a gain G (gauge um
 //              per um of command) behind the DAQ contract's two ticks of delay, P(z) = G z^-2,
 //              with G = kNominalPlantGain; the loop C(z) P(z) must keep a gain margin > 0 dB.
 //              The twin's identified small-signal gain is 0.60 to 0.67 (docs/calibration.md),
 //              and its amplifier and conditioner attenuate it further at the phase crossover, so
 //              a flat 0.7 refuses gains that cannot be stable on this stage, not all that are not:
-//              the identified loop's margins (loop_identification.hpp) say how far a set is from
-//              the edge.
+//              the identified loop's margins (calibration/loop_identification.hpp) say how far a
+//              set is from the edge.
 //   loop       what the loop itself refuses at its own sample time (control/parameter_check.hpp)
+//
+// The feedforward's overall piston gain, d S_i / d Z_d = (A 1)_i p'(Z_d), is what moves the
+// stage; bounding its two factors bounds it to [0.25, 3] (the paper's: 0.76 to 0.91 over the
+// travel). docs/calibration.md derives each band.
 #include <cstddef>
+#include <optional>
 #include <string>
 #include <string_view>
 
 #include "piezoshift/control/fringe_lock.hpp"
 #include "piezoshift/control/semi_closed_loop.hpp"
 #include "piezoshift/core/bounds.hpp"
-#include "piezoshift/io/config_file.hpp"
+#include "piezoshift/design/actuator_params.hpp"
 
-namespace piezoshift::calibration {
+namespace piezoshift::runtime {
 
-//! Largest 2-norm condition number of A a calibration may hold. The paper's A (Eq. 8) has 1.03;
+//! Largest 2-norm condition number of A a calibration may hold. The paper's A (Eq. 8) has 1.51;
 //! a tripod whose A reaches 100 turns 1 nm of gauge noise into up to 100 nm of computed position.
 inline constexpr double kMaxMatrixCondition = 100.0;
 
 //! The nominal inner loop's plant gain (header comment): the identified 0.60 to 0.67, rounded up.
 inline constexpr double kNominalPlantGain = 0.7;
+
+//! The stage's stroke [um]: the stacks' free stroke at 150 V (Section 2.1, the design's
+//! nominal_stroke_um). No plate travel exceeds it: the flexure takes it to 14.6 um (Eq. 1), and
+//! a stack at the +10 % of its stroke tolerance to 16.1 um.
+inline constexpr double kStrokeUm = design::ActuatorParams{}.nominal_stroke_um;
+
+//! p'(z) over [0, kStrokeUm]: command um per um of displacement (docs/calibration.md).
+inline constexpr core::Bounds kPolynomialSlope = core::Bounds::closed(0.5, 2.0);
+//! Each row sum of A: gauge um per um of plate piston (docs/calibration.md).
+inline constexpr core::Bounds kMatrixRowSum = core::Bounds::closed(0.5, 1.5);
+//! Each entry of A (the paper's largest is 0.70; docs/calibration.md).
+inline constexpr core::Bounds kMatrixEntry = core::Bounds::closed(-2.0, 2.0);
 
 //! A list of numbers held in a fixed array and a count (the controller holds no heap).
 template <class Value, class Count>
@@ -133,14 +161,39 @@ void visit_fringe_lock_fields(Lock& p, Visit&& visit) {
   visit("fringe_lock", "max_lost_frames", p.max_lost_frames, B::closed(1.0, 100000.0), "");
 }
 
+//! [travel]'s numbers, as visit_controller_fields: the travel one move from rest reaches and the
+//! lowest Z one move down reaches, both within the stroke (and z_min_um < z_max_um, checked
+//! whole by travel_problem).
+template <class Value, class Visit>
+void visit_travel_fields(Value& z_max_um, Value& z_min_um, Visit&& visit) {
+  using B = core::Bounds;
+  visit("travel", "z_max_um", z_max_um, B::above(0.0, kStrokeUm), "");
+  visit("travel", "z_min_um", z_min_um, B::closed(0.0, kStrokeUm), "");
+}
+
 //! The section of channel i (0-based): "improved.channel1" ...
 std::string model_section(std::size_t channel);
 
+//! A refusal: the section and key it is about (key empty for a rule over the whole section) and
+//! a sentence naming them ("[controller] A: ...").
+struct FieldProblem {
+  std::string section;
+  std::string key;
+  std::string why;
+  bool empty() const noexcept { return why.empty(); }
+};
+
 //! The first problem of params as a calibration for a loop at loop_sample_time_s (see the header
-//! comment), naming the field; "" when there is none. params.sample_time_s is not read: the
-//! loop sets it.
+//! comment); empty when there is none. params.sample_time_s is not read: the loop sets it.
+FieldProblem controller_field_problem(const control::SemiClosedLoopParams& params,
+                                      double loop_sample_time_s);
+//! controller_field_problem(...).why: "" when there is none.
 std::string controller_problem(const control::SemiClosedLoopParams& params,
                                double loop_sample_time_s);
+
+//! The first problem of a travel ([travel]: each within its range, z_min_um < z_max_um when both
+//! are given); empty when there is none.
+FieldProblem travel_problem(std::optional<double> z_max_um, std::optional<double> z_min_um);
 
 //! The sample time a calibration is made for when no loop is named: the improved controller's
 //! design rate, else the rate the gains were tuned at.
@@ -150,4 +203,4 @@ double own_sample_time_s(const control::SemiClosedLoopParams& params);
 //! comment): > 0 when stable there; +infinity when the phase never reaches -180 deg.
 double nominal_gain_margin_dB(const control::SemiClosedLoopParams& params);
 
-}  // namespace piezoshift::calibration
+}  // namespace piezoshift::runtime

@@ -1,4 +1,4 @@
-#include "piezoshift/calibration/stability_margins.hpp"
+#include "piezoshift/runtime/stability_margins.hpp"
 
 #include <cmath>
 #include <limits>
@@ -6,7 +6,7 @@
 #include <stdexcept>
 #include <vector>
 
-namespace piezoshift::calibration {
+namespace piezoshift::runtime {
 
 std::complex<double> pid_frequency_response(const control::PidParams& pid, double frequency_Hz,
                                             double sample_time_s) {
@@ -105,4 +105,4 @@ StabilityMargins stability_margins(const std::function<std::complex<double>(doub
   return m;
 }
 
-}  // namespace piezoshift::calibration
+}  // namespace piezoshift::runtime

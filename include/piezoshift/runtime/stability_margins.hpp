@@ -18,7 +18,7 @@
 
 #include "piezoshift/control/incremental_pid.hpp"
 
-namespace piezoshift::calibration {
+namespace piezoshift::runtime {
 
 struct StabilityMargins {
   double gain_margin_dB = 0.0;      //!< +inf when the phase never reaches -180 deg
@@ -36,4 +36,4 @@ std::complex<double> pid_frequency_response(const control::PidParams& pid, doubl
 StabilityMargins stability_margins(const std::function<std::complex<double>(double)>& loop,
                                    double f_min_Hz, double f_max_Hz);
 
-}  // namespace piezoshift::calibration
+}  // namespace piezoshift::runtime
