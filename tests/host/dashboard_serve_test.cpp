@@ -432,7 +432,8 @@ TEST_F(DashboardCamera, AMeasurementFromTheDashboardRecoversTheTwinsSurface) {
 
 // A measurement that throws fails alone: that path is held by ServeMemory (a measurement that
 // runs out of memory, release only). The input that used to reach it here, a surface of
-// Z4 = 1e308 nm, is now refused before serve starts (BadInput.ServesTwinSurfaceAndMaskAreChecked...).
+// Z4 = 1e308 nm, is now refused before serve starts
+// (BadInput.ServesTwinSurfaceAndMaskAreCheckedBeforeItStarts).
 
 // Another client's move while a measurement runs fails it with that reason, and no surface.
 TEST_F(DashboardCamera, AnotherClientsMoveFailsTheMeasurementWithItsReason) {
