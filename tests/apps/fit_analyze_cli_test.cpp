@@ -161,6 +161,7 @@ TEST_F(FitAnalyzeCli, AnalyzeStepFirstOrderAndItsFigure) {
     csv += fmt::format("{:.4f},{:.12f}\n", k * 1e-4, 11.0 * (1 - std::exp(-k * 1e-4 / 0.01)));
   const std::string f = write("step.csv", csv);
   const std::string fig = path("fig/step.png");
+  std::filesystem::create_directory(path("fig"));  // --plot creates no folder (docs/safety.md)
   const bool draw = piezoshift::io::find_gnuplot().has_value();
   const CliResult r =
       run("analyze step --json --data '" + f + "'" + (draw ? " --plot '" + fig + "'" : ""));
