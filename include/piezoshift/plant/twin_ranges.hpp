@@ -21,12 +21,12 @@ namespace piezoshift::plant {
 //! default is 20; 10 000 steps of about 60 ns are 0.6 ms of work per tick.
 inline constexpr double kMaxPhysicsStepsPerTick = 10000.0;
 
-//! Calls visit(section, key, value, bounds) for each value of twin (const or not) that has a
-//! numeric range, in the order of configs/paper.toml; section and key are the TOML names
-//! ("twin.daq", "sample_time_s"). value is a double, std::int64_t, std::array<double, 3>,
-//! std::optional<double> or a 3x3 matrix; each element is checked against bounds.
+namespace detail {
+
+// The twin's drive chain, in paper.toml's order: the timing, [twin.daq], [twin.amplifier] and
+// [twin.piezo] (visit_twin_values visits these first).
 template <typename Twin, typename Visit>
-void visit_twin_values(Twin& t, Visit&& visit) {
+void visit_twin_drive_values(Twin& t, Visit& visit) {
   using B = core::Bounds;
   // Timing: the 20 kHz default; up to 10 MHz (with the per-tick limit above) and down to 1 Hz.
   visit("twin", "physics_rate_Hz", t.physics_rate_Hz, B::closed(1.0, 1e7));
@@ -68,6 +68,18 @@ void visit_twin_values(Twin& t, Visit&& visit) {
   // 0.5 to 1.5 of nominal: stacks' stroke tolerance is +-10 to 15 % (PI) and the tolerance
   // studies draw +-9 %; a denormal scale failed as a contact that could not be identified.
   visit("twin.piezo", "free_stroke_scale", t.piezo.free_stroke_scale, B::closed(0.5, 1.5));
+}
+
+}  // namespace detail
+
+//! Calls visit(section, key, value, bounds) for each value of twin (const or not) that has a
+//! numeric range, in the order of configs/paper.toml; section and key are the TOML names
+//! ("twin.daq", "sample_time_s"). value is a double, std::int64_t, std::array<double, 3>,
+//! std::optional<double> or a 3x3 matrix; each element is checked against bounds.
+template <typename Twin, typename Visit>
+void visit_twin_values(Twin& t, Visit&& visit) {
+  using B = core::Bounds;
+  detail::visit_twin_drive_values(t, visit);
 
   visit("twin.contact", "open_loop_travel_um", t.contact.open_loop_travel_um, B::above(0.0, 1e4));
   visit("twin.contact", "open_loop_time_s", t.contact.open_loop_time_s, B::above(0.0, 1e9));
