@@ -18,8 +18,6 @@
 #include "calibrate_fizeau.hpp"
 #include "command.hpp"
 #include "improved_summary.hpp"
-#include "loop_rig_stack.hpp"
-#include "loop_setup.hpp"
 #include "paper_summary.hpp"
 #include "physics_budget.hpp"
 #include "piezoshift/calibration/calibration_cost.hpp"
@@ -33,6 +31,8 @@
 #include "piezoshift/core/input_error.hpp"
 #include "piezoshift/experiments/paper_experiments.hpp"
 #include "piezoshift/io/csv_writer.hpp"
+#include "piezoshift/procedures/loop_rig_stack.hpp"
+#include "piezoshift/procedures/loop_setup.hpp"
 #include "piezoshift/rig/bench.hpp"
 #include "piezoshift/rig/guided_rig.hpp"
 #include "piezoshift/rig/loop_rig.hpp"
@@ -158,12 +158,13 @@ class GuidedRigs {
       rig3_ = bench_rig3_.get();
       return;
     }
-    loop_ = std::make_unique<LoopRigStack>(LoopRigStackOptions{.daq = o.daq,
-                                                               .free_run = o.free_run,
-                                                               .seed = o.seed,
-                                                               .config_path = o.config,
-                                                               .window_s = window_s},
-                                           installation, base);
+    loop_ = std::make_unique<procedures::LoopRigStack>(
+        procedures::LoopRigStackOptions{.daq = o.daq,
+                                        .free_run = o.free_run,
+                                        .seed = o.seed,
+                                        .config_path = o.config,
+                                        .window_s = window_s},
+        installation, base);
     loop_rig_ = &loop_->rig();
     rig2_ = loop_rig_;
     rig3_ = loop_rig_;
@@ -177,7 +178,7 @@ class GuidedRigs {
  private:
   std::unique_ptr<rig::Bench> bench2_, bench3_;
   std::unique_ptr<rig::BenchRig> bench_rig2_, bench_rig3_;
-  std::unique_ptr<LoopRigStack> loop_;
+  std::unique_ptr<procedures::LoopRigStack> loop_;
   rig::LoopRig* loop_rig_ = nullptr;
   rig::GuidedRig* rig2_ = nullptr;
   rig::GuidedRig* rig3_ = nullptr;

@@ -9,7 +9,6 @@
 
 #include "command.hpp"
 #include "improved_summary.hpp"
-#include "loop_rig_stack.hpp"
 #include "paper_summary.hpp"
 #include "physics_budget.hpp"
 #include "piezoshift/calibration/calibration_cost.hpp"
@@ -21,6 +20,7 @@
 #include "piezoshift/instrument/fringe_calibration.hpp"
 #include "piezoshift/instrument/loop_scan_stage.hpp"
 #include "piezoshift/plant/geometry.hpp"
+#include "piezoshift/procedures/loop_rig_stack.hpp"
 #include "piezoshift/psi/fizeau_simulation.hpp"
 #include "piezoshift/rig/validity.hpp"
 #include "progress_bar.hpp"
@@ -214,7 +214,7 @@ int fringes_on_loop(const FizeauCalibrateRequest& q, const camera::InstrumentCon
   }
   control::SemiClosedLoopParams base;
   base.sample_time_s = config.twin.daq.sample_time_s;
-  LoopRigStack stack(
+  procedures::LoopRigStack stack(
       {.daq = q.daq, .free_run = q.free_run, .seed = q.seed, .config_path = q.config},
       ic.installation, base);
   instrument::LoopScanStage stage(stack.rig(), plant::make_twin_geometry(config.twin.geometry));

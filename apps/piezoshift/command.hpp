@@ -7,6 +7,8 @@
 
 #include <CLI/CLI.hpp>
 
+#include "piezoshift/procedures/work_begins.hpp"
+
 namespace piezoshift::app {
 
 //! Exit status of a command whose loop stopped on a latched fault, or whose outputs could not be
@@ -29,16 +31,10 @@ void add_psi_command(CLI::App& app, Action& action);        // psi_command.cpp
 void add_measure_command(CLI::App& app, Action& action);    // measure_command.cpp
 void add_tolerance_command(CLI::App& app, Action& action);  // tolerance_command.cpp
 
-//! Thrown by work_begins() when the program checks only.
-struct WorkNotRun {};
-
-//! Called by every action where its costly work begins: after its options, the files they name
-//! and its cost estimate are checked, before it simulates, calibrates, serves, connects, opens a
-//! device, analyses frames or writes a file. In the program it returns at once; with
-//! set_checks_only(true) (the fuzz targets, fuzz/program.hpp) it throws WorkNotRun, so that every
-//! subcommand's input is checked in milliseconds (docs/fuzzing.md lists where each stops).
-void work_begins();
-void set_checks_only(bool checks_only);
+// Where each action's costly work begins (procedures/work_begins.hpp).
+using procedures::set_checks_only;
+using procedures::work_begins;
+using procedures::WorkNotRun;
 
 //! The whole program on an empty app: its description, --version and every subcommand above
 //! (commands.cpp). main() and the command-line fuzz target (fuzz/) build the same app.

@@ -18,8 +18,6 @@
 #include <nlohmann/json.hpp>
 
 #include "command.hpp"
-#include "loop_setup.hpp"
-#include "loop_stack.hpp"
 #include "measure_report.hpp"
 #include "physics_budget.hpp"
 #include "piezoshift/camera/camera.hpp"
@@ -36,6 +34,8 @@
 #include "piezoshift/instrument/sequence.hpp"
 #include "piezoshift/instrument/sequence_memory.hpp"
 #include "piezoshift/instrument/twin_floor.hpp"
+#include "piezoshift/procedures/loop_setup.hpp"
+#include "piezoshift/procedures/loop_stack.hpp"
 #include "piezoshift/psi/analysis.hpp"
 #include "piezoshift/psi/fizeau_simulation.hpp"
 #include "piezoshift/rig/validity.hpp"
@@ -95,13 +95,13 @@ instrument::SequenceParams sequence_params(const MeasureOptions& o, psi::Algorit
   return p;
 }
 
-LoopStackOptions stack_options(const MeasureOptions& o) {
-  LoopStackOptions so;
+procedures::LoopStackOptions stack_options(const MeasureOptions& o) {
+  procedures::LoopStackOptions so;
   so.daq = o.daq;
   so.rate_Hz = o.rate_Hz;
   so.seed = o.seed;
   so.config_path = o.config;
-  so.clock = o.free_run ? StackClock::kFreeRun : StackClock::kRealTime;
+  so.clock = o.free_run ? procedures::StackClock::kFreeRun : procedures::StackClock::kRealTime;
   so.trigger_line = o.trigger_line;
   return so;
 }
@@ -124,7 +124,7 @@ struct MeasureSetup {
   psi::Algorithm algorithm = psi::Algorithm::kHariharan5;
   instrument::SequenceParams params;
   std::optional<camera::TwinScene> scene;
-  LoopCalibration calibration;
+  procedures::LoopCalibration calibration;
 };
 
 // Aravis's in-process fake camera on the twin: shown the twin's fringes (twin_fed_camera.hpp).
@@ -154,7 +154,7 @@ void check_trigger(const MeasureOptions& o) {
 }
 
 void check_options(const MeasureOptions& o) {
-  check_loop_rate(o.rate_Hz);
+  procedures::check_loop_rate(o.rate_Hz);
   check_trigger(o);
   if (o.out.empty())
     throw core::InputError("--out: a folder for the measurement is required");
@@ -229,18 +229,19 @@ struct Outcome {
 };
 
 // The loop, the camera and the sequence; the DAQ's outputs at 0 V whatever happens.
-Outcome acquire(const MeasureOptions& o, MeasureSetup& s, LoopStack& stack) {
+Outcome acquire(const MeasureOptions& o, MeasureSetup& s, procedures::LoopStack& stack) {
   instrument::LoopSetup loop;
   loop.controller = s.calibration.params;
   loop.limits = runtime::resolve_overrun_trip(
-      loop_safety_limits(s.config.installation.safety, std::nullopt), stack.sim() != nullptr);
+      procedures::loop_safety_limits(s.config.installation.safety, std::nullopt),
+      stack.sim() != nullptr);
   loop.rate_Hz = o.rate_Hz;
-  loop.stop_signal = &g_stop_signal;
+  loop.stop_signal = &procedures::g_stop_signal;
   std::unique_ptr<camera::Camera> cam = open_camera(o, s);
-  StopSignals signals;
+  procedures::StopSignals signals;
   ProgressBar bar(1);
   if (stack.clock().real_time())
-    request_realtime_or_warn(o.cpu);
+    procedures::request_realtime_or_warn(o.cpu);
   const plant::Twin* twin = stack.sim() != nullptr ? &stack.sim()->twin() : nullptr;
   Outcome out;
   out.sequence = instrument::acquire_sequence(stack.daq(), stack.clock(), twin, *cam, loop,
@@ -272,10 +273,11 @@ int measure(const MeasureOptions& o) {
   work_begins();  // the twin's scene, the stage, the camera
   if (o.camera == "twin" || fed_by_twin(o))
     s.scene = twin_scene(o, s.config.camera, wavelength_nm);
-  LoopStack stack(stack_options(o), s.config.installation.project);
+  procedures::LoopStack stack(stack_options(o), s.config.installation.project);
   if (s.params.trigger == instrument::TriggerMode::kLine && !stack.daq().has_trigger_line())
     throw core::InputError(fmt::format("--trigger line: DAQ {} has no trigger line", stack.name()));
-  s.calibration = resolve_calibration(o.calibration, o.daq, s.config.installation.project, o.seed,
+  s.calibration =
+      procedures::resolve_calibration(o.calibration, o.daq, s.config.installation.project, o.seed,
                                       1.0 / o.rate_Hz, o.max_physics_steps);
   if (const std::optional<std::string> who =
           instrument::lock_requested_by(o.lock, "--lock", s.calibration))

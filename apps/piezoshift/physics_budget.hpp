@@ -1,25 +1,16 @@
 #pragma once
-// --max-physics-steps, the one budget of simulated work every command that runs the twin's
-// procedures checks before it starts (rig/procedure_cost.hpp; `simulate` checks its own run the
-// same way, plant/simulation_cost.hpp).
-#include <string_view>
-
+// --max-physics-steps on the command line; the checks are the procedures' own
+// (procedures/physics_budget.hpp).
 #include <CLI/CLI.hpp>
 
-#include "piezoshift/plant/simulation_cost.hpp"
-#include "piezoshift/rig/procedure_cost.hpp"
+#include "piezoshift/procedures/physics_budget.hpp"
 
 namespace piezoshift::app {
 
 //! Adds --max-physics-steps to cmd, into budget (default plant::kDefaultPhysicsStepBudget).
 void add_physics_budget_option(CLI::App* cmd, double& budget);
 
-//! InputError when budget is outside [1, 1e15].
-void check_physics_budget(double budget);
-
-//! InputError naming the procedure, its estimate and the option when repeats x cost is above
-//! the budget on this twin.
-void check_procedure_cost(std::string_view procedure, const rig::ProcedureCost& cost,
-                          const plant::TwinParams& twin, double budget, double repeats = 1.0);
+using procedures::check_physics_budget;
+using procedures::check_procedure_cost;
 
 }  // namespace piezoshift::app

@@ -24,12 +24,12 @@
 
 #include "command.hpp"
 #include "fault_report.hpp"
-#include "loop_setup.hpp"
-#include "loop_stack.hpp"
 #include "physics_budget.hpp"
 #include "piezoshift/calibration/calibration_file.hpp"
 #include "piezoshift/config/project_config.hpp"
 #include "piezoshift/core/input_error.hpp"
+#include "piezoshift/procedures/loop_setup.hpp"
+#include "piezoshift/procedures/loop_stack.hpp"
 #include "piezoshift/runtime/control_loop.hpp"
 #include "piezoshift/runtime/csv_logger.hpp"
 #include "piezoshift/runtime/fault_injection.hpp"
@@ -127,7 +127,7 @@ nlohmann::json vec_json(const Vec3& v) {
 // What a run did, as the JSON summary reports it.
 struct RunRecord {
   const RunOptions& options;
-  LoopStack& stack;
+  procedures::LoopStack& stack;
   const ControlLoop& loop;
   const LoopResult& result;
   const SafetyLimits& limits;
@@ -236,14 +236,14 @@ nlohmann::json run_json(const RunRecord& run) {
   j["clock"] = o.free_run ? "free-run" : "realtime";
   j["duration_s"] = o.duration_s;
   j["ticks"] = r.ticks;
-  j["stop_reason"] = stop_reason_text(r);
+  j["stop_reason"] = procedures::stop_reason_text(r);
   j.update(timing_json(run.loop.stats()));
   j["realtime"] = {{"sched_fifo", rt.fifo},
                    {"mlockall", rt.memory_locked},
                    {"cpu", rt.cpu >= 0 ? nlohmann::json(rt.cpu) : nlohmann::json(nullptr)},
                    {"refused", rt.refusals}};
   add_fault_json(j, run);
-  j["safety"] = safety_json(run.limits);
+  j["safety"] = procedures::safety_json(run.limits);
   j["max_output_V"] = r.max_output_V;
   j["min_output_V"] = r.min_output_V;
   j["max_output_slew_V_per_ms"] = r.max_output_slew_V_per_ms;
@@ -261,7 +261,7 @@ void print_run(const RunRecord& run) {
   const LoopResult& r = run.result;
   const LoopStats& st = run.loop.stats();
   fmt::print("run: {} at {} Hz ({} clock), {} ticks, stopped by {}\n", run.stack.name(), o.rate_Hz,
-             o.free_run ? "free-running" : "real-time", r.ticks, stop_reason_text(r));
+             o.free_run ? "free-running" : "real-time", r.ticks, procedures::stop_reason_text(r));
   fmt::print("period error   p50 {:.1f} us  p99 {:.1f} us  p99.9 {:.1f} us  max {:.1f} us\n",
              us(st.period_error.percentile_ns(0.5)), us(st.period_error.percentile_ns(0.99)),
              us(st.period_error.percentile_ns(0.999)), us(st.period_error.max_ns()));
@@ -305,13 +305,13 @@ void print_run(const RunRecord& run) {
   }
 }
 
-LoopStackOptions stack_options(const RunOptions& o) {
-  LoopStackOptions so;
+procedures::LoopStackOptions stack_options(const RunOptions& o) {
+  procedures::LoopStackOptions so;
   so.daq = o.daq;
   so.rate_Hz = o.rate_Hz;
   so.seed = o.seed;
   so.config_path = o.config;
-  so.clock = o.free_run ? StackClock::kFreeRun : StackClock::kRealTime;
+  so.clock = o.free_run ? procedures::StackClock::kFreeRun : procedures::StackClock::kRealTime;
   so.faults = o.faults;
   so.log = o.log;
   so.log_reports_faults = false;  // run's FaultReporter does, with the value and limit
@@ -319,7 +319,7 @@ LoopStackOptions stack_options(const RunOptions& o) {
 }
 
 int run(const RunOptions& o) {
-  check_loop_rate(o.rate_Hz);
+  procedures::check_loop_rate(o.rate_Hz);
   if (!(o.duration_s > 0.0) || o.duration_s > kMaxRunDurationS)
     throw core::InputError(
         fmt::format("--duration-s {}: must be in (0, {}] s", o.duration_s, kMaxRunDurationS));
@@ -330,9 +330,9 @@ int run(const RunOptions& o) {
                        : runtime::load_installation_config(o.config);
   const config::ProjectConfig& project = installation.project;
   // The stack first: a bad --fault, --daq or device is named before the twin's calibration runs.
-  LoopStack stack(stack_options(o), project);
-  const LoopCalibration cal = resolve_calibration(o.calibration, o.daq, project, o.seed,
-                                                  1.0 / o.rate_Hz, o.max_physics_steps);
+  procedures::LoopStack stack(stack_options(o), project);
+  const procedures::LoopCalibration cal = procedures::resolve_calibration(
+      o.calibration, o.daq, project, o.seed, 1.0 / o.rate_Hz, o.max_physics_steps);
   calibration::refuse_fringe_lock(cal, "run");
   if (o.step_um && cal.travel_z_max_um && *o.step_um > *cal.travel_z_max_um)
     throw core::InputError(
@@ -343,18 +343,18 @@ int run(const RunOptions& o) {
   LoopConfig config;
   config.rate_Hz = o.rate_Hz;
   config.duration_s = o.duration_s;
-  config.stop_signal = &g_stop_signal;
+  config.stop_signal = &procedures::g_stop_signal;
   LoopStatus live;
   const bool show_live = ::isatty(STDERR_FILENO) == 1 && !o.free_run;
   config.status = &live;  // the live line's and the fault reports' source
   const SafetyLimits limits = runtime::resolve_overrun_trip(
-      loop_safety_limits(installation.safety, o.max_overruns), stack.sim() != nullptr);
+      procedures::loop_safety_limits(installation.safety, o.max_overruns), stack.sim() != nullptr);
   if (!o.json)
     fmt::print("safety: {}\n", describe(limits));
   ControlLoop loop(config, cal.params, limits, stack.daq(), stack.clock(), std::move(profile),
                    stack.telemetry());
 
-  StopSignals signals;
+  procedures::StopSignals signals;
   stack.start_logging();  // before the real-time request: the logging thread stays normal
   std::optional<LiveStatus> status_line;  // likewise: it must not inherit the loop's priority
   if (show_live)
@@ -362,7 +362,7 @@ int run(const RunOptions& o) {
   FaultReporter fault_reporter(live);  // each fault on stderr as it latches
   RealtimeReport rt;
   if (stack.clock().real_time())
-    rt = request_realtime_or_warn(o.cpu);
+    rt = procedures::request_realtime_or_warn(o.cpu);
   // Printing and reading /proc there would cost the loop deadlines, as serve's network threads.
   if (rt.cpu >= 0) {
     bool moved = fault_reporter.keep_off_cpu(rt.cpu);

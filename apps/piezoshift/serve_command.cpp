@@ -33,8 +33,6 @@
 #include "command.hpp"
 #include "dashboard_page.hpp"
 #include "fault_report.hpp"
-#include "loop_setup.hpp"
-#include "loop_stack.hpp"
 #include "physics_budget.hpp"
 #include "piezoshift/calibration/calibration_file.hpp"
 #include "piezoshift/camera/instrument_config.hpp"
@@ -48,6 +46,8 @@
 #include "piezoshift/host/locked_line_handler.hpp"
 #include "piezoshift/host/stage_model.hpp"
 #include "piezoshift/io/input_file.hpp"
+#include "piezoshift/procedures/loop_setup.hpp"
+#include "piezoshift/procedures/loop_stack.hpp"
 #include "piezoshift/psi/fizeau_simulation.hpp"
 #include "piezoshift/runtime/control_loop.hpp"
 #include "piezoshift/runtime/csv_logger.hpp"
@@ -61,7 +61,7 @@ namespace piezoshift::app {
 
 namespace {
 
-// Set in g_stop_signal when the network thread fails, so that the loop ramps down.
+// Set in procedures::g_stop_signal when the network thread fails, so that the loop ramps down.
 constexpr int kNetworkFailed = -1;
 
 // Set once the loop has run its ramp to 0 V and returned.
@@ -73,7 +73,7 @@ std::atomic<bool> g_loop_ramped{false};
 [[noreturn]] void ramp_then_abort() noexcept {
   std::fputs("piezoshift serve: a thread failed (std::terminate); ramping the outputs to 0 V\n",
              stderr);
-  g_stop_signal.store(kNetworkFailed);
+  procedures::g_stop_signal.store(kNetworkFailed);
   for (int i = 0; i < 200 && !g_loop_ramped.load(); ++i)
     std::this_thread::sleep_for(std::chrono::milliseconds(10));
   std::abort();
@@ -157,7 +157,8 @@ std::string http_token(const ServeOptions& o) {
 
 host::StageModel make_stage_model(const ServeOptions& o, const config::ProjectConfig& config,
                                   const control::SemiClosedLoopParams& params,
-                                  const LoopCalibration& cal, const runtime::SafetyLimits& safety) {
+                                  const procedures::LoopCalibration& cal,
+                                  const runtime::SafetyLimits& safety) {
   try {
     host::StageModelParams mp = host::stage_model_params(config.twin.geometry, params);
     if (cal.travel_z_max_um)
@@ -176,7 +177,7 @@ host::StageModel make_stage_model(const ServeOptions& o, const config::ProjectCo
 }
 
 void check_serve_options(const ServeOptions& o) {
-  check_loop_rate(o.rate_Hz);
+  procedures::check_loop_rate(o.rate_Hz);
   check(o.duration_s > 0.0, fmt::format("--duration-s {}: must be > 0 s", o.duration_s));
   check(o.port >= 0 && o.port <= 65535, fmt::format("--port {}: must be 0 to 65535", o.port));
   check(o.max_clients >= 1 && o.max_clients <= 64,
@@ -214,7 +215,7 @@ void check_serve_options(const ServeOptions& o) {
 }
 
 CameraSetup open_camera(const ServeOptions& o, const camera::CameraConfig& cc,
-                        const LoopCalibration& cal) {
+                        const procedures::LoopCalibration& cal) {
   CameraSetup c;
   const double wavelength_nm = c.options.sequence.wavelength_nm;
   if (o.camera == "twin" || (o.camera.starts_with("aravis:Fake") && o.daq == "sim"))
@@ -232,8 +233,8 @@ CameraSetup open_camera(const ServeOptions& o, const camera::CameraConfig& cc,
   return c;
 }
 
-LoopStackOptions stack_options(const ServeOptions& o) {
-  LoopStackOptions so;
+procedures::LoopStackOptions stack_options(const ServeOptions& o) {
+  procedures::LoopStackOptions so;
   so.daq = o.daq;
   so.rate_Hz = o.rate_Hz;
   so.seed = o.seed;
@@ -295,12 +296,13 @@ class Network {
   Network& operator=(const Network&) = delete;
 
   // Starts the servers' threads: before the real-time request, so they stay normal threads. A
-  // server that fails stops the loop through its ramp (g_stop_signal); stop() rethrows it.
+  // server that fails stops the loop through its ramp (procedures::g_stop_signal); stop() rethrows
+  // it.
   void start() {
     if (camera_)
       camera_->start([this](std::exception_ptr e) {
         camera_error_ = std::move(e);
-        g_stop_signal.store(kNetworkFailed);
+        procedures::g_stop_signal.store(kNetworkFailed);
       });
     line_thread_ = std::thread([this] { serve_until_stopped(*server_, line_error_); });
     if (http_)
@@ -353,10 +355,10 @@ class Network {
   template <typename Server>
   static void serve_until_stopped(Server& server, std::exception_ptr& error) {
     try {
-      server.run(&g_stop_signal);
+      server.run(&procedures::g_stop_signal);
     } catch (...) {
       error = std::current_exception();
-      g_stop_signal.store(kNetworkFailed);
+      procedures::g_stop_signal.store(kNetworkFailed);
     }
   }
 
@@ -378,7 +380,7 @@ void print_serve_summary(const ServeOptions& o, Network& net, const std::string&
   const host::GcsStats& gs = net.gcs().stats();
   const host::LineServerStats ns = net.server().stats();
   const runtime::LoopStats& st = loop.stats();
-  const std::string stop_reason = stop_reason_text(r);
+  const std::string stop_reason = procedures::stop_reason_text(r);
   if (!o.json) {
     fmt::print(
         "serve: {} ticks, stopped by {}; {} clients ({} refused), {} lines, {} GCS errors, {} "
@@ -417,7 +419,7 @@ void print_serve_summary(const ServeOptions& o, Network& net, const std::string&
   j["loop_commands_applied"] = r.host_commands_applied;
   j["samples_dropped"] = r.host_samples_dropped;
   j["max_output_slew_V_per_ms"] = r.max_output_slew_V_per_ms;
-  j["safety"] = safety_json(safety);
+  j["safety"] = procedures::safety_json(safety);
   if (const host::HttpServer* http = net.http()) {
     const host::HttpServerStats hs = http->stats();
     j["http"] = {{"requests", hs.requests},
@@ -443,13 +445,14 @@ int serve(const ServeOptions& o) {
     instrument.installation = runtime::load_installation_config(o.config);
   const runtime::InstallationConfig& installation = instrument.installation;
   const config::ProjectConfig& config = installation.project;
-  const runtime::SafetyLimits limits = loop_safety_limits(installation.safety, o.max_overruns);
+  const runtime::SafetyLimits limits =
+      procedures::loop_safety_limits(installation.safety, o.max_overruns);
   // The stack first: a bad --fault, --daq or device is named before the twin's calibration runs.
-  LoopStack stack(stack_options(o), config);
+  procedures::LoopStack stack(stack_options(o), config);
   const runtime::SafetyLimits safety =
       runtime::resolve_overrun_trip(limits, stack.sim() != nullptr);
-  const LoopCalibration cal = resolve_calibration(o.calibration, o.daq, config, o.seed,
-                                                  1.0 / o.rate_Hz, o.max_physics_steps);
+  const procedures::LoopCalibration cal = procedures::resolve_calibration(
+      o.calibration, o.daq, config, o.seed, 1.0 / o.rate_Hz, o.max_physics_steps);
   calibration::refuse_fringe_lock(cal, "serve");
   const host::StageModel model = make_stage_model(o, config, cal.params, cal, safety);
 
@@ -470,7 +473,7 @@ int serve(const ServeOptions& o) {
   runtime::LoopConfig lc;
   lc.rate_Hz = o.rate_Hz;
   lc.duration_s = o.duration_s;
-  lc.stop_signal = &g_stop_signal;
+  lc.stop_signal = &procedures::g_stop_signal;
   lc.stop_when_safe_after_fault = false;  // a client clears faults (SVO)
   lc.host = &link;
   runtime::LoopStatus status;  // the faults' source for the reporter
@@ -478,7 +481,7 @@ int serve(const ServeOptions& o) {
   runtime::ControlLoop loop(lc, cal.params, safety, stack.daq(), stack.clock(),
                             runtime::SetpointProfile::step(0.0), stack.telemetry());
 
-  StopSignals signals;
+  procedures::StopSignals signals;
   stack.start_logging();
   net.start();  // before the real-time request: the network threads stay normal threads
   FaultReporter fault_reporter(status);  // likewise; each fault on stderr as it latches
@@ -491,7 +494,7 @@ int serve(const ServeOptions& o) {
   fmt::print("piezoshift serve: safety ({}): {}\n",
              o.config.empty() ? "built in" : o.config + " [safety]", runtime::describe(safety));
   std::fflush(stdout);
-  const runtime::RealtimeReport rt = request_realtime_or_warn(o.cpu);
+  const runtime::RealtimeReport rt = procedures::request_realtime_or_warn(o.cpu);
   // Even under SCHED_FIFO (which preempts them) they cost the loop overruns there: with them on
   // its CPU, scripts/serve-latency counted 13 and 17 overruns under attack against 9 idle.
   // The fault reporter too: it reads /proc/loadavg and prints when a fault latches.

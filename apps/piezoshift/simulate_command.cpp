@@ -3,8 +3,8 @@
 // rig/bench.hpp: DAQ read, controller, safety supervisor, DAQ write), and reports where
 // the plate ended up, the target and the error. The controller is `run`'s: --calibration FILE,
 // or else the twin calibrated first by the paper's procedure (loop_setup.hpp,
-// resolve_calibration), so that the two commands agree. A supervisor fault ends the run's control
-// (outputs ramp to 0 V) and the command exits with status 3, as `run` does.
+// procedures::resolve_calibration), so that the two commands agree. A supervisor fault ends the
+// run's control (outputs ramp to 0 V) and the command exits with status 3, as `run` does.
 //
 //   piezoshift simulate --open-loop-volts 10,10,10 --duration-s 2
 //   piezoshift simulate --step-um 11 --duration-s 1 --log step.csv --json
@@ -27,7 +27,6 @@
 #include <nlohmann/json.hpp>
 
 #include "command.hpp"
-#include "loop_setup.hpp"
 #include "physics_budget.hpp"
 #include "piezoshift/config/project_config.hpp"
 #include "piezoshift/control/semi_closed_loop.hpp"
@@ -36,6 +35,7 @@
 #include "piezoshift/io/csv_writer.hpp"
 #include "piezoshift/plant/simulation_cost.hpp"
 #include "piezoshift/plant/twin.hpp"
+#include "piezoshift/procedures/loop_setup.hpp"
 #include "piezoshift/rig/bench.hpp"
 #include "piezoshift/runtime/safety_ranges.hpp"
 #include "piezoshift/runtime/safety_supervisor.hpp"
@@ -289,8 +289,8 @@ int run_simulate(const SimulateOptions& opt) {
   // `run`'s controller: the file, or the twin calibrated first (open loop needs none).
   control::SemiClosedLoopParams cp;
   if (closed_loop) {
-    const LoopCalibration lc = resolve_calibration(opt.calibration, "sim", config, opt.seed,
-                                                   period_s, opt.max_physics_steps);
+    const procedures::LoopCalibration lc = procedures::resolve_calibration(
+        opt.calibration, "sim", config, opt.seed, period_s, opt.max_physics_steps);
     calibration::refuse_fringe_lock(lc, "simulate");
     cp = lc.params;
     run.calibration = lc.source;

@@ -1,4 +1,4 @@
-#include "loop_rig_stack.hpp"
+#include "piezoshift/procedures/loop_rig_stack.hpp"
 
 #include <cstdio>
 
@@ -6,7 +6,7 @@
 
 #include "piezoshift/runtime/safety_ranges.hpp"
 
-namespace piezoshift::app {
+namespace piezoshift::procedures {
 
 LoopRigStack::LoopRigStack(const LoopRigStackOptions& o,
                            const runtime::InstallationConfig& installation,
@@ -35,4 +35,4 @@ LoopRigStack::LoopRigStack(const LoopRigStackOptions& o,
                refusal);
 }
 
-}  // namespace piezoshift::app
+}  // namespace piezoshift::procedures

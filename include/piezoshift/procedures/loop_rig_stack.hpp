@@ -9,12 +9,12 @@
 #include <optional>
 #include <string>
 
-#include "loop_setup.hpp"
-#include "loop_stack.hpp"
+#include "piezoshift/procedures/loop_setup.hpp"
+#include "piezoshift/procedures/loop_stack.hpp"
 #include "piezoshift/rig/loop_rig.hpp"
 #include "piezoshift/runtime/safety_ranges.hpp"
 
-namespace piezoshift::app {
+namespace piezoshift::procedures {
 
 struct LoopRigStackOptions {
   std::string daq;          //!< sim-rt or comedi[:DEVICE]
@@ -39,4 +39,4 @@ class LoopRigStack {
   std::unique_ptr<rig::LoopRig> rig_;
 };
 
-}  // namespace piezoshift::app
+}  // namespace piezoshift::procedures

@@ -25,7 +25,7 @@
 #include "piezoshift/runtime/paced_clock.hpp"
 #include "piezoshift/runtime/sim_backend.hpp"
 
-namespace piezoshift::app {
+namespace piezoshift::procedures {
 
 enum class StackClock : std::uint8_t { kRealTime, kFreeRun, kPaced };
 
@@ -88,4 +88,4 @@ class LoopStack {
   std::unique_ptr<runtime::CsvLogger> logger_;
 };
 
-}  // namespace piezoshift::app
+}  // namespace piezoshift::procedures

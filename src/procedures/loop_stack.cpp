@@ -1,16 +1,16 @@
-#include "loop_stack.hpp"
+#include "piezoshift/procedures/loop_stack.hpp"
 
 #include <cmath>
 #include <optional>
 
 #include <fmt/core.h>
 
-#include "command.hpp"
-#include "loop_setup.hpp"
 #include "piezoshift/core/input_error.hpp"
+#include "piezoshift/procedures/loop_setup.hpp"
+#include "piezoshift/procedures/work_begins.hpp"
 #include "piezoshift/runtime/comedi_backend.hpp"
 
-namespace piezoshift::app {
+namespace piezoshift::procedures {
 
 namespace {
 
@@ -107,4 +107,4 @@ void LoopStack::stop_logging() {
     logger_->stop();
 }
 
-}  // namespace piezoshift::app
+}  // namespace piezoshift::procedures

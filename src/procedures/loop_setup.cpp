@@ -1,4 +1,4 @@
-#include "loop_setup.hpp"
+#include "piezoshift/procedures/loop_setup.hpp"
 
 #include <cmath>
 
@@ -6,17 +6,17 @@
 
 #include <fmt/core.h>
 
-#include "physics_budget.hpp"
 #include "piezoshift/calibration/calibration_cost.hpp"
 #include "piezoshift/calibration/calibration_file.hpp"
 #include "piezoshift/calibration/calibration_procedure.hpp"
 #include "piezoshift/control/parameter_check.hpp"
 #include "piezoshift/core/bounds.hpp"
 #include "piezoshift/core/input_error.hpp"
+#include "piezoshift/procedures/physics_budget.hpp"
 #include "piezoshift/runtime/controller_ranges.hpp"
 #include "piezoshift/runtime/safety_ranges.hpp"
 
-namespace piezoshift::app {
+namespace piezoshift::procedures {
 
 std::atomic<int> g_stop_signal{0};
 
@@ -120,4 +120,4 @@ runtime::RealtimeReport request_realtime_or_warn(int cpu) {
   return rt;
 }
 
-}  // namespace piezoshift::app
+}  // namespace piezoshift::procedures

@@ -20,7 +20,7 @@
 #include "piezoshift/runtime/safety_ranges.hpp"
 #include "piezoshift/runtime/safety_supervisor.hpp"
 
-namespace piezoshift::app {
+namespace piezoshift::procedures {
 
 //! Throws core::InputError naming --rate-hz unless 1000 <= rate_Hz <= 10000 (the paper's 1 kHz to
 //! the DAQ's practical limit, docs/runtime.md).
@@ -77,4 +77,4 @@ std::string stop_reason_text(const runtime::LoopResult& result);
 //! warning naming what was refused.
 runtime::RealtimeReport request_realtime_or_warn(int cpu);
 
-}  // namespace piezoshift::app
+}  // namespace piezoshift::procedures
