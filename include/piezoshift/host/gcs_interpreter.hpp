@@ -2,8 +2,10 @@
 // The GCS 2.0 command interpreter of `piezoshift serve` (docs/gcs.md has the command table): it
 // turns command lines into HostCommands for the real-time loop and answers queries from the
 // loop's HostSamples. It runs on the server's one network thread (LineHandler), never on the loop.
-// One table of commands (name, syntax, help, handler) serves the dispatch and HLP?; the wave
-// generators (WaveGenerators) and the recorder's trigger (RecordTrigger) are classes of their own.
+// One table of commands (name, syntax, help, handler) serves the dispatch and HLP?; the handlers
+// are defined by command group (system, motion, parameters, data recorder, wave generators) in
+// src/host/gcs_*.cpp. The wave generators (WaveGenerators) and the recorder's trigger
+// (RecordTrigger) are classes of their own.
 //
 //   per client   the last error, as PI defines ERR?: a failed command sets its GCS error
 //                number (a later error replaces an earlier one); a failed set command answers
@@ -139,40 +141,31 @@ class GcsInterpreter final : public LineHandler {
   static const Command kCommands[];
   static const Immediate kImmediates[];
 
+  // Dispatch, sessions and the loop's samples (gcs_interpreter.cpp).
   std::string execute(Session& session, std::string_view name, const Args& args);
   void fail(Session& session, GcsError error);
   //! True for kNone; otherwise sets the error and returns false.
   bool accepted(Session& session, GcsError error);
-  //! Open-loop values := the volts the loop applies now (servo off, STP).
-  void hold_applied_volts();
   //! answer, or nothing with the error set.
   std::string reply(Session& session, GcsError error, std::string& answer);
   //! Pushes the command to the loop; false (and error 52 set) when the ring is full.
   bool send(Session& session, runtime::HostCommand command);
   void take(const runtime::HostSample& sample);
-  void moved();
-  //! The targets in force: MOV's, with each running generator's axis at its wave value.
-  AxisValues commanded() const;
-  //! Bit a: axis a not on target or its generator running, or its command not applied yet.
-  unsigned moving_mask() const;
-  //! Stops every generator (STP, #24); false (52 set) when the ring is full.
-  bool stop_waves(Session& s);
-  //! Stops generator g (it holds where it is); false (52 set) when the ring is full.
-  bool stop_wave(Session& s, std::size_t g);
-  //! Waits (at most ~50 ms, draining samples) until the loop has applied generator g's last
-  //! start or stop, so that the slot it no longer reads may be written.
-  bool slot_free(std::size_t g);
-  //! Starts generator g (WGO g 1); false with the error set.
-  bool start_wave(Session& s, std::size_t g, long long mode);
+  std::string help(Session& s, const Args& args);
 
-  // The commands (kCommands), in docs/gcs.md's order.
+  // The controller and the session (gcs_system.cpp).
   std::string identification(Session& s, const Args& args);
   std::string syntax_version(Session& s, const Args& args);
   std::string axis_identifiers(Session& s, const Args& args);
   std::string stage_types(Session& s, const Args& args);
   std::string units(Session& s, const Args& args);
-  std::string help(Session& s, const Args& args);
   std::string error_number(Session& s, const Args& args);
+  std::string command_level(Session& s, const Args& args);
+  std::string command_level_query(Session& s, const Args& args);
+  std::string ready_query(Session& s, const Args& args);
+  std::string macro_query(Session& s, const Args& args);
+
+  // Motion: servo, moves, stop, open loop and where the stage is (gcs_motion.cpp).
   std::string servo(Session& s, const Args& args);
   std::string servo_query(Session& s, const Args& args);
   std::string move_absolute(Session& s, const Args& args) { return move(s, args, false); }
@@ -182,24 +175,31 @@ class GcsInterpreter final : public LineHandler {
   std::string target_query(Session& s, const Args& args);
   std::string position_query(Session& s, const Args& args);
   std::string on_target_query(Session& s, const Args& args);
+  std::string overflow_query(Session& s, const Args& args);
   std::string stop(Session& s, const Args& args);
   std::string moving_query(Session& s, const Args& args);
-  std::string ready_query(Session& s, const Args& args);
-  std::string macro_query(Session& s, const Args& args);
   std::string velocity(Session& s, const Args& args);
   std::string velocity_query(Session& s, const Args& args);
   std::string velocity_control_query(Session& s, const Args& args);
-  std::string parameters(Session& s, const Args& args);
-  std::string set_parameters(Session& s, const Args& args);
-  std::string command_level(Session& s, const Args& args);
-  std::string command_level_query(Session& s, const Args& args);
-  std::string overflow_query(Session& s, const Args& args);
-  std::string parameter_list(Session& s, const Args& args);
   std::string open_loop(Session& s, const Args& args);
   std::string open_loop_query(Session& s, const Args& args);
   std::string voltage_query(Session& s, const Args& args);
   std::string lower_limit_query(Session& s, const Args& args);
   std::string upper_limit_query(Session& s, const Args& args);
+  void moved();
+  //! The targets in force: MOV's, with each running generator's axis at its wave value.
+  AxisValues commanded() const;
+  //! Bit a: axis a not on target or its generator running, or its command not applied yet.
+  unsigned moving_mask() const;
+  //! Open-loop values := the volts the loop applies now (servo off, STP).
+  void hold_applied_volts();
+
+  // Servo parameters (gcs_parameters.cpp).
+  std::string parameters(Session& s, const Args& args);
+  std::string set_parameters(Session& s, const Args& args);
+  std::string parameter_list(Session& s, const Args& args);
+
+  // The data recorder (gcs_data_recorder.cpp).
   std::string recorder_config(Session& s, const Args& args);
   std::string recorder_config_query(Session& s, const Args& args);
   std::string recorder_trigger(Session& s, const Args& args);
@@ -210,6 +210,8 @@ class GcsInterpreter final : public LineHandler {
   std::string recorder_tables(Session& s, const Args& args);
   std::string recorder_length(Session& s, const Args& args);
   std::string recorder_read(Session& s, const Args& args);
+
+  // The wave generators (gcs_wave_generator.cpp).
   std::string wave_define(Session& s, const Args& args);
   std::string wave_query(Session& s, const Args& args);
   std::string wave_select(Session& s, const Args& args);
@@ -223,6 +225,15 @@ class GcsInterpreter final : public LineHandler {
   std::string wave_running_query(Session& s, const Args& args);
   std::string wave_record_restart(Session& s, const Args& args);
   std::string wave_generators(Session& s, const Args& args);
+  //! Starts generator g (WGO g 1); false with the error set.
+  bool start_wave(Session& s, std::size_t g, long long mode);
+  //! Stops every generator (STP, #24); false (52 set) when the ring is full.
+  bool stop_waves(Session& s);
+  //! Stops generator g (it holds where it is); false (52 set) when the ring is full.
+  bool stop_wave(Session& s, std::size_t g);
+  //! Waits (at most ~50 ms, draining samples) until the loop has applied generator g's last
+  //! start or stop, so that the slot it no longer reads may be written.
+  bool slot_free(std::size_t g);
 
   const StageModel& model_;
   runtime::HostLink& link_;
