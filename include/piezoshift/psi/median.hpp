@@ -1,6 +1,6 @@
 #pragma once
 // The median of a set of values (the upper middle one for an even count; 0 for none), as the
-// fits' unit of modulation takes it (phase_algorithms.cpp, frame_pose.cpp).
+// fits' unit of modulation takes it (phase_fits.cpp, frame_pose.cpp).
 #include <algorithm>
 #include <cstddef>
 #include <vector>
