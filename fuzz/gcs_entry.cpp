@@ -87,7 +87,7 @@ class StandInLoop {
   std::thread thread_;  // last: starts once the members above exist
 };
 
-// Issue 27: an answer's size is bounded before it is made, whatever the arguments (a DRR? of every
+// An answer's size is bounded before it is made, whatever the arguments (a DRR? of every
 // table, HLP?, the 64 items a query may name, values of 300 digits): all its parts together at
 // most GcsInterpreter::kMaxAnswerBytes, each part at most kMaxPartBytes beyond what the line
 // itself holds (SPA? echoes its items). The rest of a pending answer is taken as LineServer does.

@@ -1,7 +1,7 @@
 // The plot target: every text a figure carries into gnuplot's script (the file name, the titles,
 // the axis labels, a marker's label), as a user's --data or --plot name would, through
-// io::check_output_path and io::write_plot_files. The promise (issue 27: a data file's name with
-// a line break ran a shell command through gnuplot's `system`): no text reaches the command
+// io::check_output_path and io::write_plot_files. The promise (a data file's name with a line
+// break once ran a shell command through gnuplot's `system`): no text reaches the command
 // stream. Checked against the same figure with every text "x" (an empty one empty): the script and
 // the data file have the same lines, none ends in a backslash (gnuplot's line continuation), every
 // quoted string ends on its line, and outside quotes and comments each line is the same.

@@ -223,7 +223,7 @@ void add_analyze_command(CLI::App& app, Action& action) {
       ->capture_default_str()
       ->check(whole_number(1, experiments::kMaxMedianWindow));
 
-  // A --plot that cannot be drawn (a folder, a folder that takes no file: issue 27) is refused
+  // A --plot that cannot be drawn (a folder, a folder that takes no file) is refused
   // before the data is read, not after the metrics are printed.
   const auto checked = [o](int (*run)(const AnalyzeOptions&)) {
     return [o, run] {

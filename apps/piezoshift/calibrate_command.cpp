@@ -304,7 +304,7 @@ int run_guided(const Options& o) {
   return 0;
 }
 
-// The improved controller (issue 12): the paper's stages for A and p, then its own models.
+// The improved controller (docs/control.md): the paper's stages for A and p, then its own models.
 int run_improved(const Options& o, const runtime::InstallationConfig& installation) {
   const config::ProjectConfig& config = installation.project;
   if (o.pid != "paper")

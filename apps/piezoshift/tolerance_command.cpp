@@ -1,5 +1,5 @@
 // `piezoshift tolerance`: which tolerances matter, and what fraction of stages built with them
-// meet the spec after calibration (issue 33, docs/tolerance.md).
+// meet the spec after calibration (docs/tolerance.md).
 #include <unistd.h>
 
 #include <cerrno>

@@ -1,8 +1,9 @@
 #pragma once
 // A check for integer options, run on the option's text before CLI11 converts it. CLI11 converts
 // with strtoll/strtoull and keeps what they return: 2^64 became INT64_MAX and -1 became 2^64 - 1
-// for an unsigned option, both in silence (issue 17: --seed -1, --max-overruns 2^64). Here the
-// text must be a whole number within [lo, hi], else CLI11 reports the option and exit status is 2.
+// for an unsigned option, both in silence (--seed -1 ran as seed 2^64 - 1, --max-overruns 2^64 as
+// INT64_MAX). Here the text must be a whole number within [lo, hi], else CLI11 reports the option
+// and exit status is 2.
 #include <charconv>
 #include <cstdint>
 #include <limits>

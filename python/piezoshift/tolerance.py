@@ -1,4 +1,4 @@
-"""Tolerance studies on a Dask cluster, or on local threads (issue 33, docs/tolerance.md).
+"""Tolerance studies on a Dask cluster, or on local threads (docs/tolerance.md).
 
 ``run_study`` runs a study as ``piezoshift tolerance`` does and writes the same files. Given a
 ``dask.distributed.Client``, each sample is a task on the cluster's workers: a worker is handed the

@@ -49,7 +49,7 @@ def test_to_dict_and_repr_use_the_field_names(config):
 
 
 def test_params_built_in_python_meet_the_readers_ranges():
-    # Issue 17: one list of ranges (plant/twin_ranges.hpp) for the TOML reader and the bindings.
+    # One list of ranges (plant/twin_ranges.hpp) for the TOML reader and the bindings.
     twin = ps.TwinParams()
     twin.physics_rate_Hz = 2e12
     assert (ps.twin_params_problem(ps.DesignInputs(), twin)

@@ -186,7 +186,7 @@ def drifting_cavity_toml(tmp_path):
 
 
 def test_the_fringe_lock_holds_the_drifting_cavity_over_the_hold(tmp_path):
-    # Issue 29's hold (docs/fizeau.md) from Python, as `measure --lock --hold-s 5`: after the
+    # The fringe lock's hold (docs/fizeau.md) from Python, as `measure --lock --hold-s 5`: after the
     # measurement the stage stays at frame 0 for 5 s of loop time, the cavity's drift in the
     # fringes, the paper's controller, seed 1 (the same figures as the CLI's, to the last digit).
     # Measured: unlocked 2.233 nm RMS from the set point (1 s means 2.031 nm: the drift no gauge
@@ -273,11 +273,12 @@ def test_bad_lock_and_hold_values_are_refused_by_name(tmp_path):
 
 
 def test_the_calibration_from_fringes_gives_a_controller_measure_runs(tmp_path):
-    # Issue 29's calibration from fringes (docs/fizeau.md), as `calibrate --interferometer fizeau
+    # The calibration from fringes (docs/fizeau.md), as `calibrate --interferometer fizeau
     # --camera twin --seed 1 --json`: the same A and p to the last digit (checked against the CLI
     # when this was written: A[0] = -0.42152971984990373, p1 = 1.016541824764393, 438 frames).
     # The default twin is built from the paper's A (Eq. 8), which the fringes find within 0.002
-    # (issue 29's bound; measured 0.0008 on seed 1), in less simulated time than the XL-80's 72 s.
+    # (the bound for A from fringes; measured 0.0008 on seed 1), in less simulated time than the
+    # XL-80's 72 s.
     d = ps.calibrate_from_fringes(seed=1)
     assert d["valid"] and d["reason"] is None
     paper = np.asarray(ps.SemiClosedLoopParams().matrix.a)

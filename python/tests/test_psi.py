@@ -56,7 +56,7 @@ def test_a_fit_that_does_not_converge_returns_no_surface():
     n = 64
     y, x = np.mgrid[0:n, 0:n]
     phi = 0.3 * x + 0.2 * y
-    # steps 1.5 rad beyond the commanded k pi/2 (issue 28): found, and refused
+    # steps 1.5 rad beyond the commanded k pi/2: found, and refused
     steps = [0.0] + [k * math.pi / 2 + 1.5 for k in range(1, 5)]
     r = ps.psi_analyze(frames_of(phi, steps), None, algorithm="aia")
     assert not r["converged"]

@@ -1,6 +1,7 @@
-"""Issue 33's done-when, on a local Dask cluster: the same 16-sample study run with --jobs 1,
---jobs 2, two shards merged, `piezoshift tolerance --scheduler` and run_study(client=...) on a
-cluster of two worker processes writes the same bytes; a scheduler that is not there is exit 2."""
+"""A distributed study's promise, on a local Dask cluster: the same 16-sample study run
+with --jobs 1, --jobs 2, two shards merged, `piezoshift tolerance --scheduler` and
+run_study(client=...) on a cluster of two worker processes writes the same bytes; a scheduler
+that is not there is exit 2."""
 import os
 import pathlib
 import subprocess

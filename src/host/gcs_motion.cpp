@@ -107,7 +107,8 @@ std::string GcsInterpreter::move(Session& s, const Args& args, bool relative) {
 
 // A tilt target a MOV does not name but took from the gauges at servo-on or STP (their noise:
 // about 0.1 urad) is set to its nominal 0 when it alone puts the move out of the travel, so that
-// `MOV Z` to TMN? or TMX? alone is reached (issue 30). A tilt a client set is never changed.
+// `MOV Z` to TMN? or TMX? alone is reached (docs/gcs.md, "Travel limits"). A tilt a client set
+// is never changed.
 bool GcsInterpreter::nominal_tilts(AxisValues& target, const std::array<bool, 3>& named) const {
   AxisValues nominal = target;
   bool changed = false;

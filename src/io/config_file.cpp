@@ -92,7 +92,7 @@ struct ConfigFileImpl {
           prefix.empty() ? std::string(k.str()) : prefix + "." + std::string(k.str());
       // A quoted key with a dot ("twin.daq.sample_time_s" = 1) is one key of that name, which no
       // read() asks for (they look keys up one table at a time), though its dotted path is that
-      // of a real setting: refused by itself, not passed as the setting it spells (issue 27).
+      // of a real setting: refused by itself, not passed as the setting it spells.
       if (k.str().find('.') != std::string_view::npos) {
         out.push_back({quoted(prefix, k.str()), node.source(),
                        node.is_table() ? "unknown section: a quoted name with a dot is one name; "

@@ -40,7 +40,7 @@ constexpr const char* kBandColor = "#009E73";
 
 // Text that must stay on one line of the script or the data file: a line break (or any other
 // control character) in a title or a file name would end the comment or string it is in and put
-// the rest into gnuplot's command stream, where `system` runs a shell (issue 27).
+// the rest into gnuplot's command stream, where `system` runs a shell.
 std::string one_line(std::string_view s) {
   std::string out;
   out.reserve(s.size());

@@ -322,7 +322,7 @@ void refer_planes(std::vector<FrameShift>& sh, const PupilXY& xy, std::vector<do
 // Tilt-aware AIA (see the header) from three starts, keeping the fit that leaves the smallest
 // residual: plain AIA's steps (flat planes); the grid of planes against AIA's phase; the grid
 // against the least-squares phase at the commanded steps. A single start lands in a wrong basin
-// once the frames' tilts reach a few tenths of a radian at the pupil edge (issue 28). The starts
+// once the frames' tilts reach a few tenths of a radian at the pupil edge. The starts
 // run on at most ~8000 pupil pixels; the winner is then finished on all of them.
 void tilt_aia(std::span<const Map> frames, const PupilXY& xy, const std::vector<std::size_t>& pix,
               const PhaseOptions& o, PhaseResult& r, std::vector<double>& phi,

@@ -1,4 +1,4 @@
-// Issue 17: input that reached an `internal error`, ran without bound or was accepted though
+// Input that once reached an `internal error`, ran without bound or was accepted though
 // wrong. Each case now exits 2 with a message naming its source (the option, or the file), or
 // finishes; the program is run as a user would.
 #include <unistd.h>
@@ -28,14 +28,14 @@ class BadInput : public piezoshift::testing::CliTest {
   }
 };
 
-// Issue 27: `--plot somedir/` was an internal error.
+// `--plot somedir/` was once an internal error.
 TEST_F(BadInput, APlotPathThatNamesAFolderIsRefusedNamingTheOption) {
   const std::string data = write("lin.csv", "zd_um,measured_um\n0,0\n1,1.001\n2,2\n");
   refused("analyze linearity --data '" + data + "' --plot '" + dir() + "/'",
           {"--plot " + dir() + "/", "names a folder"});
 }
 
-// Issue 27: `--plot /proc/x.png` exited 1 after the metrics, `--plot .` drew `..png`. A path
+// `--plot /proc/x.png` once exited 1 after the metrics, `--plot .` drew `..png`. A path
 // that names no file, or whose folder takes no file, is refused before the data is read.
 TEST_F(BadInput, APlotPathThatCannotBeWrittenIsRefusedBeforeTheData) {
   const std::string data = write("lin.csv", "zd_um,measured_um\n0,0\n1,1.001\n2,2\n");
@@ -45,7 +45,7 @@ TEST_F(BadInput, APlotPathThatCannotBeWrittenIsRefusedBeforeTheData) {
           {"--plot /proc/self/sub/x.svg: the folder /proc/self/sub does not exist (it is not "
            "created)"});
   refused("analyze repeatability --data missing.csv --plot /proc/x.png", {"--plot /proc/x.png"});
-  // Issue 47: a line break in the name was exit 1; a folder that does not exist was created.
+  // A line break in the name was once exit 1; a folder that does not exist was created.
   refused("analyze linearity --data '" + data + "' --plot '" + dir() + "/a\nb.png'",
           {"--plot " + dir() + "/a b.png: holds a control character"});
   refused("analyze linearity --data '" + data + "' --plot '" + dir() + "/new/x.png'",
@@ -116,7 +116,7 @@ TEST_F(BadInput, IntegerOptionsAreNotWrappedOrSaturated) {
 }
 
 // Command-line errors carry the program's prefix like every other error, and an option the
-// command does not have gets the closest one it does (issue 34).
+// command does not have gets the closest one it does.
 TEST_F(BadInput, CommandLineErrorsNameTheProgramAndSuggestTheClosestOption) {
   refused("compare --seeds 9-1", {"piezoshift: error: --seeds: 9-1 is not a list of distinct"});
   refused("design --cfg x", {"piezoshift: error: ",
@@ -129,7 +129,7 @@ TEST_F(BadInput, CommandLineErrorsNameTheProgramAndSuggestTheClosestOption) {
   EXPECT_NE(help.out.find("a whole number in [0, 2^64 - 1]"), std::string::npos) << help.out;
 }
 
-// Issue 47: `serve --camera twin --surface Z4=1e308` ended a measurement in an uncaught
+// `serve --camera twin --surface Z4=1e308` once ended a measurement in an uncaught
 // exception; --mask was ignored with the twin camera. Both are refused before anything runs.
 TEST_F(BadInput, ServesTwinSurfaceAndMaskAreCheckedBeforeItStarts) {
   refused("serve --camera twin --http-port 0 --surface Z4=1e308",
@@ -144,7 +144,7 @@ TEST_F(BadInput, RunTimesBeyondTheLongestRunNameTheirLimit) {
           {"--fault 'sgs-open@1e10'", "beyond the longest run, 1000000 s"});
 }
 
-// Issue 27: in-range settings that made a procedure run for hours. Every command that runs the
+// In-range settings that once made a procedure run for hours. Every command that runs the
 // twin's procedures estimates their cost first (rig/procedure_cost.hpp) and refuses it above the
 // budget, naming the settings and --max-physics-steps, before anything runs.
 TEST_F(BadInput, ProceduresThatWouldRunForHoursAreRefusedBeforeTheyStart) {

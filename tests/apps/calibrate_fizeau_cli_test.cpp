@@ -1,7 +1,7 @@
-// `piezoshift calibrate --interferometer fizeau` (issue 29): what it cannot do is
+// `piezoshift calibrate --interferometer fizeau`: what it cannot do is
 // refused with exit 2 naming the option; a scan whose fringes are lost exits 4 with the stage,
 // the frame and the tracker's reason and writes no file; a whole run writes the calibration file
-// `calibrate` writes, its source recorded as the Fizeau, with A within issue 29's band, on the
+// `calibrate` writes, its source recorded as the Fizeau, with A within 0.002 of the plant's, on the
 // twin's bench and on the real-time loop with the twin camera and Aravis's fake camera.
 #include <algorithm>
 #include <cmath>
@@ -42,7 +42,7 @@ TEST_F(FizeauCalibrateCli, WhatItCannotDoIsRefusedNamingTheOption) {
       {"--daq sim-rt --controller improved", "--controller improved with --daq"},
       {"--free-run", "--free-run needs --daq sim-rt"},
       {"--mask " + path("m.png"), "--mask: the twin's bench takes its scene's pupil"},
-      // issue 47: it was ignored on the loop with the twin camera
+      // it was once ignored on the loop with the twin camera
       {"--daq sim-rt --mask " + path("m.png"), "--mask: the twin camera renders its own pupil"},
       {"--daq sim-rt --surface Z4=1e308", "'Z4=1e308' is beyond +-2000 nm RMS per term"},
       {"--daq sim-rt --camera aravis:Basler-1 --surface Z4=1", "--surface: the test surface"},
@@ -178,7 +178,7 @@ TEST_F(FizeauLoopCli, TheStagesRunOnTheRealTimeLoopWithAravissFakeCamera) {
       piezoshift::calibration::load_calibration_file(file);
   const piezoshift::control::TransmissionMatrix paper{};
   for (std::size_t i = 0; i < 3; ++i)
-    for (std::size_t k = 0; k < 3; ++k)  // issue 29's band, the plant's A; measured 0.0014 worst
+    for (std::size_t k = 0; k < 3; ++k)  // within 0.002 of the plant's A; measured 0.0014 worst
       EXPECT_NEAR(c.matrix.a[i][k], paper.a[i][k], 0.002);
   // Stage 3's datum is the gauges' reading of its first frame: stage 2 left the stacks 0.11 um
   // above their zero (their remanence), which frame 0 as the datum would put into p0.
@@ -203,7 +203,7 @@ TEST_F(FizeauLoopCli, TheTwinCameraAndAravissFakeCameraGiveTheSameCalibration) {
   const piezoshift::control::TransmissionMatrix paper{};
   for (std::size_t i = 0; i < 3; ++i)
     for (std::size_t k = 0; k < 3; ++k) {
-      // issue 29's band against the plant's A; measured 0.00095 and 0.00106 worst, 0.0002 apart
+      // within 0.002 of the plant's A; measured 0.00095 and 0.00106 worst, 0.0002 apart
       EXPECT_NEAR(t.matrix.a[i][k], paper.a[i][k], 0.002);
       EXPECT_NEAR(f.matrix.a[i][k], paper.a[i][k], 0.002);
     }

@@ -1,7 +1,7 @@
 // Runs the guided calibration through the real-time loop (rig/loop_rig.hpp) on the twin,
 // paced by the procedure (`calibrate --daq sim-rt --free-run`): the loop in its own thread, the
 // procedure talking to it only through the host link. Its A and p must be those of `calibrate`
-// on the twin within 0.002 (issue 14); the twin's readings typed back at the prompt and read
+// on the twin within 0.002; the twin's readings typed back at the prompt and read
 // from a log matched by time give the same numbers again (the paced loop is deterministic).
 // Hardware (`--daq comedi:...`) is refused with exit 2 when the device cannot be opened.
 #include <cmath>

@@ -1,4 +1,4 @@
-// `piezoshift compare --lock` (issue 29): the Fizeau hold of compare's own controllers on seed 1
+// `piezoshift compare --lock`: the Fizeau hold of compare's own controllers on seed 1
 // (quick schedule, 5 s holds), against an independent path to the same figures: the column's
 // controller written to a calibration file, then `piezoshift measure --free-run --hold-s 5
 // [--lock] --seed 1` on the same configuration.

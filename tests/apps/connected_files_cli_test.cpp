@@ -107,7 +107,7 @@ TEST_F(ConnectedFilesCli, AnalyzeStepReadsRunsAndSimulatesOwnLogs) {
         << log;
   }
   // The two commands build the same controller (the twin calibrated first) and end where the
-  // other ends: before issue 34 simulate ran the paper's uncalibrated A and p, 0.3 um higher.
+  // other ends: simulate once ran the paper's uncalibrated A and p, 0.3 um higher.
   EXPECT_NEAR(mean_over(sim_log, "interferometer1_um", 0.45, 0.499),
               mean_over(run_log, "interferometer1_um", 0.45, 0.499), 0.002);
   const CliResult missing = run("analyze step --data '" + run_log + "' --column ifm1_um");
@@ -204,7 +204,7 @@ TEST_F(ConnectedFilesCli, ImprovedCalibrationRunsFitsAgainFromItsRecordsAndIsRef
   const CliResult gap = run("fit improved --data '" + path("gap.csv") + "'");
   EXPECT_EQ(gap.status, 2);
   EXPECT_NE(gap.err.find("gap.csv:502: t_s steps by 0.002 s"), std::string::npos) << gap.err;
-  // Issue 27: the records are written (atomically) before the calibration file, so the file's
+  // The records are written (atomically) before the calibration file, so the file's
   // presence implies them whole; each promises its rows, and `fit improved` refuses a copy cut
   // short, at a line end or within a line, naming the file.
   namespace fs = std::filesystem;

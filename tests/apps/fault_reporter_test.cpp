@@ -1,4 +1,4 @@
-// The fault reporter's thread leaves the loop's CPU as `serve`'s network threads do (issue 30):
+// The fault reporter's thread leaves the loop's CPU as `serve`'s network threads do:
 // found by its name in /proc/self/task, its CPUs read from the kernel.
 #include <gtest/gtest.h>
 #include <sched.h>

@@ -1,4 +1,4 @@
-// Issue 32, done when: every figure the commands draw, read back from its SVG
+// Every figure the commands draw, read back from its SVG
 // (support/svg_text_check.hpp): no two pieces of text overlap, every axis label has a unit, no
 // unit spelt in ASCII. `reproduce --quick` (Figures 10 to 12, the phase step, the Bode plot, the
 // measurement's surface and Zernike chart), `psi simulate` and `psi analyze` (the surface map with

@@ -149,7 +149,7 @@ TEST_F(MeasureCli, BadInputIsRefusedBeforeAnythingRuns) {
   refused("--out '" + path("x") + "' --algorithm lsq --steps-rad 0,1", "3 to 64 frames");
   refused("--out '" + path("x") + "' --base-um 11.4", "beyond the calibrated travel");
   refused("--out '" + path("x") + "' --camera files:" + path("none"), path("none"));
-  // Issue 47: --mask was ignored with the twin camera; a surface of 1e308 nm was an internal error.
+  // --mask was once ignored with the twin camera; a surface of 1e308 nm was an internal error.
   refused("--out '" + path("x") + "' --mask '" + path("m.png") + "'",
           "--mask: the twin camera renders its own pupil and analyses it");
   refused("--out '" + path("x") + "' --surface Z4=1e308",
@@ -176,7 +176,7 @@ TEST_F(MeasureCli, AMeasurementBeyondTheMemoryBoundIsRefusedBeforeItStarts) {
   EXPECT_FALSE(fs::exists(path("m")));
 }
 
-// Issue 29's lock on the twin with the cavity's drift in the fringes: the first average is the
+// The fringe lock on the twin with the cavity's drift in the fringes: the first average is the
 // reference, every later frame is locked, and the cavity's path stays nearer its set point than
 // on the gauges alone (same seed). Measured on this camera: 2.6 nm RMS unlocked (the drift over
 // the run and each step's error the calibration left), 1.6 nm locked; the rest is each frame's
@@ -241,7 +241,7 @@ TEST_F(MeasureCli, TheLockRunsOnARealTimeClockWithItsFitBesideTheLoop) {
   EXPECT_LT(std::fabs(mean), 0.5);
 }
 
-// Issue 29's `[controller] outer = "fringes"`: a calibration file that asks for the fringe lock
+// `[controller] outer = "fringes"`: a calibration file that asks for the fringe lock
 // locks `measure` exactly as --lock does (same seed: the same numbers, bit for bit), its
 // [fringe_lock] reaches the lock, and the commands that run no lock refuse the file by name.
 TEST_F(MeasureCli, ACalibrationThatAsksForTheFringeLockLocksAsTheFlagDoes) {
@@ -280,7 +280,7 @@ TEST_F(MeasureCli, ACalibrationThatAsksForTheFringeLockLocksAsTheFlagDoes) {
   }
 }
 
-// Issue 29: the fringes washed out mid-sequence (the twin camera's fringe loss, 60 ms from
+// The fringes washed out mid-sequence (the twin camera's fringe loss, 60 ms from
 // 0.45 s: within the second average) lose the measurement no frame. Each frame without fringes is
 // taken again until they come back; the lock holds its correction meanwhile and locks again
 // without a jump; every frame kept has its fringes, so the surface is as good as without the loss
@@ -321,13 +321,13 @@ TEST_F(MeasureCli, FringesLostMidSequenceAreTakenAgainAndNoFrameIsLost) {
   refused("--lock --lock-retake-s 0 --out '" + path("x") + "'", "retake");
 }
 
-// Issue 29: with the lab's drift in the fringes, the lock at most halves what the stage adds to
+// With the lab's drift in the fringes, the lock at most halves what the stage adds to
 // the surface error (improved controller, 20 averages, 96 px), the median over seeds 1 to 8 as
 // the done-when asks, each seed calibrated on its own. What the stage adds is sqrt(error^2 -
 // floor^2), the floor the whole measurement from an ideal stage with every frame's own noise
 // draws (floor_error_rms_nm). One seed alone does not decide it: locked, the stage adds 0.01 to
 // 0.04 nm to a floor of 0.119 nm, so a change of 0.007 nm in a seed's error moves its ratio from
-// 0.12 to 0.57 (seed 1 after issue 31's large moves at the slew limit, which changed the move to
+// 0.12 to 0.57 (seed 1 after the large moves at the slew limit, which changed the move to
 // the base; seeds 2 to 5 stayed at 0.15 to 0.38). Measured: docs/fizeau.md.
 TEST_F(MeasureCli, TheLockHalvesWhatTheDriftingStageAddsToTheSurface) {
   const std::string cfg = write("drift.toml",
@@ -370,11 +370,11 @@ TEST_F(MeasureCli, TheLockHalvesWhatTheDriftingStageAddsToTheSurface) {
   EXPECT_LE(median(ratio), 0.5);
 }
 
-// Issue 29's hold: after the measurement the stage stays at frame 0 for a minute of loop time
-// while the camera exposes frame after frame (4286 frames), with the cavity's drift in the
+// The fringe lock's hold: after the measurement the stage stays at frame 0 for a minute of loop
+// time while the camera exposes frame after frame (4286 frames), with the cavity's drift in the
 // fringes, the improved controller, seed 1. On the gauges alone the cavity's path is 2.04 nm RMS
 // from frame 0's (the return to frame 0 and the drift, which no gauge sees); the lock holds it
-// within 0.2 nm RMS of its set point (measured 0.177 nm), issue 29's bound. The paper's
+// within 0.2 nm RMS of its set point (measured 0.177 nm), the lock's bound. The paper's
 // controller cannot be held so close frame by frame: its own jitter from one 1 ms exposure to
 // the next is above the bound (0.54 nm locked; docs/fizeau.md).
 TEST_F(MeasureCli, TheLockHoldsTheCavityWithinAFifthOfANanometreOverAMinute) {
@@ -405,8 +405,8 @@ TEST_F(MeasureCli, AFailedSequenceWritesNothing) {
   EXPECT_FALSE(fs::exists(path("b")));
 }
 
-// Issue 28's done-when: with the improved controller on the default stage and camera, the twin's
-// surface within 0.5 nm RMS and the steps from the fringes within 5 mrad of the stage's true
+// measure's acceptance figures: with the improved controller on the default stage and camera, the
+// twin's surface within 0.5 nm RMS and the steps from the fringes within 5 mrad of the stage's true
 // steps; the measurement within 1.5 x its floor. One measurement's camera noise alone is 0.529 nm
 // RMS on this camera (the same frames from an ideal stage: ideal_error_rms_nm), so 4 averages.
 TEST_F(MeasureCli, ImprovedControllerRecoversTheSurfaceAndTheSteps) {
@@ -424,7 +424,7 @@ TEST_F(MeasureCli, ImprovedControllerRecoversTheSurfaceAndTheSteps) {
   EXPECT_EQ(t["overruns"], 0);  // a simulated clock is never late
 }
 
-// Issue 28's line trigger: the loop's tick raises the twin's trigger line, whose recorded edge
+// The line trigger: the loop's tick raises the twin's trigger line, whose recorded edge
 // triggers the twin camera. Both triggers start each exposure at the scheduled time of the tick
 // after the one the stage settled on (software: camera.trigger(ticks x T) between the ticks;
 // line: the next tick's edge), and the camera sees the same poses, so the same frames: measured,

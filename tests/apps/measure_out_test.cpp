@@ -1,4 +1,4 @@
-// Issue 47: a file appearing in an empty --out while a measurement ran made the finished
+// A file appearing in an empty --out while a measurement ran once made the finished
 // measurement be discarded (exit 2). Where it goes now: --out while it is free (absent, or an
 // empty folder), else the first free sibling --out.1 .. --out.99, never into or over what appeared.
 #include <gtest/gtest.h>

@@ -92,7 +92,7 @@ TEST_F(PsiCliTest, BadInputExitsTwoNamingTheFile) {
   expect_bad("psi simulate --out '" + path("s") + "' --surface Z4=oops --no-budget", "Z4=oops");
 }
 
-// Issue 27. The frames are bounded before they are decoded (64 files; 150 copies of one PNG ended
+// The frames are bounded before they are decoded (64 files; 150 copies of one PNG ended
 // in std::bad_alloc); `psi calibrate` refuses the frames without fringes that `psi analyze`
 // refuses (it wrote step_gain = 0 with converged = true) and a nominal step outside
 // [0.05, pi - 0.05] rad (1e-300 gave a NaN gain), each with exit 2 and no file written.
@@ -134,7 +134,7 @@ TEST_F(PsiCliTest, FrameCountDegenerateFramesAndNominalStepAreRefused) {
   EXPECT_FALSE(std::filesystem::exists(path("a")));
 }
 
-// Issue 28: without --mask the whole frame was the pupil, and AIA's steps came out 0.47 rad off
+// Without --mask the whole frame was once the pupil, and AIA's steps came out 0.47 rad off
 // (PVr 305 nm instead of 258 at 256 px). The pupil is now found from the fringe modulation: here
 // it is exactly simulate's mask, so steps, PVr and the calibration's gain match the masked run
 // to rounding (tolerances 1e-6 rad, 1e-6 nm, 1e-9).

@@ -1,4 +1,4 @@
-// `piezoshift tolerance` as a user runs it (issue 33): the same study on one thread, two threads
+// `piezoshift tolerance` as a user runs it: the same study on one thread, two threads
 // and two shards merged gives the same bytes; an interrupted run resumes; bad files exit 2. Six
 // samples keep it short under the sanitizers; the 16-sample study of the issue, with a Dask
 // cluster besides, is python/tests_dask.
@@ -134,8 +134,8 @@ TEST_F(ToleranceCli, BadTolerancesExit2NamingTheKey) {
   EXPECT_FALSE(std::filesystem::exists(path("x")));
 }
 
-// Issue 47: what a shard file, --shard or --scheduler says is checked before it is used. A
-// shard's header claiming 1e12 samples ended merge in std::bad_alloc (exit 1); a file of '['
+// What a shard file, --shard or --scheduler says is checked before it is used. A
+// shard's header claiming 1e12 samples once ended merge in std::bad_alloc (exit 1); a file of '['
 // took 5 GB to parse; --shard 2/18446744073709551615 wrapped round; --shard 5/8 --samples 4 ran
 // nothing with a misleading message; --scheduler garbage ended in a Python traceback.
 TEST_F(ToleranceCli, ShardFilesShardsAndSchedulersAreCheckedBeforeUse) {

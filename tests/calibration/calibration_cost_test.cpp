@@ -69,7 +69,7 @@ TEST(CalibrationCost, ImprovedCalibrationWithItsTravelMatchesTheMeter) {
 
 TEST(CalibrationCost, ASettingThatWouldTakeHoursIsOverTheBudget) {
   config::ProjectConfig c;
-  c.twin.interferometer.static_average_s = 1e6;  // issue 27: about 28 h of `calibrate`
+  c.twin.interferometer.static_average_s = 1e6;  // about 28 h of `calibrate`
   const rig::CostEstimate e = rig::estimate_cost(
       calibration_cost(CalibrationOptions::paper_gains_only(), c.twin.daq.sample_time_s), c.twin);
   EXPECT_GT(e.simulated_s, 7.6e7);

@@ -1,6 +1,6 @@
 // The controller's field list (runtime/controller_ranges.hpp): the calibration file's reader
 // and writer walk it (every number read back bit for bit), and controller_problem() refuses what
-// would make the stage report nonsense or the loop unstable (issue 27), naming the field.
+// would make the stage report nonsense or the loop unstable, naming the field.
 #include <cmath>
 #include <cstring>
 #include <limits>
@@ -217,7 +217,7 @@ TEST(ControllerProblem, NominalGainMarginMatchesAnIndependentEvaluation) {
   EXPECT_NE(controller_problem(p, 1e-3).find("unstable"), std::string::npos);
 }
 
-// Issue 27: kp 5, ki 3, kd 2 ran with the plate swinging between 2.3 and 7.0 um and no fault.
+// kp 5, ki 3, kd 2 ran with the plate swinging between 2.3 and 7.0 um and no fault.
 TEST_F(ControllerFile, GainsOutsideTheStableRegionAreRefusedAtLoad) {
   SemiClosedLoopParams p;
   p.gains = {5.0, 3.0, 2.0};
@@ -300,7 +300,7 @@ TEST(ControllerProblem, TheFeedforwardsGainBandsHoldAtTheirEdges) {
             std::string::npos);
 }
 
-// [controller] outer = "fringes" and [fringe_lock] (issue 29): read into the lock's parameters
+// [controller] outer = "fringes" and [fringe_lock]: read into the lock's parameters
 // only when the file asks for it, refused by a caller that runs no lock, each bad value named.
 TEST_F(ControllerFile, TheFringeLockIsReadWhenTheFileAsksForItAndRefusedWhereNoneRuns) {
   const std::string gains = "[controller]\nkp = 0.6\nki = 0.2\nkd = 0.001\n";

@@ -117,7 +117,7 @@ TEST(CsvTable, AHeaderWiderThanTheLimitIsRefused) {
             "data.csv:2: the header has 1048577 fields, more than the limit of 1024");
 }
 
-// Issue 27: a 64 MiB file of commas took 3.9 GB, 32 bytes a comma, before it was refused. A row
+// A 64 MiB file of commas once took 3.9 GB, 32 bytes a comma, before it was refused. A row
 // is now counted, not split, when read: the reader holds the text and 16 bytes a row.
 class CsvTableMemory : public piezoshift::testing::TempDirTest {};
 
@@ -166,7 +166,7 @@ TEST_F(CsvTableMemory, RowsOfEmptyCellsAsWideAsTheHeaderCostNoMemoryPerCell) {
   }
 }
 
-// Issue 47: a valid 64 MiB file of one-cell rows peaked at 1.39 GB (16 bytes a row, and the
+// A valid 64 MiB file of one-cell rows once peaked at 1.39 GB (16 bytes a row, and the
 // rows' vector doubling while read). Now 8 bytes a row, reserved once: the text, the rows and a
 // column of 8 bytes a row, nothing more.
 TEST_F(CsvTableMemory, OneCellRowsCostEightBytesEachAndAColumnEightMore) {

@@ -60,7 +60,7 @@ TEST(CsvWriter, UncreatableFileIsAnInputErrorNamingIt) {
 }
 
 // A record replaced atomically: the old file stays whole until close() writes every row at once
-// (issue 27: `calibrate --controller improved` left excitation.csv half written when stopped);
+// (`calibrate --controller improved` once left excitation.csv half written when stopped);
 // a writer dropped without close() leaves the old file and no temporary.
 TEST(CsvWriter, ReplaceAtomicallyKeepsTheOldFileUntilClose) {
   const auto path = temp_file("record.csv");

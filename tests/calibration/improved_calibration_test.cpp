@@ -1,4 +1,4 @@
-// The improved controller (issue 12), calibrated by its own procedure on the twin and judged
+// The improved controller (docs/control.md), calibrated by its own procedure on the twin and judged
 // through the shipping loop beside the paper's controller calibrated on the same plant: the
 // lambda/8 phase step (1 ms exposures of the true plate) and the 11 um step. Figures in
 // docs/control.md; the issue's targets not met are listed there.
@@ -107,7 +107,7 @@ TEST(ImprovedController, TheSameProcedureWorksOnOtherPlants) {
   }
 }
 
-// Issue 31: configs/plants/ at compare's 10 kHz (the DAQ at 0.1 ms, the interferometer's dynamic
+// configs/plants/ at compare's 10 kHz (the DAQ at 0.1 ms, the interferometer's dynamic
 // samples at 10 kHz).
 config::ProjectConfig plant_at_10kHz(const std::string& name) {
   config::ProjectConfig c =
@@ -158,7 +158,7 @@ TEST(ImprovedController, At10kHzStageZeroHoldsThickerAndHeavierPlates) {
   EXPECT_EQ(nominal.holding.tests, 1);
 }
 
-// Issue 31, what limits the improved lambda/8 step at 1 kHz on configs/plants/thick-plate.toml
+// What limits the improved lambda/8 step at 1 kHz on configs/plants/thick-plate.toml
 // (docs/compare.md): the 20 mm plate's piston mode, 1024 Hz, sits 2.4 % above the 1 kHz tick,
 // so each command step rings it by about the step on the true plate, at an alias of 24 Hz that
 // stage 5 does not resolve in its 30 ms record and that a positive tick-synchronous shaper could
@@ -196,7 +196,7 @@ TEST(ImprovedController, At1kHzAThickPlatesModeNearTheTickRateSetsThePhaseStep) 
   EXPECT_LE(q.settling_time_s, 5e-3);  // measured 4 ms
 }
 
-// Issue 31, the 11 um step on configs/plants/payload.toml (docs/compare.md, "Large steps"): made
+// The 11 um step on configs/plants/payload.toml (docs/compare.md, "Large steps"): made
 // by the shaper's rate limit, the 1 kHz DAQ steps (about 12 V at the stack) are each slewed by
 // the current-limited amplifier in half a tick and then held, which rings the 1170 Hz piston mode
 // every tick, and the shaped ramp's unequal steps do not cancel it: the plate overshoots by 3 %.
@@ -225,7 +225,7 @@ TEST(ImprovedController, LargeStepAtTheSlewLimitDoesNotRingThePlate) {
   EXPECT_LT(c.large_move.slew_overshoot_pct, c.large_move.shaper_overshoot_pct);
 }
 
-// Issue 31, the what-if equal legs (configs/what-if/equal-legs.toml): there the slew's stop left
+// The what-if equal legs (configs/what-if/equal-legs.toml): there the slew's stop left
 // a ring of 1.42 % of the 11 um step (seed 1), the shaper alone 0.20 %. Stage 7 reads the two on
 // the plant with the interferometer's 1 kHz samples (0.88 against 0.22 %), so the slew path is
 // turned off and the step is the shaper's: under 1 % of true overshoot.

@@ -1,4 +1,4 @@
-// A diagnostic, not a test (issue 31): the improved controller calibrated on a plant as compare
+// A diagnostic, not a test: the improved controller calibrated on a plant as compare
 // --quick calibrates it at 1 kHz, its lambda/8 step (compare's seed + 80) and the 1 ms exposure
 // means of the true plate, minus the same seed's record without the step (own err). Built on
 // demand only: cmake --build --preset release --target improved_step_trace, then

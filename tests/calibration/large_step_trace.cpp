@@ -1,4 +1,4 @@
-// A diagnostic, not a test (issue 31): the improved controller calibrated on a plant as compare
+// A diagnostic, not a test: the improved controller calibrated on a plant as compare
 // --quick calibrates it at 1 kHz, then compare's 11 um step (run_step_response's seed + 20: 0.5 s
 // at 0, then 11 um on the three points) traced per tick: the shaper's output (a local copy of the
 // controller's shaper on channel 1's target), the commands, the gauges and the true plate (its

@@ -1,4 +1,4 @@
-// A diagnostic, not a test (issue 31): a plant driven open loop by a 1 kHz staircase of commands
+// A diagnostic, not a test: a plant driven open loop by a 1 kHz staircase of commands
 // (one per line in DIAG_SEQ_FILE, SGS-scaled um, the same on the three channels, the first held
 // 1 s before), simulated with the DAQ at 10 kHz so the true plate is printed every 0.1 ms.
 //   build/release/tests/calibration/open_loop_ring PLANT   (default|payload|...)

@@ -346,7 +346,7 @@ TEST(TwinCameraTest, ConfigureRefusesAnotherSizeAndValuesOutOfRange) {
   s.width_px = 64;
   EXPECT_NE(refusal(s).find("width_px x height_px = 64 x 32"), std::string::npos) << refusal(s);
   s = settings();
-  // A trigger line is the sim backend's wire (its edges reach trigger()): taken since issue 28.
+  // A trigger line is the sim backend's wire (its edges reach trigger()): taken.
   s.trigger = TriggerSource::kLine;
   EXPECT_EQ(refusal(s), "accepted");
   EXPECT_EQ(cam.settings().trigger, TriggerSource::kLine);

@@ -143,9 +143,9 @@ TEST(ImprovedController, TracksAPlantThatIsItsModelWithABias) {
   EXPECT_EQ(out.saturated_mask, 0);
 }
 
-// A large move (issue 31): the command steps by the slew limit each tick, the reference follows
-// what the model reads (so the correction does not wind up on the move), the slew stops
-// slew_approach_um before the target and the shaper makes the rest; a small move never slews.
+// A large move (docs/control.md, "Large moves"): the command steps by the slew limit each tick, the
+// reference follows what the model reads (so the correction does not wind up on the move), the slew
+// stops slew_approach_um before the target and the shaper makes the rest; a small move never slews.
 TEST(ImprovedController, LargeMoveSlewsThenTheShaperFinishes) {
   SemiClosedLoopParams params = model_loop_params();
   params.improved.command_slew_um_per_s = 2000.0;  // 2 um of command per tick

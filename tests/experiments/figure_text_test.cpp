@@ -1,4 +1,4 @@
-// Issue 32: the text of every figure, read back from the SVG gnuplot draws (support/
+// The text of every figure, read back from the SVG gnuplot draws (support/
 // svg_text_check.hpp): no two pieces of text overlap, every axis label has a unit, no unit in
 // ASCII. First the checker itself on figures made to fail it, then the paper's Figures 10 to 12
 // as the report draws them (on made-up data: the real commands' figures are checked in

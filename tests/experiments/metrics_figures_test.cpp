@@ -59,7 +59,7 @@ TEST(MetricsFigures, LinearityAndRepeatabilityFiguresRender) {
   EXPECT_GT(fs::file_size(*io::render(rep, out_dir() / "repeatability").png), 1000u);
 }
 
-// Issue 17: data spread over microns (reproduce's own linearity.csv, 0 to 11 um) needed more than
+// Data spread over microns (reproduce's own linearity.csv, 0 to 11 um) needed more than
 // the histogram's 10000 bins of 1 nm: the bin widens to 1, 2 or 5 x 10^k nm, named on the axis.
 TEST(MetricsFigures, RepeatabilityHistogramWidensItsBinForMicronSpreads) {
   EXPECT_EQ(histogram_bin_nm(4.0, 1.0), 1.0);

@@ -35,7 +35,7 @@ TEST(Repeatability, RejectsFewerThanTwoAndNonFinite) {
   EXPECT_THROW(repeatability_metrics(bad), MetricsError);
 }
 
-// Issue 17: finite values whose squares overflow gave e_R = inf; now a failure naming the range.
+// Finite values whose squares overflow once gave e_R = inf; now a failure naming the range.
 TEST(Repeatability, ValuesThatOverflowEq9AreRefused) {
   const std::vector<double> huge{1e308, -1e308};
   try {

@@ -128,7 +128,7 @@ TEST(Plot, MissingGnuplotIsAClearError) {
   }
 }
 
-// Issue 27: a data file's name with a line break, written unescaped into a comment of the script,
+// A data file's name with a line break, once written unescaped into a comment of the script,
 // put its next line into gnuplot's command stream, and gnuplot's `system` ran a shell. Titles,
 // labels and names with line breaks, quotes and backslashes stay inside their comment or string.
 TEST(Plot, NoTitleLabelOrNameReachesGnuplotsCommandStream) {
@@ -159,7 +159,7 @@ TEST(Plot, NoTitleLabelOrNameReachesGnuplotsCommandStream) {
   EXPECT_FALSE(fs::exists(pwned));
 }
 
-// Issue 47: --plot wrote its .gp and .dat through links planted at their names, in place; a
+// --plot once wrote its .gp and .dat through links planted at their names, in place; a
 // line break in the name was exit 1; --plot /nonexistent/x.png created /nonexistent. The side
 // files replace a planted link (its target untouched), a name with a control character and a
 // folder that does not exist are refused, and no folder is created.

@@ -1,4 +1,4 @@
-// The command_line fuzz target reaches every subcommand within a bounded cost (issue 30): one
+// The command_line fuzz target reaches every subcommand within a bounded cost: one
 // well-formed command line per subcommand passes all of its checks and stops where its costly
 // work would begin (app::work_begins), having simulated nothing and written no file. Counted,
 // not timed: the twin's ticks, physics steps and static measurements (rig::simulation_meter)

@@ -157,7 +157,7 @@ TEST(DashboardOptions, ANonLoopbackBindWithoutATokenIsRefusedAtStartUp) {
   EXPECT_EQ(WEXITSTATUS(status), 2);
 }
 
-// Issue 27: a token file is read as every input file is. /dev/zero grew the process to 2 GB before
+// A token file is read as every input file is. /dev/zero grew the process to 2 GB before
 // `internal error: std::bad_alloc`, and a FIFO hung the start-up; each is now refused at once,
 // with exit 2 and the file named, before the loop starts.
 TEST(DashboardOptions, ATokenFileThatIsNotASmallRegularFileIsRefusedNamingIt) {
@@ -321,7 +321,7 @@ TEST_F(Dashboard, TenStreamsDoNotDelayGcsAnswers) {
 
 }  // namespace
 
-// ---- serve --camera (issue 28): the live view and a measurement started from the dashboard
+// ---- serve --camera: the live view and a measurement started from the dashboard
 
 namespace {
 

@@ -297,7 +297,7 @@ TEST(DataRecorderTest, ReadErrors) {
   EXPECT_EQ(r.read(1, -1, {}, 1e-3, text), GcsError::kTableDeactivated);
 }
 
-// Issue 27: a count near the largest long long overflowed start - 1 + count and answered a header
+// A count near the largest long long once overflowed start - 1 + count and answered a header
 // of 9223372036854775807 points; a table named twice doubled the columns.
 TEST(DataRecorderTest, ReadRefusesHugeCountsAndRepeatedTables) {
   DataRecorder r;
@@ -366,7 +366,7 @@ TEST(DataRecorderTest, OffTableIsSkippedByDefaultRead) {
   EXPECT_NEAR(p.rows[1].at(0), input_at(1).position[0], 1e-8);
 }
 
-// A DRR? made a part at a time (issue 27: the server answers other clients between the parts)
+// A DRR? made a part at a time (the server answers other clients between the parts)
 // is read()'s answer byte for byte, each part whole rows of at most max_values values.
 TEST(DataRecorderTest, PartsJoinedAreTheWholeRead) {
   DataRecorder r;

@@ -1,4 +1,4 @@
-// Issue 30: `piezoshift serve` driven as EPICS's motorPIGCS2 driver drives an E-727 (its
+// `piezoshift serve` driven as EPICS's motorPIGCS2 driver drives an E-727 (its
 // PIasynController, PIE727Controller, PIGCSPiezoController, PIGCSController and PIInterface, read
 // in epics-motor/motorPIGCS2; no code taken). The replay keeps the driver's framing: a command and
 // its LF go in two writes (PIInterface::sendOnly), a query's LF goes with asyn's writeRead, which

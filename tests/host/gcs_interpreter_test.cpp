@@ -522,8 +522,8 @@ TEST_F(GcsInterpreterTest, OverlongLineQueues3) {
   EXPECT_EQ(err(1), 0);
 }
 
-// PI's ERR?: the last error that occurred, reset to 0 when read; not a queue (issue 30: a driver
-// that reads ERR? after MOV got a stale error of an earlier query from the queue).
+// PI's ERR?: the last error that occurred, reset to 0 when read; not a queue (with a queue, a
+// driver that reads ERR? after MOV got a stale error of an earlier query).
 TEST_F(GcsInterpreterTest, ErrIsTheLastErrorPerClientResetWhenRead) {
   EXPECT_EQ(cmd("MOV Q 1", 1), "");
   for (int i = 0; i < 20; ++i)
@@ -718,13 +718,13 @@ TEST_F(GcsInterpreterTest, RecorderRecordsTheLoopsSamples) {
   for (const Case& k :
        {Case{"DRR? 0", 17}, Case{"DRR? 1 -1", 17}, Case{"DRR? 1 4", 77}, Case{"DRR? 5", 77},
         Case{"DRR? 1 1 6", 78}, Case{"DRR? 1 1 9", 57}, Case{"DRR? a", 1},
-        // Issue 27: a count that overflowed start - 1 + count, a table named twice.
+        // A count that overflowed start - 1 + count, a table named twice.
         Case{"DRR? 2 9223372036854775807", 77}, Case{"DRR? 1 9223372036854775807", 77},
         Case{"DRR? 1 1 1 2 1", 1}, Case{"DRR? 1 1 1 2 3 4 5 1 2 3 4 5 9", 1}}) {
     EXPECT_EQ(cmd(k.line), failed_answer(k.line)) << k.line;
     EXPECT_EQ(err(), k.error) << k.line;
   }
-  // Issue 27: a line naming 100 000 tables (or 2000 different numbers) is refused, not answered
+  // A line naming 100 000 tables (or 2000 different numbers) is refused, not answered
   // with as many columns.
   std::string many = "DRR? 1 1";
   for (int t = 0; t < 100000; ++t)
@@ -838,7 +838,7 @@ TEST_F(GcsInterpreterTest, WaveTablesAndGeneratorSettings) {
   EXPECT_EQ(cmd("WAV? 1 1"), "1 1=5\n");  // the failed definitions left it as it was
 }
 
-// Issue 30: pitools.writewavepoints writes a table in bunches, `WAV 1 X PNT 1 20 ...`, then
+// pitools.writewavepoints writes a table in bunches, `WAV 1 X PNT 1 20 ...`, then
 // `WAV 1 & PNT 21 20 ...` (newer releases name the table's next point; older ones 1).
 TEST_F(GcsInterpreterTest, AppendedBunchesNameTheTablesNextPointOrOne) {
   const auto bunch = [](const char* mode, int start, int first) {
@@ -950,7 +950,7 @@ TEST_F(GcsInterpreterTest, CountsSamplesAndDrops) {
   EXPECT_EQ(gcs_.stats().lines, 2u);
 }
 
-// Issue 30: what EPICS's motorPIGCS2 needs to drive this server as an E-727.
+// What EPICS's motorPIGCS2 needs to drive this server as an E-727.
 TEST_F(GcsInterpreterTest, IdentificationNamesTheE727AndWhatAnswers) {
   std::string idn = cmd("*IDN?");
   EXPECT_EQ(idn,

@@ -441,7 +441,7 @@ class TurnCountingHandler final : public LineHandler {
   int drr_last_turn_ = 0;
 };
 
-// Issue 17: one client sends 100 DRR? (each a full table of the recorder) and reads nothing; the
+// One client sends 100 DRR? (each a full table of the recorder) and reads nothing; the
 // POS? of another client right after must not wait for those answers to be made. Before the
 // per-client throttle the server made kLinesPerTurn (32) answers of the burst in one turn, and a
 // POS? arriving meanwhile waited for all of them. What is asserted is counted in the server's

@@ -11,7 +11,7 @@
 //   room       with the table full, a newcomer takes the place of the client whose line or
 //              request head has been incomplete longest (2 s at least: clients sending
 //              a byte every 0.9 s refused 196 of 198 newcomers), else of the client silent
-//              longest (issue 27: eight silent GCS clients locked everyone out for the 600 s idle
+//              longest (eight silent GCS clients once locked everyone out for the 600 s idle
 //              timeout); event streams leave slots for requests (sixteen streams made every
 //              other dashboard request a 503).
 // Descriptor exhaustion (the accept back-off) is pinned for both in line_server_test.cpp and
@@ -252,7 +252,7 @@ TEST(PollServerRefusal, LineConnectionBeyondMaxClientsIsCounted) {
   EXPECT_EQ(server.stats().accepted, 1u);
 }
 
-// Issue 27: eight GCS clients that connect and say nothing held every slot until the idle
+// Eight GCS clients that connect and say nothing once held every slot until the idle
 // timeout. Now a ninth takes the place of the one silent longest, the first.
 TEST(PollServerRoom, LineSilentClientsGiveWayToANewcomer) {
   LineCounting handler;
@@ -517,7 +517,7 @@ int open_stream(HttpConnection& c, std::uint16_t port) {
   return http_status(got);
 }
 
-// Issue 27: sixteen event streams, which never time out, made every other request a 503. Streams
+// Sixteen event streams, which never time out, once made every other request a 503. Streams
 // may take all but reserved_for_requests (2) of the 16 slots; a GET is answered beside them.
 TEST(PollServerRoom, HttpStreamsLeaveSlotsForRequests) {
   HttpCounting handler;

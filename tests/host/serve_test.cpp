@@ -133,7 +133,7 @@ TEST_F(Serve, EveryZUpToTheAdvertisedTravelIsReachedByOneMove) {
     EXPECT_NEAR(value_of(c.query_lines("POS?"), "Z"), z, 0.01);
   }
   // MOV Z alone, each time after a servo-on that takes the gauges' pose, their tilt noise too, as
-  // the target (issue 30: it was refused with 7 at the ends)
+  // the target (it was once refused with 7 at the ends)
   for (const double z : {z_max, z_min, 5.0, z_max}) {
     c.send("SVO Z 0 U 0 V 0");
     c.send("SVO Z 1 U 1 V 1");
@@ -420,7 +420,7 @@ TEST_F(Serve, SeveralClientsAtOnceEachWithItsOwnErrorQueue) {
   EXPECT_EQ(summary.at("clients_refused"), 1);
 }
 
-// Issue 30: a client that connects after a fault latched learns it as from a PI controller: its
+// A client that connects after a fault latched learns it as from a PI controller: its
 // first ERR? is -1024 (then 0), and SVO? answers 0.
 TEST_F(Serve, AClientConnectingAfterAFaultReadsItFromErr) {
   const std::uint16_t port = start({"--fault", "sgs-open@0.3:1"});
@@ -562,7 +562,7 @@ int wait_exit_or_kill(const Spawned& s, int limit_s) {
   return -2;
 }
 
-// Issue 17: a twin of 2e10 Hz physics spun for minutes past --duration-s and SIGTERM. Such a rate
+// A twin of 2e10 Hz physics once spun for minutes past --duration-s and SIGTERM. Such a rate
 // is refused by file and key; the heaviest accepted one (1e7 Hz, 10 000 physics steps per 1 ms
 // tick) honours both.
 TEST_F(Serve, HeaviestAcceptedTwinHonoursDurationAndSigterm) {
@@ -602,7 +602,7 @@ TEST_F(Serve, SafetySectionIsAppliedAndShown) {
   EXPECT_EQ(j.at("safety").at("max_consecutive_overruns"), 1000000);
 }
 
-// Issue 30: serve prints each fault on stderr when it latches, while it runs on, and its
+// serve prints each fault on stderr when it latches, while it runs on, and its
 // summaries (JSON and text) name every fault: rule, channel, time, value and limit.
 TEST_F(Serve, EveryFaultIsPrintedWhenItLatchesAndNamedInTheSummary) {
   ASSERT_NE(start({"--fault", "sgs-open@0.3:1"}), 0);

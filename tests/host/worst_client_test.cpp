@@ -1,4 +1,4 @@
-// Issue 27's done-when for the servers: while one client sends the worst input it can within the
+// The servers' promise under attack: while one client sends the worst input it can within the
 // limits, every other client's POS? is answered after at most two turns of the attacker's work,
 // and no turn holds the interpreter (hence its mutex, which the dashboard shares) for more than a
 // bounded amount of work. Counted in turns and bytes of answers made, never timed (the machine
@@ -211,7 +211,7 @@ TEST(WorstClient, GcsFloodDelaysAnotherClientsPosByAtMostTwoTurns) {
   EXPECT_GT(counting.pos_beside_the_flood.load(), 0);
   EXPECT_LE(counting.most_in_one_round, kTurnBytes);
   EXPECT_LE(counting.most_before_a_pos, 2 * kTurnBytes);
-  // Before issue 27's parts, one DRR? alone was a turn of 1.18 MB.
+  // Before answers were made in parts, one DRR? alone was a turn of 1.18 MB.
   EXPECT_GT(counting.most_in_one_round, LineServerLimits{}.output_high_water_bytes / 2);
 }
 
@@ -263,7 +263,7 @@ HttpRequest post(std::uint64_t client, const std::string& body) {
   return r;
 }
 
-// Issue 27: one 8 kB POST of GCS lines held the interpreter for 1.44 s. Now it runs in turns of
+// One 8 kB POST of GCS lines once held the interpreter for 1.44 s. Now it runs in turns of
 // at most kTurnBytes of answers, and a GCS client's line runs between any two.
 TEST(WorstClient, DashboardPostRunsInTurnsOfBoundedWork) {
   FullRecorder recorder;

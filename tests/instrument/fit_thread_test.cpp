@@ -1,4 +1,4 @@
-// instrument::FitThread: the fringe lock's fit beside the loop's ticks (issue 29).
+// instrument::FitThread: the fringe lock's fit beside the loop's ticks.
 #include "piezoshift/instrument/fit_thread.hpp"
 
 #include <gtest/gtest.h>

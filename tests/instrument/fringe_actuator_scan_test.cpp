@@ -290,7 +290,7 @@ TEST(FringeActuatorScanTest, ThreeScansGiveTheTransmissionMatrix) {
       "plant's %.5f; %.1f s simulated, %.1f s wall (XL-80 stage 2 %.1f s simulated)\n",
       worst(f.a, paper), worst(f.a, x.fit.a), worst(x.fit.a, paper), fa.poses,
       1000.0 * fa.rms_residual_um, worst(fa.a, paper), sim_s, wall_s, x.simulated_time_s);
-  // issue 29's done-when band for A (measured 0.00096 and 0.00120)
+  // the acceptance band for A from fringes (measured 0.00096 and 0.00120)
   EXPECT_LT(worst(f.a, paper), 0.002);
   EXPECT_LT(worst(f.a, x.fit.a), 0.002);
   EXPECT_LT(sim_s, x.simulated_time_s);

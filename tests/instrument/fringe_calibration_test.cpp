@@ -1,7 +1,7 @@
 // The paper's calibration with the Fizeau's fringes as the interferometer
 // (fringe_calibration.hpp), through the shipping loop on the simulated bench with the twin camera,
 // against the plant's own A and against the XL-80's calibration (calibration::calibrate) on the
-// same seed: issue 29's "calibration from fringes" done-when, on three plants.
+// same seed: the acceptance figures of the calibration from fringes, on three plants.
 #include <gtest/gtest.h>
 
 #include <algorithm>
@@ -160,8 +160,8 @@ std::optional<SeedFigures> one_seed(const Plant& pl, std::uint64_t seed) {
 
 class FringeCalibrationPlants : public ::testing::TestWithParam<int> {};
 
-// Seeds 1 to 8 (issue 29's medians), seed 1 held to the band on its own too. Table 4 (issue 29's
-// done-when): the median of each figure of the paper's controller calibrated from fringes lies
+// Seeds 1 to 8 (the acceptance figures are medians), seed 1 held to the band on its own too.
+// Table 4: the median of each figure of the paper's controller calibrated from fringes lies
 // within the same controller's spread over the same seeds calibrated with the XL-80 (its smallest
 // to largest).
 TEST_P(FringeCalibrationPlants, AWithinTheBandAndTable4WithinTheXl80sSpreadInLessTime) {
@@ -188,7 +188,7 @@ TEST_P(FringeCalibrationPlants, AWithinTheBandAndTable4WithinTheXl80sSpreadInLes
       xv[k].push_back(r.x_table4.v[k]);
     }
     if (seed == 1) {
-      EXPECT_LT(r.f_err, 0.002);  // issue 29's band, on seed 1 alone
+      EXPECT_LT(r.f_err, 0.002);  // A within 0.002 of the plant's, on seed 1 alone
       // p: the XL-80's curve within 15 nm over the 11 um span (0.14 %; measured 1.6 to 2.9 nm
       // on seed 1, docs/fizeau.md)
       EXPECT_LT(r.p_nm, 15.0);
@@ -200,7 +200,7 @@ TEST_P(FringeCalibrationPlants, AWithinTheBandAndTable4WithinTheXl80sSpreadInLes
       pl.name.c_str(), median(f_err), *std::max_element(f_err.begin(), f_err.end()), median(x_err),
       *std::max_element(x_err.begin(), x_err.end()), median(p_nm),
       *std::max_element(p_nm.begin(), p_nm.end()));
-  EXPECT_LT(median(f_err), 0.002);  // issue 29's done-when: the median over seeds 1 to 8
+  EXPECT_LT(median(f_err), 0.002);  // the acceptance figure: the median over seeds 1 to 8
   const char* names[4] = {"11 um step settling [s]", "linearity, zero-end [%]",
                           "repeatability at 5 um [nm]", "repeatability at 10 um [nm]"};
   for (std::size_t k = 0; k < 4; ++k) {

@@ -146,8 +146,8 @@ TEST(ConfigFile, UnknownKeyAndUnknownSection) {
   EXPECT_TRUE(contains(error_of([&] { root.reject_unknown(); }), "stray: unknown key"));
 }
 
-// Issue 27: a quoted key with dots is one key of that name. Beside the setting whose path it
-// spells, it passed as that setting (its value never read, nothing said).
+// A quoted key with dots is one key of that name. Beside the setting whose path it
+// spells, it once passed as that setting (its value never read, nothing said).
 TEST(ConfigFile, AQuotedDottedKeyIsRefusedEvenBesideTheSettingItSpells) {
   const std::string text = "\"twin.daq.sample_time_s\" = \"x\"\n[twin.daq]\nsample_time_s = 1e-4\n";
   const ConfigFile f = ConfigFile::parse(text, "q.toml");
@@ -301,7 +301,7 @@ TEST_F(ConfigFileOnDisk, MissingFileIsAnInputError) {
   EXPECT_TRUE(contains(m, "cannot open: No such file or directory")) << m;
 }
 
-// Issue 17: a directory read as an empty file (every key silently defaulted), a FIFO blocked or
+// A directory once read as an empty file (every key silently defaulted), a FIFO blocked or
 // streamed without end; both are refused at once, and so is a file above the limit.
 TEST_F(ConfigFileOnDisk, OnlyABoundedRegularFileIsRead) {
   std::string m = error_of([&] { ConfigFile::load(dir_.string()); });

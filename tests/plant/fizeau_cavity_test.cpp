@@ -173,7 +173,7 @@ HoldStatistics simulate_holds(const LabParams& lab, const CavityParams& c, doubl
   return {m, std::sqrt(v / static_cast<double>(ms.size()))};
 }
 
-// The figure a fringe lock must beat (issue 29): the rms of d_c over a 60 s hold on the default
+// The figure a fringe lock must beat: the rms of d_c over a 60 s hold on the default
 // lab, at the twin's 1 kHz. The band is 4 standard errors of the seeds' mean (the estimate's own
 // spread, measured from the same seeds): about +-25 % of the mean square (+-12 % of the rms) with
 // 400 seeds, whose holds' mean squares spread by about 1.3 times their mean.

@@ -90,7 +90,7 @@ TEST(Hysteresis, SweepAgreesWithTheOperatorUpdateOnRandomMonotoneRuns) {
   }
 }
 
-// Issue 17: an input beyond every breakpoint (infinite, as a denormal output_max_V made it) used to
+// An input beyond every breakpoint (infinite, as a denormal output_max_V made it) used to
 // pass the last breakpoint's sentinel forever; the sweep stops after the last operator.
 TEST(Hysteresis, SweepTerminatesOnAnInfiniteInput) {
   const PrandtlIshlinskii pi(HysteresisParams{0.125, 8}, 150.0);

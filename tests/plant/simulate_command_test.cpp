@@ -43,7 +43,7 @@ TEST_F(SimulateCommand, StepWithThePapersControllerLogsEveryTickWithUnits) {
   EXPECT_EQ(j["ticks"], 500);
   // As `run`: without --calibration the twin is calibrated first by the paper's procedure, so
   // the points reach Z_d = 5 um but for the twin's noise and what creep is left after 0.5 s
-  // (measured 4.9955 to 5.0028 um). Until issue 34, simulate ran the paper's own A and p here and
+  // (measured 4.9955 to 5.0028 um). Simulate once ran the paper's own A and p here and
   // ended 0.31 um high (the test below keeps that case).
   EXPECT_NE(j["calibration"].get<std::string>().find("the twin's own calibration"),
             std::string::npos);
@@ -142,7 +142,7 @@ TEST_F(SimulateCommand, BadInputExitsTwoWithAClearMessage) {
   EXPECT_NE(r.err.find("p.csv:3"), std::string::npos) << r.err;
 }
 
-// Issue 17: a simulation's cost is estimated before it starts and refused above the budget unless
+// A simulation's cost is estimated before it starts and refused above the budget unless
 // the budget is raised explicitly; values beyond the twin's ranges name the file, line and key.
 TEST_F(SimulateCommand, CostIsEstimatedAndRefusedAboveTheBudgetUnlessRaised) {
   RunResult r = run("--step-um 5 --duration-s 1e308");

@@ -85,7 +85,7 @@ TEST(TwinConfig, BadValuesAreRefusedByName) {
       std::string::npos);
 }
 
-// Issue 17: values that made the twin allocate without bound (bad_alloc), run without bound or loop
+// Values that made the twin allocate without bound (bad_alloc), run without bound or loop
 // forever are refused by the reader with the file, line, column and key.
 TEST(TwinConfig, ValuesBeyondTheTwinsBoundsAreRefusedWithFileLineAndKey) {
   std::string m = error_for("f.toml", "[twin]\nphysics_rate_Hz = 2e12\n");

@@ -166,7 +166,7 @@ std::string input_error(F&& f) {
   return "";
 }
 
-// Issue 27: 150 copies of one PNG ended `psi analyze` in std::bad_alloc. The count is refused
+// 150 copies of one PNG once ended `psi analyze` in std::bad_alloc. The count is refused
 // before any file is read (the paths here do not exist), the pixels after the first frame only.
 TEST(FrameSetTest, CountIsRefusedBeforeAnyFileIsRead) {
   const std::vector<std::string> many(kMaxFrames + 1, "/nonexistent/f.png");

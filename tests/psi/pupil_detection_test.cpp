@@ -1,4 +1,4 @@
-// The pupil found from the frames' fringe modulation when no mask is given (issue 28).
+// The pupil found from the frames' fringe modulation when no mask is given.
 #include "piezoshift/psi/pupil_detection.hpp"
 
 #include <gtest/gtest.h>

@@ -1,4 +1,4 @@
-// Tilt-aware AIA on frames made independently of the algorithm's model (issue 28): a fringe
+// Tilt-aware AIA on frames made independently of the algorithm's model: a fringe
 // generator of its own (cos of the surface's phase + each frame's piston and tilt plane, Gaussian
 // noise from std::mt19937), not psi::render_frame, and not the algorithm's pupil coordinates.
 #include <gtest/gtest.h>
@@ -173,12 +173,12 @@ TEST(TiltAiaIndependentTest, OneSequenceReachesItsNoiseFloor) {
   EXPECT_NEAR(o.tilt.noise_rms, o.tilt.residual_rms, 0.0005);
 }
 
-// Issue 28's acceptance: 20 seeded sequences, 256 px pupil, steps k pi/2 plus errors of 0.2 rad
-// std (truncated at 0.4), each frame tilted by up to 1 rad at the pupil edge in any direction:
-// tilt-aia within 2 x its noise floor on every one, or not converged; never converged on a
-// surface worse than the 5-frame's. Measured: all 20 converged at 1.000 x the floor (0.41 to
-// 0.49 nm), the 5-frame 2.4 to 9.6 nm. So that the test cannot pass by giving up, at least 18 of
-// the 20 must converge.
+// The acceptance figure of tilt-aware AIA: 20 seeded sequences, 256 px pupil, steps k pi/2 plus
+// errors of 0.2 rad std (truncated at 0.4), each frame tilted by up to 1 rad at the pupil edge in
+// any direction: tilt-aia within 2 x its noise floor on every one, or not converged; never
+// converged on a surface worse than the 5-frame's. Measured: all 20 converged at 1.000 x the floor
+// (0.41 to 0.49 nm), the 5-frame 2.4 to 9.6 nm. So that the test cannot pass by giving up, at least
+// 18 of the 20 must converge.
 TEST(TiltAiaIndependentTest, TwentySeededSequencesReachTheFloorOrSayNot) {
   int converged = 0;
   double worst_ratio = 0.0;

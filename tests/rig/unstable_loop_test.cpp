@@ -1,4 +1,4 @@
-// A loop calibrated outside its stable region (issue 27): kp 5, ki 3, kd 2 ran `run --step-um 5`
+// A loop calibrated outside its stable region: kp 5, ki 3, kd 2 ran `run --step-um 5`
 // with one point of the plate swinging between 2.3 and 7.0 um and no fault. Such gains are
 // refused at load (tests/calibration/controller_ranges_test.cpp); set anyway, the supervisor's
 // oscillation rule trips within a stated time, on the shipping loop.

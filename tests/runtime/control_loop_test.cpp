@@ -162,7 +162,7 @@ TEST(ControlLoop, ExplicitClearResumesControl) {
   EXPECT_LE(r.max_output_slew_V_per_ms, 1.5 + 1e-9);
 }
 
-// Issue 30: every latch is kept, a cleared fault and the next one are two entries, each with its
+// Every latch is kept, a cleared fault and the next one are two entries, each with its
 // scheduled time, and each is published to the status for the host's reporter.
 TEST(ControlLoop, EveryLatchedFaultIsKeptAndPublished) {
   FakeBackend daq;
@@ -197,7 +197,7 @@ TEST(ControlLoop, EveryLatchedFaultIsKeptAndPublished) {
   EXPECT_EQ(r.fault.tick, 400U) << "LoopResult::fault: the one latched at the end";
 }
 
-// Issue 30: an overrun trip carries the worst lateness of its overruns. The burst's ticks take
+// An overrun trip carries the worst lateness of its overruns. The burst's ticks take
 // 1.5 periods each: 0.5 ms past the next deadline, and each skips a slot, so the latch at tick
 // 103 is scheduled at 106 ms.
 TEST(ControlLoop, AnOverrunTripCarriesItsWorstLateness) {

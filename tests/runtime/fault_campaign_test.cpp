@@ -197,7 +197,7 @@ TEST(FaultCampaign, EveryFaultIsCaughtWithinItsStatedLatencyAndOutputsStayInLimi
   }
 }
 
-// Issue 17: after a long stall the twin advanced every missed period, so a twin slower than real
+// After a long stall the twin once advanced every missed period, so a twin slower than real
 // time made each tick longer than the last and never caught up; a read advances at most
 // kMaxCatchUpPeriods.
 TEST(SimBackendCatchUp, ALateTickAdvancesAtMostTheCatchUpLimit) {

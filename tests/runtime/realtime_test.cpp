@@ -1,6 +1,6 @@
 // runtime::keep_off_cpu: `serve` takes the loop's CPU out of its network threads' CPUs, so that
-// no client's work competes with the loop for it (issue 27). runtime::leave_loop_scheduling: a
-// worker the loop's thread starts leaves the CPU it inherited (issue 29: the fringe lock's fit).
+// no client's work competes with the loop for it. runtime::leave_loop_scheduling: a
+// worker the loop's thread starts leaves the CPU it inherited (the fringe lock's fit).
 #include <gtest/gtest.h>
 #include <pthread.h>
 #include <sched.h>

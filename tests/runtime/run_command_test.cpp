@@ -142,7 +142,7 @@ TEST_F(RunCommand, InjectedFaultIsReportedWithItsLatencyAndExit3) {
   }
 }
 
-// Issue 30: every fault is named by its rule, channel, time and the value that tripped it
+// Every fault is named by its rule, channel, time and the value that tripped it
 // against its limit, with their unit: on stderr as it latches (no --log needed) and in both
 // summaries.
 TEST_F(RunCommand, EveryFaultIsNamedWithItsRuleChannelTimeValueAndLimit) {
@@ -180,7 +180,7 @@ TEST_F(RunCommand, EveryFaultIsNamedWithItsRuleChannelTimeValueAndLimit) {
   EXPECT_FALSE(f.contains("load_average")) << "only an overrun trip names the load";
 }
 
-// Issue 30: on the twin a late host is counted and reported, not a fault, unless [safety] asks
+// On the twin a late host is counted and reported, not a fault, unless [safety] asks
 // (trip_on_overruns: 0 never, 1 always, 2 on hardware only, the default). The burst makes five
 // ticks of 1.5 periods each on the simulated clock: deterministic lateness.
 TEST_F(RunCommand, OnTheTwinOverrunsAreCountedNotTrippedByDefault) {
@@ -204,7 +204,7 @@ TEST_F(RunCommand, OnTheTwinOverrunsAreCountedNotTrippedByDefault) {
   EXPECT_NE(slurp(path("err2")).find("trip_on_overruns"), std::string::npos) << slurp(path("err2"));
 }
 
-// Issue 30: an overrun trip names its rule (the count against its limit), the worst lateness and
+// An overrun trip names its rule (the count against its limit), the worst lateness and
 // the machine's load. On the simulated clock the burst's ticks each take 1.5 periods: 500 us
 // past the next deadline, three in a row. The twin trips on them only when [safety] asks.
 TEST_F(RunCommand, AnOverrunTripNamesItsRuleLatenessAndTheLoad) {

@@ -28,7 +28,7 @@ TEST(SafetyRanges, DefaultsAreInRangeAndEveryLimitIsListed) {
   int n = 0;
   SafetyLimits l;
   visit_safety_limits(l, [&](const char*, const char*, auto&, core::Bounds) { ++n; });
-  EXPECT_EQ(n, 23);  // every field of SafetyLimits (trip_on_overruns the 23rd, issue 30)
+  EXPECT_EQ(n, 23);  // every field of SafetyLimits (trip_on_overruns the 23rd)
 }
 
 TEST(SafetyRanges, SectionSetsLimitsAndRefusesOutOfRangeAndContradictions) {

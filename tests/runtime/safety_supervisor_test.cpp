@@ -249,7 +249,7 @@ TEST(SafetySupervisor, ThreeConsecutiveOverrunsLatch) {
   EXPECT_EQ(s.fault().value, 3.0);
 }
 
-// Issue 30: with trip_on_overruns never (the twin's default in run and serve) a late host is
+// With trip_on_overruns never (the twin's default in run and serve) a late host is
 // counted, not a fault; "on hardware" is "always" to the supervisor.
 TEST(SafetySupervisor, OverrunsTripOnlyWhereTheLimitsAskForIt) {
   for (const std::uint32_t mode : {kOverrunTripNever, kOverrunTripAlways, kOverrunTripOnHardware}) {
@@ -420,7 +420,7 @@ TEST(SafetySupervisor, AnOscillatingTrackingErrorLatchesOscillation) {
   std::uint64_t k = 0;
   for (; k < 200 && !s.faulted(); ++k) {
     in.tick = k;
-    // y swings +-0.4 um about S every 2 ticks (the limit cycle kp 5, ki 3, kd 2 ran in, issue 27,
+    // y swings +-0.4 um about S every 2 ticks (the limit cycle kp 5, ki 3, kd 2 ran in
     // swung 2.4 um at 250 Hz); |S - y| stays below the tracking rule's 1 um.
     const double y = 3.5 + ((k / 2) % 2 == 0 ? 0.4 : -0.4);
     in.feedback_um = control::filled(y);

@@ -130,7 +130,7 @@ TEST_F(AtomicFileTest, ReplacesContentAndLeavesNoTemporary) {
   EXPECT_EQ(files, 1);
 }
 
-// Issue 17: `calibrate` killed during its write left ".cal.toml.tmp.PID" behind; the next write
+// `calibrate` killed during its write once left ".cal.toml.tmp.PID" behind; the next write
 // removes the temporaries of dead processes and leaves a live writer's alone.
 TEST_F(AtomicFileTest, NextWriteRemovesTheTemporaryOfAKilledWriterOnly) {
   const pid_t child = ::fork();
@@ -148,7 +148,7 @@ TEST_F(AtomicFileTest, NextWriteRemovesTheTemporaryOfAKilledWriterOnly) {
   EXPECT_EQ(read_text(path("cal.toml")), "new\n");
 }
 
-// Issue 27: a symlink planted at the temporary's name made the write go through it to the file it
+// A symlink planted at the temporary's name once made the write go through it to the file it
 // pointed to. The link is removed, its target left as it was, and the file written.
 TEST_F(AtomicFileTest, APlantedSymlinkAtTheTemporarysNameIsNotWrittenThrough) {
   const std::string victim = write("victim.txt", "precious\n");

@@ -1,7 +1,7 @@
 #pragma once
-// Checks on the text of a figure as gnuplot's svg terminal writes it (issue 32): no two pieces
-// of text overlap, every axis label carries a unit, and no unit is spelt in ASCII ("um", "+-",
-// "lambda") where the symbol belongs.
+// Checks on the text of a figure as gnuplot's svg terminal writes it (docs/figures.md): no two
+// pieces of text overlap, every axis label carries a unit, and no unit is spelt in ASCII ("um",
+// "+-", "lambda") where the symbol belongs.
 //
 // gnuplot writes each piece of text as
 //   <g transform="translate(X,Y) [rotate(A)]" ... font-size="S" text-anchor="start|middle|end">

@@ -1,6 +1,6 @@
 #pragma once
 // The PID gains a procedure holds its poses with, chosen on the plant before the procedure
-// excites it (issue 31). The paper's gains are per sample at 1 ms; re-expressed at another rate
+// excites it. The paper's gains are per sample at 1 ms; re-expressed at another rate
 // (10 kHz) they keep the continuous controller they stand for, whose gain reaches up to the
 // plate's mode; a heavier or thicker plate brings that mode down to where the gauges see it, and
 // the loop rings up at the mode (a 20 mm plate at 10 kHz: +7 % per 2 ms from a 0.3 um step). A

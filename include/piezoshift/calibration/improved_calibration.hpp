@@ -4,7 +4,7 @@
 // own:
 //   0.   the inner loop identified open loop at the loop's rate, and the PID gains stages 1 to 3
 //        hold with chosen on it: the paper's when their margins there suffice, else scaled down
-//        (holding_gains.hpp; issue 31: at 10 kHz a thicker plate's mode made the paper's
+//        (holding_gains.hpp: at 10 kHz a thicker plate's mode made the paper's
 //        re-expressed gains unstable and stage 2 tripped the supervisor)       seed + 6
 //   1-3. the paper's procedure (calibration_procedure.hpp): A and p, the gauge-to-plate map the
 //        improved controller keeps as its feedforward          seeds seed .. seed + 2
@@ -15,9 +15,9 @@
 //        Prony's method; it sets the shaper's taps                  seed + 5
 //   6.   the correction loop's integral gain for a chosen bandwidth, and the rate limit from the
 //        amplifier's slew (its current limit into the stack's capacitance).
-//   7.   large moves tried both ways on the plant (issue 31): the 11 um step with the slew path
+//   7.   large moves tried both ways on the plant: the 11 um step with the slew path
 //        and with the shaper alone, the plate's overshoot read by the interferometer's dynamic
-//        samples; the slew path kept when they read under half of issue 31's 1 % or no more
+//        samples; the slew path kept when they read under half the 1 % overshoot allowed or no more
 //        than the shaper alone's, else turned off. The slew's stop leaves a ring whose phase is
 //        set by the plate's true mode, which the 1 kHz fold of stage 5 does not give
 //        (docs/control.md, "Large moves")                           seed + 7
@@ -56,15 +56,15 @@ struct ImprovedCalibrationOptions {
   HoldingGainsOptions holding{};   //!< stage 0
   //! Stage 7: Table 4's 11 um step (the paper's), from 0 after large_move_pre_s, recorded for
   //! large_move_record_s; the slew path kept when the samples read its overshoot under
-  //! large_move_keep_below_pct: half issue 31's 1 %, because the 1 kHz samples read a ring's
-  //! peak low, at 0.17 to 0.94 of the plate's true overshoot (seed 1, six plants:
+  //! large_move_keep_below_pct: half the 1 % overshoot allowed, because the 1 kHz samples read a
+  //! ring's peak low, at 0.17 to 0.94 of the plate's true overshoot (seed 1, six plants:
   //! docs/control.md), or when they read it no larger than the shaper alone's.
   double large_move_trial_um = 11.0;
   double large_move_pre_s = 0.3;
   double large_move_record_s = 0.2;
   double large_move_keep_below_pct = 0.5;
   //! Stages 5 and 7 read the laser interferometer's dynamic samples (the XL-80's, at the loop's
-  //! rate). false: there is none (the calibration from fringes, issue 29: a camera's 78 frames/s
+  //! rate). false: there is none (the calibration from fringes: a camera's 78 frames/s
   //! cannot sample the plate's kHz mode): no mode nulled (shaped false, the rate limit alone)
   //! and the slew path as stage 6 designs it, not tried.
   bool dynamic_interferometer = true;

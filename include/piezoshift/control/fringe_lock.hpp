@@ -1,5 +1,5 @@
 #pragma once
-// The fringe lock (issue 29): an outer loop at the camera's frame rate that holds the Fizeau
+// The fringe lock (docs/fizeau.md): an outer loop at the camera's frame rate that holds the Fizeau
 // cavity's optical path and the reference plate's tip and tilt on their set points, from the
 // fringes, by correcting the pose the semi-closed loop holds. The gauges cannot see the cavity's
 // drift (the air's index, the mount: plant/fizeau_cavity.hpp) nor their own excitation drift; the

@@ -1,5 +1,5 @@
 #pragma once
-// A second-order notch on a sampled signal, unit gain at DC (issue 31: compare's oracle takes the
+// A second-order notch on a sampled signal, unit gain at DC (compare's oracle takes the
 // plate's lightly damped mode out of its feedback where its ring test finds the PID rings there):
 //
 //   H(z) = g (1 - 2 cos(theta) z^-1 + z^-2) / (1 - 2 r cos(theta) z^-1 + r^2 z^-2)

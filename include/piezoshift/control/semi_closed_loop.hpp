@@ -8,8 +8,8 @@
 // Z_d are the desired displacements of the measurement points P1..P3 (um). update_actuators()
 // skips the feedforward and takes actuator targets S directly (calibration stages 1 and 2).
 //
-// The improved controller (kind = kImproved, issue 12) keeps the feedforward S = A p(Z_d) and
-// replaces the PID of each channel by
+// The improved controller (kind = kImproved, docs/control.md) keeps the feedforward S = A p(Z_d)
+// and replaces the PID of each channel by
 //   r   = shaper(S_i)                  rate limit at the amplifier's slew, mode-cancelling taps
 //   e   = r(k - D) - y                 the model's error, D = the loop's delay
 //   c  += ki_e e, |c| <= limit          slow integral correction; ki_e = ki, raised in proportion
@@ -25,7 +25,7 @@
 // towards model^-1(S_i + c), unshaped: a DAQ step of the full slew keeps the current-limited
 // amplifier slewing through the tick, where smaller shaped steps make it slew and pause every
 // tick, which rings the plate's mode; slew_approach_um before the target the shaper takes over
-// from where the slew left (issue 31).
+// from where the slew left (docs/control.md, "Large moves").
 //
 // Real-time safe: no heap, no exceptions, no I/O; every member is noexcept. Templated on the
 // scalar type (see vec3.hpp): SemiClosedLoopController is the double one, the firmware runs
@@ -45,7 +45,7 @@ namespace piezoshift::control {
 
 enum class ControllerKind : std::uint8_t {
   kPaper,     //!< the paper's PIDs (Eqs. 6, 7)
-  kImproved,  //!< model inverse, shaping and a slow correction (issue 12)
+  kImproved,  //!< model inverse, shaping and a slow correction
 };
 
 inline constexpr std::size_t kMaxReferenceDelayTicks = 8;
@@ -71,7 +71,7 @@ struct BasicImprovedParams {
   //! Large moves at the slew limit (0: off, the shaper makes every move): a move of more than
   //! twice slew_approach_um is made by the command stepping this fast (um of command per second,
   //! at most what the supervisor passes) until the target is slew_approach_um away, then the
-  //! shaper makes the rest (issue 31; docs/control.md, "Large moves").
+  //! shaper makes the rest (docs/control.md, "Large moves").
   T command_slew_um_per_s = T(0);
   T slew_approach_um = T(1);  //!< SGS um
 };

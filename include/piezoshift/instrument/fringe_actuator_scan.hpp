@@ -1,6 +1,6 @@
 #pragma once
-// One actuator's calibration scan read from the Fizeau's fringes instead of the XL-80 (issue 29,
-// the first slice of "calibration from fringes"): the inner loops alone (DriveMode::kActuators,
+// One actuator's calibration scan read from the Fizeau's fringes instead of the XL-80 (the
+// first slice of "calibration from fringes"): the inner loops alone (DriveMode::kActuators,
 // as the paper's calibration moves one actuator at a time), the camera exposing at each settled
 // pose, psi::FringeTracker giving P1..P3 of every frame relative to the first.
 //

@@ -1,6 +1,6 @@
 #pragma once
 // The paper's three calibration stages (calibration/calibration_procedure.hpp) with the Fizeau's
-// fringes as the interferometer instead of the XL-80 (issue 29, "calibration from fringes";
+// fringes as the interferometer instead of the XL-80 ("calibration from fringes", docs/fizeau.md;
 // `piezoshift calibrate --interferometer fizeau --camera twin`):
 //   1. PID gains  calibration::tune_pid, unchanged: it reads the gauges, no interferometer
 //   2. matrix A   one fringe actuator scan per actuator (fringe_actuator_scan.hpp) on one

@@ -1,5 +1,5 @@
 #pragma once
-// The fringe lock in a phase-shifting sequence (issue 29): the sequence's own frames hold the
+// The fringe lock in a phase-shifting sequence (docs/fizeau.md): the sequence's own frames hold the
 // Fizeau cavity, so its steps are made relative to the locked cavity and not to the gauges.
 //
 //   the reference: the first average's first frames, at steps 0, pi/2, pi, 3 pi/2 (and 2 pi)

@@ -1,5 +1,5 @@
 #pragma once
-// Calibration stage 3's motion read from the Fizeau's fringes instead of the XL-80 (issue 29):
+// Calibration stage 3's motion read from the Fizeau's fringes instead of the XL-80:
 // the full controller (drive_points, with the gains and A found and p the identity, as stage 3
 // runs) moves the three points together from 0 to max_um, the camera exposing at each settled
 // pose and psi::FringeTracker giving P1..P3 of every frame relative to the first.

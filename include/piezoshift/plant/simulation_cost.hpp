@@ -1,6 +1,6 @@
 #pragma once
 // What a simulation of the twin will cost, estimated before it starts, and the budget it must fit
-// (issue 17: a config or a duration must not start a run that takes hours or exhausts memory).
+// (a config or a duration must not start a run that takes hours or exhausts memory).
 // The twin's memory does not grow with the run (one buffer of kMaxPhysicsStepsPerTick forces at
 // most, twin_ranges.hpp; 6 MB resident measured), so the cost is time: physics steps, measured at
 // 57 ns (1e7 Hz physics) to 94 ns (the default 20 kHz, with the per-tick work) each on a shared

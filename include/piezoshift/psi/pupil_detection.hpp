@@ -1,5 +1,5 @@
 #pragma once
-// The pupil found from the frames' fringe modulation, for frames given without a mask (issue 28:
+// The pupil found from the frames' fringe modulation, for frames given without a mask (when
 // analysed whole, the unmodulated background pulled AIA's steps 0.47 rad off and the PVr from
 // 258 to 305 nm).
 //   modulation m(pixel) = the temporal standard deviation of the frames at that pixel

@@ -1,7 +1,7 @@
 #pragma once
 // What a procedure on the simulated bench will cost, estimated before it starts, against the
-// budget `simulate` already keeps (plant/simulation_cost.hpp; issue 27: an in-range setting such
-// as static_average_s = 1e6 must not start a calibration that takes 28 hours).
+// budget `simulate` already keeps (plant/simulation_cost.hpp): an in-range setting such
+// as static_average_s = 1e6 must not start a calibration that takes 28 hours.
 //
 // A procedure's simulated time is fixed_s plus window_s per second of the interferometer's
 // static window (static_average_s): each static measurement waits for the next whole window,

@@ -14,9 +14,9 @@
 // result. That is the floor no controller fed by the gauges can beat. Labelled impossible on
 // hardware wherever it is reported.
 //
-// notches (issue 31): where the PID closed on the plate rings at the plate's modes, compare's
-// oracle may take them out of its feedback (control/notch_filter.hpp, in series per channel, on
-// A z_true); by default there is none and the feedback is the plate's as above.
+// notches (docs/control.md): where the PID closed on the plate rings at the plate's modes,
+// compare's oracle may take them out of its feedback (control/notch_filter.hpp, in series per
+// channel, on A z_true); by default there is none and the feedback is the plate's as above.
 //
 // read()/write()/truth() are real-time safe, like the twin's.
 #include <array>

@@ -1,5 +1,5 @@
 #pragma once
-// A tolerance study as one runs it (issue 33, docs/tolerance.md): its inputs loaded (the
+// A tolerance study as one runs it (docs/tolerance.md): its inputs loaded (the
 // tolerances, the nominal configuration, the spec), its samples run and recorded one file each
 // (so an interrupted run resumes from what it has), and its outputs written. `piezoshift
 // tolerance` runs the samples on local threads; the Python API (python/piezoshift/tolerance.py)

@@ -1,5 +1,5 @@
 #pragma once
-// Tolerances as data (issue 33): a TOML file naming parameters of the design and the twin by
+// Tolerances as data: a TOML file naming parameters of the design and the twin by
 // their configuration keys, each with a distribution of its deviation from the nominal value and
 // the source of that tolerance (docs/tolerance.md):
 //

@@ -1,5 +1,5 @@
 #pragma once
-// One sample of a tolerance study (issue 33, docs/tolerance.md): a plant drawn from the
+// One sample of a tolerance study (docs/tolerance.md): a plant drawn from the
 // tolerances, its design evaluated (Eqs. 1-4: first mode, hinge stress), its twin calibrated by
 // the chosen procedure and measured by a quick experiment set, each through the machinery
 // `reproduce` and `compare` use (calibration::calibrate or calibrate_improved, then the

@@ -1,5 +1,5 @@
 #pragma once
-// A tolerance study's results (issue 33, docs/tolerance.md): the spec and the yield against it,
+// A tolerance study's results (docs/tolerance.md): the spec and the yield against it,
 // the worst samples, the sensitivity table, and the files: tolerance.json (the study, every
 // sample, the yield and the worst samples; no wall times, so the same study gives the same bytes
 // whatever the number of jobs or shards), tolerance.csv, a per-sample record for resuming, and
