@@ -1,10 +1,9 @@
 #pragma once
-// The reference plate's pose, frame by frame, from the Fizeau camera alone (the first
-// piece of "calibration from fringes", docs/fizeau.md): fed frames in order, each at a new, unknown
-// pose of the plate against a fixed test surface, it returns each frame's piston, tip and tilt
-// relative to the first frame, and the displacements of the measurement points P1..P3 (paper, Fig.
-// 7, the three points the XL-80 reads for Eq. 8) through the rigid plate (kinematics/tripod.hpp,
-// Eq. 5).
+// The reference plate's pose, frame by frame, from the Fizeau camera alone (the first piece of
+// "calibration from fringes"): fed frames in order, each at a new, unknown pose of the plate
+// against a fixed test surface, it returns each frame's piston, tip and tilt relative to the
+// first frame, and the displacements of the measurement points P1..P3 (paper, Fig. 7, the
+// three points the XL-80 reads for Eq. 8) through the rigid plate (kinematics/tripod.hpp, Eq. 5).
 //
 // Method: tilt-aware AIA (phase_algorithms.hpp) on the first W frames gives the reference
 // phase; every later frame is then located against it, frame k being
