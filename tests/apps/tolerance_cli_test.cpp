@@ -1,6 +1,6 @@
 // `piezoshift tolerance` as a user runs it: the same study on one thread, two threads
 // and two shards merged gives the same bytes; an interrupted run resumes; bad files exit 2. Six
-// samples keep it short under the sanitizers; the 16-sample study of the issue, with a Dask
+// samples keep it short under the sanitizers; the 16-sample study, with a Dask
 // cluster besides, is python/tests_dask.
 #include <filesystem>
 #include <set>

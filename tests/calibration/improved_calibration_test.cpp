@@ -1,7 +1,7 @@
 // The improved controller (docs/control.md), calibrated by its own procedure on the twin and judged
 // through the shipping loop beside the paper's controller calibrated on the same plant: the
 // lambda/8 phase step (1 ms exposures of the true plate) and the 11 um step. Figures in
-// docs/control.md; the issue's targets not met are listed there.
+// docs/control.md; the targets not met are listed there.
 #include <gtest/gtest.h>
 
 #include "piezoshift/calibration/calibration_file.hpp"
@@ -53,12 +53,12 @@ TEST(ImprovedController, OnTheDefaultTwinItHoldsQuieterAndSettlesFaster) {
   }
   const PhaseSteps p = phase_steps(config, c, 1);
   ASSERT_TRUE(p.improved.validity.valid) << p.improved.validity.reason;
-  EXPECT_LE(p.improved.hold_jitter_nm_rms, 0.3);  // the issue's target
+  EXPECT_LE(p.improved.hold_jitter_nm_rms, 0.3);  // the improved controller's target
   EXPECT_LT(p.improved.hold_jitter_nm_rms, 0.6 * p.paper.hold_jitter_nm_rms);
   EXPECT_LT(p.improved.settling_time_s, 0.6 * p.paper.settling_time_s);
 
   // The correction loop's margins on the identified loop (its real delays), at the hold's gain
-  // and at the boost's ceiling: the issue asks for 6 dB and 45 deg.
+  // and at the boost's ceiling: the design asks for 6 dB and 45 deg.
   const LoopIdentification loop = identify_loop(config, c.static_map.controller, 91);
   for (const double ki :
        {c.controller.improved.correction_ki, c.controller.improved.correction_ki_max}) {

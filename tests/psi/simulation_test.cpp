@@ -110,7 +110,7 @@ TEST(PsiSimulationTest, TwinMeasurementErrorIsSmallAndSplitsIntoStageAndCamera) 
 // are pinned close: the tolerances (0.5 % of the errors, 1.5 % of the stage part, which is
 // sqrt(err^2 - ideal^2) and amplifies their change 3.6 x; 0.05 nm of a step; one 1 ms tick of
 // settling) admit the last-digit differences of another compiler's libm or FMA contraction, not a
-// change in what the stage or the analysis does (the issue found 0.390 / 0.054 nm and 53-814 ms
+// change in what the stage or the analysis does (0.390 / 0.054 nm and 53-814 ms were once found
 // still quoted after both had changed).
 TEST(PsiSimulationTest, TheDocumentedRunPrintsItsFigures) {
   SimulationParams p;

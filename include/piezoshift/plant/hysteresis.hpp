@@ -18,7 +18,7 @@
 // (for H = 12.5 %); the average over the full stroke is 1.
 //
 // Source of H: PI piezo tutorial, hysteresis of open-loop stacks "2 % (small signal), widening to
-// 10 % to 15 % under large-signal conditions"; the issue asks for 10 to 15 % over 0-150-0 V.
+// 10 % to 15 % under large-signal conditions"; the twin's target is 10 to 15 % over 0-150-0 V.
 // Cycles smaller than rho_0 v_span (9.4 V with N = 8) see only w0: no hysteresis, the
 // small-signal end of that statement.
 //
