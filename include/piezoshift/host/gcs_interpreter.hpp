@@ -141,7 +141,7 @@ class GcsInterpreter final : public LineHandler {
   static const Command kCommands[];
   static const Immediate kImmediates[];
 
-  // Dispatch, sessions and the loop's samples (gcs_interpreter.cpp).
+  // Dispatch, HLP? (the table itself), sessions and the loop's samples (gcs_interpreter.cpp).
   std::string execute(Session& session, std::string_view name, const Args& args);
   void fail(Session& session, GcsError error);
   //! True for kNone; otherwise sets the error and returns false.
