@@ -14,8 +14,9 @@
 //                    on_target_um (Z) and on_target_urad (tip, tilt) for settle_s, every axis
 //   position         POS?: the pose the strain gauges say (StageModel::pose_from_sgs)
 //   record, read     DRC/RTR/DRR? (station_recorder.hpp), from the loop's present tick
-//   fault            the fault the safety supervisor latched, by its rule's name; move(),
-//                    servo(true)'s move and wait_on_target() throw StationFaulted while it holds
+//   fault            the fault the safety supervisor latched, by its rule's name; move() and
+//                    wait_on_target() throw StationFaulted while it holds, servo(true) when it
+//                    latches again at once (a gauge still open)
 //   close            the loop's ramp to 0 V, then its thread joined (idempotent; the destructor)
 //
 // Time: every wait counts the loop's ticks, so a timeout is loop time (on the monotonic clock it
