@@ -163,12 +163,17 @@ std::uint64_t LoopStation::ticks_of(double duration_s) const {
 }
 
 void LoopStation::run_ticks(std::uint64_t ticks) {
-  rig_->settle(static_cast<double>(ticks) / rate_Hz_);
+  const bool had = have_sample_;
+  const std::uint64_t before = last_.tick;
+  rig_->settle(static_cast<double>(ticks) / rate_Hz_);  // at least one tick more, unless it ended
+  // The loop ends only when close() stops it; a wait that saw no tick would spin for ever.
+  if (had && last_.tick == before)
+    throw std::runtime_error("the control loop stopped: " + rig_->fault());
 }
 
 void LoopStation::update() {
   check_open();
-  rig_->settle(0.0);
+  run_ticks(0);
 }
 
 void LoopStation::servo(bool on) {
