@@ -48,6 +48,7 @@
 #include "piezoshift/io/input_file.hpp"
 #include "piezoshift/procedures/loop_setup.hpp"
 #include "piezoshift/procedures/loop_stack.hpp"
+#include "piezoshift/procedures/stage_model_setup.hpp"
 #include "piezoshift/psi/fizeau_simulation.hpp"
 #include "piezoshift/runtime/control_loop.hpp"
 #include "piezoshift/runtime/csv_logger.hpp"
@@ -153,27 +154,6 @@ std::string http_token(const ServeOptions& o) {
   check(token.empty() || token.size() >= 16,
         "--http-token: at least 16 characters (e.g. `openssl rand -hex 16`)");
   return token;
-}
-
-host::StageModel make_stage_model(const ServeOptions& o, const config::ProjectConfig& config,
-                                  const control::SemiClosedLoopParams& params,
-                                  const procedures::LoopCalibration& cal,
-                                  const runtime::SafetyLimits& safety) {
-  try {
-    host::StageModelParams mp = host::stage_model_params(config.twin.geometry, params);
-    if (cal.travel_z_max_um)
-      mp.z_max_um = *cal.travel_z_max_um;
-    if (cal.travel_z_min_um)
-      mp.z_min_um = *cal.travel_z_min_um;
-    mp.amplifier_gain = config.twin.amplifier.gain;
-    mp.channel_max_V = safety.output_max_V * mp.amplifier_gain;
-    return host::StageModel(mp);
-  } catch (const std::invalid_argument& e) {
-    // The calibration's A and the config's geometry meet here: name both.
-    throw core::InputError(fmt::format(
-        "{} with {}: {}", o.calibration.empty() ? "built-in calibration" : o.calibration,
-        o.config.empty() ? "the built-in configuration" : o.config, e.what()));
-  }
 }
 
 void check_serve_options(const ServeOptions& o) {
@@ -454,7 +434,9 @@ int serve(const ServeOptions& o) {
   const procedures::LoopCalibration cal = procedures::resolve_calibration(
       o.calibration, o.daq, config, o.seed, 1.0 / o.rate_Hz, o.max_physics_steps);
   calibration::refuse_fringe_lock(cal, "serve");
-  const host::StageModel model = make_stage_model(o, config, cal.params, cal, safety);
+  const host::StageModel model = procedures::loop_stage_model(
+      config, cal, safety, o.calibration.empty() ? "built-in calibration" : o.calibration,
+      o.config.empty() ? "the built-in configuration" : o.config);
 
   CameraSetup camera_setup;
   if (!o.camera.empty())

@@ -8,6 +8,7 @@ have the C++ field names (units in every name); time series are numpy arrays.
 from ._piezoshift import *  # noqa: F401,F403
 # the exception types are not always picked up by the star import
 from ._piezoshift import InputError, FitError, MetricsError, ProcedureFailed  # noqa: F401
+from ._piezoshift import StageFault, StageTimeout  # noqa: F401
 from . import _piezoshift as _ext
 import inspect as _inspect
 

@@ -23,5 +23,6 @@ void bind_reproduction(py::module_& m);  // reproduction_py.cpp
 void bind_camera(py::module_& m);        // camera_py.cpp
 void bind_instrument(py::module_& m);    // instrument_py.cpp: after the controller and cameras
 void bind_tolerance(py::module_& m);     // tolerance_py.cpp
+void bind_station(py::module_& m);       // station_py.cpp: Stage, StageFault, StageTimeout
 
 }  // namespace piezoshift::python

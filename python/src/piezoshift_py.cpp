@@ -4,7 +4,8 @@
 // reference, so cfg.design.hinge.thickness_m = ... edits in place). Three-channel values (Vec3)
 // and 3x3 matrices come back as numpy copies and are set by assigning a whole value; time series
 // (std::vector<double>) come back as 1-D numpy arrays; images (frames, maps) as 2-D arrays. The
-// real-time runtime is not bound, but measure() runs it on the twin's simulated clock.
+// real-time loop is reached through Stage (station_py.cpp), and measure() runs it on the twin's
+// simulated clock.
 // Each library module's bindings are in a file of its own (bindings.hpp); this one only calls
 // them, in an order that registers every type before a signature names it.
 #include <pybind11/pybind11.h>
@@ -13,7 +14,8 @@
 
 PYBIND11_MODULE(_piezoshift, m) {
   namespace bind = piezoshift::python;
-  m.doc() = "piezoshift: design, digital twin, calibration and experiments (offline API)";
+  m.doc() =
+      "piezoshift: design, digital twin, calibration, experiments and the real-time loop (Stage)";
   bind::bind_errors(m);
   bind::bind_psi(m);
   bind::bind_control(m);
@@ -27,4 +29,5 @@ PYBIND11_MODULE(_piezoshift, m) {
   bind::bind_camera(m);
   bind::bind_instrument(m);
   bind::bind_tolerance(m);
+  bind::bind_station(m);
 }

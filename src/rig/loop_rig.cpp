@@ -90,6 +90,8 @@ void LoopRig::take(const runtime::HostSample& h) {
                  : fmt::format("the safety supervisor tripped ({}, at {:.3f} s)",
                                runtime::to_string(reason), clock_s());
   }
+  if (observer_)
+    observer_(h);
   if (follow_ != nullptr && h.tick >= follow_from_ && h.tick < follow_to_)
     (*follow_)(h);
   if (window_ticks_ == 0)
@@ -200,6 +202,13 @@ void LoopRig::drive_points(const Vec3& zd_um) {
   c.zd_um = zd_um;
   command(c);
   drive_ = Drive::kPoints;
+}
+
+void LoopRig::hold() {
+  runtime::HostCommand c;
+  c.kind = runtime::HostCommand::Kind::kServoOff;
+  command(c);
+  drive_ = Drive::kOpenLoop;
 }
 
 void LoopRig::settle(double duration_s) {

@@ -9,6 +9,7 @@
 //   drive_actuators   kActuators S (the PIDs alone, stage 2)
 //   drive_points      kServoOn Z_d from open loop, kMoveTo Z_d when already on Z_d (stage 3)
 //   rest              kServoOff then kOpenLoop 0 V (the supervisor's slew limit takes it down)
+//   hold              kServoOff: the loop opens and holds the volts applied (clears a fault)
 //   settle, measure   the loop's samples, drained from its ring: each command counts from the
 //                     tick it was applied at (the samples carry its sequence number); a window is
 //                     the mean SGS feedback over window_s of ticks, its start and end on the
@@ -28,6 +29,7 @@
 #include <memory>
 #include <string>
 #include <thread>
+#include <utility>
 
 #include "piezoshift/rig/guided_rig.hpp"
 #include "piezoshift/runtime/control_loop.hpp"
@@ -84,6 +86,14 @@ class LoopRig final : public GuidedRig {
   double clock_s() const;
   //! The last tick's sample the rig has taken.
   const runtime::HostSample& last_sample() const { return last_; }
+  //! kServoOff: opens the loop holding the volts it applies (and clears a latched fault in the
+  //! loop, not the rig's fault()); the next drive_points() closes it again bumplessly.
+  void hold();
+  //! Hands every sample the rig takes, in tick order on the caller's thread, to `each` (empty:
+  //! none): a host that keeps its own account of the loop (procedures/loop_station.hpp).
+  void set_observer(std::function<void(const runtime::HostSample&)> each) {
+    observer_ = std::move(each);
+  }
   //! Runs the next `ticks` ticks from the loop's present one, handing each tick's sample to
   //! `each` in tick order on the caller's thread as the rig takes it (a fringe scan's exposure:
   //! instrument/loop_scan_stage.hpp). Returns early, as settle() does, when the loop ends.
@@ -138,6 +148,7 @@ class LoopRig final : public GuidedRig {
   const std::function<void(const runtime::HostSample&)>* follow_ = nullptr;
   std::uint64_t follow_from_ = 0;
   std::uint64_t follow_to_ = 0;  // one past the last
+  std::function<void(const runtime::HostSample&)> observer_;
 };
 
 }  // namespace piezoshift::rig
