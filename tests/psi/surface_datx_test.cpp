@@ -284,6 +284,41 @@ TEST(DatxFileTest, BadFilesAreRefusedNamingThemAndWhy) {
   fs::remove_all(d);
 }
 
+// HDF5 1.10.8 reads some damaged files out of bounds: one byte flipped of a 40 x 30 map's file
+// (found by flipping every 7th byte: 7 of 400 under AddressSanitizer, heap overflows in
+// H5Aexists and H5Aread). Three of them are segfaults of the library (signal 11, release build):
+// before the parse ran in a child process, `psi compare` died on them. Now those are refused
+// naming the file, and none of the seven ends the test process. (With another HDF5 version other
+// bytes may be the ones.)
+TEST(DatxFileTest, FilesThatCrashHdf5AreRefusedNotACrashOfTheProgram) {
+  const fs::path d = temp_dir();
+  ScaledSurface s;
+  s.height_nm = Map(40, 30);
+  for (std::size_t p = 0; p < s.height_nm.size(); ++p)
+    s.height_nm.v[p] = p % 7 != 0 ? static_cast<double>(p) * 0.1 : kNan;
+  s.m_per_px = 1e-4;
+  s.title = "t";
+  write_datx((d / "a.datx").string(), s, 632.8e-9);
+  const std::string good = bytes_of(d / "a.datx");
+  const auto flipped = [&](std::size_t at) {
+    std::string bad = good;
+    bad[at] = static_cast<char>(bad[at] ^ 0x5a);
+    const fs::path p = d / ("flip" + std::to_string(at) + ".datx");
+    std::ofstream(p, std::ios::binary) << bad;
+    return p;
+  };
+  ASSERT_EQ(good.size(), 19624u);  // the layout these offsets were found in
+  for (const std::size_t at : {3094u, 13090u, 13146u})
+    expect_refused(flipped(at), "a damaged HDF5 file: the HDF5 library failed reading it");
+  for (const std::size_t at : {17255u, 17542u, 17556u, 19621u}) {
+    try {
+      read_datx(flipped(at).string());
+    } catch (const core::InputError&) {
+    }
+  }
+  fs::remove_all(d);
+}
+
 TEST(DatxFileTest, UnknownUnitsAndAMissingScaleAreRefused) {
   const fs::path d = temp_dir();
   const fs::path p = d / "bad.datx";

@@ -34,7 +34,9 @@ void write_datx(const std::string& path, const ScaledSurface& s, double waveleng
 //! Reads a .datx. core::InputError naming the file and what is wrong: not a regular file or
 //! larger than io::kMaxFrameFileBytes, not HDF5, no /Data/Surface dataset, a dataset that is not
 //! 2-D numbers or has more than psi::kMaxFrameSetPixels pixels (refused before it is read), a
-//! height unit or resolution it does not know, no lateral resolution.
+//! height unit or resolution it does not know, no lateral resolution; a file on which the HDF5
+//! library itself fails (HDF5 1.10 reads some damaged files out of bounds: the file is parsed in
+//! a child process, so that is a refusal, not a crash) or takes more than 60 s.
 ScaledSurface read_datx(const std::string& path);
 
 }  // namespace piezoshift::psi
