@@ -16,6 +16,7 @@
 #include "piezoshift/io/plot.hpp"
 #include "piezoshift/psi/npy.hpp"
 #include "piezoshift/psi/png_image.hpp"
+#include "piezoshift/psi/surface_datx.hpp"
 #include "piezoshift/psi/surface_figure.hpp"
 #include "piezoshift/psi/surface_file.hpp"
 #include "piezoshift/psi/zernike_figure.hpp"
@@ -384,9 +385,12 @@ void write_measurement(MeasureRecord& r, const std::string& out_name) {
     write_frames(r, tmp / "frames");
     psi::write_mask_png((tmp / "mask.png").string(), *r.mask);
     psi::write_npy((tmp / "surface_nm.npy").string(), r.analysis->surface_nm);
-    if (r.m_per_px > 0.0)
-      psi::write_gsf((tmp / "surface_m.gsf").string(),
-                     {r.analysis->surface_nm, r.m_per_px, "surface, piston and tilt removed"});
+    if (r.m_per_px > 0.0) {
+      const psi::ScaledSurface s{r.analysis->surface_nm, r.m_per_px,
+                                 "surface, piston and tilt removed"};
+      psi::write_gsf((tmp / "surface_m.gsf").string(), s);
+      psi::write_datx((tmp / "surface_nm.datx").string(), s, r.params->wavelength_nm * 1e-9);
+    }
     const auto [lo, hi] = psi::finite_range(r.analysis->surface_nm);
     psi::write_surface_map(tmp / "surface_nm.png", r.analysis->surface_nm, lo, hi,
                            fmt::format("Measured surface: RMS {:.2f} nm, PV {:.2f} nm",

@@ -36,7 +36,8 @@ struct MeasureRecord {
   //! --out when something appeared in it while the measurement ran: written beside it instead.
   std::string out_given;
   //! The surface's lateral scale, metres on the plate per pixel (instrument::plate_m_per_px of
-  //! the mask and [camera] pupil_radius_m): surface_m.gsf's. 0: no .gsf written.
+  //! the mask and [camera] pupil_radius_m): surface_m.gsf's and surface_nm.datx's. 0: neither
+  //! written.
   double m_per_px = 0.0;
 };
 
@@ -48,7 +49,7 @@ nlohmann::json measure_json(const MeasureRecord& r);
 void check_measure_out(const std::string& out);
 
 //! Writes the measurement into out (which must not exist, or be an empty folder): frames,
-//! surface (.npy, .png, and .gsf with its lateral scale), truth, mask, exposures.csv,
+//! surface (.npy, .png, and .gsf and .datx with its lateral scale), truth, mask, exposures.csv,
 //! measurement.json, figures and report.md. Built in a sibling folder first and renamed into
 //! place at the end. A finished measurement is never discarded: when out has become something
 //! else while it ran (a file appeared in it), it goes to the first free of out.1 .. out.99

@@ -2,8 +2,9 @@
 //   simulate   the acquisition on the twin with the paper's controller, frames rendered from the
 //              plate's true motion, analysed; the surface error the stage causes; a budget table
 //   analyze    frames (8- or 16-bit PNG) to a surface map: surface_nm.npy, surface_nm.png,
-//              surface_m.gsf (with its lateral scale), JSON
-//   compare    two .gsf maps of one part: the difference, its RMS, Zernike terms (psi_compare.hpp)
+//              surface_m.gsf and surface_nm.datx (with its lateral scale), JSON
+//   compare    two maps (.gsf, .datx) of one part: the difference, its RMS, Zernike terms
+//              (psi_compare.hpp)
 //   calibrate  the steps the stage made, recovered from frames (AIA), as a TOML table
 // Bad files, sizes, counts or values exit with status 2 and a message naming the file or option.
 #include <algorithm>
@@ -34,6 +35,7 @@
 #include "piezoshift/psi/pupil_detection.hpp"
 #include "piezoshift/psi/simulation.hpp"
 #include "piezoshift/psi/step_calibration.hpp"
+#include "piezoshift/psi/surface_datx.hpp"
 #include "piezoshift/psi/surface_figure.hpp"
 #include "piezoshift/psi/surface_file.hpp"
 #include "piezoshift/psi/zernike.hpp"
@@ -107,15 +109,17 @@ void check_pupil_radius(double radius_m) {
     throw core::InputError(problem);
 }
 
-// Writes surface_nm.npy and surface_nm.png into out, and surface_m.gsf when m_per_px > 0 (the
-// lateral scale, metres on the plate per pixel); returns the JSON of the analysis.
+// Writes surface_nm.npy and surface_nm.png into out, and surface_m.gsf and surface_nm.datx when
+// m_per_px > 0 (the lateral scale, metres on the plate per pixel); returns the analysis's JSON.
 Json write_analysis(const psi::Analysis& a, psi::Algorithm alg, double wavelength_nm,
                     const std::string& out, const Json& pupil = nullptr, double m_per_px = 0.0) {
   fs::create_directories(out);
   psi::write_npy((fs::path(out) / "surface_nm.npy").string(), a.surface_nm);
-  if (m_per_px > 0.0)
-    psi::write_gsf((fs::path(out) / "surface_m.gsf").string(),
-                   {a.surface_nm, m_per_px, "surface, piston and tilt removed"});
+  if (m_per_px > 0.0) {
+    const psi::ScaledSurface s{a.surface_nm, m_per_px, "surface, piston and tilt removed"};
+    psi::write_gsf((fs::path(out) / "surface_m.gsf").string(), s);
+    psi::write_datx((fs::path(out) / "surface_nm.datx").string(), s, wavelength_nm * 1e-9);
+  }
   const auto [lo, hi] = psi::finite_range(a.surface_nm);
   psi::write_surface_map(
       fs::path(out) / "surface_nm.png", a.surface_nm, lo, hi,
@@ -160,7 +164,8 @@ void print_analysis(const psi::Analysis& a, psi::Algorithm alg, const std::strin
     fmt::print(" Z{}={:.2f}", j + 1, a.zernike_nm[j]);
   fmt::print("\nwritten: {0}/surface_nm.npy {0}/surface_nm.png {0}/analysis.json", out);
   if (m_per_px > 0.0)
-    fmt::print(" {}/surface_m.gsf ({:.6g} mm per pixel)", out, 1e3 * m_per_px);
+    fmt::print(" {0}/surface_m.gsf {0}/surface_nm.datx ({1:.6g} mm per pixel)", out,
+               1e3 * m_per_px);
   fmt::print("\n");
 }
 
@@ -438,7 +443,7 @@ void add_psi_command(CLI::App& app, Action& action) {
   ana->add_option("--wavelength-nm", o->wavelength_nm, "Wavelength [nm]")->capture_default_str();
   ana->add_flag("--remove-power", o->remove_power, "Remove power (Z4) as well as piston and tilt");
   ana->add_option("--pupil-radius-m", o->pupil_radius_m,
-                  "The pupil's radius on the plate [m]: the lateral scale of surface_m.gsf")
+                  "The pupil's radius on the plate [m]: the lateral scale of the .gsf and .datx")
       ->capture_default_str();
   ana->add_option("--out", o->out, "Output folder")->required();
   ana->add_flag("--json", o->json, "Machine-readable output");
@@ -456,9 +461,9 @@ void add_psi_command(CLI::App& app, Action& action) {
 
   auto c = std::make_shared<PsiCompareOptions>();
   CLI::App* cmp = psi->add_subcommand(
-      "compare", "Two surface maps (.gsf) of one part: B - A, its RMS and Zernike terms");
-  cmp->add_option("a", c->a, "Map A (Gwyddion Simple Field, .gsf)")->required();
-  cmp->add_option("b", c->b, "Map B (.gsf), the same size and lateral scale")->required();
+      "compare", "Two surface maps (.gsf, .datx) of one part: B - A, its RMS and Zernike terms");
+  cmp->add_option("a", c->a, "Map A (Gwyddion Simple Field .gsf, or Zygo .datx)")->required();
+  cmp->add_option("b", c->b, "Map B (.gsf or .datx), the same size and lateral scale")->required();
   cmp->add_option("--out", c->out, "Folder for difference_m.gsf and comparison.json");
   cmp->add_flag("--json", c->json, "Machine-readable output");
 

@@ -1,6 +1,7 @@
-// `piezoshift psi compare A.gsf B.gsf`: a map measured elsewhere against ours, pixel for pixel
-// (docs/psi.md). Both are read as Gwyddion Simple Field files with their lateral scale; maps of
-// different sizes or scales are refused, naming which; an unreadable file exits 2 naming it.
+// `piezoshift psi compare A.gsf B.datx`: a map measured elsewhere against ours, pixel for pixel
+// (docs/psi.md). Each is read as a Gwyddion Simple Field (.gsf) or Zygo .datx file with its
+// lateral scale; maps of different sizes or scales are refused, naming which; an unreadable file
+// exits 2 naming it.
 #include "psi_compare.hpp"
 
 #include <algorithm>
@@ -16,6 +17,7 @@
 #include "piezoshift/core/input_error.hpp"
 #include "piezoshift/io/atomic_file.hpp"
 #include "piezoshift/psi/surface_comparison.hpp"
+#include "piezoshift/psi/surface_datx.hpp"
 #include "piezoshift/psi/surface_file.hpp"
 
 namespace piezoshift::app {
@@ -28,10 +30,13 @@ constexpr int kZernikeTerms = 37;
 constexpr double kScaleTolerance = 1e-6;  // relative: a scale written as 17 digits reads back equal
 
 psi::ScaledSurface read_surface(const std::string& path) {
-  if (fs::path(path).extension() != ".gsf")
-    throw core::InputError(
-        fmt::format("{}: only Gwyddion Simple Field files (.gsf) are compared", path));
-  return psi::read_gsf(path);
+  const fs::path extension = fs::path(path).extension();
+  if (extension == ".gsf")
+    return psi::read_gsf(path);
+  if (extension == ".datx")
+    return psi::read_datx(path);
+  throw core::InputError(
+      fmt::format("{}: only Gwyddion Simple Field (.gsf) and Zygo .datx files are compared", path));
 }
 
 // A GSF title is one line: a file name's line breaks and NULs become spaces.

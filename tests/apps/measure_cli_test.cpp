@@ -4,6 +4,8 @@
 #include <algorithm>
 #include <cmath>
 #include <cstdio>
+#include <cstdlib>
+#include <cstring>
 #include <filesystem>
 #include <fstream>
 #include <iterator>
@@ -16,6 +18,7 @@
 
 #include "../support/cli_test.hpp"
 #include "piezoshift/psi/npy.hpp"
+#include "piezoshift/psi/surface_datx.hpp"
 #include "piezoshift/psi/surface_file.hpp"
 
 namespace piezoshift {
@@ -95,7 +98,7 @@ TEST_F(MeasureCli, TwinMeasurementWritesEverythingAndItsFramesReplay) {
   const std::string cam = small_camera();
   const Json j = measure("--config '" + cam + "' --out '" + path("m") + "'");
   for (const char* f : {"frames/frame_a1_00.png", "frames/frame_a1_04.png", "mask.png",
-                        "surface_nm.npy", "surface_m.gsf", "surface_m_mask.gsf",
+                        "surface_nm.npy", "surface_m.gsf", "surface_m_mask.gsf", "surface_nm.datx",
                         "surface_truth_nm.npy", "exposures.csv", "measurement.json", "report.md"})
     EXPECT_TRUE(fs::exists(path("m") + "/" + f)) << f;
   // The .gsf: the .npy's surface in float32 metres, its pixels without a value masked, and the
@@ -112,6 +115,25 @@ TEST_F(MeasureCli, TwinMeasurementWritesEverythingAndItsFramesReplay) {
       ASSERT_EQ(gsf.height_nm.v[p], static_cast<float>(npy.v[p] * 1e-9) * 1e9) << p;
     }
   }
+  // The .datx: the .npy's doubles bit for bit and the same scale, read by read_datx (as psi
+  // compare does) and by h5py as prysm reads it.
+  const psi::ScaledSurface datx = psi::read_datx(path("m") + "/surface_nm.datx");
+  EXPECT_EQ(datx.m_per_px, gsf.m_per_px);
+  ASSERT_EQ(datx.height_nm.size(), npy.size());
+  for (std::size_t p = 0; p < npy.size(); ++p) {
+    ASSERT_EQ(std::isnan(datx.height_nm.v[p]), std::isnan(npy.v[p])) << p;
+    if (!std::isnan(npy.v[p])) {
+      ASSERT_EQ(std::memcmp(&datx.height_nm.v[p], &npy.v[p], sizeof(double)), 0) << p;
+    }
+  }
+  const std::string py = "/usr/bin/python3 '" + testing::source_dir() +
+                         "/tests/support/read_datx_h5py.py' '" + path("m") + "/surface_nm.datx' '" +
+                         path("m") + "/surface_nm.npy' > '" + path("h5py.json") + "'";
+  ASSERT_EQ(std::system(py.c_str()), 0) << py;
+  const Json h5 = Json::parse(testing::slurp(path("h5py.json")));
+  EXPECT_EQ(h5["same_as_npy"], true);
+  EXPECT_EQ(h5["resolution"].get<double>(), j["lateral_scale_m_per_px"].get<double>());
+  EXPECT_EQ(h5["unit"], "NanoMeters");
   EXPECT_EQ(j["frames"], 5);
   EXPECT_EQ(j["exposures"].size(), 5u);
   EXPECT_TRUE(j["converged"].get<bool>());

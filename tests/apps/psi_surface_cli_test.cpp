@@ -2,12 +2,17 @@
 // gwyddion-thumbnailer loads the file with Gwyddion's GSF module and states the field's pixels
 // and real size) and a reader written here in Python from gwyddion.net's specification (numpy),
 // which checks the layout and gives the heights; then `psi compare` of two such maps, and its
-// refusals (sizes, lateral scales, unreadable files), each naming what is wrong.
+// refusals (sizes, lateral scales, unreadable files), each naming what is wrong. The same
+// surface as surface_nm.datx (Zygo's HDF5 layout) read by h5py the way prysm reads it, and by
+// psi compare, whose refusals of a bad .datx name the file.
+#include <algorithm>
 #include <cmath>
 #include <cstdio>
 #include <cstdlib>
+#include <cstring>
 #include <filesystem>
 #include <fstream>
+#include <limits>
 #include <string>
 
 #include <gtest/gtest.h>
@@ -15,6 +20,8 @@
 
 #include "../support/cli_test.hpp"
 #include "piezoshift/psi/npy.hpp"
+#include "piezoshift/psi/surface_datx.hpp"
+#include "piezoshift/psi/surface_file.hpp"
 
 namespace piezoshift {
 namespace {
@@ -158,6 +165,97 @@ TEST_F(PsiSurfaceCliTest, GwyddionAndAnIndependentReaderOpenTheSurfaceWithItsSca
   EXPECT_EQ(r["outside"], 0.0);  // outside the pupil: 0 m, masked
 }
 
+// surface_nm.datx through h5py (Debian's python3-h5py) as prysm 0.21.1's read_zygo_datx reads
+// it (tests/support/read_datx_h5py.py): the .npy's doubles bit for bit, the lateral scale, the
+// units; read back by read_datx bit for bit; the height range Gwyddion sees in the .gsf.
+TEST_F(PsiSurfaceCliTest, AnHdf5ReaderOpensTheDatxWithTheSameValuesAndScale) {
+  const std::string sim = simulate("sim", 64);
+  const Json j = analyze(sim, path("a"));
+  const std::string datx = path("a") + "/surface_nm.datx";
+  const std::string npy = path("a") + "/surface_nm.npy";
+  ASSERT_TRUE(fs::exists(datx));
+  const std::string out = path("h5py.json");
+  const std::string py = "/usr/bin/python3 '" + testing::source_dir() +
+                         "/tests/support/read_datx_h5py.py' '" + datx + "' '" + npy + "' > '" +
+                         out + "'";
+  ASSERT_EQ(std::system(py.c_str()), 0) << py;
+  const Json r = Json::parse(testing::slurp(out));
+  EXPECT_EQ(r["rows"], 64);
+  EXPECT_EQ(r["columns"], 64);
+  EXPECT_EQ(r["dtype"], "float64");
+  EXPECT_EQ(r["unit"], "NanoMeters");
+  EXPECT_EQ(r["same_as_npy"], true);  // every height the very double of surface_nm.npy
+  EXPECT_EQ(r["valid"], j["valid_pixels"]);
+  EXPECT_EQ(r["resolution"].get<double>(), j["lateral_scale_m_per_px"].get<double>());
+  EXPECT_EQ(r["resolution_unit"], "Meters");
+  EXPECT_EQ(r["wavelength_m"].get<double>(), j["wavelength_nm"].get<double>() * 1e-9);
+  EXPECT_EQ(r["no_data"].get<double>(), std::numeric_limits<double>::max());
+  EXPECT_EQ(r["title"], "surface, piston and tilt removed");
+
+  // The same heights as the .gsf Gwyddion opens, to float32's precision, so the same range.
+  const psi::ScaledSurface gsf = psi::read_gsf(path("a") + "/surface_m.gsf");
+  double lo = 1e300, hi = -1e300;
+  for (const double v : gsf.height_nm.v)
+    if (!std::isnan(v)) {
+      lo = std::min(lo, v);
+      hi = std::max(hi, v);
+    }
+  EXPECT_NEAR(r["min"].get<double>(), lo, 1e-6 * std::fabs(lo));
+  EXPECT_NEAR(r["max"].get<double>(), hi, 1e-6 * std::fabs(hi));
+  EXPECT_GT(r["max"].get<double>() - r["min"].get<double>(), 10.0);  // nm: the part's figure
+
+  // read_datx: bit for bit, as psi compare reads it.
+  const psi::ScaledSurface back = psi::read_datx(datx);
+  const psi::Map m = psi::read_npy(npy);
+  ASSERT_EQ(back.height_nm.size(), m.size());
+  for (std::size_t p = 0; p < m.size(); ++p) {
+    ASSERT_EQ(std::isnan(back.height_nm.v[p]), std::isnan(m.v[p])) << p;
+    if (!std::isnan(m.v[p])) {
+      ASSERT_EQ(std::memcmp(&back.height_nm.v[p], &m.v[p], sizeof(double)), 0) << p;
+    }
+  }
+  EXPECT_EQ(back.m_per_px, j["lateral_scale_m_per_px"].get<double>());
+}
+
+// psi compare of the .gsf against the .datx of one analysis: float32's rounding only; a .datx
+// that is not one, truncated, or without a surface exits 2 naming the file.
+TEST_F(PsiSurfaceCliTest, CompareReadsTheDatxAndRefusesABadOneNamingIt) {
+  const std::string sim = simulate("sim", 64);
+  analyze(sim, path("a"));
+  const std::string gsf = path("a") + "/surface_m.gsf";
+  const std::string datx = path("a") + "/surface_nm.datx";
+  testing::CliResult r = run("psi compare '" + datx + "' '" + datx + "' --json");
+  ASSERT_EQ(r.status, 0) << r.err;
+  EXPECT_EQ(Json::parse(r.out)["difference_rms_nm"], 0.0);
+  r = run("psi compare '" + gsf + "' '" + datx + "' --json");
+  ASSERT_EQ(r.status, 0) << r.err;
+  Json j = Json::parse(r.out);
+  EXPECT_EQ(j["common_pixels"], j["a"]["valid_pixels"]);
+  EXPECT_EQ(j["a"]["m_per_px"], j["b"]["m_per_px"]);
+  EXPECT_LT(j["difference_rms_nm"].get<double>(), 1e-5);  // float32 metres against doubles
+  EXPECT_GT(j["difference_rms_nm"].get<double>(), 0.0);
+
+  std::ofstream(path("junk.datx")) << "not a surface";
+  expect_refused("psi compare '" + gsf + "' '" + path("junk.datx") + "'",
+                 path("junk.datx") + ": not an HDF5 file");
+  const std::string whole = testing::slurp(datx);
+  std::ofstream(path("cut.datx"), std::ios::binary) << whole.substr(0, whole.size() / 2);
+  expect_refused("psi compare '" + path("cut.datx") + "' '" + gsf + "'",
+                 path("cut.datx") + ": not an HDF5 file (or a truncated one)");
+  // HDF5 without Zygo's groups: a .gsf renamed would be refused as not HDF5; this one is HDF5.
+  const std::string py = "/usr/bin/python3 -c \"import h5py; h5py.File('" + path("empty.datx") +
+                         "', 'w').create_group('Data')\"";
+  ASSERT_EQ(std::system(py.c_str()), 0) << py;
+  expect_refused("psi compare '" + gsf + "' '" + path("empty.datx") + "'",
+                 path("empty.datx") + ": no group /Data/Surface");
+  expect_refused("psi compare '" + gsf + "' '" + path("absent.datx") + "'",
+                 path("absent.datx") + ": no such file");
+  // Given to psi analyze as a frame, a .datx is named too.
+  expect_refused("psi analyze '" + datx + "' '" + datx + "' '" + datx + "' '" + datx + "' --out '" +
+                     path("e") + "'",
+                 datx);
+}
+
 TEST_F(PsiSurfaceCliTest, CompareGivesTheDifferenceAndRefusesMapsThatDoNotMatch) {
   const std::string sim = simulate("sim", 64);
   analyze(sim, path("a"));
@@ -204,7 +302,8 @@ TEST_F(PsiSurfaceCliTest, CompareGivesTheDifferenceAndRefusesMapsThatDoNotMatch)
                  path("junk.gsf") + ": not a Gwyddion Simple Field file");
   expect_refused("psi compare '" + path("absent.gsf") + "' '" + a + "'", path("absent.gsf"));
   expect_refused("psi compare '" + a + "' '" + path("a") + "/surface_nm.npy'",
-                 "surface_nm.npy: only Gwyddion Simple Field files (.gsf) are compared");
+                 "surface_nm.npy: only Gwyddion Simple Field (.gsf) and Zygo .datx files are "
+                 "compared");
   expect_refused(
       "psi analyze '" + sim + "/frame_00.png' --pupil-radius-m 0 --out '" + path("e") + "'",
       "--pupil-radius-m = 0 must be");
