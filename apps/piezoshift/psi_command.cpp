@@ -24,6 +24,7 @@
 #include "piezoshift/config/project_config.hpp"
 #include "piezoshift/core/bounds.hpp"
 #include "piezoshift/core/input_error.hpp"
+#include "piezoshift/core/wavelength.hpp"
 #include "piezoshift/instrument/fringe_actuator_scan.hpp"
 #include "piezoshift/io/atomic_file.hpp"
 #include "piezoshift/psi/analysis.hpp"
@@ -54,7 +55,7 @@ struct PsiOptions {
   std::string out;
   bool json = false;
   std::string algorithm;
-  double wavelength_nm = 632.8;
+  double wavelength_nm = core::kHeNeWavelength_nm;
   // analyze, calibrate
   std::vector<std::string> frames;
   std::string mask;
