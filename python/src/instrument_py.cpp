@@ -1,13 +1,12 @@
 // Python binding of the instrument module (docs/python.md, "Cameras and measurements"): measure()
 // takes one phase-shifting measurement on the twin as `piezoshift measure --daq sim --free-run`
-// does (the shipping loop in owner mode on a simulated clock, the camera exposing once the stage
-// has settled, then the analysis) and returns its result as a dict with the JSON names of
-// `measure --json`, plus the maps and frames as numpy arrays. The fringe lock (`lock`) and the
-// hold after the measurement (`hold_s`) are the CLI's: the lock built and checked by
-// instrument::measurement_lock_setup, the hold summed up by instrument::hold_summary, both shared
-// with `measure --lock --hold-s`, and its records as hold.csv's columns. A measurement that is not
-// valid or whose fits did not converge raises ProcedureFailed (the CLI's exit status 4), the
-// partial result in its `result` attribute.
+// does, by the same procedure: its arguments become a procedures::MeasureRequest (checked by the
+// same validate, refusals naming the argument), procedures::run_measure runs it with the GIL
+// released, and the dict is procedures::measure_json's (the CLI's --json) converted, plus the
+// maps, frames and the hold's records as numpy arrays. A measurement that is not valid or whose
+// fits did not converge raises ProcedureFailed (the CLI's exit status 4), the partial result in
+// its `result` attribute. calibrate_from_fringes() encodes with the CLI's
+// procedures::fringe_calibration_json.
 #include <pybind11/numpy.h>
 #include <pybind11/pybind11.h>
 #include <pybind11/stl.h>

@@ -157,7 +157,8 @@ void bind_psi(py::module_& m) {
       },
       py::arg("frames"), py::arg("mask") = py::none(), py::arg("algorithm") = "hariharan5",
       py::arg("steps_rad") = std::vector<double>{},
-      py::arg("wavelength_nm") = ps::core::kHeNeWavelength_nm, py::arg("remove_power") = false,
+      py::arg("wavelength_nm") = piezoshift::core::kHeNeWavelength_nm,
+      py::arg("remove_power") = false,
       "Frames (N, H, W) to a surface map [nm] and its figures (docs/psi.md); mask None: the "
       "pupil found from the fringe modulation");
 
