@@ -57,13 +57,21 @@ TEST(MeasureRequestTest, TheCliNeedsAFreshOutFolder) {
   EXPECT_NE(refusal(cli).find("exists and is not an empty folder"), std::string::npos);
 }
 
-class MeasureRunTest : public testing::TempDirTest {};
+// The paper's controller as given (Section 4), so that no start-up calibration runs first.
+class MeasureRunTest : public testing::TempDirTest {
+ protected:
+  MeasureRequest request() {
+    MeasureRequest r;
+    r.caller = MeasureCaller::kPython;
+    r.free_run = true;
+    r.controller = control::SemiClosedLoopParams{};
+    r.config_file = write("cam.toml", "[camera]\nwidth_px = 96\nheight_px = 96\n");
+    return r;
+  }
+};
 
 TEST_F(MeasureRunTest, OnTheTwinTheOutcomeAndItsJsonAgree) {
-  MeasureRequest r;
-  r.caller = MeasureCaller::kPython;
-  r.free_run = true;
-  r.config_file = write("cam.toml", "[camera]\nwidth_px = 96\nheight_px = 96\n");
+  MeasureRequest r = request();
   r.seed = 2;
   const MeasureOutcome m = run_measure(r);
   ASSERT_EQ(m.end, MeasureEnd::kMeasured) << m.reason;
@@ -71,6 +79,7 @@ TEST_F(MeasureRunTest, OnTheTwinTheOutcomeAndItsJsonAgree) {
   EXPECT_EQ(m.params.wavelength_nm, core::kHeNeWavelength_nm);
   EXPECT_EQ(m.camera, "twin");
   EXPECT_EQ(m.daq, "sim");
+  EXPECT_EQ(m.calibration_source, "a controller from Python");
   EXPECT_FALSE(m.real_time);
   const nlohmann::json j = measure_json(m);
   EXPECT_EQ(j["clock"], "free-run");
@@ -87,10 +96,7 @@ TEST_F(MeasureRunTest, OnTheTwinTheOutcomeAndItsJsonAgree) {
 }
 
 TEST_F(MeasureRunTest, ASequenceThatCannotSettleIsAnOutcomeNotAnException) {
-  MeasureRequest r;
-  r.caller = MeasureCaller::kPython;
-  r.free_run = true;
-  r.config_file = write("cam.toml", "[camera]\nwidth_px = 96\nheight_px = 96\n");
+  MeasureRequest r = request();
   r.on_target.band_nm = 1e-6;
   r.on_target.timeout_s = 0.05;
   const MeasureOutcome m = run_measure(r);
