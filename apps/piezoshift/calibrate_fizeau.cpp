@@ -9,7 +9,6 @@
 
 #include "command.hpp"
 #include "improved_summary.hpp"
-#include "paper_summary.hpp"
 #include "physics_budget.hpp"
 #include "piezoshift/calibration/calibration_cost.hpp"
 #include "piezoshift/calibration/calibration_file.hpp"
@@ -20,6 +19,7 @@
 #include "piezoshift/instrument/fringe_calibration.hpp"
 #include "piezoshift/instrument/loop_scan_stage.hpp"
 #include "piezoshift/plant/geometry.hpp"
+#include "piezoshift/procedures/calibration_json.hpp"
 #include "piezoshift/procedures/loop_rig_stack.hpp"
 #include "piezoshift/psi/fizeau_simulation.hpp"
 #include "piezoshift/rig/validity.hpp"
@@ -32,18 +32,11 @@ namespace {
 
 nlohmann::json outcome_json(const FizeauCalibrateRequest& q,
                             const instrument::FringeCalibrationOutcome& r) {
-  nlohmann::json j = paper_calibration_json(r.controller, r.matrix, r.polynomial);
+  nlohmann::json j = procedures::fringe_calibration_json(r);
   j["calibration_file"] = q.out;
   j["interferometer"] = "fizeau";
   j["camera"] = q.camera.empty() ? "twin" : q.camera;
   j["daq"] = q.daq.empty() ? "bench" : q.daq;
-  j["pupil_source"] = r.pupil_from_modulation ? "modulation" : "given";
-  j["p_points"] = r.polynomial.command_um.size();
-  j["p_skipped_commands"] = r.polynomial.saturated_points;
-  j["frames"] = instrument::frames_read(r);
-  j["stage2_simulated_s"] = r.stage2_simulated_s;
-  j["stage3_simulated_s"] = r.stage3_simulated_s;
-  j["wall_s"] = r.wall_time_s;
   return j;
 }
 

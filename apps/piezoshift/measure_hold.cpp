@@ -12,27 +12,6 @@
 
 namespace piezoshift::app {
 
-using Json = nlohmann::json;
-
-namespace {
-
-Json number_or_null(const std::optional<double>& v) {
-  return v ? Json(*v) : Json(nullptr);
-}
-
-}  // namespace
-
-Json hold_json(const instrument::SequenceResult& s) {
-  const instrument::HoldSummary h = instrument::hold_summary(s);
-  return {{"frames", h.frames},
-          {"span_s", h.span_s},
-          {"frame_interval_s", number_or_null(h.frame_interval_s)},
-          {"path_error_rms_nm", number_or_null(h.path_error_rms_nm)},
-          {"path_error_max_nm", number_or_null(h.path_error_max_nm)},
-          {"path_error_1s_means_rms_nm", number_or_null(h.path_error_1s_means_rms_nm)},
-          {"lock_states", h.lock_states.empty() ? Json(nullptr) : Json(h.lock_states)}};
-}
-
 std::string hold_markdown(const instrument::SequenceResult& s) {
   const instrument::HoldSummary h = instrument::hold_summary(s);
   return fmt::format(

@@ -11,10 +11,6 @@
 
 namespace piezoshift::app {
 
-//! The hold's summary: duration, frames, their mean interval, the path's RMS and largest
-//! excursion from its set point (twin truth, else null), and the lock's states over the hold.
-nlohmann::json hold_json(const instrument::SequenceResult& s);
-
 //! One row of report.md's table.
 std::string hold_markdown(const instrument::SequenceResult& s);
 

@@ -14,6 +14,7 @@
 #include "piezoshift/io/atomic_file.hpp"
 #include "piezoshift/io/csv_writer.hpp"
 #include "piezoshift/io/plot.hpp"
+#include "piezoshift/procedures/measure_json.hpp"
 #include "piezoshift/psi/npy.hpp"
 #include "piezoshift/psi/png_image.hpp"
 #include "piezoshift/psi/surface_datx.hpp"
@@ -34,48 +35,6 @@ io::Panel panel(std::string title, std::string x_label, std::string y_label) {
   p.x_label = std::move(x_label);
   p.y_label = std::move(y_label);
   return p;
-}
-
-// What the stage added to the floor, in quadrature; 0 when the measurement is at its floor.
-double stage_error_nm(double measured_nm, double floor_nm) {
-  return std::sqrt(std::max(0.0, measured_nm * measured_nm - floor_nm * floor_nm));
-}
-
-Json number_or_null(double v) {
-  return std::isfinite(v) ? Json(v) : Json(nullptr);
-}
-
-Json exposures_json(const instrument::SequenceResult& s) {
-  Json a = Json::array();
-  for (const instrument::ExposureRecord& e : s.exposures) {
-    Json j{{"average", e.average + 1},
-           {"frame", e.frame},
-           {"frame_id", e.frame_id},
-           {"commanded_step_rad", e.commanded_step_rad},
-           {"commanded_piston_nm", e.commanded_piston_nm},
-           {"move_time_s", e.move_time_s},
-           {"settle_s", e.settled_time_s - e.move_time_s},
-           {"trigger_time_s", e.trigger_time_s},
-           {"exposure_end_s", e.exposure_end_s},
-           {"gauge_error_mean_nm", e.gauge_error_mean_nm},
-           {"gauge_error_max_nm", e.gauge_error_max_nm},
-           {"arrival_wall_s", e.arrival_wall_s}};
-    if (!e.lock_state.empty()) {
-      j["lock_state"] = e.lock_state;
-      j["lock_correction_nm"] = number_or_null(e.lock_correction_nm);
-      j["fringe_piston_nm"] = number_or_null(e.fringe_piston_nm);
-      j["lock_reason"] = e.lock_reason.empty() ? Json(nullptr) : Json(e.lock_reason);
-      j["retakes"] = e.retakes;
-    }
-    if (e.has_truth) {
-      j["truth_piston_nm"] = e.truth_piston_nm;
-      j["truth_blur_nm"] = e.truth_blur_nm;
-      j["truth_tip_urad"] = e.truth_tip_urad;
-      j["truth_tilt_urad"] = e.truth_tilt_urad;
-    }
-    a.push_back(j);
-  }
-  return a;
 }
 
 void write_exposures_csv(const instrument::SequenceResult& s, const fs::path& path) {
@@ -182,6 +141,7 @@ io::Figure stage_figure(const MeasureRecord& r) {
 std::string report_markdown(const MeasureRecord& r) {
   const instrument::MeasurementAnalysis& a = *r.analysis;
   const instrument::SequenceResult& s = *r.sequence;
+  const procedures::MeasureOutcome& m = *r.outcome;
   std::string md = fmt::format(
       "# Phase-shifting measurement\n\n"
       "Camera `{}`, DAQ `{}` at {} Hz ({} clock), algorithm `{}`, {} frames x {} averages; "
@@ -191,22 +151,23 @@ std::string report_markdown(const MeasureRecord& r) {
       "| valid pixels | {} |\n| steps: worst recovered - true | {} |\n"
       "| measurement, wall time | {:.3f} s (floor {:.3f} s, ratio {:.2f}) |\n"
       "| loop overruns | {} |\n",
-      r.camera, r.daq, r.rate_Hz, r.real_time ? "real-time" : "simulated", r.algorithm,
-      r.params->steps_rad.size(), r.params->averages, r.calibration_source, a.figures.rms,
+      m.camera, m.daq, m.rate_Hz, m.real_time ? "real-time" : "simulated", m.algorithm,
+      r.params->steps_rad.size(), r.params->averages, m.calibration_source, a.figures.rms,
       a.figures.pv, a.figures.pvr, a.figures.pixels, a.step_error_text(), s.wall_time_s, s.floor_s,
       s.floor_s > 0 ? s.wall_time_s / s.floor_s : 0.0, s.overruns);
-  if (r.error_rms_nm)
-    md += fmt::format("| measured - true surface, RMS | {:.3f} nm |\n", *r.error_rms_nm);
-  if (r.ideal_error_rms_nm)
+  if (m.error_rms_nm)
+    md += fmt::format("| measured - true surface, RMS | {:.3f} nm |\n", *m.error_rms_nm);
+  if (m.ideal_error_rms_nm)
     md += fmt::format(
         "| the same frames from an ideal stage (camera and algorithm floor, one average) | "
         "{:.3f} nm |\n",
-        *r.ideal_error_rms_nm);
-  if (r.floor_error_rms_nm && r.error_rms_nm)
+        *m.ideal_error_rms_nm);
+  if (m.floor_error_rms_nm && m.error_rms_nm)
     md += fmt::format(
         "| the whole measurement from an ideal stage (its floor) / what the stage added, "
         "sqrt(measured^2 - floor^2) | {:.3f} / {:.3f} nm |\n",
-        *r.floor_error_rms_nm, stage_error_nm(*r.error_rms_nm, *r.floor_error_rms_nm));
+        *m.floor_error_rms_nm,
+        procedures::stage_error_rms_nm(*m.error_rms_nm, *m.floor_error_rms_nm));
   if (const std::optional<double> path =
           instrument::path_error_rms_nm(s, r.params->steps_rad.size()))
     md += fmt::format(
@@ -232,89 +193,20 @@ std::string report_markdown(const MeasureRecord& r) {
 
 }  // namespace
 
-// out must be absent or an empty folder: a measurement never mixes with another's files.
-void check_measure_out(const std::string& name) {
-  const fs::path out(name);
-  std::error_code ec;
-  if (!fs::exists(out, ec))
-    return;
-  if (!fs::is_directory(out, ec) || !fs::is_empty(out, ec))
-    throw core::InputError(fmt::format(
-        "--out {}: exists and is not an empty folder (a measurement is written whole into a "
-        "new one)",
-        out.string()));
+MeasureRecord measure_record(const procedures::MeasureOutcome& m) {
+  return MeasureRecord{.outcome = &m,
+                       .params = &m.params,
+                       .sequence = &m.sequence,
+                       .analysis = &*m.analysis,
+                       .mask = &m.mask,
+                       .truth_nm = m.truth_nm ? &*m.truth_nm : nullptr,
+                       .out = {},
+                       .out_given = {},
+                       .m_per_px = m.m_per_px};
 }
 
 Json measure_json(const MeasureRecord& r) {
-  const instrument::MeasurementAnalysis& a = *r.analysis;
-  const instrument::SequenceResult& s = *r.sequence;
-  Json j{{"camera", r.camera},
-         {"daq", r.daq},
-         {"trigger", instrument::to_string(r.params->trigger)},
-         {"rate_Hz", r.rate_Hz},
-         {"clock", r.real_time ? "realtime" : "free-run"},
-         {"calibration", r.calibration_source},
-         {"algorithm", r.algorithm},
-         {"wavelength_nm", r.params->wavelength_nm},
-         {"frames", r.params->steps_rad.size()},
-         {"averages", r.params->averages},
-         {"commanded_steps_rad", r.params->steps_rad},
-         {"recovered_steps_rad", a.recovered_steps_rad},
-         {"true_steps_rad", a.true_steps_rad.empty() ? Json(nullptr) : Json(a.true_steps_rad)},
-         {"step_error_max_mrad", a.has_step_error() ? Json(a.step_error_max_mrad) : Json(nullptr)},
-         {"steps_reason", a.steps_reason.empty() ? Json(nullptr) : Json(a.steps_reason)},
-         {"converged", a.converged},
-         {"reason", a.reason.empty() ? Json(nullptr) : Json(a.reason)},
-         {"surface_rms_nm", a.figures.rms},
-         {"surface_pv_nm", a.figures.pv},
-         {"surface_pvr_nm", a.figures.pvr},
-         {"valid_pixels", a.figures.pixels},
-         {"zernike_nm", a.zernike_nm},
-         {"error_rms_nm", r.error_rms_nm ? Json(*r.error_rms_nm) : Json(nullptr)},
-         {"ideal_error_rms_nm", r.ideal_error_rms_nm ? Json(*r.ideal_error_rms_nm) : Json(nullptr)},
-         {"floor_error_rms_nm", r.floor_error_rms_nm ? Json(*r.floor_error_rms_nm) : Json(nullptr)},
-         {"stage_error_rms_nm", r.floor_error_rms_nm && r.error_rms_nm
-                                    ? Json(stage_error_nm(*r.error_rms_nm, *r.floor_error_rms_nm))
-                                    : Json(nullptr)},
-         {"timing",
-          {{"wall_time_s", s.wall_time_s},
-           {"floor_s", s.floor_s},
-           {"ratio_to_floor",
-            s.floor_s > 0.0 ? number_or_null(s.wall_time_s / s.floor_s) : Json(nullptr)},
-           {"loop_time_s", s.loop_time_s},
-           {"ticks", s.ticks},
-           {"overruns", s.overruns}}},
-         {"exposures", exposures_json(s)}};
-  // The cavity's path from its set point after the first average (the lock's reference).
-  const std::optional<double> path = instrument::path_error_rms_nm(s, r.params->steps_rad.size());
-  j["path_error_rms_nm"] = path ? Json(*path) : Json(nullptr);
-  j["lock"] = nullptr;
-  if (s.lock)
-    j["lock"] = {{"gain_per_frame",
-                  r.params->lock ? Json(r.params->lock->lock.gain_per_frame) : Json(nullptr)},
-                 {"reference_frames", s.lock->reference_frames},
-                 {"locked_frames", s.lock->locked},
-                 {"holding_frames", s.lock->holding},
-                 {"lost_frames", s.lock->lost},
-                 {"retaken_frames", s.lock->retaken},
-                 {"pupil_source", s.lock->pupil_from_modulation ? "modulation" : "given"},
-                 {"pupil_pixels", s.lock->pupil_pixels},
-                 {"first_refusal",
-                  s.lock->first_refusal.empty() ? Json(nullptr) : Json(s.lock->first_refusal)},
-                 {"correction_piston_nm", s.lock->correction[0]},
-                 {"correction_theta_x_urad", s.lock->correction[1]},
-                 {"correction_theta_y_urad", s.lock->correction[2]}};
-  j["hold"] = s.hold.empty() ? Json(nullptr) : hold_json(s);
-  Json averages = Json::array();
-  for (const psi::SurfaceFigures& f : a.average_figures)
-    averages.push_back({{"rms_nm", f.rms}, {"pv_nm", f.pv}, {"pvr_nm", f.pvr}});
-  j["average_figures"] = averages;
-  if (!r.out.empty())
-    j["out"] = r.out;
-  if (!r.out_given.empty())
-    j["out_given"] = r.out_given;
-  j["lateral_scale_m_per_px"] = r.m_per_px > 0.0 ? Json(r.m_per_px) : Json(nullptr);
-  return j;
+  return procedures::measure_json(*r.outcome, {.out = r.out, .out_given = r.out_given});
 }
 
 std::optional<fs::path> measurement_destination(const fs::path& out) {

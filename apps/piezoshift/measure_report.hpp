@@ -9,28 +9,20 @@
 
 #include "piezoshift/instrument/measurement.hpp"
 #include "piezoshift/instrument/sequence.hpp"
+#include "piezoshift/procedures/measure_outcome.hpp"
 #include "piezoshift/psi/grid.hpp"
 
 namespace piezoshift::app {
 
 struct MeasureRecord {
-  std::string camera;     //!< the camera's name ("twin", "aravis:Fake_1", ...)
-  std::string daq;        //!< the DAQ backend's name
-  std::string algorithm;  //!< psi's name of the analysis' algorithm
-  std::string calibration_source;
-  double rate_Hz = 1000.0;
-  bool real_time = true;
+  //! What ran and its figures against the truth (procedures::run_measure's outcome), which
+  //! measure_json encodes; the pointers below point into it.
+  const procedures::MeasureOutcome* outcome = nullptr;
   const instrument::SequenceParams* params = nullptr;
   const instrument::SequenceResult* sequence = nullptr;
   const instrument::MeasurementAnalysis* analysis = nullptr;
   const psi::Mask* mask = nullptr;
   const psi::Map* truth_nm = nullptr;  //!< the twin camera's surface, else nullptr
-  std::optional<double> error_rms_nm;  //!< measured - truth, piston and tilt removed
-  //! The same frames from an ideal stage (the camera's and the algorithm's floor, one average).
-  std::optional<double> ideal_error_rms_nm;
-  //! The same over the whole measurement, every exposure with its own frame's noise draws
-  //! (twin camera): the floor the stage's error adds to.
-  std::optional<double> floor_error_rms_nm;
   //! The folder the measurement was written to (write_measurement's), "" before.
   std::string out;
   //! --out when something appeared in it while the measurement ran: written beside it instead.
@@ -41,12 +33,12 @@ struct MeasureRecord {
   double m_per_px = 0.0;
 };
 
-//! The summary measure prints with --json and writes as measurement.json.
-nlohmann::json measure_json(const MeasureRecord& r);
+//! The record of a measurement that has an analysis (kMeasured, kNotConverged); it points into m.
+MeasureRecord measure_record(const procedures::MeasureOutcome& m);
 
-//! Refuses (InputError) an --out that exists and is not an empty folder: called before the
-//! measurement, and again by write_measurement.
-void check_measure_out(const std::string& out);
+//! The summary measure prints with --json and writes as measurement.json:
+//! procedures::measure_json of the outcome, with where it was written.
+nlohmann::json measure_json(const MeasureRecord& r);
 
 //! Writes the measurement into out (which must not exist, or be an empty folder): frames,
 //! surface (.npy, .png, and .gsf and .datx with its lateral scale), truth, mask, exposures.csv,

@@ -25,6 +25,7 @@
 #include "piezoshift/config/project_config.hpp"
 #include "piezoshift/core/bounds.hpp"
 #include "piezoshift/core/input_error.hpp"
+#include "piezoshift/core/wavelength.hpp"
 #include "piezoshift/instrument/fringe_actuator_scan.hpp"
 #include "piezoshift/io/atomic_file.hpp"
 #include "piezoshift/psi/analysis.hpp"
@@ -56,7 +57,7 @@ struct PsiOptions {
   std::string out;
   bool json = false;
   std::string algorithm;
-  double wavelength_nm = 632.8;
+  double wavelength_nm = core::kHeNeWavelength_nm;
   // analyze, calibrate
   std::vector<std::string> frames;
   std::string mask;

@@ -30,15 +30,6 @@ std::vector<double> parse_list(const std::string& text, const std::string& optio
   return v;
 }
 
-psi::Mask read_mask_of_size(const std::string& path, int width_px, int height_px,
-                            std::string_view of) {
-  psi::Mask m = psi::read_mask_png(path);
-  if (m.width != width_px || m.height != height_px)
-    throw core::InputError(fmt::format("{}: mask is {} x {} pixels, {} {} x {}", path, m.width,
-                                       m.height, of, width_px, height_px));
-  return m;
-}
-
 // The pupil: the mask file given, else found from the frames' fringe modulation
 // (pupil_detection.hpp), with what the JSON reports of it. who prefixes a refusal.
 PupilChoice choose_pupil(const std::string& path, std::span<const psi::Map> frames,

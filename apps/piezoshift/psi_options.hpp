@@ -11,13 +11,12 @@
 
 #include "piezoshift/psi/grid.hpp"
 #include "piezoshift/psi/phase_algorithms.hpp"
+#include "piezoshift/psi/png_image.hpp"
 
 namespace piezoshift::app {
 
-//! The mask PNG at path; InputError naming it when it is not width_px x height_px (`of`: what
-//! must have that size, "the frames", "the camera's frames").
-psi::Mask read_mask_of_size(const std::string& path, int width_px, int height_px,
-                            std::string_view of);
+//! The mask PNG at path, of a size (psi/png_image.hpp).
+using psi::read_mask_of_size;
 //! "0,1.5,3.1" as numbers; InputError naming option and the item that is not one.
 std::vector<double> parse_list(const std::string& text, const std::string& option);
 //! The pupil: the mask PNG at path (of the frames' size), else found from the frames' fringe

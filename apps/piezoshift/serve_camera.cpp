@@ -20,6 +20,7 @@
 #include "piezoshift/host/gcs_client.hpp"
 #include "piezoshift/host/gcs_error.hpp"
 #include "piezoshift/instrument/measurement.hpp"
+#include "piezoshift/instrument/twin_measurement.hpp"
 #include "piezoshift/psi/analysis.hpp"
 #include "piezoshift/psi/fringe_visibility.hpp"
 #include "piezoshift/psi/png_image.hpp"
@@ -106,7 +107,7 @@ json steps_json(const instrument::MeasurementAnalysis& a, const instrument::Sequ
 MeasurementOutcome analyse(const instrument::SequenceResult& r, psi::Algorithm algorithm,
                            const instrument::SequenceParams& p,
                            const std::optional<camera::TwinScene>& scene,
-                           const std::string& mask_path, double wavelength_nm) {
+                           const std::string& mask_path) {
   MeasurementOutcome out;
   const std::size_t n = p.steps_rad.size();
   const std::vector<psi::Map> frames = instrument::frame_maps(
@@ -126,10 +127,7 @@ MeasurementOutcome analyse(const instrument::SequenceResult& r, psi::Algorithm a
     out.j["reason"] = e.what();
     return out;
   }
-  psi::AnalysisOptions ao;
-  ao.phase.algorithm = algorithm;
-  ao.phase.steps_rad = p.steps_rad;
-  ao.wavelength_nm = wavelength_nm;
+  const psi::AnalysisOptions ao = instrument::measurement_analysis_options(algorithm, p);
   instrument::MeasurementAnalysis a;
   try {
     a = instrument::analyze_measurement(r, p, mask, ao);
@@ -480,7 +478,7 @@ void ServeCamera::finish_measurement() {
     publish_frame(r.frames.front());  // no live view: the measurement's first frame instead
   MeasurementOutcome out;
   if (r.validity.valid)
-    out = analyse(r, req.algorithm, req.params, scene_, options_.mask, options_.wavelength_nm);
+    out = analyse(r, req.algorithm, req.params, scene_, options_.mask);
   else
     out.j["reason"] = r.validity.reason;
   json& j = out.j;

@@ -46,7 +46,6 @@ struct ServeCameraOptions {
   double preview_period_s = 0.25;  //!< 4 live frames per second
   //! false: no live frames (files:DIR, whose recorded frames are the measurements' own)
   bool preview = true;
-  double wavelength_nm = 632.8;
   std::string mask;  //!< the pupil as a PNG for cameras other than the twin ("" : from the frames)
   instrument::SequenceParams sequence;  //!< base, settle criterion, timeouts (steps per request)
   std::optional<double> travel_z_max_um;

@@ -45,6 +45,7 @@
 #include "piezoshift/host/line_server.hpp"
 #include "piezoshift/host/locked_line_handler.hpp"
 #include "piezoshift/host/stage_model.hpp"
+#include "piezoshift/instrument/twin_measurement.hpp"
 #include "piezoshift/io/input_file.hpp"
 #include "piezoshift/procedures/loop_setup.hpp"
 #include "piezoshift/procedures/loop_stack.hpp"
@@ -197,16 +198,14 @@ void check_serve_options(const ServeOptions& o) {
 CameraSetup open_camera(const ServeOptions& o, const camera::CameraConfig& cc,
                         const procedures::LoopCalibration& cal) {
   CameraSetup c;
-  const double wavelength_nm = c.options.sequence.wavelength_nm;
   if (o.camera == "twin" || (o.camera.starts_with("aravis:Fake") && o.daq == "sim"))
-    c.scene = camera::make_twin_scene(
-        o.surface.empty() ? psi::SurfaceSpec{} : psi::parse_surface_spec(o.surface),
-        camera::measurement_optics(cc.settings, cc.pupil_radius_m, wavelength_nm), o.seed);
+    c.scene = instrument::measurement_scene(
+        o.surface.empty() ? psi::SurfaceSpec{} : psi::parse_surface_spec(o.surface), cc,
+        c.options.sequence, o.seed);
   c.camera = camera::make_camera(o.camera, cc, c.scene ? &*c.scene : nullptr);
   c.options.period_s = 1.0 / o.rate_Hz;
   // A replay's frames are the measurements' own: a live view would use them up.
   c.options.preview = !o.camera.starts_with("files:");
-  c.options.wavelength_nm = wavelength_nm;
   c.options.mask = o.mask;
   c.options.travel_z_max_um = cal.travel_z_max_um;
   c.options.calibration_source = cal.source;

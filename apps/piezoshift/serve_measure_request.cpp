@@ -41,8 +41,10 @@ MeasureRequestCheck check_measure_request(std::string_view body, const MeasureRe
     const json avg = j.value("averages", json(1));
     if (!alg.is_string())
       throw core::InputError("algorithm: a name (4step, carre, hariharan5, ...)");
-    if (!avg.is_number_integer() || avg.get<long long>() < 1 || avg.get<long long>() > 100)
-      throw core::InputError("averages: a whole number, 1 to 100");
+    if (!avg.is_number_integer() || avg.get<long long>() < instrument::kMinAverages ||
+        avg.get<long long>() > instrument::kMaxAverages)
+      throw core::InputError(fmt::format("averages: a whole number, {} to {}",
+                                         instrument::kMinAverages, instrument::kMaxAverages));
     req.algorithm = psi::parse_algorithm(alg.get<std::string>());
     req.params.steps_rad = instrument::commanded_steps(req.algorithm, {}, "algorithm");
     req.params.averages = static_cast<int>(avg.get<long long>());

@@ -21,6 +21,7 @@
 #include "piezoshift/camera/make_camera.hpp"
 #include "piezoshift/camera/twin_camera.hpp"
 #include "piezoshift/core/input_error.hpp"
+#include "piezoshift/core/wavelength.hpp"
 #include "values.hpp"
 
 namespace piezoshift::python {
@@ -28,8 +29,6 @@ namespace piezoshift::python {
 namespace {
 
 namespace cam = ps::camera;
-
-constexpr double kWavelength_nm = 632.8;  // measure's: HeNe
 
 void bind_camera_enums(py::module_& m) {
   py::enum_<cam::PixelFormat>(m, "PixelFormat")
@@ -112,10 +111,11 @@ void bind_twin_scene(py::module_& m) {
         const ps::psi::SurfaceSpec spec =
             surface.empty() ? ps::psi::SurfaceSpec{} : ps::psi::parse_surface_spec(surface);
         const cam::CameraConfig cc = config.value_or(cam::CameraConfig{});
-        return cam::make_twin_scene(spec,
-                                    fizeau.value_or(cam::measurement_optics(
-                                        cc.settings, cc.pupil_radius_m, kWavelength_nm)),
-                                    seed);
+        return cam::make_twin_scene(
+            spec,
+            fizeau.value_or(cam::measurement_optics(cc.settings, cc.pupil_radius_m,
+                                                    ps::core::kHeNeWavelength_nm)),
+            seed);
       },
       py::arg("surface") = "", py::arg("config") = py::none(), py::arg("seed") = 1,
       py::arg("fizeau") = py::none(),

@@ -15,6 +15,7 @@
 #include "bindings.hpp"
 #include "piezoshift/config/project_config.hpp"
 #include "piezoshift/core/input_error.hpp"
+#include "piezoshift/core/wavelength.hpp"
 #include "piezoshift/psi/analysis.hpp"
 #include "piezoshift/psi/pupil_detection.hpp"
 #include "piezoshift/psi/simulation.hpp"
@@ -155,7 +156,8 @@ void bind_psi(py::module_& m) {
         return d;
       },
       py::arg("frames"), py::arg("mask") = py::none(), py::arg("algorithm") = "hariharan5",
-      py::arg("steps_rad") = std::vector<double>{}, py::arg("wavelength_nm") = 632.8,
+      py::arg("steps_rad") = std::vector<double>{},
+      py::arg("wavelength_nm") = piezoshift::core::kHeNeWavelength_nm,
       py::arg("remove_power") = false,
       "Frames (N, H, W) to a surface map [nm] and its figures (docs/psi.md); mask None: the "
       "pupil found from the fringe modulation");

@@ -19,11 +19,6 @@ namespace {
 
 namespace rp = ps::reproduction;
 
-// Through Python's json module, so the dict holds exactly what summary.json holds.
-py::object json_to_python(const nlohmann::json& j) {
-  return py::module_::import("json").attr("loads")(j.dump());
-}
-
 void bind_results(py::module_& m) {
   using RoO = rp::ReproduceOptions;
   py::class_<RoO>(m, "ReproduceOptions")

@@ -9,6 +9,8 @@
 #include <string>
 #include <vector>
 
+#include <nlohmann/json.hpp>
+
 #include "piezoshift/control/vec3.hpp"
 #include "piezoshift/core/input_error.hpp"
 
@@ -75,6 +77,12 @@ inline std::vector<Vec3> from_numpy_n3(const InArray& a, const char* name) {
       rows[static_cast<std::size_t>(i)][j] = r(i, j);
   }
   return rows;
+}
+
+//! A library encoder's JSON as Python objects, through Python's json module, so the dict holds
+//! exactly what the CLI's --json prints (NaN and infinity are null in both).
+inline py::object json_to_python(const nlohmann::json& j) {
+  return py::module_::import("json").attr("loads")(j.dump());
 }
 
 }  // namespace piezoshift::python

@@ -561,8 +561,8 @@ std::string sequence_problem(const SequenceParams& p) {
     return fmt::format("settle hold {} s: must be in [0, 10]", p.on_target.hold_s);
   if (!(p.on_target.timeout_s > 0.0 && p.on_target.timeout_s <= 60.0))
     return fmt::format("settle timeout {} s: must be in (0, 60]", p.on_target.timeout_s);
-  if (p.averages < 1 || p.averages > 100)
-    return fmt::format("{} averages: must be 1 to 100", p.averages);
+  if (p.averages < kMinAverages || p.averages > kMaxAverages)
+    return fmt::format("{} averages: must be {} to {}", p.averages, kMinAverages, kMaxAverages);
   if (!(p.frame_timeout_s > 0.0 && p.frame_timeout_s <= 600.0))
     return fmt::format("frame timeout {} s: must be in (0, 600]", p.frame_timeout_s);
   if (!(p.hold_s >= 0.0 && p.hold_s <= 3600.0))

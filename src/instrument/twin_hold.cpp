@@ -10,20 +10,15 @@
 #include "piezoshift/core/input_error.hpp"
 #include "piezoshift/instrument/acquisition.hpp"
 #include "piezoshift/instrument/measurement_lock.hpp"
-#include "piezoshift/runtime/loop_clock.hpp"
+#include "piezoshift/instrument/twin_measurement.hpp"
 #include "piezoshift/runtime/safety_ranges.hpp"
-#include "piezoshift/runtime/sim_backend.hpp"
 
 namespace piezoshift::instrument {
 namespace {
 
-// measure's defaults (apps/piezoshift/measure_command.cpp): the HeNe line, hariharan5.
-constexpr double kWavelength_nm = 632.8;
-
 SequenceParams hold_sequence(const TwinHoldOptions& o) {
   SequenceParams p;
   p.steps_rad = commanded_steps(psi::Algorithm::kHariharan5, {}, "--steps-rad");
-  p.wavelength_nm = kWavelength_nm;
   p.averages = o.averages;
   p.hold_s = o.hold_s;
   if (const std::string why = sequence_problem(p); !why.empty())
@@ -36,20 +31,9 @@ SequenceParams hold_sequence(const TwinHoldOptions& o) {
 TwinHold twin_hold(const camera::InstrumentConfig& config,
                    const calibration::LoopCalibration& calibration, const TwinHoldOptions& o) {
   SequenceParams params = hold_sequence(o);
-  const camera::TwinScene scene = camera::make_twin_scene(
-      psi::SurfaceSpec{},
-      camera::measurement_optics(config.camera.settings, config.camera.pupil_radius_m,
-                                 kWavelength_nm),
-      o.seed);
+  const camera::TwinScene scene =
+      measurement_scene(psi::SurfaceSpec{}, config.camera, params, o.seed);
   const config::ProjectConfig& project = config.installation.project;
-  runtime::SimOptions so;
-  so.design = project.design;
-  so.twin = project.twin;
-  so.seed = o.seed;
-  so.rate_Hz = o.rate_Hz;
-  runtime::SimBackend sim(so);
-  sim.configure();
-  runtime::SimulatedClock clock;
   if (const std::optional<std::string> who = lock_requested_by(o.lock, "--lock", calibration))
     params.lock =
         measurement_lock_setup(scene.mask, config.camera.pupil_radius_m, project.twin.geometry,
@@ -65,7 +49,7 @@ TwinHold twin_hold(const camera::InstrumentConfig& config,
   std::unique_ptr<camera::Camera> cam = camera::make_camera("twin", config.camera, &scene);
   cam->start();
   TwinHold out;
-  out.sequence = acquire_sequence(sim, clock, &sim.twin(), *cam, loop, params);
+  out.sequence = acquire_on_simulated_twin(project, o.seed, o.rate_Hz, "", *cam, loop, params);
   cam->stop();
   out.summary = hold_summary(out.sequence);
   return out;

@@ -26,10 +26,10 @@ extern "C" void on_stop_signal(int signo) {
 }
 }  // namespace
 
-void check_loop_rate(double rate_Hz) {
+void check_loop_rate(double rate_Hz, std::string_view option) {
   if (!(rate_Hz >= 1000.0 && rate_Hz <= 10000.0))
     throw core::InputError(
-        fmt::format("--rate-hz {}: supported rates are 1000 to 10000 Hz", rate_Hz));
+        fmt::format("{} {}: supported rates are 1000 to 10000 Hz", option, rate_Hz));
 }
 
 runtime::SafetyLimits loop_safety_limits(const runtime::SafetyLimits& installation,

@@ -188,6 +188,14 @@ Mask read_mask_png(const std::string& path) {
   return m;
 }
 
+Mask read_mask_of_size(const std::string& path, int width_px, int height_px, std::string_view of) {
+  Mask m = read_mask_png(path);
+  if (m.width != width_px || m.height != height_px)
+    throw core::InputError(fmt::format("{}: mask is {} x {} pixels, {} {} x {}", path, m.width,
+                                       m.height, of, width_px, height_px));
+  return m;
+}
+
 std::string encode_false_colour_png(const Map& map, double lo, double hi) {
   const int bar = std::max(12, map.width / 16), gap = std::max(4, map.width / 64);
   const int w = map.width + gap + bar, h = map.height;

@@ -26,6 +26,7 @@
 
 #include "piezoshift/config/project_config.hpp"
 #include "piezoshift/control/semi_closed_loop.hpp"
+#include "piezoshift/core/wavelength.hpp"
 #include "piezoshift/rig/bench.hpp"
 #include "piezoshift/rig/progress.hpp"
 #include "piezoshift/rig/validity.hpp"
@@ -33,8 +34,8 @@
 namespace piezoshift::experiments {
 
 struct PhaseStepOptions {
-  double wavelength_nm = 632.8;      //!< He-Ne, the Fizeau interferometer's source
-  double start_um = 5.0;             //!< mid-travel
+  double wavelength_nm = core::kHeNeWavelength_nm;  //!< He-Ne, the Fizeau interferometer's source
+  double start_um = 5.0;                            //!< mid-travel
   double settle_s = 1.0;             //!< at start_um before the hold (the approach's transient)
   double hold_s = 0.5;               //!< the hold whose jitter is measured
   double record_s = 0.1;             //!< after the step command

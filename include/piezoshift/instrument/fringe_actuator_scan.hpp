@@ -25,6 +25,7 @@
 #include <vector>
 
 #include "piezoshift/camera/camera.hpp"
+#include "piezoshift/core/wavelength.hpp"
 #include "piezoshift/instrument/scan_stage.hpp"
 #include "piezoshift/psi/fringe_tracker.hpp"
 #include "piezoshift/psi/grid.hpp"
@@ -38,12 +39,13 @@ struct FringeActuatorScanParams {
   double base_um = 2.0;      //!< common SGS target at the scan's start (stage 2's base)
   double move_um = 7.0;      //!< the actuator alone, base_um -> base_um + move_um (stage 2's)
   int reference_frames = 5;  //!< the tracker's first window
-  double wavelength_nm = 632.8;
-  double reference_step_um = 632.8e-3 / 8.0;  //!< lambda/8 of piston a reference frame
+  double wavelength_nm = core::kHeNeWavelength_nm;
+  double reference_step_um =
+      core::kHeNeWavelength_um / 8.0;  //!< lambda/8 of piston a reference frame
   //! The largest step a frame may make anywhere in the pupil, predicted from the commanded leg
   //! step: half the tracker's 0.75 pi limit (118.6 nm), a margin of 2 for what the prediction
   //! ignores (the gauges' gains, the plate's coupling of the legs, the PIDs' settling error).
-  double max_pupil_step_nm = 0.5 * 0.75 * 632.8 / 4.0;
+  double max_pupil_step_nm = 0.5 * 0.75 * core::kHeNeWavelength_nm / 4.0;
   double settle_s = 0.1;               //!< after each move, before the exposure
   double initial_settle_s = 0.5;       //!< after the servo closes at the reference's first pose
   double pupil_radius_m = 0.025;       //!< the pupil on the plate (FizeauParams::pupil_radius_m)

@@ -26,6 +26,7 @@
 #include "piezoshift/camera/instrument_config.hpp"
 #include "piezoshift/camera/twin_camera.hpp"
 #include "piezoshift/config/project_config.hpp"
+#include "piezoshift/core/wavelength.hpp"
 #include "piezoshift/instrument/fringe_actuator_scan.hpp"
 #include "piezoshift/instrument/fringe_piston_scan.hpp"
 #include "piezoshift/instrument/scan_stage.hpp"
@@ -53,8 +54,8 @@ struct FringeCalibrationOptions {
   calibration::CalibrationOptions stages{};
   double settle_s = 0.1;  //!< after each move, before the exposure (the scans' default)
   //! The largest step a frame may make in the pupil: half the tracker's limit (the scans')
-  double max_pupil_step_nm = 0.5 * 0.75 * 632.8 / 4.0;
-  double wavelength_nm = 632.8;
+  double max_pupil_step_nm = 0.5 * 0.75 * core::kHeNeWavelength_nm / 4.0;
+  double wavelength_nm = core::kHeNeWavelength_nm;
 };
 
 struct FringeCalibrationOutcome {

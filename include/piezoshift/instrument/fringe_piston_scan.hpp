@@ -23,6 +23,7 @@
 #include <vector>
 
 #include "piezoshift/camera/camera.hpp"
+#include "piezoshift/core/wavelength.hpp"
 #include "piezoshift/instrument/fringe_actuator_scan.hpp"
 #include "piezoshift/psi/grid.hpp"
 #include "piezoshift/rig/bench.hpp"
@@ -33,10 +34,11 @@ namespace piezoshift::instrument {
 struct FringePistonScanParams {
   double max_um = 11.0;      //!< stage 3's span (PolynomialIdentificationOptions::max_um)
   int reference_frames = 5;  //!< the tracker's first window
-  double wavelength_nm = 632.8;
-  double reference_step_um = 632.8e-3 / 8.0;  //!< lambda/8 of piston a reference frame
+  double wavelength_nm = core::kHeNeWavelength_nm;
+  double reference_step_um =
+      core::kHeNeWavelength_um / 8.0;  //!< lambda/8 of piston a reference frame
   //! The largest move between frames: half the tracker's 118.6 nm (fringe_actuator_scan.hpp)
-  double max_pupil_step_nm = 0.5 * 0.75 * 632.8 / 4.0;
+  double max_pupil_step_nm = 0.5 * 0.75 * core::kHeNeWavelength_nm / 4.0;
   double settle_s = 0.1;               //!< after each move, before the exposure
   double initial_settle_s = 0.5;       //!< after the servo closes at Z_d = 0
   double frame_timeout_s = 5.0;        //!< wall time for a frame to arrive after its exposure

@@ -43,6 +43,7 @@
 #include <vector>
 
 #include "piezoshift/camera/camera.hpp"
+#include "piezoshift/core/wavelength.hpp"
 #include "piezoshift/instrument/fringe_lock_session.hpp"
 #include "piezoshift/plant/twin.hpp"
 #include "piezoshift/psi/phase_algorithms.hpp"
@@ -59,14 +60,19 @@ enum class TriggerMode : std::uint8_t { kSoftware, kLine };
 //! "software", "line".
 const char* to_string(TriggerMode mode) noexcept;
 
+//! The measurements a sequence averages: the one range every front end checks (`measure
+//! --averages`, Python's averages, the dashboard's POST /api/measure) and sequence_problem().
+inline constexpr int kMinAverages = 1;
+inline constexpr int kMaxAverages = 100;
+
 struct SequenceParams {
   std::vector<double> steps_rad;  //!< the phase steps of one measurement, steps_rad[0] = 0
-  double wavelength_nm = 632.8;   //!< HeNe, the usual Fizeau source
-  double base_um = 5.0;           //!< Z_d of P1..P3 at frame 0 (mid travel)
+  double wavelength_nm = core::kHeNeWavelength_nm;  //!< HeNe, the usual Fizeau source
+  double base_um = 5.0;                             //!< Z_d of P1..P3 at frame 0 (mid travel)
   double initial_settle_s = 0.2;  //!< after the servo closes at the base, before frame 0
   psi::OnTarget on_target{};      //!< the settle criterion (band, hold time, timeout)
-  int averages = 1;               //!< measurements taken one after the other
-  double frame_timeout_s = 2.0;   //!< after its exposure, for a frame to arrive
+  int averages = 1;  //!< measurements taken one after the other, kMinAverages..kMaxAverages
+  double frame_timeout_s = 2.0;  //!< after its exposure, for a frame to arrive
   TriggerMode trigger = TriggerMode::kSoftware;
   std::uint32_t trigger_pulse_ticks = 1;  //!< kLine: the pulse's width, 1 to 1000 ticks
   //! The fringe lock (fringe_lock_session.hpp); none: the semi-closed loop alone

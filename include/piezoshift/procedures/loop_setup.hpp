@@ -8,6 +8,7 @@
 #include <memory>
 #include <optional>
 #include <string>
+#include <string_view>
 
 #include <nlohmann/json.hpp>
 
@@ -22,9 +23,9 @@
 
 namespace piezoshift::procedures {
 
-//! Throws core::InputError naming --rate-hz unless 1000 <= rate_Hz <= 10000 (the paper's 1 kHz to
-//! the DAQ's practical limit, docs/runtime.md).
-void check_loop_rate(double rate_Hz);
+//! Throws core::InputError naming option (the CLI's --rate-hz, Python's rate_Hz) unless
+//! 1000 <= rate_Hz <= 10000 (the paper's 1 kHz to the DAQ's practical limit, docs/runtime.md).
+void check_loop_rate(double rate_Hz, std::string_view option = "--rate-hz");
 
 //! The installation's limits (a config's [safety], or the built-in ones), with --max-overruns
 //! consecutive overruns instead when given; throws core::InputError when that is not in

@@ -6,13 +6,14 @@
 // pose trajectory; the stage keeps the tick-by-tick log.
 #include <vector>
 
+#include "piezoshift/core/wavelength.hpp"
 #include "piezoshift/psi/stage.hpp"
 
 namespace piezoshift::psi {
 
 struct AcquisitionParams {
   int frames = 5;
-  double step_nm = 632.8 / 8.0;  //!< pi/2 at 632.8 nm
+  double step_nm = core::kHeNeWavelength_nm / 8.0;  //!< pi/2 at 632.8 nm
   OnTarget on_target{};
   double exposure_s = 1e-3;  //!< the camera's exposure
 };

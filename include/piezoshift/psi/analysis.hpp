@@ -9,6 +9,7 @@
 #include <span>
 #include <vector>
 
+#include "piezoshift/core/wavelength.hpp"
 #include "piezoshift/psi/phase_algorithms.hpp"
 #include "piezoshift/psi/surface_metrics.hpp"
 
@@ -16,7 +17,7 @@ namespace piezoshift::psi {
 
 struct AnalysisOptions {
   PhaseOptions phase{};
-  double wavelength_nm = 632.8;
+  double wavelength_nm = core::kHeNeWavelength_nm;
   Removal removal = Removal::kTilt;
   int zernike_terms = 37;
   double min_modulation_fraction = 0.1;

@@ -17,6 +17,7 @@
 #include <string>
 #include <vector>
 
+#include "piezoshift/core/wavelength.hpp"
 #include "piezoshift/psi/phase_algorithms.hpp"
 
 namespace piezoshift::psi {
@@ -24,7 +25,7 @@ namespace piezoshift::psi {
 struct BudgetParams {
   int size_px = 64;  //!< square camera; the pupil is 0.45 of it in radius
   int trials = 3;
-  double wavelength_nm = 632.8;
+  double wavelength_nm = core::kHeNeWavelength_nm;
   double pupil_radius_m = 0.025;
   double exposure_s = 1e-3;
   double step_gain_error = 0.02;

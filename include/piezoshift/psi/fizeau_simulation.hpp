@@ -22,6 +22,7 @@
 #include <utility>
 #include <vector>
 
+#include "piezoshift/core/wavelength.hpp"
 #include "piezoshift/plant/random.hpp"
 #include "piezoshift/psi/grid.hpp"
 
@@ -54,8 +55,8 @@ struct FizeauParams {
   int height_px = 256;
   double pupil_radius_px = 120.0;  //!< the pupil on the camera
   double pupil_radius_m = 0.025;   //!< on the plate: a 50 mm aperture (assumed; not in the paper)
-  double wavelength_nm = 632.8;    //!< HeNe, the usual Fizeau source
-  int subsamples = 4;              //!< integration points per pose interval
+  double wavelength_nm = core::kHeNeWavelength_nm;  //!< HeNe, the usual Fizeau source
+  int subsamples = 4;                               //!< integration points per pose interval
 };
 
 struct CameraParams {

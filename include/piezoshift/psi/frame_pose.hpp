@@ -35,6 +35,7 @@
 #include <string>
 #include <vector>
 
+#include "piezoshift/core/wavelength.hpp"
 #include "piezoshift/psi/grid.hpp"
 
 namespace piezoshift::psi {
@@ -88,7 +89,7 @@ FramePoseReference frame_pose_reference(std::span<const Map> frames, const Mask&
                                         double pupil_radius_m = 0.025);
 
 struct FramePoseOptions {
-  double wavelength_nm = 632.8;
+  double wavelength_nm = core::kHeNeWavelength_nm;
   int max_iterations = 20;
   double tolerance_nm = 1e-4;  //!< settled: no point of the pupil moved more in the last step
   //! The least contrast taken as fringes: assumed 0.3 (a third of the reference's; the camera's

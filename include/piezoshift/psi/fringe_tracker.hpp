@@ -61,6 +61,7 @@
 #include <string>
 #include <vector>
 
+#include "piezoshift/core/wavelength.hpp"
 #include "piezoshift/kinematics/tripod.hpp"
 #include "piezoshift/psi/frame_pose.hpp"
 #include "piezoshift/psi/grid.hpp"
@@ -76,9 +77,9 @@ enum class FringeMethod : std::uint8_t {
 
 struct FringeTrackerParams {
   FringeMethod method = FringeMethod::kReference;
-  int window_frames = 5;         //!< W, frames per tilt-aia fit (at least 3)
-  int hop_frames = 0;            //!< kWindows: frames the window advances by, 1..W-1; 0: W - 1
-  double wavelength_nm = 632.8;  //!< HeNe (fizeau_simulation.hpp)
+  int window_frames = 5;  //!< W, frames per tilt-aia fit (at least 3)
+  int hop_frames = 0;     //!< kWindows: frames the window advances by, 1..W-1; 0: W - 1
+  double wavelength_nm = core::kHeNeWavelength_nm;  //!< HeNe (fizeau_simulation.hpp)
   //! plate metres per camera pixel (FizeauParams: pupil_radius_m / pupil_radius_px)
   double plate_m_per_px = 0.025 / 120.0;
   //! P1..P3 in the plate frame [m] (plant::make_twin_geometry(...).points on the twin)

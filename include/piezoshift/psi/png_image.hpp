@@ -11,6 +11,7 @@
 //   encode_*: the same images as a PNG file's bytes, for a caller that sends them (the dashboard).
 // Set-up only; every error is core::InputError naming the file.
 #include <string>
+#include <string_view>
 
 #include "piezoshift/psi/grid.hpp"
 
@@ -28,6 +29,9 @@ void write_png_gray16(const std::string& path, const Map& counts);
 std::string encode_png_gray16(const Map& counts);
 void write_mask_png(const std::string& path, const Mask& mask);
 Mask read_mask_png(const std::string& path);
+//! read_mask_png of a mask that must be width_px x height_px: core::InputError naming path and
+//! `of` (what it must match: "the frames") when it is not.
+Mask read_mask_of_size(const std::string& path, int width_px, int height_px, std::string_view of);
 //! Writes the map with the colour scale spanning [lo, hi]; returns nothing, throws on I/O.
 void write_false_colour_png(const std::string& path, const Map& map, double lo, double hi);
 std::string encode_false_colour_png(const Map& map, double lo, double hi);

@@ -13,6 +13,7 @@
 #include <span>
 #include <string>
 #include <vector>
+#include "piezoshift/core/wavelength.hpp"
 
 namespace piezoshift::psi {
 
@@ -24,7 +25,7 @@ inline constexpr double kMaxNominalStepRad = std::numbers::pi - 0.05;
 
 struct StepCalibration {
   std::string algorithm = "aia";
-  double wavelength_nm = 632.8;
+  double wavelength_nm = core::kHeNeWavelength_nm;
   double nominal_step_rad = 0.0;
   std::vector<double> steps_rad;      //!< delta_k, delta_0 = 0
   std::vector<double> steps_nm;       //!< the mirror's motion, delta_k lambda / (4 pi)

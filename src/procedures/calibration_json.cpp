@@ -1,6 +1,6 @@
-#include "paper_summary.hpp"
+#include "piezoshift/procedures/calibration_json.hpp"
 
-namespace piezoshift::app {
+namespace piezoshift::procedures {
 
 nlohmann::json matrix_json(const control::Mat3& a) {
   nlohmann::json rows = nlohmann::json::array();
@@ -23,4 +23,16 @@ nlohmann::json paper_calibration_json(
           {"p_rms_residual_um", polynomial.fit.rms_residual_um}};
 }
 
-}  // namespace piezoshift::app
+nlohmann::json fringe_calibration_json(const instrument::FringeCalibrationOutcome& r) {
+  nlohmann::json j = paper_calibration_json(r.controller, r.matrix, r.polynomial);
+  j["pupil_source"] = r.pupil_from_modulation ? "modulation" : "given";
+  j["p_points"] = r.polynomial.command_um.size();
+  j["p_skipped_commands"] = r.polynomial.saturated_points;
+  j["frames"] = instrument::frames_read(r);
+  j["stage2_simulated_s"] = r.stage2_simulated_s;
+  j["stage3_simulated_s"] = r.stage3_simulated_s;
+  j["wall_s"] = r.wall_time_s;
+  return j;
+}
+
+}  // namespace piezoshift::procedures
