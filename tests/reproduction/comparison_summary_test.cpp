@@ -346,9 +346,10 @@ TEST(ComparisonSummary, TheHoldsAreReportedOnlyWhenAskedForAndAFailureIsNamed) {
   EXPECT_EQ(j["hold_s"], 30.0);
   EXPECT_EQ(j["hold_improved_locked_within_target"], true);
   EXPECT_TRUE(j["hold_not_valid"].empty());
-  EXPECT_EQ(hold_check_text(on),
-            "Issue 29: the improved controller's locked hold, median 0.180 nm RMS from the set "
-            "point, ≤ 0.2 nm: yes");
+  EXPECT_EQ(
+      hold_check_text(on),
+      "The lock's target: the improved controller's locked hold, median 0.180 nm RMS from the set "
+      "point, ≤ 0.2 nm: yes");
 
   seeds[1].holds[static_cast<std::size_t>(HoldVariant::kImprovedLocked)].validity.fail(
       "a frame lost: made up");
