@@ -8,12 +8,7 @@
 
 #include <fmt/core.h>
 
-#include "piezoshift/calibration/fit_error.hpp"
-#include "piezoshift/calibration/holding_gains.hpp"
-#include "piezoshift/calibration/improved_calibration.hpp"
-#include "piezoshift/control/notch_filter.hpp"
 #include "piezoshift/core/wall_time.hpp"
-#include "piezoshift/instrument/fringe_calibration.hpp"
 #include "piezoshift/reproduction/figure_format.hpp"
 
 #include "comparison_seed.hpp"
