@@ -346,8 +346,8 @@ int run_improved(const Options& o, const runtime::InstallationConfig& installati
                   "{}",
                   o.seed, o.config.empty() ? "built-in defaults" : o.config),
       travel.single_move_um, travel.single_move_min_um);
-  const ImprovedSummary summary{ic.controller.improved, ic.model, ic.mode, ic.shaped,
-                                &ic.large_move};
+  const ImprovedSummary summary{ic.controller.improved, ic.model,        ic.mode, ic.shaped,
+                                &ic.large_move,         &ic.rate_verdict};
   if (o.json) {
     nlohmann::json j = improved_json(summary);
     j["calibration_file"] = o.out;

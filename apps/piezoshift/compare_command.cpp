@@ -1,5 +1,5 @@
 // `piezoshift compare`: the paper's controller, the improved one and the oracle, side by side
-// (issue 12, docs/compare.md).
+// (docs/compare.md).
 #include <algorithm>
 #include <charconv>
 #include <cmath>
@@ -100,11 +100,13 @@ std::string summary_tables(const reproduction::ComparisonResult& result) {
     if (!t.not_applicable.empty())
       not_judged += fmt::format("  n/a: {}: {}\n", t.text, t.not_applicable);
   }
+  if (!result.rate_verdict.empty())
+    not_judged += "  " + reproduction::rate_verdict_text(result) + "\n";
   std::string out =
       reproduction::text_table(medians) + "\n" + reproduction::text_table(targets) + not_judged;
   if (result.options.fringes) {
     std::vector<std::vector<std::string>> spread{
-        {"Table 4 (issue 29)", "paper_fringes median", "paper's seed spread", "within"}};
+        {"Table 4, fringes vs XL-80", "paper_fringes median", "paper's seed spread", "within"}};
     for (const auto& c : result.fringes_within_spread)
       spread.push_back(reproduction::spread_row(result, c));
     out += "\n" + reproduction::text_table(spread);
@@ -205,11 +207,11 @@ void add_compare_command(CLI::App& app, Action& action) {
   cmd->add_flag("--json", o->json, "print the JSON summary");
   cmd->add_flag("--fringes", o->fringes,
                 "a fourth column: the paper's controller calibrated from the Fizeau's fringes, no "
-                "XL-80 (issue 29); costs its calibration (10 to 16 s of wall time a seed) and its "
+                "XL-80; costs its calibration (10 to 16 s of wall time a seed) and its "
                 "experiments (about as long as the paper's column)");
   CLI::Option* lock = cmd->add_flag(
       "--lock", o->lock,
-      "the Fizeau hold (issue 29): per seed the paper's and the improved controller, "
+      "the Fizeau hold: per seed the paper's and the improved controller, "
       "each unlocked and locked, as `measure --free-run --averages 10 --hold-s H "
       "[--lock]` on a 96 px twin camera with the cavity's drift in the fringes; a "
       "table of its own, not a column; costs four holds a seed (5 to 8 s of wall time "

@@ -2,6 +2,7 @@
 
 #include <algorithm>
 #include <charconv>
+#include <cmath>
 #include <optional>
 #include <string_view>
 #include <vector>
@@ -42,6 +43,21 @@ nlohmann::json improved_json(const ImprovedSummary& s) {
         {"slew_overshoot_pct", s.large_move->slew_overshoot_pct},
         {"shaper_overshoot_pct", s.large_move->shaper_overshoot_pct},
         {"slew_kept", s.large_move->slew_kept}};
+  if (s.rate_verdict) {
+    const calibration::RateVerdict& v = *s.rate_verdict;
+    const auto number = [](double x) {
+      return std::isfinite(x) ? nlohmann::json(x) : nlohmann::json(nullptr);
+    };
+    j["rate_verdict"] = {{"mode_Hz", v.mode_Hz},
+                         {"loop_rate_Hz", v.loop_rate_Hz},
+                         {"folded_Hz", v.folded_Hz},
+                         {"phase_step_s", number(v.step_s)},
+                         {"target_s", v.target_s},
+                         {"mode_is_the_limit", v.mode_is_the_limit},
+                         {"faster_rate_Hz", v.faster_rate_Hz},
+                         {"faster_phase_step_s", v.faster_step_s},
+                         {"text", v.text()}};
+  }
   j["correction_ki"] = s.controller.correction_ki;
   j["sample_time_s"] = s.controller.sample_time_s;
   return j;
@@ -71,6 +87,13 @@ void print_improved(const ImprovedSummary& s) {
         s.large_move->shaper_overshoot_pct);
   else if (s.large_move)
     fmt::print("moves    the slew path not tried: {}\n", s.large_move->not_tried);
+  if (s.rate_verdict && s.rate_verdict->mode_is_the_limit)
+    fmt::print("rate     {}\n", s.rate_verdict->text());
+  else if (s.rate_verdict && s.rate_verdict->mode_Hz > 0.0)
+    fmt::print(
+        "rate     the plate's mode at {:.0f} Hz allows the lambda/8 step in {:.0f} ms at "
+        "this loop's rate\n",
+        s.rate_verdict->mode_Hz, 1e3 * s.rate_verdict->step_s);
 }
 
 namespace {

@@ -22,6 +22,9 @@ struct ImprovedSummary {
   bool shaped;
   //! Stage 7 on the twin; nullptr from records (`fit improved`: no plant to try moves on)
   const calibration::LargeMoveTrial* large_move = nullptr;
+  //! Stage 5b's verdict on the loop's rate on the twin; nullptr without a laser interferometer
+  //! or from records
+  const calibration::RateVerdict* rate_verdict = nullptr;
 };
 
 nlohmann::json improved_json(const ImprovedSummary& s);

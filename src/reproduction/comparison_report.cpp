@@ -54,7 +54,7 @@ void prefixed(nlohmann::json& j, const ComparisonResult& r, LoopVariant k, Value
 }
 
 // compare --lock's medians: hold_<variant>_<figure>, null and the reason in hold_not_valid when
-// not valid; issue 29's check.
+// not valid; the check of the locked hold against its 0.2 nm.
 void hold_json(nlohmann::json& j, const ComparisonResult& r) {
   nlohmann::json not_valid = nlohmann::json::object();
   for (const HoldVariant v : kHoldVariants)
@@ -354,7 +354,7 @@ void introduction(Document& doc, const ComparisonResult& r, const std::string& c
       r.simulated_time_s, r.wall_time_s));
   if (r.options.fringes)
     doc.paragraph(
-        "Fourth column (--fringes, issue 29): the paper's controller calibrated from the "
+        "Fourth column (--fringes): the paper's controller calibrated from the "
         "Fizeau's fringes on the twin camera, no laser interferometer, then the same experiments "
         "as the paper's column on the same seeds. Reported, not targeted.");
 }
@@ -413,7 +413,7 @@ std::vector<std::vector<std::string>> hold_median_table(const ComparisonResult& 
 std::string hold_check_text(const ComparisonResult& r) {
   const FigureValue& m = r.hold_medians[static_cast<std::size_t>(HoldVariant::kImprovedLocked)][0];
   return fmt::format(
-      "Issue 29: the improved controller's locked hold, median {} RMS from the set point, "
+      "The lock's target: the improved controller's locked hold, median {} RMS from the set point, "
       "≤ {:g} nm: {}",
       m.validity.valid ? format_figure(m.value, "nm", 0.001) : "NOT VALID", kHoldTarget_nm,
       r.hold_target_met() ? "yes" : "no");
@@ -421,7 +421,7 @@ std::string hold_check_text(const ComparisonResult& r) {
 
 namespace {
 
-// compare --lock: the holds' medians, issue 29's check, and the holds seed by seed.
+// compare --lock: the holds' medians, the check against 0.2 nm, and the holds seed by seed.
 void hold_section(Document& doc, const ComparisonResult& r) {
   doc.heading(2, hold_title(r));
   doc.paragraph(fmt::format(
@@ -431,7 +431,7 @@ void hold_section(Document& doc, const ComparisonResult& r) {
       "(twin truth), RMS, and the RMS of its means over whole seconds.",
       kHoldAverages, r.options.lock_hold_s));
   doc.table(hold_median_table(r));
-  doc.paragraph(hold_check_text(r) + ". Reported, not one of issue 12's targets.");
+  doc.paragraph(hold_check_text(r) + ". Reported, not one of the improved controller's targets.");
   for (const SeedComparison& sc : r.seeds) {
     doc.table(hold_table(
         [&sc](HoldVariant v, std::size_t i) {
@@ -476,14 +476,31 @@ void medians_section(Document& doc, const ComparisonResult& r) {
   for (const SpreadCheck& c : r.fringes_within_spread)
     spread.push_back(spread_row(r, c));
   doc.paragraph(
-      "Issue 29's done-when: the median of each Table 4 figure of the paper's controller "
+      "Can the fringes replace the XL-80? The median of each Table 4 figure of the paper's "
+      "controller "
       "calibrated from fringes, against the same controller's spread over the same seeds "
       "calibrated with the XL-80 (its smallest to its largest seed).");
   doc.table(std::move(spread));
 }
 
+// The improved calibration's verdict on one seed (null: no mode identified).
+nlohmann::json rate_verdict_json(const calibration::RateVerdict& v) {
+  if (!(v.mode_Hz > 0.0))
+    return nullptr;
+  const auto number = [](double x) {
+    return std::isfinite(x) ? nlohmann::json(x) : nlohmann::json(nullptr);
+  };
+  return {{"mode_Hz", v.mode_Hz},
+          {"loop_rate_Hz", v.loop_rate_Hz},
+          {"folded_Hz", v.folded_Hz},
+          {"phase_step_s", number(v.step_s)},
+          {"mode_is_the_limit", v.mode_is_the_limit},
+          {"faster_rate_Hz", v.faster_rate_Hz},
+          {"faster_phase_step_s", v.faster_step_s}};
+}
+
 void targets_section(Document& doc, const ComparisonResult& r) {
-  doc.heading(2, "Issue 12's targets, on the improved controller's medians");
+  doc.heading(2, "Targets, on the improved controller's medians");
   std::vector<std::vector<std::string>> rows{{"target", "bound", "improved (median)", "met"}};
   std::vector<std::string> not_judged;
   for (const Target& t : r.targets) {
@@ -497,6 +514,8 @@ void targets_section(Document& doc, const ComparisonResult& r) {
   doc.table(std::move(rows));
   for (const std::string& why : not_judged)
     doc.paragraph("Not applicable, " + why);
+  if (!r.rate_verdict.empty())
+    doc.paragraph(rate_verdict_text(r));
 }
 
 // drawn: the seed draw_figures() drew, or r.seeds.end() when none.
@@ -545,6 +564,14 @@ void per_seed_section(Document& doc, const ComparisonResult& r, const ReportFile
 
 }  // namespace
 
+std::string rate_verdict_text(const ComparisonResult& r) {
+  if (r.rate_verdict.empty())
+    return "";
+  return "The 1 kHz λ/8 step is held to 10 ms, not 5: on every seed the improved calibration "
+         "names the plate's mode as its limit; " +
+         r.rate_verdict + ".";
+}
+
 nlohmann::json comparison_json(const ComparisonResult& r) {
   nlohmann::json j;
   j["seeds"] = r.options.seeds;
@@ -565,6 +592,7 @@ nlohmann::json comparison_json(const ComparisonResult& r) {
           r.seeds[s][LoopVariant::kPaperFringes].calibration_wall_time_s;
     if (r.options.lock)
       hold_seed_json(o, r.seeds[s]);
+    o["improved_rate_verdict"] = rate_verdict_json(r.seeds[s][LoopVariant::kImproved].rate_verdict);
     per.push_back(std::move(o));
   }
   j["per_seed"] = std::move(per);
@@ -581,11 +609,15 @@ nlohmann::json comparison_json(const ComparisonResult& r) {
     x["met"] = t.met;
     if (!t.not_applicable.empty())
       x["not_applicable"] = t.not_applicable;
+    if (!t.bound_reason.empty())
+      x["bound_reason"] = t.bound_reason;
     targets.push_back(std::move(x));
   }
   j["targets"] = std::move(targets);
+  j["improved_rate_verdict"] =
+      r.rate_verdict.empty() ? nlohmann::json(nullptr) : nlohmann::json(r.rate_verdict);
   if (r.options.fringes) {
-    // Issue 29's done-when per Table 4 figure: true, false, or null with the reason.
+    // Within the XL-80's seed spread per Table 4 figure: true, false, or null with the reason.
     nlohmann::json within = nlohmann::json::object();
     nlohmann::json not_judged = nlohmann::json::object();
     for (const SpreadCheck& c : r.fringes_within_spread) {

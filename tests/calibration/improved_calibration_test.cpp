@@ -47,6 +47,9 @@ TEST(ImprovedController, OnTheDefaultTwinItHoldsQuieterAndSettlesFaster) {
   EXPECT_TRUE(c.shaped);
   // The piston mode, 1419 Hz, folds to 419 Hz at the interferometer's 1 kHz.
   EXPECT_NEAR(c.mode.mode_Hz, 419.0, 25.0);
+  // Stage 5b sees it unfolded (1415 Hz measured), and it is no limit at 1 kHz: no verdict.
+  EXPECT_NEAR(c.rate_verdict.mode_Hz, 1419.0, 10.0);
+  EXPECT_FALSE(c.rate_verdict.mode_is_the_limit);
   for (const HysteresisFit& m : c.model) {
     EXPECT_EQ(m.delay_ticks, 2U);
     EXPECT_LT(m.rms_residual_um, 0.012);
@@ -171,6 +174,13 @@ TEST(ImprovedController, At1kHzAThickPlatesModeNearTheTickRateSetsThePhaseStep) 
       config::load_project_config(testing::source_dir() + "/configs/plants/thick-plate.toml");
   const ImprovedCalibrationOutcome c = calibrated(thick, 1);
   EXPECT_FALSE(c.shaped);
+  // The calibration says so: stage 5b's mode (1020 Hz measured; the twin's 1024), the 1 kHz step
+  // it allows (27 ms) and a faster rate that meets 5 ms.
+  EXPECT_TRUE(c.rate_verdict.mode_is_the_limit) << c.rate_verdict.mode_Hz;
+  EXPECT_NEAR(c.rate_verdict.mode_Hz, 1024.0, 10.0);
+  EXPECT_GT(c.rate_verdict.step_s, 20e-3);
+  EXPECT_GT(c.rate_verdict.faster_rate_Hz, 1000.0);
+  EXPECT_LE(c.rate_verdict.faster_step_s, 5e-3);
   // The true plate after the step (the controller's own bench, seed 81): its ring over one tick.
   rig::Bench bench(thick, c.controller, 81);
   bench.drive_points(control::Vec3{5.0, 5.0, 5.0});

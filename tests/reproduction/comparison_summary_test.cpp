@@ -346,9 +346,10 @@ TEST(ComparisonSummary, TheHoldsAreReportedOnlyWhenAskedForAndAFailureIsNamed) {
   EXPECT_EQ(j["hold_s"], 30.0);
   EXPECT_EQ(j["hold_improved_locked_within_target"], true);
   EXPECT_TRUE(j["hold_not_valid"].empty());
-  EXPECT_EQ(hold_check_text(on),
-            "Issue 29: the improved controller's locked hold, median 0.180 nm RMS from the set "
-            "point, ≤ 0.2 nm: yes");
+  EXPECT_EQ(
+      hold_check_text(on),
+      "The lock's target: the improved controller's locked hold, median 0.180 nm RMS from the set "
+      "point, ≤ 0.2 nm: yes");
 
   seeds[1].holds[static_cast<std::size_t>(HoldVariant::kImprovedLocked)].validity.fail(
       "a frame lost: made up");
@@ -387,6 +388,55 @@ TEST(ComparisonSummary, TheReportOfRunsThatFailedIsWrittenAndSaysWhy) {
   EXPECT_NE(text.find("made up for the test"), std::string::npos);
   EXPECT_NE(text.find("no controller was calibrated on any seed"), std::string::npos);
   std::filesystem::remove_all(dir);
+}
+
+}  // namespace
+}  // namespace piezoshift::reproduction
+
+namespace piezoshift::reproduction {
+namespace {
+
+// The improved calibration's verdict on the loop's rate: named on every seed, the 1 kHz lambda/8
+// step is held to 10 ms and the report, the terminal and the JSON say why; named on one seed of
+// two, nothing changes (5 ms).
+TEST(ComparisonSummary, ARateVerdictOnEverySeedHoldsThe1kHzStepTo10ms) {
+  CompareOptions o;
+  o.seeds = {1, 2};
+  const auto with_verdicts = [&](double mode1_Hz, double mode2_Hz) {
+    std::vector<SeedComparison> seeds(2);
+    seeds[0].seed = 1;
+    seeds[1].seed = 2;
+    seeds[0].runs[1].rate_verdict = calibration::judge_loop_rate(mode1_Hz, 1000.0, 2);
+    seeds[1].runs[1].rate_verdict = calibration::judge_loop_rate(mode2_Hz, 1000.0, 2);
+    return summarize_comparison(config::ProjectConfig{}, o, seeds);
+  };
+  const auto step_target = [](const ComparisonResult& r) {
+    for (const Target& t : r.targets)
+      if (t.key == "phase_step_settling_time_s")
+        return t;
+    ADD_FAILURE() << "no 1 kHz step target";
+    return Target{};
+  };
+  const ComparisonResult named = with_verdicts(1020.0, 1024.0);
+  EXPECT_EQ(named.rate_verdict, calibration::judge_loop_rate(1020.0, 1000.0, 2).text());
+  const Target t = step_target(named);
+  EXPECT_DOUBLE_EQ(t.bound, 10e-3);
+  EXPECT_EQ(t.bound_text, "≤ 10 ms (the plate's mode, below)");
+  EXPECT_NE(t.bound_reason.find("folds to 20 Hz at the 1 kHz loop rate"), std::string::npos)
+      << t.bound_reason;
+  EXPECT_NE(rate_verdict_text(named).find("held to 10 ms, not 5"), std::string::npos);
+  const nlohmann::json j = comparison_json(named);
+  EXPECT_EQ(j["improved_rate_verdict"], named.rate_verdict);
+  EXPECT_DOUBLE_EQ(j["per_seed"][1]["improved_rate_verdict"]["mode_Hz"].get<double>(), 1024.0);
+  EXPECT_EQ(j["per_seed"][1]["improved_rate_verdict"]["mode_is_the_limit"], true);
+  EXPECT_DOUBLE_EQ(j["per_seed"][1]["improved_rate_verdict"]["faster_rate_Hz"].get<double>(),
+                   2000.0);
+
+  const ComparisonResult once = with_verdicts(1024.0, 1419.0);  // the default twin's on seed 2
+  EXPECT_EQ(once.rate_verdict, "");
+  EXPECT_DOUBLE_EQ(step_target(once).bound, 5e-3);
+  EXPECT_TRUE(comparison_json(once)["improved_rate_verdict"].is_null());
+  EXPECT_EQ(rate_verdict_text(once), "");
 }
 
 }  // namespace

@@ -13,6 +13,8 @@
 //        tick and fitted (hysteresis_identification.hpp)        seed + 4
 //   5.   the plate's mode: a small open-loop step, the interferometer's dynamic samples fitted by
 //        Prony's method; it sets the shaper's taps                  seed + 5
+//   5b.  the same step with the interferometer at 10 kHz, the mode unfolded, for the verdict on
+//        the loop's rate (rate_verdict.hpp); not used by the controller    seed + 8
 //   6.   the correction loop's integral gain for a chosen bandwidth, and the rate limit from the
 //        amplifier's slew (its current limit into the stack's capacitance).
 //   7.   large moves tried both ways on the plant: the 11 um step with the slew path
@@ -30,6 +32,7 @@
 #include "piezoshift/calibration/holding_gains.hpp"
 #include "piezoshift/calibration/hysteresis_identification.hpp"
 #include "piezoshift/calibration/mode_identification.hpp"
+#include "piezoshift/calibration/rate_verdict.hpp"
 
 namespace piezoshift::calibration {
 
@@ -53,7 +56,11 @@ struct ImprovedCalibrationOptions {
   double mode_step_from_um = 5.0;  //!< stage 5: open-loop command held, then
   double mode_step_um = 0.3;       //!< stepped by this
   double mode_record_s = 0.03;     //!< and the interferometer recorded this long
-  HoldingGainsOptions holding{};   //!< stage 0
+  //! Stage 5b: the interferometer's dynamic rate for the unfolded mode (an XL-80 samples up to
+  //! 50 kHz), and the lambda/8 step's bound the verdict judges the loop's rate against.
+  double verdict_interferometer_rate_Hz = 10000.0;
+  double verdict_phase_step_target_s = 5e-3;
+  HoldingGainsOptions holding{};  //!< stage 0
   //! Stage 7: Table 4's 11 um step (the paper's), from 0 after large_move_pre_s, recorded for
   //! large_move_record_s; the slew path kept when the samples read its overshoot under
   //! large_move_keep_below_pct: half the 1 % overshoot allowed, because the 1 kHz samples read a
@@ -90,6 +97,10 @@ struct ImprovedCalibrationOutcome {
   //! uses it.
   PlateModeEstimate mode;
   bool shaped = false;
+  //! Stage 5b: the mode unfolded (stage 5's when the interferometer already ran at the verdict's
+  //! rate), and the verdict on the loop's rate it gives (empty without an interferometer).
+  PlateModeEstimate unfolded_mode;
+  RateVerdict rate_verdict;
   //! The excitation as recorded (stage 4), per tick: t_s, command and gauge per channel.
   std::vector<double> record_t_s;
   std::array<std::vector<double>, 3> record_command_um, record_gauge_um;

@@ -26,4 +26,11 @@ inline constexpr std::size_t kModeSkipSamples = 3;
 //! than 9 samples, or a real pole pair) gives mode_Hz = 0: the caller then shapes for no mode.
 PlateModeEstimate identify_plate_mode(std::span<const double> x_um, double sample_rate_Hz);
 
+//! The frequency [Hz] of the ring-down's largest spectral peak between min_Hz and the Nyquist
+//! frequency (the record after kModeSkipSamples, its mean and slope removed, a Hann window; 1 Hz
+//! steps); 0 for a record too short. Where several modes ring (a fast record sees the piston
+//! mode and the tilts, which a one-mode Prony fit blends), it picks the loudest: the piston
+//! mode after a step of the three legs together.
+double ring_peak_Hz(std::span<const double> x_um, double sample_rate_Hz, double min_Hz);
+
 }  // namespace piezoshift::calibration

@@ -1,5 +1,5 @@
 #pragma once
-// `piezoshift compare` (issue 12): three variants of the loop side by side, through the same
+// `piezoshift compare`: three variants of the loop side by side, through the same
 // experiments and the same seeds: the paper's controller and the improved one, each calibrated by
 // its own procedure and fed by the strain gauges, and the paper's controller fed by the oracle (a
 // feedback, not a controller). For each seed s:
@@ -12,15 +12,15 @@
 //             (Feedback::kOracle, as reproduce()): impossible on hardware, the floor of any
 //             controller fed by the strain gauges; its gains chosen as the improved calibration's
 //             stage 0 chooses its own (the ring test on its plate feedback, seed + 93: the
-//             paper's where they hold, issue 31); the same set, no 10 kHz step and no
+//             paper's where they hold); the same set, no 10 kHz step and no
 //             inner-loop analysis of its own
-//   paper_fringes  (opt-in, CompareOptions::fringes; issue 29) the paper's controller calibrated
+//   paper_fringes  (opt-in, CompareOptions::fringes) the paper's controller calibrated
 //             from the Fizeau's fringes with no laser interferometer
 //             (instrument::calibrate_twin_from_fringes(s): the twin camera on its defaults, the
 //             default surface, stage 1 scoring the paper's gains alone), then everything the
 //             paper's variant runs, by the same rules; its simulated time includes the
 //             calibration's. Reported beside the others, never targeted.
-//   the hold  (opt-in, CompareOptions::lock; issue 29) the Fizeau's hold on the twin camera with
+//   the hold  (opt-in, CompareOptions::lock) the Fizeau's hold on the twin camera with
 //             the cavity's drift in the fringes, the paper's and the improved controller each
 //             unlocked and locked (comparison_hold.hpp): beside the columns, not one of them.
 // so a figure of the paper's controller on seed s is bit for bit reproduce()'s on seed s.
@@ -35,9 +35,9 @@
 // make the comparison not valid (a fixed design the issue does not judge, found unstable by the
 // procedure, not by the supervisor).
 //
-// The targets are issue 12's done-when criteria, judged on the improved controller's medians;
-// linearity against the oracle is judged on the unseen grid and downwards (issue 31): on the
-// paper's levels that target is not applicable (Target::not_applicable says why).
+// The targets are what the improved controller was built to meet, judged on the improved
+// controller's medians; linearity against the oracle is judged on the unseen grid and downwards: on
+// the paper's levels that target is not applicable (Target::not_applicable says why).
 #include <array>
 #include <cstdint>
 #include <functional>
@@ -45,6 +45,7 @@
 #include <string>
 #include <vector>
 
+#include "piezoshift/calibration/rate_verdict.hpp"
 #include "piezoshift/reproduction/comparison_hold.hpp"
 #include "piezoshift/reproduction/reproduction.hpp"
 
@@ -53,7 +54,7 @@ namespace piezoshift::reproduction {
 struct CompareOptions {
   std::vector<std::uint64_t> seeds{1, 2, 3, 4, 5, 6, 7, 8};
   bool quick = false;  //!< Schedule::quick() instead of Schedule::paper()
-  //! A fourth column: the paper's controller calibrated from the Fizeau's fringes (issue 29).
+  //! A fourth column: the paper's controller calibrated from the Fizeau's fringes.
   //! Off: nothing of it is run or reported, the output is the three columns' bit for bit.
   bool fringes = false;
   //! The Fizeau's hold, unlocked and locked, of the paper's and the improved controller (issue
@@ -110,6 +111,9 @@ struct VariantRun {
   double simulated_time_s = 0.0;  //!< its calibration and experiments
   //! paper_fringes: the calibration from fringes' wall time.
   double calibration_wall_time_s = 0.0;
+  //! The improved controller: its calibration's verdict on the loop's rate (stage 5b,
+  //! calibration/rate_verdict.hpp); empty for the others.
+  calibration::RateVerdict rate_verdict;
 };
 
 struct SeedComparison {
@@ -150,7 +154,12 @@ std::vector<FigureSpec> comparison_figures(const config::ProjectConfig& config);
 FigureValue median_over_seeds(const std::vector<FigureValue>& per_seed,
                               const std::vector<std::uint64_t>& seeds);
 
-//! One of issue 12's done-when criteria on the improved controller's median.
+//! The 1 kHz lambda/8 step's bound where the improved calibration names the plate's mode as its
+//! limit (a mode near a multiple of the tick rate, or a fold that needs 5 or more taps): such a
+//! plate is held to the 10 kHz step's bound at 10 kHz and to this at 1 kHz.
+inline constexpr double kModeLimitedPhaseStep_s = 10e-3;
+
+//! One of the improved controller's targets, judged on its median.
 struct Target {
   std::string text;         //!< e.g. "11 um step settles to +-10 nm"
   std::string key;          //!< the figure
@@ -162,6 +171,9 @@ struct Target {
   bool at_least = false;  //!< >= bound (travel, margins), else <= bound
   //! Why the target is not judged ("": it is); such a target is never met.
   std::string not_applicable;
+  //! Why the bound is not the usual one ("": it is): the 1 kHz lambda/8 step's 10 ms where the
+  //! improved calibration names the plate's mode as what limits it.
+  std::string bound_reason;
   bool met = false;
 
   //! "yes", "no", "n/a" (not applicable) or "-" (compare does not measure it).
@@ -174,8 +186,8 @@ inline constexpr std::array<const char*, 4> kTable4Figures{
     "step_settling_time_s", "linearity_zero_end_pct", "repeatability_5um_nm",
     "repeatability_10um_nm"};
 
-//! Issue 29's done-when on one Table 4 figure: is the median of the paper's controller calibrated
-//! from fringes within the seed spread (smallest to largest seed) of the same controller
+//! Can fringes replace the XL-80? On one Table 4 figure: is the median of the paper's controller
+//! calibrated from fringes within the seed spread (smallest to largest seed) of the same controller
 //! calibrated with the XL-80? Reported, not a target.
 struct SpreadCheck {
   std::string key;  //!< the figure
@@ -200,6 +212,10 @@ struct ComparisonResult {
   std::array<std::array<FigureValue, kHoldFigures.size()>, kHoldVariants.size()> hold_medians;
   double simulated_time_s = 0.0;
   double wall_time_s = 0.0;
+  //! The improved calibration's verdict on the loop's rate where it names the plate's mode on
+  //! every seed (the first seed's sentence): the 1 kHz lambda/8 step is then held to
+  //! kModeLimitedPhaseStep_s. "": it names none (or not on every seed).
+  std::string rate_verdict;
 
   //! loop_variants(options).
   std::vector<LoopVariant> variants() const { return loop_variants(options); }
@@ -209,7 +225,7 @@ struct ComparisonResult {
   std::vector<FigureValue> per_seed(std::size_t figure, LoopVariant k) const;
   //! The per-seed values of one hold figure (kHoldFigures) of one hold.
   std::vector<FigureValue> hold_per_seed(HoldVariant v, std::size_t figure) const;
-  //! Issue 29's check: the improved controller's locked hold, median RMS, within kHoldTarget_nm
+  //! The lock's check: the improved controller's locked hold, median RMS, within kHoldTarget_nm
   //! (false without options.lock or when that median is not a number). Reported, not a target.
   bool hold_target_met() const;
   //! Every measured median of every variant valid (and of every hold, with options.lock).

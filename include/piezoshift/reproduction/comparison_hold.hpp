@@ -1,5 +1,5 @@
 #pragma once
-// `compare --lock` (issue 29): the Fizeau's hold beside the comparison's columns. Per seed s,
+// `compare --lock`: the Fizeau's hold beside the comparison's columns. Per seed s,
 // the paper's controller (the `paper` column's, calibrated with the XL-80) and the improved one
 // (the `improved` column's) each run instrument::twin_hold twice, on the semi-closed loop alone
 // and with the fringe lock: what
@@ -9,7 +9,7 @@
 // ([twin.cavity] in_fringes = true) and CAL that column's controller. Figures per run (twin
 // truth): the RMS of the cavity's optical path from its set point over the hold's exposures, and
 // the RMS of its means over whole seconds; a run that fails (or a controller not calibrated) is
-// not valid with its reason, never a number. Issue 29's done-when: the improved controller's
+// not valid with its reason, never a number. The lock's target: the improved controller's
 // locked median within kHoldTarget_nm, reported beside the semi-closed loop's on the same seeds.
 #include <array>
 #include <cstddef>
@@ -39,10 +39,10 @@ const char* hold_key(HoldVariant v);
 bool hold_of_improved(HoldVariant v);
 bool hold_locked(HoldVariant v);
 
-//! Issue 29's target: the cavity's path within 0.2 nm RMS of its set point over the hold, with
+//! The lock's target: the cavity's path within 0.2 nm RMS of its set point over the hold, with
 //! the lock (the improved controller's median over seeds).
 inline constexpr double kHoldTarget_nm = 0.2;
-//! The hold's default length, issue 29's minute.
+//! The hold's default length: a minute, a measurement's worth of holding.
 inline constexpr double kDefaultHold_s = 60.0;
 //! Measurements before the hold (the first is the lock's reference).
 inline constexpr int kHoldAverages = 10;

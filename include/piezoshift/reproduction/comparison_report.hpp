@@ -39,8 +39,13 @@ std::string hold_title(const ComparisonResult& r);
 //! compare --lock: the holds' medians, a row per controller, a column per figure unlocked and
 //! locked ("NOT VALID" for a median that is not; the reasons are invalid_reasons()'s).
 std::vector<std::vector<std::string>> hold_median_table(const ComparisonResult& r);
-//! compare --lock: issue 29's check on the improved controller's locked median, one line.
+//! compare --lock: the lock's check on the improved controller's locked median, one line.
 std::string hold_check_text(const ComparisonResult& r);
+
+//! Where the improved calibration names the plate's mode on every seed: the 1 kHz lambda/8
+//! step's 10 ms bound and the calibration's sentence (the mode, the step it allows at 1 kHz, the
+//! rate that meets 5 ms); "" otherwise. The report and compare's terminal print it.
+std::string rate_verdict_text(const ComparisonResult& r);
 
 //! config_label says where the configuration came from (a path, or the built-in defaults).
 ReportFiles write_comparison_report(const ComparisonResult& r, const std::filesystem::path& dir,

@@ -1,6 +1,6 @@
 #pragma once
 // Table 4's figures beside the paper's values, each judged against the band it must land in.
-// The bands are issue 11's acceptance bands around the paper's values, the ones
+// The bands are the acceptance bands around the paper's values, the ones
 // tests/reproduction/reproduction_test.cpp holds the twin to:
 //   open-loop travel          12.9 µm    12.9 ± 0.3 µm
 //   semi-closed-loop travel   11.5 µm    11.5 ± 0.5 µm

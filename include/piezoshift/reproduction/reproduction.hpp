@@ -117,7 +117,7 @@ ExperimentSet run_experiment_set(const config::ProjectConfig& config,
                                  std::uint64_t seed, const Schedule& schedule,
                                  const rig::Progress& progress = {});
 
-//! The second loop rate of reproduce and compare (issue 12): 10 kHz, beside the DAQ's.
+//! The second loop rate of reproduce and compare: 10 kHz, beside the DAQ's.
 inline constexpr double kFastSampleTime_s = 1e-4;
 
 //! The loop rates the inner loop is analysed at: the DAQ's, and 10 kHz unless that is the DAQ's.
