@@ -4,11 +4,15 @@
 // configs/plants/drawn-nominal.toml (excitation drift off), each through `compare --quick`
 // (reproduction::compare) and held to the targets of docs/compare.md, "Drawn plants".
 //
-// One seed per plant here (about 60 s each alone in release, so the eight stay within the
-// acceptance tier's budget when ctest spreads them); the table in docs/compare.md is seeds 1 to
-// 3 of the same plants. PIEZOSHIFT_DRAWN_SEEDS=N runs seeds 1..N instead.
+// One seed per plant, and in `make test` the first two samples only: a plant's `compare --quick`
+// costs 3.5 to 6 min of one core on this machine (a heavy plate's modes and stage 5b's 10 kHz
+// bench), so all eight would add about half an hour of CPU to CI. The whole sweep is
+// PIEZOSHIFT_DRAWN_SAMPLES=8 (read when the tests are listed: set it for the build, or run the
+// binary with it); PIEZOSHIFT_DRAWN_SEEDS=N runs seeds 1..N instead of seed 1. The samples are
+// the first N of the draw, not chosen by their results; docs/compare.md has each one's figures.
 #include <gtest/gtest.h>
 
+#include <algorithm>
 #include <cstdlib>
 #include <string>
 
@@ -85,9 +89,16 @@ TEST_P(DrawnPlants, QuickCompareMeetsTheTargets) {
       << r.rate_verdict;
 }
 
-INSTANTIATE_TEST_SUITE_P(Seed50, DrawnPlants, ::testing::Range(0, 8), [](const auto& param_info) {
-  return fmt::format("sample_{}", param_info.param);
-});
+int drawn_samples() {
+  const char* n = std::getenv("PIEZOSHIFT_DRAWN_SAMPLES");
+  const int samples = n ? std::atoi(n) : 2;
+  return std::clamp(samples, 1, 8);
+}
+
+INSTANTIATE_TEST_SUITE_P(Seed50, DrawnPlants, ::testing::Range(0, drawn_samples()),
+                         [](const auto& param_info) {
+                           return fmt::format("sample_{}", param_info.param);
+                         });
 
 }  // namespace
 }  // namespace piezoshift::reproduction
