@@ -57,7 +57,6 @@ class Stage {
         if (given[a])
           pose[a] = *given[a];
       s.move(pose);
-      return 0;
     });
   }
 
@@ -144,15 +143,10 @@ void bind_stage_errors(py::module_& m) {
   });
 }
 
-}  // namespace
-
-void bind_station(py::module_& m) {
-  bind_stage_errors(m);
+// The loop's life and its motion: the constructor, `with`, servo, move, wait on target.
+void bind_stage_motion(py::class_<Stage>& stage) {
   const pr::LoopStationOptions defaults;
-  py::class_<Stage>(m, "Stage",
-                    "A stage behind the real-time loop (docs/python.md): the twin at the loop's "
-                    "rate (daq='sim-rt') or a Comedi board ('comedi:/dev/comediN'); use it in a "
-                    "`with` block, whose exit ramps the outputs to 0 V")
+  stage
       .def(py::init([](const std::string& daq, double rate_Hz, std::uint64_t seed,
                        const Calibration& calibration, const std::optional<std::string>& config,
                        const std::vector<std::string>& faults, bool free_run, double on_target_um,
@@ -177,20 +171,11 @@ void bind_station(py::module_& m) {
       .def("__enter__", [](Stage& s) -> Stage& { return s; })
       .def("__exit__",
            [](Stage& s, const py::object&, const py::object&, const py::object&) {
-             s.locked([](pr::LoopStation& st) {
-               st.close();
-               return 0;
-             });
+             s.locked([](pr::LoopStation& st) { st.close(); });
              return false;
            })
       .def(
-          "servo",
-          [](Stage& s, bool on) {
-            s.locked([on](pr::LoopStation& st) {
-              st.servo(on);
-              return 0;
-            });
-          },
+          "servo", [](Stage& s, bool on) { s.locked([on](pr::LoopStation& st) { st.servo(on); }); },
           py::arg("on"),
           "SVO: on closes the loop at the pose the gauges show, off holds the volts applied; "
           "either clears a latched fault (StageFault when it latches again at once)")
@@ -203,14 +188,17 @@ void bind_station(py::module_& m) {
       .def(
           "wait_on_target",
           [](Stage& s, double timeout_s) {
-            s.locked([timeout_s](pr::LoopStation& st) {
-              st.wait_on_target(timeout_s);
-              return 0;
-            });
+            s.locked([timeout_s](pr::LoopStation& st) { st.wait_on_target(timeout_s); });
           },
           py::arg("timeout_s") = 10.0,
           "Returns once every axis is within the on-target band for settle_s (ONT?); "
-          "StageTimeout after timeout_s of loop time, StageFault when a fault latches")
+          "StageTimeout after timeout_s of loop time, StageFault when a fault latches");
+}
+
+// What the stage reads back (on target, poses, volts, the recorder, the fault, the limits), and
+// close.
+void bind_stage_readings(py::class_<Stage>& stage) {
+  stage
       .def_property_readonly("on_target",
                              [](Stage& s) {
                                return s.locked([](pr::LoopStation& st) {
@@ -257,10 +245,7 @@ void bind_station(py::module_& m) {
             std::vector<pr::RecorderSignal> parsed;
             for (const std::string& name : signals)
               parsed.push_back(pr::parse_recorder_signal(name));
-            s.locked([&](pr::LoopStation& st) {
-              st.record(samples, every, parsed);
-              return 0;
-            });
+            s.locked([&](pr::LoopStation& st) { st.record(samples, every, parsed); });
           },
           py::arg("samples"), py::arg("every") = 1, py::arg("signals") = std::vector<std::string>{},
           "Records `samples` points, one every `every` ticks, from the next tick: signals "
@@ -272,13 +257,7 @@ void bind_station(py::module_& m) {
                              "None, or the latched fault: name, channel, tick, time_s, "
                              "description")
       .def(
-          "close",
-          [](Stage& s) {
-            s.locked([](pr::LoopStation& st) {
-              st.close();
-              return 0;
-            });
-          },
+          "close", [](Stage& s) { s.locked([](pr::LoopStation& st) { st.close(); }); },
           "Ramps the outputs to 0 V and stops the loop (idempotent; also at the `with` exit)")
       .def_property_readonly(
           "closed", [](Stage& s) { return s.locked([](auto& st) { return st.closed(); }); })
@@ -292,6 +271,19 @@ void bind_station(py::module_& m) {
       .def_property_readonly(
           "max_limits", [](Stage& s) { return pose_array(s.station().model().max_limits()); },
           "TMX?: [Z um, tip urad, tilt urad]");
+}
+
+}  // namespace
+
+void bind_station(py::module_& m) {
+  bind_stage_errors(m);
+  py::class_<Stage> stage(
+      m, "Stage",
+      "A stage behind the real-time loop (docs/python.md): the twin at the loop's "
+      "rate (daq='sim-rt') or a Comedi board ('comedi:/dev/comediN'); use it in a "
+      "`with` block, whose exit ramps the outputs to 0 V");
+  bind_stage_motion(stage);
+  bind_stage_readings(stage);
 }
 
 }  // namespace piezoshift::python
